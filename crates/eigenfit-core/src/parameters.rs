@@ -1,0 +1,268 @@
+//! Model parameters: name, unit, nominal value, bounds and the scale an update works in.
+
+use thiserror::Error;
+
+/// The space in which an update strategy moves a parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Scale {
+    /// Steps in the value itself.
+    #[default]
+    Linear,
+    /// Steps in ln(value): right for stiffnesses that span decades (value must stay > 0).
+    Log,
+}
+
+/// One updatable parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    /// Unique name, e.g. `k_bearing_0`.
+    pub name: String,
+    /// Unit for display, e.g. `N/m`.
+    pub unit: String,
+    /// Nominal (starting) value.
+    pub nominal: f64,
+    /// Lower bound (inclusive).
+    pub lower: f64,
+    /// Upper bound (inclusive).
+    pub upper: f64,
+    /// Update scale.
+    pub scale: Scale,
+}
+
+impl Parameter {
+    /// A linear parameter without bounds.
+    pub fn new(name: impl Into<String>, unit: impl Into<String>, nominal: f64) -> Self {
+        Self {
+            name: name.into(),
+            unit: unit.into(),
+            nominal,
+            lower: f64::NEG_INFINITY,
+            upper: f64::INFINITY,
+            scale: Scale::Linear,
+        }
+    }
+
+    /// Sets the bounds.
+    pub fn with_bounds(mut self, lower: f64, upper: f64) -> Self {
+        self.lower = lower;
+        self.upper = upper;
+        self
+    }
+
+    /// Sets the update scale.
+    pub fn with_scale(mut self, scale: Scale) -> Self {
+        self.scale = scale;
+        self
+    }
+
+    /// Maps a value to the update scale (identity or ln).
+    pub fn to_scaled(&self, value: f64) -> f64 {
+        match self.scale {
+            Scale::Linear => value,
+            Scale::Log => value.ln(),
+        }
+    }
+
+    /// Maps a scaled value back (identity or exp).
+    pub fn from_scaled(&self, scaled: f64) -> f64 {
+        match self.scale {
+            Scale::Linear => scaled,
+            Scale::Log => scaled.exp(),
+        }
+    }
+
+    /// d(value)/d(scaled) at `value`: 1 or value.
+    pub fn scale_derivative(&self, value: f64) -> f64 {
+        match self.scale {
+            Scale::Linear => 1.0,
+            Scale::Log => value,
+        }
+    }
+
+    /// Checks that `value` is finite and within the bounds.
+    pub fn check(&self, value: f64) -> Result<(), ParameterError> {
+        if !value.is_finite() {
+            return Err(ParameterError::NonFinite {
+                name: self.name.clone(),
+                value,
+            });
+        }
+        if value < self.lower || value > self.upper {
+            return Err(ParameterError::OutOfBounds {
+                name: self.name.clone(),
+                value,
+                lower: self.lower,
+                upper: self.upper,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Why a parameter definition or a parameter vector is invalid.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ParameterError {
+    /// Two parameters share a name.
+    #[error("parameter name `{0}` is used twice")]
+    DuplicateName(String),
+    /// A parameter has an empty name.
+    #[error("parameter {0} has an empty name")]
+    EmptyName(usize),
+    /// Bounds are NaN or reversed, or a log parameter allows values ≤ 0.
+    #[error("parameter `{name}`: bounds [{lower}, {upper}] are invalid ({why})")]
+    BadBounds {
+        name: String,
+        lower: f64,
+        upper: f64,
+        why: &'static str,
+    },
+    /// A value is NaN or infinite.
+    #[error("parameter `{name}` = {value}: must be finite")]
+    NonFinite { name: String, value: f64 },
+    /// A value lies outside its bounds.
+    #[error("parameter `{name}` = {value} lies outside its bounds [{lower}, {upper}]")]
+    OutOfBounds {
+        name: String,
+        value: f64,
+        lower: f64,
+        upper: f64,
+    },
+    /// A parameter vector has the wrong length.
+    #[error("expected {expected} parameter values, got {got}")]
+    Count { expected: usize, got: usize },
+    /// No parameter has this name.
+    #[error("no parameter named `{0}`")]
+    UnknownName(String),
+}
+
+/// An ordered, validated list of parameters (validated once at construction, then trusted).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ParameterSet {
+    params: Vec<Parameter>,
+}
+
+impl ParameterSet {
+    /// Validates names, bounds and nominal values.
+    pub fn new(params: Vec<Parameter>) -> Result<Self, ParameterError> {
+        for (i, p) in params.iter().enumerate() {
+            if p.name.trim().is_empty() {
+                return Err(ParameterError::EmptyName(i));
+            }
+            if params[..i].iter().any(|q| q.name == p.name) {
+                return Err(ParameterError::DuplicateName(p.name.clone()));
+            }
+            let bad = |why| ParameterError::BadBounds {
+                name: p.name.clone(),
+                lower: p.lower,
+                upper: p.upper,
+                why,
+            };
+            if p.lower.is_nan() || p.upper.is_nan() || p.lower > p.upper {
+                return Err(bad("lower must not exceed upper"));
+            }
+            if p.scale == Scale::Log && p.lower <= 0.0 {
+                return Err(bad("a log-scale parameter needs a positive lower bound"));
+            }
+            p.check(p.nominal)?;
+        }
+        Ok(Self { params })
+    }
+
+    /// Number of parameters.
+    pub fn len(&self) -> usize {
+        self.params.len()
+    }
+
+    /// True when there are no parameters.
+    pub fn is_empty(&self) -> bool {
+        self.params.is_empty()
+    }
+
+    /// The parameters in order.
+    pub fn as_slice(&self) -> &[Parameter] {
+        &self.params
+    }
+
+    /// Iterates over the parameters.
+    pub fn iter(&self) -> std::slice::Iter<'_, Parameter> {
+        self.params.iter()
+    }
+
+    /// Parameter `i`.
+    pub fn get(&self, i: usize) -> Option<&Parameter> {
+        self.params.get(i)
+    }
+
+    /// Index of the parameter called `name`.
+    pub fn index_of(&self, name: &str) -> Result<usize, ParameterError> {
+        self.params
+            .iter()
+            .position(|p| p.name == name)
+            .ok_or_else(|| ParameterError::UnknownName(name.to_string()))
+    }
+
+    /// The nominal values in order.
+    pub fn nominal_values(&self) -> Vec<f64> {
+        self.params.iter().map(|p| p.nominal).collect()
+    }
+
+    /// Checks a full parameter vector: length, finiteness, bounds.
+    pub fn check(&self, values: &[f64]) -> Result<(), ParameterError> {
+        if values.len() != self.params.len() {
+            return Err(ParameterError::Count {
+                expected: self.params.len(),
+                got: values.len(),
+            });
+        }
+        self.params
+            .iter()
+            .zip(values)
+            .try_for_each(|(p, &v)| p.check(v))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_names_the_parameter() {
+        let k = Parameter::new("k1", "N/m", 1e5)
+            .with_bounds(0.0, 1e12)
+            .with_scale(Scale::Log);
+        assert_eq!(
+            ParameterSet::new(vec![k]).unwrap_err().to_string(),
+            "parameter `k1`: bounds [0, 1000000000000] are invalid (a log-scale parameter needs a positive lower bound)"
+        );
+        let a = Parameter::new("a", "m", 1.0);
+        assert_eq!(
+            ParameterSet::new(vec![a.clone(), a.clone()]).unwrap_err(),
+            ParameterError::DuplicateName("a".into())
+        );
+        let set = ParameterSet::new(vec![a.with_bounds(0.0, 2.0)]).unwrap();
+        assert_eq!(
+            set.check(&[3.0]).unwrap_err().to_string(),
+            "parameter `a` = 3 lies outside its bounds [0, 2]"
+        );
+        assert_eq!(
+            set.check(&[]).unwrap_err(),
+            ParameterError::Count {
+                expected: 1,
+                got: 0
+            }
+        );
+        assert!(matches!(
+            set.check(&[f64::NAN]),
+            Err(ParameterError::NonFinite { .. })
+        ));
+    }
+
+    #[test]
+    fn log_scale_round_trips() {
+        let k = Parameter::new("k", "N/m", 1e5).with_scale(Scale::Log);
+        assert!((k.from_scaled(k.to_scaled(3.7e8)) - 3.7e8).abs() < 1e-6);
+        assert_eq!(k.scale_derivative(2.0), 2.0);
+    }
+}

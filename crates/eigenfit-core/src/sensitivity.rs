@@ -1,0 +1,307 @@
+//! Eigen-sensitivities: how eigenvalues, frequencies and mode shapes move with a parameter.
+//!
+//! * eigenvalue: dλₖ/dpᵢ = φₖᵀ(∂K/∂pᵢ − λₖ ∂M/∂pᵢ)φₖ — for a support stiffness on DOF j this is
+//!   φⱼₖ², the paper's eq. 21;
+//! * frequency: dfₖ/dpᵢ = (dλₖ/dpᵢ) / (8π² fₖ);
+//! * mode shape by modal expansion (the paper's eq. 22, generalised to ∂M ≠ 0) — exact only with
+//!   all n modes — and by Nelson's method, exact with the one mode.
+//!
+//! Every result is refused for a repeated or nearly repeated eigenvalue: there the derivative of
+//! an individual mode is not defined, and any number returned would be silently wrong.
+
+use crate::model::{ModelError, StructuralModel};
+use crate::modes::Modes;
+use crate::solver::{EigenSolver, SolveError};
+use crate::system::{System, SystemDerivative};
+use nalgebra::{DMatrix, DVector};
+use thiserror::Error;
+
+/// Relative gap below which two eigenvalues count as repeated.
+pub const DEFAULT_REPEATED_TOLERANCE: f64 = 1e-8;
+
+/// Why a sensitivity could not be computed.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum SensitivityError {
+    /// Mode `mode` shares its eigenvalue with mode `other` (relative gap below the tolerance).
+    #[error(
+        "modes {mode} and {other} have (nearly) repeated eigenvalues {lambda_mode:e} and {lambda_other:e} \
+         (relative gap {relative_gap:e}): the derivative of an individual mode is not defined there"
+    )]
+    RepeatedEigenvalue {
+        mode: usize,
+        other: usize,
+        lambda_mode: f64,
+        lambda_other: f64,
+        relative_gap: f64,
+    },
+    /// A frequency sensitivity of a zero-frequency (rigid-body) mode.
+    #[error("mode {mode} has λ = {lambda:e} ≤ 0: its frequency sensitivity is undefined")]
+    ZeroFrequency { mode: usize, lambda: f64 },
+    /// A mode index beyond the computed modes.
+    #[error("mode {mode} requested but only {count} modes were computed")]
+    ModeIndex { mode: usize, count: usize },
+    /// Nelson's linear system is singular.
+    #[error("Nelson's system for mode {mode} is singular")]
+    Singular { mode: usize },
+    /// The model failed to assemble or differentiate.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The eigen-solve failed.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+}
+
+/// Checks that mode `k` is separated from every other computed mode.
+///
+/// Two eigenvalues count as repeated when |λₖ − λₗ| ≤ `tolerance`·max(|λₖ|, |λₗ|) + `floor`;
+/// `floor` absorbs round-off around λ = 0 (rigid-body modes), see [`noise_floor`].
+pub fn check_distinct(
+    modes: &Modes,
+    k: usize,
+    tolerance: f64,
+    floor: f64,
+) -> Result<(), SensitivityError> {
+    let lam = &modes.eigenvalues;
+    if k >= lam.len() {
+        return Err(SensitivityError::ModeIndex {
+            mode: k,
+            count: lam.len(),
+        });
+    }
+    for l in 0..lam.len() {
+        if l == k {
+            continue;
+        }
+        let gap = (lam[k] - lam[l]).abs();
+        let size = lam[k].abs().max(lam[l].abs());
+        if gap <= tolerance * size + floor {
+            return Err(SensitivityError::RepeatedEigenvalue {
+                mode: k,
+                other: l,
+                lambda_mode: lam[k],
+                lambda_other: lam[l],
+                relative_gap: if size > 0.0 { gap / size } else { 0.0 },
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Round-off level of computed eigenvalues of `system`: 1e-10 · max|Kᵢⱼ| / max|Mᵢⱼ|.
+pub fn noise_floor(system: &System) -> f64 {
+    let kmax = system.stiffness().amax();
+    let mmax = system.mass().amax();
+    if mmax > 0.0 {
+        1e-10 * kmax / mmax
+    } else {
+        0.0
+    }
+}
+
+/// dλₖ/dpᵢ = φₖᵀ(∂K − λₖ∂M)φₖ for one mode and one parameter derivative (no distinctness check).
+pub fn eigenvalue_derivative(modes: &Modes, k: usize, d: &SystemDerivative) -> f64 {
+    let phi = modes.shape(k);
+    d.shifted_bilinear(modes.eigenvalues[k], phi, phi)
+}
+
+/// Eigenvalue and frequency sensitivities of the lowest modes to every parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sensitivities {
+    /// The modes the sensitivities belong to.
+    pub modes: Modes,
+    /// dλₖ/dpᵢ, m×np, in (rad/s)² per parameter unit.
+    pub eigenvalues: DMatrix<f64>,
+    /// dfₖ/dpᵢ, m×np, in Hz per parameter unit.
+    pub frequencies_hz: DMatrix<f64>,
+}
+
+impl Sensitivities {
+    /// Solves the lowest `count` modes of `model` at `p` and their sensitivities to every parameter.
+    ///
+    /// One extra mode is solved (when the model has one) so that the highest requested mode is
+    /// checked against its upper neighbour too.
+    pub fn compute<M, S>(
+        model: &M,
+        solver: &S,
+        p: &[f64],
+        count: usize,
+    ) -> Result<Self, SensitivityError>
+    where
+        M: StructuralModel + ?Sized,
+        S: EigenSolver + ?Sized,
+    {
+        let system = model.assemble(p)?;
+        let extra = (count + 1).min(system.dofs());
+        let mut modes = solver.lowest(&system, extra)?;
+        let floor = noise_floor(&system);
+        for k in 0..count.min(modes.count()) {
+            check_distinct(&modes, k, DEFAULT_REPEATED_TOLERANCE, floor)?;
+        }
+        if modes.count() > count {
+            modes = Modes {
+                eigenvalues: modes.eigenvalues.rows(0, count).into_owned(),
+                shapes: modes.shapes.columns(0, count).into_owned(),
+            };
+        }
+        let np = model.parameters().len();
+        let mut dl = DMatrix::zeros(count, np);
+        for i in 0..np {
+            let d = model.derivative(p, i)?;
+            for k in 0..count {
+                dl[(k, i)] = eigenvalue_derivative(&modes, k, &d);
+            }
+        }
+        let mut df = DMatrix::zeros(count, np);
+        for k in 0..count {
+            let lambda = modes.eigenvalues[k];
+            if lambda <= 0.0 {
+                return Err(SensitivityError::ZeroFrequency { mode: k, lambda });
+            }
+            let f = crate::eigenvalue_to_hz(lambda);
+            let factor = 1.0 / (8.0 * std::f64::consts::PI.powi(2) * f);
+            df.row_mut(k).copy_from(&(dl.row(k) * factor));
+        }
+        Ok(Self {
+            modes,
+            eigenvalues: dl,
+            frequencies_hz: df,
+        })
+    }
+}
+
+/// dφₖ/dpᵢ by modal expansion over the supplied modes (the paper's eq. 4 with eq. 22):
+///
+/// dφₖ = Σₗ≠ₖ φₗ φₗᵀ(∂K − λₖ∂M)φₖ / (λₖ − λₗ) − ½ (φₖᵀ∂Mφₖ) φₖ.
+///
+/// Exact only when `modes` holds all n modes; with fewer it is the truncated approximation.
+pub fn eigenvector_derivative_modal(
+    modes: &Modes,
+    k: usize,
+    d: &SystemDerivative,
+    floor: f64,
+) -> Result<DVector<f64>, SensitivityError> {
+    check_distinct(modes, k, DEFAULT_REPEATED_TOLERANCE, floor)?;
+    let lk = modes.eigenvalues[k];
+    let phik = modes.shape(k);
+    let n = modes.shapes.nrows();
+    let mut out = DVector::zeros(n);
+    for l in 0..modes.count() {
+        let coeff = if l == k {
+            -0.5 * d.mass.bilinear(phik, phik)
+        } else {
+            d.shifted_bilinear(lk, modes.shape(l), phik) / (lk - modes.eigenvalues[l])
+        };
+        out.axpy(coeff, &modes.shapes.column(l), 1.0);
+    }
+    Ok(out)
+}
+
+/// dφₖ/dpᵢ by Nelson's method: exact, needs only mode k (and a distinct λₖ).
+///
+/// Solves (K − λₖM) v = −(∂K − λₖ∂M)φₖ + (dλₖ) Mφₖ with the entry of largest |φₖ| pinned to zero,
+/// then adds c φₖ with c = −φₖᵀMv − ½φₖᵀ∂Mφₖ to keep the mass normalisation.
+pub fn eigenvector_derivative_nelson(
+    system: &System,
+    modes: &Modes,
+    k: usize,
+    d: &SystemDerivative,
+) -> Result<DVector<f64>, SensitivityError> {
+    check_distinct(modes, k, DEFAULT_REPEATED_TOLERANCE, noise_floor(system))?;
+    let lk = modes.eigenvalues[k];
+    let phi = DVector::from_column_slice(modes.shape(k));
+    let dlk = eigenvalue_derivative(modes, k, d);
+    let m_phi = system.mass() * &phi;
+    let mut rhs = &m_phi * dlk;
+    d.stiffness
+        .mul_add(-1.0, phi.as_slice(), rhs.as_mut_slice());
+    d.mass.mul_add(lk, phi.as_slice(), rhs.as_mut_slice());
+    let mut a = system.stiffness() - system.mass() * lk;
+    let pivot = phi.iamax();
+    a.row_mut(pivot).fill(0.0);
+    a.column_mut(pivot).fill(0.0);
+    a[(pivot, pivot)] = 1.0;
+    rhs[pivot] = 0.0;
+    let v = a
+        .lu()
+        .solve(&rhs)
+        .ok_or(SensitivityError::Singular { mode: k })?;
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(SensitivityError::Singular { mode: k });
+    }
+    let c = -m_phi.dot(&v) - 0.5 * d.mass.bilinear(phi.as_slice(), phi.as_slice());
+    Ok(v + phi * c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{DenseSolver, SparseSymmetric};
+
+    fn chain() -> (System, Modes) {
+        let k = DMatrix::from_row_slice(3, 3, &[3.0, -1.0, 0.0, -1.0, 2.0, -1.0, 0.0, -1.0, 1.5]);
+        let m = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 0.5]));
+        let sys = System::new(k, m).unwrap();
+        let modes = DenseSolver.lowest(&sys, 3).unwrap();
+        (sys, modes)
+    }
+
+    #[test]
+    fn support_stiffness_sensitivity_is_squared_modal_displacement() {
+        // The paper's eq. 21: ∂K/∂k = e_j e_jᵀ gives dλ = φ_j².
+        let (_, modes) = chain();
+        let mut dk = SparseSymmetric::zeros(3);
+        dk.add(1, 1, 1.0);
+        let d = SystemDerivative {
+            stiffness: dk,
+            mass: SparseSymmetric::zeros(3),
+        };
+        for k in 0..3 {
+            assert_eq!(
+                eigenvalue_derivative(&modes, k, &d),
+                modes.shapes[(1, k)].powi(2)
+            );
+        }
+    }
+
+    #[test]
+    fn nelson_equals_full_modal_expansion() {
+        let (sys, modes) = chain();
+        let mut dk = SparseSymmetric::zeros(3);
+        dk.add(0, 1, 0.3);
+        dk.add(2, 2, 1.0);
+        let mut dm = SparseSymmetric::zeros(3);
+        dm.add(1, 1, 0.7);
+        let d = SystemDerivative {
+            stiffness: dk,
+            mass: dm,
+        };
+        for k in 0..3 {
+            let a = eigenvector_derivative_nelson(&sys, &modes, k, &d).unwrap();
+            let b = eigenvector_derivative_modal(&modes, k, &d, 0.0).unwrap();
+            assert!(
+                (&a - &b).amax() < 1e-12 * a.amax().max(1.0),
+                "mode {k}: {a} vs {b}"
+            );
+        }
+    }
+
+    #[test]
+    fn repeated_eigenvalues_are_refused() {
+        let sys = System::new(DMatrix::identity(2, 2), DMatrix::identity(2, 2)).unwrap();
+        let modes = DenseSolver.lowest(&sys, 2).unwrap();
+        let d = SystemDerivative::zeros(2);
+        let err = eigenvector_derivative_nelson(&sys, &modes, 0, &d).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                SensitivityError::RepeatedEigenvalue {
+                    mode: 0,
+                    other: 1,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+    }
+}

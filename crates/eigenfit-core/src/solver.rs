@@ -1,0 +1,61 @@
+//! The [`EigenSolver`] trait for the generalized symmetric-definite problem K φ = λ M φ.
+
+use crate::modes::Modes;
+use crate::system::System;
+use thiserror::Error;
+
+/// Why an eigen-solve failed.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum SolveError {
+    /// M is not positive definite (a massless DOF, a negative mass, …).
+    #[error("the mass matrix is not positive definite{}", .detail.as_deref().map(|d| format!(" ({d})")).unwrap_or_default())]
+    MassNotPositiveDefinite { detail: Option<String> },
+    /// More modes were requested than the system has.
+    #[error("{requested} modes requested but the system has only {available} degrees of freedom")]
+    TooManyModes { requested: usize, available: usize },
+    /// Zero modes were requested.
+    #[error("at least one mode must be requested")]
+    NoModes,
+    /// The backend produced NaN or did not converge.
+    #[error("eigen-solver `{backend}` failed: {detail}")]
+    Backend {
+        backend: &'static str,
+        detail: String,
+    },
+}
+
+/// Computes the lowest modes of K φ = λ M φ.
+///
+/// Implementations return λ ascending and Φ mass-normalised (ΦᵀMΦ = I) with
+/// [`apply_sign_rule`](crate::apply_sign_rule) applied, so backends are interchangeable.
+pub trait EigenSolver {
+    /// Short backend name for reports, e.g. `dense` or `lapack`.
+    fn name(&self) -> &'static str;
+
+    /// The lowest `count` modes.
+    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError>;
+}
+
+impl<T: EigenSolver + ?Sized> EigenSolver for &T {
+    fn name(&self) -> &'static str {
+        (**self).name()
+    }
+    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
+        (**self).lowest(system, count)
+    }
+}
+
+/// Checks `count` against the system size; shared by all backends.
+pub fn check_count(system: &System, count: usize) -> Result<(), SolveError> {
+    if count == 0 {
+        return Err(SolveError::NoModes);
+    }
+    if count > system.dofs() {
+        return Err(SolveError::TooManyModes {
+            requested: count,
+            available: system.dofs(),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,1 @@
+//! LAPACK backend (in progress).

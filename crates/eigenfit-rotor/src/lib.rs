@@ -1,0 +1,1 @@
+//! Rotor plugin (in progress).
