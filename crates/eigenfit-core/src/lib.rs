@@ -21,22 +21,32 @@
 //! ```
 
 pub mod dense;
+pub mod measurement;
 pub mod model;
 pub mod modes;
 pub mod parameters;
+pub mod residual;
 pub mod sensitivity;
 pub mod solver;
 pub mod sparse;
+pub mod statistics;
 pub mod system;
+pub mod update;
 
 pub use dense::DenseSolver;
+pub use measurement::{MeasuredMode, Measurement, MeasurementError};
 pub use model::{finite_difference_derivative, ModelError, StructuralModel};
 pub use modes::{apply_sign_rule, Modes};
 pub use parameters::{Parameter, ParameterError, ParameterSet, Scale};
+pub use residual::{Linearisation, Pairing, Problem, ResidualError, ResidualKind};
 pub use sensitivity::{Sensitivities, SensitivityError};
 pub use solver::{EigenSolver, SolveError};
 pub use sparse::SparseSymmetric;
+pub use statistics::{uncertainty, Identifiability, Uncertainty};
 pub use system::{System, SystemDerivative, SystemError};
+pub use update::{
+    Damped, Driver, Estimate, Newton, PStep, Termination, UpdateError, UpdateStrategy,
+};
 
 /// Converts an eigenvalue λ = ω² (rad/s)² to a frequency in Hz.
 ///

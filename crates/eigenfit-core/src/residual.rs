@@ -1,0 +1,270 @@
+//! The update problem: a model, a solver and measured modes; its residual and Jacobian at a point.
+
+use crate::measurement::Measurement;
+use crate::model::StructuralModel;
+use crate::parameters::ParameterSet;
+use crate::sensitivity::{Sensitivities, SensitivityError};
+use crate::solver::EigenSolver;
+use crate::{eigenvalue_to_hz, hz_to_eigenvalue};
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+use thiserror::Error;
+
+/// The quantity compared between model and measurement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ResidualKind {
+    /// λ = (2πf)², the paper's eq. 27.
+    Eigenvalue,
+    /// Frequencies in Hz.
+    FrequencyHz,
+    /// (f_measured − f_model) / f_measured: every mode weighs the same without given std.
+    #[default]
+    Relative,
+}
+
+/// How measured modes find their model partners.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum Pairing {
+    /// Measured mode number k pairs with the model's k-th lowest mode (the paper).
+    #[default]
+    Order,
+    /// Each measured shape pairs with the model mode of highest MAC at the sensor DOFs.
+    Mac {
+        /// Model DOF of each entry of the measured shapes.
+        sensor_dofs: Vec<usize>,
+    },
+}
+
+/// Why the residual could not be evaluated.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ResidualError {
+    /// The model or the solver failed.
+    #[error(transparent)]
+    Sensitivity(#[from] SensitivityError),
+    /// The model has fewer modes than the measurement needs.
+    #[error("the measurement refers to mode {needed} but the model has only {available} degrees of freedom")]
+    TooFewModelModes { needed: usize, available: usize },
+    /// MAC pairing was asked for data without shapes, or with the wrong sensor count.
+    #[error("MAC pairing: {0}")]
+    Mac(String),
+}
+
+/// Everything an update step needs at one parameter vector.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Linearisation {
+    /// The parameter vector.
+    pub parameters: Vec<f64>,
+    /// Model mode paired with each measured mode.
+    pub paired_modes: Vec<usize>,
+    /// Model eigenvalues of the paired modes.
+    pub model_eigenvalues: DVector<f64>,
+    /// Measured eigenvalues (eq. 23).
+    pub measured_eigenvalues: DVector<f64>,
+    /// dλ/dp of the paired modes in physical parameter units (the paper's sensitivity matrix).
+    pub eigenvalue_jacobian: DMatrix<f64>,
+    /// Model frequencies of the paired modes, Hz.
+    pub frequencies_hz: Vec<f64>,
+    /// Measured frequencies, Hz.
+    pub measured_hz: Vec<f64>,
+    /// Weighted residual (measured − model) in the problem's [`ResidualKind`].
+    pub residual: DVector<f64>,
+    /// Weighted d(model)/dp in physical units, so that J Δp ≈ residual.
+    pub jacobian: DMatrix<f64>,
+}
+
+impl Linearisation {
+    /// ½‖r‖²: the least-squares cost (½χ² when std is given).
+    pub fn cost(&self) -> f64 {
+        0.5 * self.residual.norm_squared()
+    }
+
+    /// Largest |f_model − f_measured| in Hz (the paper's stopping test).
+    pub fn max_abs_diff_hz(&self) -> f64 {
+        self.frequencies_hz
+            .iter()
+            .zip(&self.measured_hz)
+            .fold(0.0, |m, (a, b)| f64::max(m, (a - b).abs()))
+    }
+
+    /// Largest |f_model − f_measured| / f_measured.
+    pub fn max_rel_diff(&self) -> f64 {
+        self.frequencies_hz
+            .iter()
+            .zip(&self.measured_hz)
+            .fold(0.0, |m, (a, b)| f64::max(m, ((a - b) / b).abs()))
+    }
+}
+
+/// A model, a solver, measured modes, and how to compare them.
+pub struct Problem<M, S> {
+    /// The structure.
+    pub model: M,
+    /// The eigen-solver backend.
+    pub solver: S,
+    /// The measured modes.
+    pub measured: Measurement,
+    /// The compared quantity.
+    pub kind: ResidualKind,
+    /// The pairing rule.
+    pub pairing: Pairing,
+}
+
+impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
+    /// A problem with relative residuals and order pairing.
+    pub fn new(model: M, solver: S, measured: Measurement) -> Self {
+        Self {
+            model,
+            solver,
+            measured,
+            kind: ResidualKind::default(),
+            pairing: Pairing::Order,
+        }
+    }
+
+    /// Sets the residual kind.
+    pub fn with_kind(mut self, kind: ResidualKind) -> Self {
+        self.kind = kind;
+        self
+    }
+
+    /// Sets the pairing rule.
+    pub fn with_pairing(mut self, pairing: Pairing) -> Self {
+        self.pairing = pairing;
+        self
+    }
+
+    /// The model's parameters.
+    pub fn parameters(&self) -> &ParameterSet {
+        self.model.parameters()
+    }
+
+    /// Residual and Jacobian at `p`.
+    pub fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        let needed = self.measured.modes_needed();
+        let dofs = self.model.dofs();
+        if needed > dofs {
+            return Err(ResidualError::TooFewModelModes {
+                needed,
+                available: dofs,
+            });
+        }
+        let count = match self.pairing {
+            Pairing::Order => needed,
+            Pairing::Mac { .. } => (2 * needed + 2).min(dofs),
+        };
+        let sens = Sensitivities::compute(&self.model, &self.solver, p, count)?;
+        let paired = self.pair(&sens)?;
+        let m = paired.len();
+        let np = self.model.parameters().len();
+        let mut lin = Linearisation {
+            parameters: p.to_vec(),
+            paired_modes: paired.clone(),
+            model_eigenvalues: DVector::zeros(m),
+            measured_eigenvalues: DVector::zeros(m),
+            eigenvalue_jacobian: DMatrix::zeros(m, np),
+            frequencies_hz: vec![0.0; m],
+            measured_hz: vec![0.0; m],
+            residual: DVector::zeros(m),
+            jacobian: DMatrix::zeros(m, np),
+        };
+        for (row, (meas, &k)) in self.measured.modes().iter().zip(&paired).enumerate() {
+            let lambda = sens.modes.eigenvalues[k];
+            let f = eigenvalue_to_hz(lambda);
+            let fm = meas.frequency_hz;
+            lin.model_eigenvalues[row] = lambda;
+            lin.measured_eigenvalues[row] = hz_to_eigenvalue(fm);
+            lin.frequencies_hz[row] = f;
+            lin.measured_hz[row] = fm;
+            lin.eigenvalue_jacobian
+                .row_mut(row)
+                .copy_from(&sens.eigenvalues.row(k));
+            // Residual value, Jacobian row and weight in the chosen quantity.
+            let (r, scale, sigma) = match self.kind {
+                ResidualKind::Eigenvalue => (
+                    lin.measured_eigenvalues[row] - lambda,
+                    1.0,
+                    meas.std_hz.map_or(1.0, |s| 8.0 * PI * PI * fm * s),
+                ),
+                ResidualKind::FrequencyHz => (
+                    fm - f,
+                    1.0 / (8.0 * PI * PI * f),
+                    meas.std_hz.unwrap_or(1.0),
+                ),
+                ResidualKind::Relative => (
+                    (fm - f) / fm,
+                    1.0 / (8.0 * PI * PI * f * fm),
+                    meas.std_hz.map_or(1.0, |s| s / fm),
+                ),
+            };
+            lin.residual[row] = r / sigma;
+            lin.jacobian
+                .row_mut(row)
+                .copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));
+        }
+        Ok(lin)
+    }
+
+    fn pair(&self, sens: &Sensitivities) -> Result<Vec<usize>, ResidualError> {
+        match &self.pairing {
+            Pairing::Order => Ok(self.measured.modes().iter().map(|m| m.mode).collect()),
+            Pairing::Mac { sensor_dofs } => {
+                let shapes: Vec<&Vec<f64>> = self
+                    .measured
+                    .modes()
+                    .iter()
+                    .map(|m| {
+                        m.shape.as_ref().ok_or_else(|| {
+                            ResidualError::Mac(format!("mode {} has no shape", m.mode))
+                        })
+                    })
+                    .collect::<Result<_, _>>()?;
+                if let Some(bad) = sensor_dofs.iter().find(|&&d| d >= self.model.dofs()) {
+                    return Err(ResidualError::Mac(format!(
+                        "sensor DOF {bad} does not exist in the model"
+                    )));
+                }
+                if shapes.iter().any(|s| s.len() != sensor_dofs.len()) {
+                    return Err(ResidualError::Mac(format!(
+                        "shapes must have one entry per sensor DOF ({})",
+                        sensor_dofs.len()
+                    )));
+                }
+                let model_at_sensors: Vec<Vec<f64>> = (0..sens.modes.count())
+                    .map(|k| {
+                        sensor_dofs
+                            .iter()
+                            .map(|&d| sens.modes.shapes[(d, k)])
+                            .collect()
+                    })
+                    .collect();
+                let mut taken = vec![false; model_at_sensors.len()];
+                let mut out = Vec::with_capacity(shapes.len());
+                for s in shapes {
+                    let best = (0..model_at_sensors.len())
+                        .filter(|&k| !taken[k])
+                        .max_by(|&a, &b| {
+                            mac(s, &model_at_sensors[a]).total_cmp(&mac(s, &model_at_sensors[b]))
+                        })
+                        .ok_or_else(|| {
+                            ResidualError::Mac("more measured modes than model modes".into())
+                        })?;
+                    taken[best] = true;
+                    out.push(best);
+                }
+                Ok(out)
+            }
+        }
+    }
+}
+
+/// Modal assurance criterion (aᵀb)² / (aᵀa · bᵀb), in [0, 1].
+pub fn mac(a: &[f64], b: &[f64]) -> f64 {
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
+    let den = dot(a, a) * dot(b, b);
+    if den > 0.0 {
+        dot(a, b).powi(2) / den
+    } else {
+        0.0
+    }
+}

@@ -1,0 +1,170 @@
+//! The iteration loop: termination reasons, observers, history.
+
+use super::{Evaluate, StepStatus, UpdateError, UpdateStrategy};
+use crate::residual::Linearisation;
+
+/// Why a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Termination {
+    /// The strategy's convergence test holds.
+    Converged,
+    /// The iteration limit was reached first.
+    IterationLimit,
+    /// The iterate left the physical range, or the model failed there.
+    Diverged(String),
+    /// No acceptable step could be found.
+    Stalled(String),
+}
+
+impl Termination {
+    /// True for [`Termination::Converged`].
+    pub fn is_converged(&self) -> bool {
+        matches!(self, Termination::Converged)
+    }
+
+    /// Short label: `converged`, `iteration-limit`, `diverged`, `stalled`.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Termination::Converged => "converged",
+            Termination::IterationLimit => "iteration-limit",
+            Termination::Diverged(_) => "diverged",
+            Termination::Stalled(_) => "stalled",
+        }
+    }
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Termination::Diverged(why) | Termination::Stalled(why) => {
+                write!(f, "{}: {why}", self.label())
+            }
+            _ => f.write_str(self.label()),
+        }
+    }
+}
+
+/// The state after one iteration (iteration 0 is the starting point).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IterationRecord {
+    /// Iteration number.
+    pub iteration: usize,
+    /// Parameters.
+    pub parameters: Vec<f64>,
+    /// Model frequencies of the paired modes, Hz.
+    pub frequencies_hz: Vec<f64>,
+    /// ½‖r‖² of the weighted residual.
+    pub cost: f64,
+    /// Largest |f_model − f_measured|, Hz.
+    pub max_abs_diff_hz: f64,
+}
+
+impl IterationRecord {
+    fn new(iteration: usize, lin: &Linearisation) -> Self {
+        Self {
+            iteration,
+            parameters: lin.parameters.clone(),
+            frequencies_hz: lin.frequencies_hz.clone(),
+            cost: lin.cost(),
+            max_abs_diff_hz: lin.max_abs_diff_hz(),
+        }
+    }
+}
+
+/// Watches a run, one call per iteration (progress bars, logs, plots).
+pub trait Observer {
+    /// Called with the starting point and after each iteration.
+    fn observe(&mut self, record: &IterationRecord);
+}
+
+/// The outcome of a run. Always carries the last good point and the history, whatever the ending.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Estimate {
+    /// Strategy name.
+    pub strategy: &'static str,
+    /// Final parameters (the last good iterate).
+    pub parameters: Vec<f64>,
+    /// Iterations taken.
+    pub iterations: usize,
+    /// Model evaluations (eigen-solves with sensitivities), including rejected trials.
+    pub evaluations: usize,
+    /// Why the run ended.
+    pub termination: Termination,
+    /// Starting point and every iteration.
+    pub history: Vec<IterationRecord>,
+    /// Linearisation at the final parameters.
+    pub last: Linearisation,
+}
+
+/// Owns the loop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Driver {
+    /// Iteration limit.
+    pub max_iterations: usize,
+}
+
+impl Default for Driver {
+    fn default() -> Self {
+        Self {
+            max_iterations: 1000,
+        }
+    }
+}
+
+impl Driver {
+    /// Runs `strategy` from `initial`. Fails only when the starting point itself cannot be
+    /// evaluated or the strategy does not fit the problem; every later failure ends the run with
+    /// a [`Termination`] and keeps what was computed.
+    pub fn run(
+        &self,
+        problem: &dyn Evaluate,
+        strategy: &mut dyn UpdateStrategy,
+        initial: &[f64],
+        observers: &mut [&mut dyn Observer],
+    ) -> Result<Estimate, UpdateError> {
+        problem
+            .parameters()
+            .check(initial)
+            .map_err(|e| UpdateError::Setup(e.to_string()))?;
+        let mut current = problem.linearise(initial)?;
+        strategy.start(problem, &current)?;
+        let mut history = vec![IterationRecord::new(0, &current)];
+        observers.iter_mut().for_each(|o| o.observe(&history[0]));
+        let mut evaluations = 1;
+        let mut iterations = 0;
+        let termination = if strategy.converged(&current) {
+            Termination::Converged
+        } else {
+            loop {
+                if iterations >= self.max_iterations {
+                    break Termination::IterationLimit;
+                }
+                match strategy.step(problem, &current) {
+                    Ok(step) => {
+                        iterations += 1;
+                        evaluations += step.evaluations;
+                        current = step.next;
+                        let record = IterationRecord::new(iterations, &current);
+                        observers.iter_mut().for_each(|o| o.observe(&record));
+                        history.push(record);
+                        if step.status == StepStatus::Converged {
+                            break Termination::Converged;
+                        }
+                    }
+                    Err(UpdateError::Diverged(why)) => break Termination::Diverged(why),
+                    Err(UpdateError::Stalled(why)) => break Termination::Stalled(why),
+                    Err(e) => break Termination::Stalled(e.to_string()),
+                }
+            }
+        };
+        Ok(Estimate {
+            strategy: strategy.name(),
+            parameters: current.parameters.clone(),
+            iterations,
+            evaluations,
+            termination,
+            history,
+            last: current,
+        })
+    }
+}

@@ -1,0 +1,134 @@
+//! Update strategies and the driver that owns the iteration loop.
+//!
+//! A strategy ([`UpdateStrategy`]) turns the linearisation at the current point into the next
+//! point; the [`Driver`] owns the loop, the iteration limit, the history and the termination
+//! reason, like argmin's `Executor`.
+
+pub(crate) mod damped;
+mod driver;
+mod newton;
+mod pstep;
+
+pub use damped::Damped;
+pub use driver::{Driver, Estimate, IterationRecord, Observer, Termination};
+pub use newton::Newton;
+pub use pstep::PStep;
+
+use crate::parameters::ParameterSet;
+use crate::residual::{Linearisation, Problem, ResidualError};
+use crate::{EigenSolver, StructuralModel};
+use thiserror::Error;
+
+/// What a strategy sees of the problem: the parameters and the linearisation at any point.
+pub trait Evaluate {
+    /// The model's parameters.
+    fn parameters(&self) -> &ParameterSet;
+    /// Residual and Jacobian at `p`.
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError>;
+}
+
+impl<M: StructuralModel, S: EigenSolver> Evaluate for Problem<M, S> {
+    fn parameters(&self) -> &ParameterSet {
+        Problem::parameters(self)
+    }
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        Problem::linearise(self, p)
+    }
+}
+
+/// Why an update step could not be taken.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum UpdateError {
+    /// The strategy cannot be used on this problem (e.g. Newton needs a square system).
+    #[error("{0}")]
+    Setup(String),
+    /// The iterate left the physical range or the model failed there.
+    #[error("diverged: {0}")]
+    Diverged(String),
+    /// No acceptable step could be found.
+    #[error("stalled: {0}")]
+    Stalled(String),
+    /// The residual could not be evaluated at the starting point.
+    #[error(transparent)]
+    Residual(#[from] ResidualError),
+}
+
+/// Whether the iterate returned by a step has converged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepStatus {
+    /// Keep iterating.
+    Continue,
+    /// The strategy's convergence test holds at the new iterate.
+    Converged,
+}
+
+/// One accepted step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    /// Linearisation at the new point.
+    pub next: Linearisation,
+    /// Convergence verdict at the new point.
+    pub status: StepStatus,
+    /// Model evaluations spent (including rejected trials).
+    pub evaluations: usize,
+}
+
+/// One way of moving from the current linearisation to the next point.
+pub trait UpdateStrategy {
+    /// Name for reports, e.g. `newton`.
+    fn name(&self) -> &'static str;
+    /// Resets internal state before a run starting at `initial`.
+    fn start(&mut self, problem: &dyn Evaluate, initial: &Linearisation)
+        -> Result<(), UpdateError>;
+    /// Whether `lin` already satisfies the convergence test (checked at the start).
+    fn converged(&self, lin: &Linearisation) -> bool;
+    /// Takes one step.
+    fn step(
+        &mut self,
+        problem: &dyn Evaluate,
+        current: &Linearisation,
+    ) -> Result<Step, UpdateError>;
+}
+
+/// Solves the paper's eq. 28, S Δk = Δλ with the target eigenvalues `target`, and returns k + Δk.
+pub(crate) fn newton_point(
+    current: &Linearisation,
+    target: &nalgebra::DVector<f64>,
+) -> Result<Vec<f64>, UpdateError> {
+    let s = &current.eigenvalue_jacobian;
+    if s.nrows() != s.ncols() {
+        return Err(UpdateError::Setup(format!(
+            "the paper's Newton step needs as many modes as parameters (eq. 27); got {} modes for {} parameters",
+            s.nrows(),
+            s.ncols()
+        )));
+    }
+    let dlambda = target - &current.model_eigenvalues;
+    let dk = s
+        .clone()
+        .lu()
+        .solve(&dlambda)
+        .filter(|d| d.iter().all(|v| v.is_finite()))
+        .ok_or_else(|| UpdateError::Stalled("the sensitivity matrix is singular".into()))?;
+    Ok(current
+        .parameters
+        .iter()
+        .zip(dk.iter())
+        .map(|(k, d)| k + d)
+        .collect())
+}
+
+/// Linearises at `p`, turning a point outside the bounds or a failed model into `Diverged`.
+pub(crate) fn evaluate_or_diverge(
+    problem: &dyn Evaluate,
+    p: &[f64],
+) -> Result<Linearisation, UpdateError> {
+    problem
+        .parameters()
+        .check(p)
+        .map_err(|e| UpdateError::Diverged(e.to_string()))?;
+    problem
+        .linearise(p)
+        .map_err(|e| UpdateError::Diverged(e.to_string()))
+}

@@ -1,0 +1,54 @@
+//! The paper's plain method (section III): Δk from eq. 28, added to k every iteration.
+
+use super::{
+    evaluate_or_diverge, newton_point, Evaluate, Step, StepStatus, UpdateError, UpdateStrategy,
+};
+use crate::residual::Linearisation;
+
+/// Plain Newton on eigenvalues in linear stiffness, as in the paper: square system (as many
+/// modes as parameters), no damping, no bounds handling — a step that leaves the physical range
+/// ends the run as diverged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Newton {
+    /// Convergence: every |f_model − f_measured| below this, Hz (the paper: 0.01 Hz).
+    pub tolerance_hz: f64,
+}
+
+impl Default for Newton {
+    fn default() -> Self {
+        Self { tolerance_hz: 0.01 }
+    }
+}
+
+impl UpdateStrategy for Newton {
+    fn name(&self) -> &'static str {
+        "newton"
+    }
+
+    fn start(&mut self, _: &dyn Evaluate, initial: &Linearisation) -> Result<(), UpdateError> {
+        newton_point(initial, &initial.measured_eigenvalues).map(|_| ())
+    }
+
+    fn converged(&self, lin: &Linearisation) -> bool {
+        lin.max_abs_diff_hz() < self.tolerance_hz
+    }
+
+    fn step(
+        &mut self,
+        problem: &dyn Evaluate,
+        current: &Linearisation,
+    ) -> Result<Step, UpdateError> {
+        let p = newton_point(current, &current.measured_eigenvalues)?;
+        let next = evaluate_or_diverge(problem, &p)?;
+        let status = if self.converged(&next) {
+            StepStatus::Converged
+        } else {
+            StepStatus::Continue
+        };
+        Ok(Step {
+            next,
+            status,
+            evaluations: 1,
+        })
+    }
+}
