@@ -20,6 +20,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod compare;
 pub mod dense;
 pub mod measurement;
 pub mod model;
@@ -45,7 +46,7 @@ pub use sparse::SparseSymmetric;
 pub use statistics::{uncertainty, Identifiability, Uncertainty};
 pub use system::{System, SystemDerivative, SystemError};
 pub use update::{
-    Damped, Driver, Estimate, Newton, PStep, Termination, UpdateError, UpdateStrategy,
+    Damped, Driver, Estimate, Newton, PStep, StrategyKind, Termination, UpdateError, UpdateStrategy,
 };
 
 /// Converts an eigenvalue λ = ω² (rad/s)² to a frequency in Hz.

@@ -132,3 +132,46 @@ pub(crate) fn evaluate_or_diverge(
         .linearise(p)
         .map_err(|e| UpdateError::Diverged(e.to_string()))
 }
+
+/// The built-in strategies, by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum StrategyKind {
+    /// [`Newton`], the paper's plain method.
+    Newton,
+    /// [`PStep`], the paper's Fig. 1.
+    PStep,
+    /// [`Damped`] least squares.
+    Damped,
+}
+
+impl StrategyKind {
+    /// Every built-in strategy.
+    pub const ALL: [StrategyKind; 3] = [
+        StrategyKind::Newton,
+        StrategyKind::PStep,
+        StrategyKind::Damped,
+    ];
+
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            StrategyKind::Newton => "newton",
+            StrategyKind::PStep => "p-step",
+            StrategyKind::Damped => "damped",
+        }
+    }
+
+    /// Looks a strategy up by [`name`](Self::name).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// A fresh strategy with default settings.
+    pub fn build(self) -> Box<dyn UpdateStrategy> {
+        match self {
+            StrategyKind::Newton => Box::new(Newton::default()),
+            StrategyKind::PStep => Box::new(PStep::default()),
+            StrategyKind::Damped => Box::new(Damped::default()),
+        }
+    }
+}

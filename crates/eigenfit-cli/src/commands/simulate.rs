@@ -1,0 +1,130 @@
+//! `eigenfit simulate`: natural frequencies of a model, at one point or over a stiffness sweep.
+
+use crate::error::{input, CliError};
+use crate::source::{parameter_vector, parse_list, ModelArgs};
+use clap::Args;
+use eigenfit_core::{EigenSolver, StructuralModel};
+use serde_json::json;
+
+/// Arguments of `simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Bearing stiffnesses K1,K2,… in N/m (default: the model's values).
+    #[arg(long, value_name = "K1,K2,…", allow_hyphen_values = true)]
+    pub stiffness: Option<String>,
+    /// Override one parameter, NAME=VALUE (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub sets: Vec<String>,
+    /// Number of modes.
+    #[arg(long, default_value_t = 4)]
+    pub modes: usize,
+    /// Critical speed map: every bearing at the same stiffness, log-spaced FROM:TO:COUNT (N/m).
+    #[arg(long, value_name = "FROM:TO:COUNT")]
+    pub sweep: Option<String>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `simulate`.
+pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
+    let (rotor, label) = args.model.load()?;
+    let solver = args.model.solver()?;
+    if args.modes == 0 || args.modes > rotor.dofs() {
+        return Err(input(format!(
+            "--modes {}: must be between 1 and {} for this model",
+            args.modes,
+            rotor.dofs()
+        )));
+    }
+    let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
+    if let Some(sweep) = &args.sweep {
+        let points = sweep_points(sweep)?;
+        let mut rows = Vec::with_capacity(points.len());
+        for k in points {
+            let p = vec![k; names.len()];
+            rows.push((k, frequencies(&rotor, solver.as_ref(), &p, args.modes)?));
+        }
+        if args.json {
+            let sweep: Vec<_> = rows
+                .iter()
+                .map(|(k, f)| json!({"stiffness": k, "frequencies_hz": f}))
+                .collect();
+            println!(
+                "{}",
+                json!({"model": label, "solver": solver.name(), "sweep": sweep})
+            );
+        } else {
+            println!("{label}: natural frequencies against support stiffness (all bearings equal)");
+            print!("{:>14}", "k [N/m]");
+            (1..=args.modes).for_each(|m| print!("{:>14}", format!("f{m} [Hz]")));
+            println!();
+            for (k, f) in rows {
+                print!("{k:>14.4e}");
+                f.iter().for_each(|v| print!("{v:>14.4}"));
+                println!();
+            }
+        }
+        return Ok(());
+    }
+    let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
+    let f = frequencies(&rotor, solver.as_ref(), &p, args.modes)?;
+    if args.json {
+        let params: serde_json::Map<_, _> = names
+            .iter()
+            .cloned()
+            .zip(p.iter().map(|&v| json!(v)))
+            .collect();
+        println!(
+            "{}",
+            json!({"model": label, "solver": solver.name(), "parameters": params, "frequencies_hz": f})
+        );
+    } else {
+        println!("{label} ({} DOF, {} solver)", rotor.dofs(), solver.name());
+        for (n, v) in names.iter().zip(&p) {
+            println!("  {n} = {v:.6e} N/m");
+        }
+        println!("{:>6}{:>18}", "mode", "frequency [Hz]");
+        for (i, v) in f.iter().enumerate() {
+            println!("{:>6}{v:>18.6}", i + 1);
+        }
+    }
+    Ok(())
+}
+
+fn frequencies(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    modes: usize,
+) -> Result<Vec<f64>, CliError> {
+    let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
+    let m = solver
+        .lowest(&system, modes)
+        .map_err(|e| CliError::Failure(e.to_string()))?;
+    Ok(m.frequencies_hz())
+}
+
+fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
+    let parts: Vec<&str> = text.split(':').collect();
+    let bad = || {
+        input(format!(
+            "--sweep `{text}`: expected FROM:TO:COUNT with 0 < FROM < TO and COUNT ≥ 2"
+        ))
+    };
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let ends = parse_list("--sweep", &format!("{},{}", parts[0], parts[1]))?;
+    let count: usize = parts[2].trim().parse().map_err(|_| bad())?;
+    let (a, b) = (ends[0], ends[1]);
+    if !(a > 0.0 && b > a && count >= 2) {
+        return Err(bad());
+    }
+    let (la, lb) = (a.log10(), b.log10());
+    Ok((0..count)
+        .map(|i| 10f64.powf(la + (lb - la) * i as f64 / (count - 1) as f64))
+        .collect())
+}

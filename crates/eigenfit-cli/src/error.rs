@@ -1,0 +1,38 @@
+//! CLI errors and their exit codes.
+
+use thiserror::Error;
+
+/// Exit code for success.
+pub const EXIT_OK: u8 = 0;
+/// Exit code for a failure inside eigenfit (a solver that broke on valid input).
+pub const EXIT_FAILURE: u8 = 1;
+/// Exit code for bad input: arguments, model files, measured data (clap also uses 2).
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit code for an estimation that ended without converging (results are still printed).
+pub const EXIT_NOT_CONVERGED: u8 = 3;
+
+/// What went wrong, with the exit code it maps to.
+#[derive(Debug, Error)]
+pub enum CliError {
+    /// The user's input is wrong; the message says what and where.
+    #[error("{0}")]
+    Input(String),
+    /// eigenfit failed on valid input.
+    #[error("{0}")]
+    Failure(String),
+}
+
+impl CliError {
+    /// The process exit code.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Input(_) => EXIT_BAD_INPUT,
+            CliError::Failure(_) => EXIT_FAILURE,
+        }
+    }
+}
+
+/// Shorthand for an input error.
+pub fn input(msg: impl Into<String>) -> CliError {
+    CliError::Input(msg.into())
+}
