@@ -1,0 +1,184 @@
+//! Safe wrappers around the two LAPACK drivers: workspace queries, buffer sizing, `info` mapping.
+//!
+//! Matrices are column-major slices of length n² (nalgebra's `DMatrix` storage), leading
+//! dimension n. Only the upper triangle of K and M is read (`UPLO = 'U'`).
+
+use crate::backend;
+use eigenfit_core::SolveError;
+
+/// `ITYPE = 1`: K φ = λ M φ.
+const ITYPE: [i32; 1] = [1];
+const UPLO: u8 = b'U';
+
+/// All eigenpairs by `dsygvd`: (λ ascending, Φ column-major n×n with ΦᵀMΦ = I).
+pub(crate) fn sygvd(n: usize, k: &[f64], m: &[f64]) -> Result<(Vec<f64>, Vec<f64>), SolveError> {
+    let ni = lapack_int(n, "n")?;
+    let mut a = k.to_vec();
+    let mut b = m.to_vec();
+    let mut w = vec![0.0; n];
+    let mut info = 0;
+
+    // Workspace query (LWORK = LIWORK = -1): optimal sizes come back in work[0] and iwork[0].
+    let mut work = [0.0];
+    let mut iwork = [0];
+    // SAFETY: every array is at least as long as LAPACK reads or writes for these arguments:
+    // a and b are n×n with leading dimension n, w has n entries, and a query writes only
+    // work[0] and iwork[0].
+    unsafe {
+        lapack::dsygvd(
+            &ITYPE, b'V', UPLO, ni, &mut a, ni, &mut b, ni, &mut w, &mut work, -1, &mut iwork, -1,
+            &mut info,
+        );
+    }
+    check_info("dsygvd", info, n, None)?;
+    // Documented minima for JOBZ = 'V'; never trust a query to return less.
+    let lwork = workspace(work[0], 1 + 6 * n + 2 * n * n, "lwork")?;
+    let liwork = workspace(f64::from(iwork[0]), 3 + 5 * n, "liwork")?;
+    let mut work = vec![0.0; lwork];
+    let mut iwork = vec![0; liwork];
+    // SAFETY: as above, and work/iwork have the lengths passed as LWORK/LIWORK.
+    unsafe {
+        lapack::dsygvd(
+            &ITYPE,
+            b'V',
+            UPLO,
+            ni,
+            &mut a,
+            ni,
+            &mut b,
+            ni,
+            &mut w,
+            &mut work,
+            lapack_int(lwork, "lwork")?,
+            &mut iwork,
+            lapack_int(liwork, "liwork")?,
+            &mut info,
+        );
+    }
+    check_info("dsygvd", info, n, None)?;
+    Ok((w, a))
+}
+
+/// Eigenpairs `1..=count` by `dsygvx` (`RANGE = 'I'`): (λ ascending, Φ column-major n×count).
+pub(crate) fn sygvx(
+    n: usize,
+    k: &[f64],
+    m: &[f64],
+    count: usize,
+) -> Result<(Vec<f64>, Vec<f64>), SolveError> {
+    let ni = lapack_int(n, "n")?;
+    let iu = lapack_int(count, "count")?;
+    let mut a = k.to_vec();
+    let mut b = m.to_vec();
+    let mut w = vec![0.0; n];
+    let mut z = vec![0.0; n * count];
+    let mut iwork = vec![0; 5 * n];
+    let mut ifail = vec![0; n];
+    let mut found = 0;
+    let mut info = 0;
+    // SAFETY: dlamch only reads its character argument.
+    let abstol = 2.0 * unsafe { lapack::dlamch(b'S') };
+
+    let mut work = [0.0];
+    // SAFETY: a, b are n×n (leading dimension n); w has n entries; z is n×count with leading
+    // dimension n, and RANGE = 'I' with IL = 1, IU = count yields exactly count columns;
+    // iwork has 5n and ifail n entries; a query (LWORK = -1) writes only work[0].
+    unsafe {
+        lapack::dsygvx(
+            &ITYPE, b'V', b'I', UPLO, ni, &mut a, ni, &mut b, ni, 0.0, 0.0, 1, iu, abstol,
+            &mut found, &mut w, &mut z, ni, &mut work, -1, &mut iwork, &mut ifail, &mut info,
+        );
+    }
+    check_info("dsygvx", info, n, None)?;
+    let lwork = workspace(work[0], (8 * n).max(1), "lwork")?;
+    let mut work = vec![0.0; lwork];
+    // SAFETY: as above, and work has the length passed as LWORK.
+    unsafe {
+        lapack::dsygvx(
+            &ITYPE,
+            b'V',
+            b'I',
+            UPLO,
+            ni,
+            &mut a,
+            ni,
+            &mut b,
+            ni,
+            0.0,
+            0.0,
+            1,
+            iu,
+            abstol,
+            &mut found,
+            &mut w,
+            &mut z,
+            ni,
+            &mut work,
+            lapack_int(lwork, "lwork")?,
+            &mut iwork,
+            &mut ifail,
+            &mut info,
+        );
+    }
+    check_info("dsygvx", info, n, Some(&ifail))?;
+    if usize::try_from(found) != Ok(count) {
+        return Err(backend(format!(
+            "dsygvx returned {found} eigenpairs, {count} were requested"
+        )));
+    }
+    w.truncate(count);
+    Ok((w, z))
+}
+
+/// Maps LAPACK's `info` for `dsygvd` / `dsygvx` (with `ifail` for the latter).
+fn check_info(routine: &str, info: i32, n: usize, ifail: Option<&[i32]>) -> Result<(), SolveError> {
+    let Ok(i) = usize::try_from(info) else {
+        return Err(backend(format!(
+            "{routine}: argument {} had an illegal value",
+            -i64::from(info)
+        )));
+    };
+    if i == 0 {
+        Ok(())
+    } else if i > n {
+        Err(SolveError::MassNotPositiveDefinite {
+            detail: Some(format!(
+                "the leading minor of order {} of M is not positive definite ({routine} info = {info})",
+                i - n
+            )),
+        })
+    } else if let Some(ifail) = ifail {
+        let which: Vec<i32> = ifail.iter().take(i).copied().collect();
+        Err(backend(format!(
+            "{routine}: {i} eigenvector(s) failed to converge (indices {which:?})"
+        )))
+    } else {
+        Err(backend(format!(
+            "{routine}: the eigensolver failed to converge (info = {info})"
+        )))
+    }
+}
+
+/// Workspace length: the queried optimum, at least the documented minimum.
+fn workspace(queried: f64, minimum: usize, what: &str) -> Result<usize, SolveError> {
+    // Optimal sizes come back as doubles; round up and reject nonsense.
+    let q = if queried.is_finite() && queried > 0.0 {
+        queried.ceil()
+    } else {
+        0.0
+    };
+    if q > i32::MAX as f64 {
+        return Err(backend(format!(
+            "{what} = {q} exceeds LAPACK's 32-bit integer range"
+        )));
+    }
+    Ok((q as usize).max(minimum))
+}
+
+fn lapack_int(v: usize, what: &str) -> Result<i32, SolveError> {
+    i32::try_from(v).map_err(|_| {
+        backend(format!(
+            "{what} = {v} exceeds LAPACK's 32-bit integer range"
+        ))
+    })
+}
