@@ -28,6 +28,8 @@ enum Command {
     Simulate(commands::simulate::SimulateArgs),
     /// Update the bearing stiffnesses to match measured frequencies.
     Estimate(commands::estimate::EstimateArgs),
+    /// Compare update strategies over targets and a grid of initial guesses.
+    Compare(commands::compare::CompareArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(a) => commands::simulate::run(a).map(|()| error::EXIT_OK),
         Command::Estimate(a) => commands::estimate::run(a),
+        Command::Compare(a) => commands::compare::run(a).map(|()| error::EXIT_OK),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -5,7 +5,14 @@ use crate::solver::{check_count, EigenSolver, SolveError};
 use crate::system::System;
 use nalgebra::{Cholesky, DMatrix, DVector, SymmetricEigen};
 
-/// Dense solver: M = LLᵀ, A = L⁻¹ K L⁻ᵀ, A = Y Λ Yᵀ, Φ = L⁻ᵀ Y. Needs no system library; O(n³).
+/// Dense solver for the lowest modes, accurate to round-off *relative to each eigenvalue*.
+///
+/// The textbook reduction M = LLᵀ, A = L⁻¹KL⁻ᵀ loses the lowest eigenvalues to round-off of
+/// size ε·λ_max: for a stiff shaft on soft supports (λ_max/λ₁ ≈ 10⁸) that is 10⁻⁸ relative.
+/// This solver reduces the inverted problem instead: with K_σ = K + σM = LLᵀ (σ = 0 when K is
+/// positive definite, a small shift for rigid-body modes), B = L⁻¹ML⁻ᵀ has eigenvalues
+/// μ = 1/(λ + σ), the lowest modes become the largest μ, and their relative accuracy is
+/// ε·λ/λ₁. Φ = L⁻ᵀY/√μ is mass-normalised. Needs no system library; O(n³).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct DenseSolver;
 
@@ -16,51 +23,107 @@ impl EigenSolver for DenseSolver {
 
     fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
         check_count(system, count)?;
-        let chol = Cholesky::new(system.mass().clone())
-            .ok_or(SolveError::MassNotPositiveDefinite { detail: None })?;
-        let l = chol.l();
-        // A = L⁻¹ K L⁻ᵀ via two triangular solves: X = L⁻¹ K, then A = (L⁻¹ Xᵀ)ᵀ.
-        let x = l
-            .solve_lower_triangular(system.stiffness())
-            .ok_or_else(|| not_pd("zero pivot in L"))?;
-        let a = l
-            .solve_lower_triangular(&x.transpose())
-            .ok_or_else(|| not_pd("zero pivot in L"))?;
-        let a = (&a + a.transpose()) * 0.5;
-        let eig = SymmetricEigen::try_new(a, f64::EPSILON, 0).ok_or(SolveError::Backend {
-            backend: "dense",
-            detail: "symmetric QR iteration did not converge".into(),
-        })?;
-        let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-        order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-        order.truncate(count);
-        let eigenvalues = DVector::from_iterator(count, order.iter().map(|&i| eig.eigenvalues[i]));
-        let y = DMatrix::from_columns(
-            &order
-                .iter()
-                .map(|&i| eig.eigenvectors.column(i))
-                .collect::<Vec<_>>(),
-        );
-        let mut shapes = l
-            .transpose()
-            .solve_upper_triangular(&y)
-            .ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
-        if eigenvalues
-            .iter()
-            .chain(shapes.iter())
-            .any(|v| !v.is_finite())
-        {
-            return Err(SolveError::Backend {
-                backend: "dense",
-                detail: "non-finite result".into(),
-            });
+        let (k, m) = (system.stiffness(), system.mass());
+        // M must be positive definite for the problem to be symmetric-definite at all.
+        if Cholesky::new(m.clone()).is_none() {
+            return Err(SolveError::MassNotPositiveDefinite { detail: None });
         }
-        apply_sign_rule(&mut shapes);
-        Ok(Modes {
-            eigenvalues,
-            shapes,
-        })
+        if let Some(chol) = Cholesky::new(k.clone()).filter(well_conditioned) {
+            return inverted_solve(&chol, m, 0.0, count);
+        }
+        // Rigid-body modes: K is singular. A first pass with a tiny shift σ₀ locates the lowest
+        // elastic mode; the second shifts to it, since a mode's relative error is
+        // ε·(λ + σ)²/(σλ): smallest near σ = λ, and ε·λ/σ above it.
+        let scale = k.diagonal().amax() / m.diagonal().amax();
+        let sigma0 = 1e-8 * scale.max(f64::MIN_POSITIVE);
+        let first = shifted(k, m, sigma0, count)?;
+        match first.eigenvalues.iter().find(|&&l| l > 1e-3 * sigma0) {
+            Some(&sigma1) if sigma1 > 10.0 * sigma0 => shifted(k, m, sigma1, count),
+            _ => Ok(first),
+        }
     }
+}
+
+/// A Cholesky factor whose pivots do not reveal a (numerically) singular matrix.
+fn well_conditioned(c: &Cholesky<f64, nalgebra::Dyn>) -> bool {
+    let d = c.l_dirty().diagonal();
+    let (dmin, dmax) = d.iter().fold((f64::INFINITY, 0.0_f64), |(a, b), &v| {
+        (a.min(v.abs()), b.max(v.abs()))
+    });
+    dmin > 1e-7 * dmax
+}
+
+fn shifted(
+    k: &DMatrix<f64>,
+    m: &DMatrix<f64>,
+    sigma: f64,
+    count: usize,
+) -> Result<Modes, SolveError> {
+    let chol = Cholesky::new(k + m * sigma).ok_or(SolveError::Backend {
+        backend: "dense",
+        detail: "K + σM is not positive definite: K has negative stiffness".into(),
+    })?;
+    inverted_solve(&chol, m, sigma, count)
+}
+
+/// Lowest `count` modes from K + σM = LLᵀ: eigen-decompose B = L⁻¹ML⁻ᵀ, μ = 1/(λ + σ).
+fn inverted_solve(
+    chol: &Cholesky<f64, nalgebra::Dyn>,
+    m: &DMatrix<f64>,
+    sigma: f64,
+    count: usize,
+) -> Result<Modes, SolveError> {
+    let l = chol.l();
+    let x = l
+        .solve_lower_triangular(m)
+        .ok_or_else(|| not_pd("zero pivot in L"))?;
+    let b = l
+        .solve_lower_triangular(&x.transpose())
+        .ok_or_else(|| not_pd("zero pivot in L"))?;
+    let b = (&b + b.transpose()) * 0.5;
+    let eig = SymmetricEigen::try_new(b, f64::EPSILON, 0).ok_or(SolveError::Backend {
+        backend: "dense",
+        detail: "symmetric QR iteration did not converge".into(),
+    })?;
+    // Largest μ first = lowest λ first.
+    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
+    order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
+    order.truncate(count);
+    if order.iter().any(|&i| eig.eigenvalues[i] <= 0.0) {
+        return Err(SolveError::Backend {
+            backend: "dense",
+            detail: "a reduced eigenvalue is not positive".into(),
+        });
+    }
+    let eigenvalues = DVector::from_iterator(
+        count,
+        order.iter().map(|&i| 1.0 / eig.eigenvalues[i] - sigma),
+    );
+    let y = DMatrix::from_columns(
+        &order
+            .iter()
+            .map(|&i| eig.eigenvectors.column(i) / eig.eigenvalues[i].sqrt())
+            .collect::<Vec<_>>(),
+    );
+    let mut shapes = l
+        .transpose()
+        .solve_upper_triangular(&y)
+        .ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
+    if eigenvalues
+        .iter()
+        .chain(shapes.iter())
+        .any(|v| !v.is_finite())
+    {
+        return Err(SolveError::Backend {
+            backend: "dense",
+            detail: "non-finite result".into(),
+        });
+    }
+    apply_sign_rule(&mut shapes);
+    Ok(Modes {
+        eigenvalues,
+        shapes,
+    })
 }
 
 fn not_pd(detail: &str) -> SolveError {

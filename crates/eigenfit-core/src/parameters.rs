@@ -28,6 +28,8 @@ pub struct Parameter {
     pub upper: f64,
     /// Update scale.
     pub scale: Scale,
+    /// Where a global search looks for this parameter, if narrower than the bounds.
+    pub search: Option<(f64, f64)>,
 }
 
 impl Parameter {
@@ -40,6 +42,34 @@ impl Parameter {
             lower: f64::NEG_INFINITY,
             upper: f64::INFINITY,
             scale: Scale::Linear,
+            search: None,
+        }
+    }
+
+    /// Sets the range a global search (restart seeds) covers.
+    pub fn with_search_range(mut self, lower: f64, upper: f64) -> Self {
+        self.search = Some((lower, upper));
+        self
+    }
+
+    /// The range a global search covers: the one set, else the bounds when finite (and, for a
+    /// log parameter, within four decades of the nominal value), else the nominal ± 10·max(|nominal|, 1).
+    pub fn search_range(&self) -> (f64, f64) {
+        if let Some(r) = self.search {
+            return r;
+        }
+        match self.scale {
+            Scale::Log => (
+                self.lower.max(self.nominal * 1e-4),
+                self.upper.min(self.nominal * 1e4),
+            ),
+            Scale::Linear => {
+                let w = 10.0 * self.nominal.abs().max(1.0);
+                (
+                    self.lower.max(self.nominal - w),
+                    self.upper.min(self.nominal + w),
+                )
+            }
         }
     }
 

@@ -17,7 +17,8 @@ pub enum ResidualKind {
     Eigenvalue,
     /// Frequencies in Hz.
     FrequencyHz,
-    /// (f_measured − f_model) / f_measured: every mode weighs the same without given std.
+    /// ln(f_measured / f_model), the relative difference to first order: every mode weighs the
+    /// same without given std.
     #[default]
     Relative,
 }
@@ -71,6 +72,8 @@ pub struct Linearisation {
     pub residual: DVector<f64>,
     /// Weighted d(model)/dp in physical units, so that J Δp ≈ residual.
     pub jacobian: DMatrix<f64>,
+    /// True when the residual is weighted by measured standard deviations (cost = ½χ²).
+    pub has_std: bool,
 }
 
 impl Linearisation {
@@ -167,6 +170,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             measured_hz: vec![0.0; m],
             residual: DVector::zeros(m),
             jacobian: DMatrix::zeros(m, np),
+            has_std: self.measured.has_std(),
         };
         for (row, (meas, &k)) in self.measured.modes().iter().zip(&paired).enumerate() {
             let lambda = sens.modes.eigenvalues[k];
@@ -191,9 +195,11 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
                     1.0 / (8.0 * PI * PI * f),
                     meas.std_hz.unwrap_or(1.0),
                 ),
+                // ln(f_m/f): the relative difference to first order, and linear in ln k where
+                // the supports dominate (f ∝ √k), which makes log-stiffness steps nearly exact.
                 ResidualKind::Relative => (
-                    (fm - f) / fm,
-                    1.0 / (8.0 * PI * PI * f * fm),
+                    (fm / f).ln(),
+                    1.0 / (2.0 * lambda),
                     meas.std_hz.map_or(1.0, |s| s / fm),
                 ),
             };

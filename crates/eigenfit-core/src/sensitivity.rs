@@ -132,6 +132,7 @@ impl Sensitivities {
         S: EigenSolver + ?Sized,
     {
         let system = model.assemble(p)?;
+        crate::solver::check_count(&system, count)?;
         let extra = (count + 1).min(system.dofs());
         let mut modes = solver.lowest(&system, extra)?;
         let floor = noise_floor(&system);

@@ -128,7 +128,7 @@ fn profile_chi2(problem: &dyn Evaluate, at: &Linearisation, i: usize, value: f64
     let mut p = at.parameters.clone();
     p[i] = value;
     let fixed = (0..p.len()).map(|j| j == i).collect();
-    let mut damped = Damped::default().with_fixed(fixed);
+    let mut damped = Damped::default().with_fixed(fixed).with_max_restarts(0);
     let est = Driver { max_iterations: 60 }
         .run(problem, &mut damped, &p, &mut [])
         .ok()?;
@@ -151,7 +151,7 @@ fn profile_bound(problem: &dyn Evaluate, at: &Linearisation, i: usize, dir: f64)
             i,
             par.from_scaled(s).clamp(par.lower, par.upper),
         )
-        .map_or(true, |c| c - chi2_min > CHI2_95_1DOF)
+        .is_none_or(|c| c - chi2_min > CHI2_95_1DOF)
     };
     let s_hat = par.to_scaled(at.parameters[i]);
     let s_limit = par.to_scaled(limit);

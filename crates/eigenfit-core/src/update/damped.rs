@@ -1,4 +1,4 @@
-//! Damped least squares (Levenberg–Marquardt) in scaled parameters, with bounds.
+//! Damped least squares (Levenberg–Marquardt) in scaled parameters, with bounds and restarts.
 
 use super::{Evaluate, Step, StepStatus, UpdateError, UpdateStrategy};
 use crate::parameters::ParameterSet;
@@ -7,38 +7,73 @@ use nalgebra::{DMatrix, DVector};
 
 /// Levenberg–Marquardt on the weighted residual, in each parameter's scale (log for
 /// stiffnesses), with Marquardt's diagonal scaling, a gain-ratio test that accepts or rejects
-/// each trial (Nielsen's damping update), bounds by projection, and a cap on the scaled step so a
-/// flat start (a stiff support, where the frequencies barely move) cannot jump across decades.
+/// each trial (Nielsen's damping update), bounds by an active set, and a cap on the scaled step so
+/// a flat start (a stiff support, where the frequencies barely move) cannot jump across decades.
 /// Any number of modes ≥ the number of free parameters.
+///
+/// Robust from any start: when the iteration settles on a point that does not fit (a local
+/// minimum, or a plateau where a support is so stiff the data no longer see it), it restarts from
+/// the untried point of a coarse log grid with the lowest residual, and at the end returns the
+/// best point it found. Restarts count as iterations.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Damped {
-    /// Converged when every |f_model − f_measured| / f_measured is below this.
+    /// A fit is exact when every |f_model − f_measured| / f_measured is below this.
     pub residual_tolerance: f64,
-    /// Converged when an accepted scaled step has ‖δ‖∞ below this.
+    /// Converged when a scaled step ‖δ‖∞ falls below this without heavy damping.
     pub step_tolerance: f64,
     /// Largest ‖δ‖∞ of one step in scaled units (ln 100: two decades for a log parameter).
     pub max_step: f64,
-    /// Rejected trials allowed per iteration before the run stalls.
+    /// Rejected trials allowed per iteration before the run counts as stuck.
     pub max_trials: usize,
+    /// Restarts from the coarse grid allowed before the best point found is returned.
+    pub max_restarts: usize,
     /// Parameters held at their starting value (profile likelihood, partial updates).
     pub fixed: Vec<bool>,
     mu: f64,
     nu: f64,
+    seeds: Option<Vec<Vec<f64>>>,
+    best: Option<Linearisation>,
+    restarts: usize,
+    stuck_for: usize,
+    recent_cost: f64,
 }
 
 impl Default for Damped {
     fn default() -> Self {
         Self {
-            residual_tolerance: 1e-12,
+            residual_tolerance: 1e-10,
             step_tolerance: 1e-10,
             max_step: 100f64.ln(),
             max_trials: 30,
+            max_restarts: 8,
             fixed: Vec::new(),
             mu: 1e-3,
             nu: 2.0,
+            seeds: None,
+            best: None,
+            restarts: 0,
+            stuck_for: 0,
+            recent_cost: f64::INFINITY,
         }
     }
 }
+
+/// Iterations without a 0.1% cost reduction after which a run counts as stuck on a plateau.
+const PLATEAU_ITERATIONS: usize = 12;
+/// Grid points per free parameter for restart seeds: 5 for one or two free parameters, fewer
+/// beyond, and never more than [`MAX_SEEDS`] in all.
+fn seeds_per_axis(free: usize) -> usize {
+    match free {
+        0..=2 => 5,
+        3 => 4,
+        4 => 3,
+        _ => 2,
+    }
+}
+/// Most restart seeds evaluated.
+const MAX_SEEDS: usize = 243;
+/// Relative frequency misfit above which a run starts from the best coarse-grid point.
+const FAR_START: f64 = 0.2;
 
 impl Damped {
     /// Holds the parameters flagged `true` fixed.
@@ -47,9 +82,117 @@ impl Damped {
         self
     }
 
+    /// Sets the number of restarts (0: a plain local Levenberg–Marquardt).
+    pub fn with_max_restarts(mut self, max_restarts: usize) -> Self {
+        self.max_restarts = max_restarts;
+        self
+    }
+
+    /// Restarts taken in the last run.
+    pub fn restarts(&self) -> usize {
+        self.restarts
+    }
+
     fn is_free(&self, i: usize) -> bool {
         !self.fixed.get(i).copied().unwrap_or(false)
     }
+
+    /// Good enough to stop without restarting: an exact fit, or with standard deviations a
+    /// χ² per degree of freedom that noise can explain (≤ 4).
+    fn acceptable(&self, lin: &Linearisation, free: usize) -> bool {
+        if self.converged(lin) {
+            return true;
+        }
+        let dof = lin.residual.len().saturating_sub(free);
+        lin.has_std && dof > 0 && 2.0 * lin.cost() / dof as f64 <= 4.0
+    }
+
+    fn remember(&mut self, lin: &Linearisation) {
+        if self.best.as_ref().is_none_or(|b| lin.cost() < b.cost()) {
+            self.best = Some(lin.clone());
+        }
+    }
+
+    /// The point reached does not fit: restart from the best untried seed, or end with the best
+    /// point found.
+    fn restart(
+        &mut self,
+        problem: &dyn Evaluate,
+        current: &Linearisation,
+    ) -> Result<Step, UpdateError> {
+        self.remember(current);
+        let seeds = self
+            .seeds
+            .get_or_insert_with(|| ranked_seeds(problem, &current.parameters, &self.fixed));
+        let mut evaluations = 0;
+        while self.restarts < self.max_restarts && !seeds.is_empty() {
+            let p = seeds.remove(0);
+            evaluations += 1;
+            if let Ok(next) = problem.linearise(&p) {
+                self.restarts += 1;
+                self.mu = 1e-3;
+                self.nu = 2.0;
+                self.stuck_for = 0;
+                self.recent_cost = next.cost();
+                return Ok(Step {
+                    next,
+                    status: StepStatus::Continue,
+                    evaluations,
+                });
+            }
+        }
+        let best = self.best.clone().unwrap_or_else(|| current.clone());
+        Ok(Step {
+            next: best,
+            status: StepStatus::Converged,
+            evaluations,
+        })
+    }
+}
+
+/// Coarse log grid over each free parameter's search range, ranked by residual (lowest first).
+fn ranked_seeds(problem: &dyn Evaluate, around: &[f64], fixed: &[bool]) -> Vec<Vec<f64>> {
+    let params = problem.parameters();
+    let per_axis = seeds_per_axis(
+        (0..params.len())
+            .filter(|&i| !fixed.get(i).copied().unwrap_or(false))
+            .count(),
+    );
+    let axes: Vec<Vec<f64>> = params
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            if fixed.get(i).copied().unwrap_or(false) {
+                return vec![around[i]];
+            }
+            let (lo, hi) = p.search_range();
+            let (a, b) = (p.to_scaled(lo), p.to_scaled(hi));
+            (0..per_axis)
+                .map(|k| p.from_scaled(a + (b - a) * (k as f64 + 0.5) / per_axis as f64))
+                .collect()
+        })
+        .collect();
+    let mut points: Vec<Vec<f64>> = vec![Vec::new()];
+    for axis in &axes {
+        points = points
+            .into_iter()
+            .flat_map(|pre| {
+                axis.iter().map(move |&v| {
+                    let mut q = pre.clone();
+                    q.push(v);
+                    q
+                })
+            })
+            .take(MAX_SEEDS)
+            .collect();
+    }
+    let mut ranked: Vec<(f64, Vec<f64>)> = points
+        .into_iter()
+        .filter_map(|p| problem.linearise(&p).ok().map(|l| (l.cost(), p)))
+        .filter(|(c, _)| c.is_finite())
+        .collect();
+    ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
+    ranked.into_iter().map(|(_, p)| p).collect()
 }
 
 /// Jacobian with respect to the scaled parameters: J · diag(dp/ds).
@@ -83,6 +226,11 @@ impl UpdateStrategy for Damped {
         }
         self.mu = 1e-3;
         self.nu = 2.0;
+        self.seeds = None;
+        self.best = None;
+        self.restarts = 0;
+        self.stuck_for = 0;
+        self.recent_cost = initial.cost();
         Ok(())
     }
 
@@ -95,100 +243,217 @@ impl UpdateStrategy for Damped {
         problem: &dyn Evaluate,
         current: &Linearisation,
     ) -> Result<Step, UpdateError> {
+        let free = (0..problem.parameters().len())
+            .filter(|&i| self.is_free(i))
+            .count();
+        // Far from the data at the start (a frequency off by more than FAR_START): begin from
+        // the best point of the coarse grid instead, when it fits better.
+        if self.seeds.is_none() && self.max_restarts > 0 && current.max_rel_diff() > FAR_START {
+            let seeds = ranked_seeds(problem, &current.parameters, &self.fixed);
+            let evaluations = seeds.len();
+            self.seeds = Some(seeds);
+            if let Some(Ok(next)) = self
+                .seeds
+                .as_mut()
+                .and_then(|s| (!s.is_empty()).then(|| s.remove(0)))
+                .map(|p| problem.linearise(&p))
+            {
+                if next.cost() < current.cost() {
+                    self.remember(current);
+                    self.recent_cost = next.cost();
+                    return Ok(Step {
+                        next,
+                        status: StepStatus::Continue,
+                        evaluations: evaluations + 1,
+                    });
+                }
+            }
+        }
+        match self.lm_step(problem, current) {
+            Ok(Some(step)) => {
+                let next = step.next;
+                if self.converged(&next) {
+                    return Ok(Step {
+                        next,
+                        status: StepStatus::Converged,
+                        evaluations: step.evaluations,
+                    });
+                }
+                // Plateau watch: a long run of negligible progress on a point that does not fit.
+                if next.cost() < 0.999 * self.recent_cost {
+                    self.recent_cost = next.cost();
+                    self.stuck_for = 0;
+                } else {
+                    self.stuck_for += 1;
+                }
+                if self.stuck_for >= PLATEAU_ITERATIONS && !self.acceptable(&next, free) {
+                    let mut restarted = self.restart(problem, &next)?;
+                    restarted.evaluations += step.evaluations;
+                    return Ok(restarted);
+                }
+                Ok(Step {
+                    next,
+                    status: StepStatus::Continue,
+                    evaluations: step.evaluations,
+                })
+            }
+            // Stationary, or no step reduces the residual: done if the fit is good, else restart.
+            Ok(None) | Err(UpdateError::Stalled(_))
+                if self.acceptable(current, free) || self.max_restarts == 0 =>
+            {
+                self.remember(current);
+                let best = self.best.clone().unwrap_or_else(|| current.clone());
+                Ok(Step {
+                    next: best,
+                    status: StepStatus::Converged,
+                    evaluations: 0,
+                })
+            }
+            Ok(None) | Err(UpdateError::Stalled(_)) => self.restart(problem, current),
+            Err(e) => Err(e),
+        }
+    }
+}
+
+impl Damped {
+    /// One Levenberg–Marquardt iteration: `Ok(None)` when the current point is stationary.
+    fn lm_step(
+        &mut self,
+        problem: &dyn Evaluate,
+        current: &Linearisation,
+    ) -> Result<Option<Step>, UpdateError> {
         let params = problem.parameters();
         let np = params.len();
-        let mut js = scaled_jacobian(params, current);
-        for i in (0..np).filter(|&i| !self.is_free(i)) {
-            js.column_mut(i).fill(0.0);
-        }
-        let a = js.transpose() * &js;
-        let g = js.transpose() * &current.residual;
-        // Marquardt scaling, floored so a (nearly) insensitive parameter still gets damped.
-        let amax = a.diagonal().amax().max(f64::MIN_POSITIVE);
-        let d = DVector::from_iterator(np, (0..np).map(|i| a[(i, i)].max(1e-12 * amax)));
+        let js = scaled_jacobian(params, current);
+        let g_full = js.transpose() * &current.residual;
         let s0: Vec<f64> = params
             .iter()
             .zip(&current.parameters)
             .map(|(p, &v)| p.to_scaled(v))
             .collect();
+        let (lo, hi) = scaled_bounds(params);
+        // Active set: a parameter on a bound whose gradient pushes outward stays there this step.
+        let free: Vec<bool> = (0..np)
+            .map(|i| {
+                self.is_free(i)
+                    && !(s0[i] <= lo[i] && g_full[i] < 0.0)
+                    && !(s0[i] >= hi[i] && g_full[i] > 0.0)
+            })
+            .collect();
+        let mut js_free = js;
+        for i in (0..np).filter(|&i| !free[i]) {
+            js_free.column_mut(i).fill(0.0);
+        }
+        if stationary(&js_free, &current.residual) {
+            return Ok(None);
+        }
+        let a = js_free.transpose() * &js_free;
+        let g = js_free.transpose() * &current.residual;
+        // Marquardt scaling, floored so a (nearly) insensitive parameter still gets damped.
+        let amax = a.diagonal().amax().max(f64::MIN_POSITIVE);
+        let d = DVector::from_iterator(np, (0..np).map(|i| a[(i, i)].max(1e-12 * amax)));
         let cost0 = current.cost();
         let mut evaluations = 0;
         for _ in 0..self.max_trials {
             let mut lhs = a.clone();
             for i in 0..np {
-                if self.is_free(i) {
+                if free[i] {
                     lhs[(i, i)] += self.mu * d[i];
                 } else {
                     lhs[(i, i)] = 1.0;
                 }
             }
             let Some(mut delta) = lhs.cholesky().map(|c| c.solve(&g)) else {
-                self.mu *= self.nu;
-                self.nu *= 2.0;
+                self.reject();
                 continue;
             };
             let cap = delta.amax();
             if cap > self.max_step {
                 delta *= self.max_step / cap;
             }
-            // Project onto the bounds in scaled space.
             let mut p_new = Vec::with_capacity(np);
             for (i, par) in params.iter().enumerate() {
-                let lo = if par.lower.is_finite() {
-                    par.to_scaled(par.lower)
-                } else {
-                    f64::NEG_INFINITY
-                };
-                let hi = if par.upper.is_finite() {
-                    par.to_scaled(par.upper)
-                } else {
-                    f64::INFINITY
-                };
-                let s = (s0[i] + delta[i]).clamp(lo, hi);
+                let s = (s0[i] + delta[i]).clamp(lo[i], hi[i]);
                 delta[i] = s - s0[i];
                 p_new.push(par.from_scaled(s).clamp(par.lower, par.upper));
+            }
+            if delta.amax() <= self.step_tolerance {
+                // Gauss–Newton has nothing left to do: a minimum — unless heavy damping alone
+                // made the step small, which is a stall, not a solution.
+                return if self.mu <= 1e6 {
+                    Ok(None)
+                } else {
+                    Err(UpdateError::Stalled(format!(
+                        "steps shrank to {:.1e} under damping {:.1e} without reducing the residual",
+                        delta.amax(),
+                        self.mu
+                    )))
+                };
             }
             let predicted = delta.dot(&g) - 0.5 * delta.dot(&(&a * &delta));
             evaluations += 1;
             let trial = match problem.linearise(&p_new) {
                 Ok(t) if t.residual.iter().all(|v| v.is_finite()) => t,
                 _ => {
-                    self.mu *= self.nu;
-                    self.nu *= 2.0;
+                    self.reject();
                     continue;
                 }
             };
             let actual = cost0 - trial.cost();
-            let small_step = delta.amax() <= self.step_tolerance;
             if predicted > 0.0 && actual / predicted > 1e-4 {
                 let rho = actual / predicted;
                 self.mu *= f64::max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0).powi(3));
                 self.nu = 2.0;
-                let status = if self.converged(&trial) || small_step {
-                    StepStatus::Converged
-                } else {
-                    StepStatus::Continue
-                };
-                return Ok(Step {
+                return Ok(Some(Step {
                     next: trial,
-                    status,
+                    status: StepStatus::Continue,
                     evaluations,
-                });
+                }));
             }
-            if small_step || predicted <= 0.0 {
-                // No descent left at round-off level: the current point is the minimum.
-                return Ok(Step {
-                    next: current.clone(),
-                    status: StepStatus::Converged,
-                    evaluations,
-                });
-            }
-            self.mu *= self.nu;
-            self.nu *= 2.0;
+            self.reject();
         }
         Err(UpdateError::Stalled(format!(
             "no acceptable step in {} trials",
             self.max_trials
         )))
     }
+
+    fn reject(&mut self) {
+        self.mu *= self.nu;
+        self.nu *= 2.0;
+    }
+}
+
+/// Scaled lower and upper bounds (±∞ where a bound is infinite).
+fn scaled_bounds(params: &ParameterSet) -> (Vec<f64>, Vec<f64>) {
+    params
+        .iter()
+        .map(|p| {
+            let lo = if p.lower.is_finite() {
+                p.to_scaled(p.lower)
+            } else {
+                f64::NEG_INFINITY
+            };
+            let hi = if p.upper.is_finite() {
+                p.to_scaled(p.upper)
+            } else {
+                f64::INFINITY
+            };
+            (lo, hi)
+        })
+        .unzip()
+}
+
+/// MINPACK's gradient test: the residual is orthogonal to every Jacobian column (cosine below
+/// 1e-10), so no parameter change can reduce it further. A zero column (a parameter the data do
+/// not see) counts as orthogonal.
+fn stationary(js: &DMatrix<f64>, r: &DVector<f64>) -> bool {
+    let rn = r.norm();
+    if rn == 0.0 {
+        return true;
+    }
+    js.column_iter().all(|c| {
+        let cn = c.norm();
+        cn == 0.0 || (c.dot(r) / (cn * rn)).abs() <= 1e-10
+    })
 }

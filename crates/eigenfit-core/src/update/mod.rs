@@ -91,22 +91,22 @@ pub trait UpdateStrategy {
     ) -> Result<Step, UpdateError>;
 }
 
-/// Solves the paper's eq. 28, S Δk = Δλ with the target eigenvalues `target`, and returns k + Δk.
+/// Solves the paper's eq. 28, S Δk = Δλ, on the first N modes (N = number of parameters, as in
+/// eq. 27) with target eigenvalues `target`, and returns k + Δk.
 pub(crate) fn newton_point(
     current: &Linearisation,
     target: &nalgebra::DVector<f64>,
 ) -> Result<Vec<f64>, UpdateError> {
-    let s = &current.eigenvalue_jacobian;
-    if s.nrows() != s.ncols() {
+    let n = current.eigenvalue_jacobian.ncols();
+    if current.eigenvalue_jacobian.nrows() < n {
         return Err(UpdateError::Setup(format!(
-            "the paper's Newton step needs as many modes as parameters (eq. 27); got {} modes for {} parameters",
-            s.nrows(),
-            s.ncols()
+            "the paper's Newton step needs as many modes as parameters (eq. 27); got {} modes for {n} parameters",
+            current.eigenvalue_jacobian.nrows()
         )));
     }
-    let dlambda = target - &current.model_eigenvalues;
+    let s = current.eigenvalue_jacobian.rows(0, n).into_owned();
+    let dlambda = target.rows(0, n) - current.model_eigenvalues.rows(0, n);
     let dk = s
-        .clone()
         .lu()
         .solve(&dlambda)
         .filter(|d| d.iter().all(|v| v.is_finite()))
@@ -117,6 +117,16 @@ pub(crate) fn newton_point(
         .zip(dk.iter())
         .map(|(k, d)| k + d)
         .collect())
+}
+
+/// Largest |f_model − f_measured| (Hz) over the first N modes, N = number of parameters: the
+/// paper's stopping test for its square system.
+pub(crate) fn square_max_diff_hz(lin: &Linearisation) -> f64 {
+    let n = lin.parameters.len().min(lin.frequencies_hz.len());
+    lin.frequencies_hz[..n]
+        .iter()
+        .zip(&lin.measured_hz[..n])
+        .fold(0.0, |m, (a, b)| f64::max(m, (a - b).abs()))
 }
 
 /// Linearises at `p`, turning a point outside the bounds or a failed model into `Diverged`.

@@ -1,7 +1,8 @@
 //! The paper's plain method (section III): Δk from eq. 28, added to k every iteration.
 
 use super::{
-    evaluate_or_diverge, newton_point, Evaluate, Step, StepStatus, UpdateError, UpdateStrategy,
+    evaluate_or_diverge, newton_point, square_max_diff_hz, Evaluate, Step, StepStatus, UpdateError,
+    UpdateStrategy,
 };
 use crate::residual::Linearisation;
 
@@ -30,7 +31,7 @@ impl UpdateStrategy for Newton {
     }
 
     fn converged(&self, lin: &Linearisation) -> bool {
-        lin.max_abs_diff_hz() < self.tolerance_hz
+        square_max_diff_hz(lin) < self.tolerance_hz
     }
 
     fn step(

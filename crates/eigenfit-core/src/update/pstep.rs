@@ -1,7 +1,8 @@
 //! The paper's Fig. 1: large eigenvalue differences are split into p parts, converged one by one.
 
 use super::{
-    evaluate_or_diverge, newton_point, Evaluate, Step, StepStatus, UpdateError, UpdateStrategy,
+    evaluate_or_diverge, newton_point, square_max_diff_hz, Evaluate, Step, StepStatus, UpdateError,
+    UpdateStrategy,
 };
 use crate::eigenvalue_to_hz;
 use crate::residual::Linearisation;
@@ -53,6 +54,7 @@ impl PStep {
         lin.frequencies_hz
             .iter()
             .zip(target.iter())
+            .take(lin.parameters.len())
             .all(|(f, &l)| (f - eigenvalue_to_hz(l)).abs() < self.tolerance_hz)
     }
 }
@@ -65,7 +67,7 @@ impl UpdateStrategy for PStep {
     fn start(&mut self, _: &dyn Evaluate, initial: &Linearisation) -> Result<(), UpdateError> {
         newton_point(initial, &initial.measured_eigenvalues)?;
         self.start_eigenvalues = initial.model_eigenvalues.clone();
-        self.stages = if initial.max_abs_diff_hz() > self.split_above_hz {
+        self.stages = if square_max_diff_hz(initial) > self.split_above_hz {
             self.parts
         } else {
             1
@@ -75,7 +77,7 @@ impl UpdateStrategy for PStep {
     }
 
     fn converged(&self, lin: &Linearisation) -> bool {
-        lin.max_abs_diff_hz() < self.tolerance_hz
+        square_max_diff_hz(lin) < self.tolerance_hz
     }
 
     fn step(
