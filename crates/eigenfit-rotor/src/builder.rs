@@ -1,0 +1,430 @@
+//! [`RotorBuilder`]: collect a rotor description unchecked, validate it once in
+//! [`build`](RotorBuilder::build).
+
+use crate::error::RotorError;
+use crate::file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section};
+use crate::model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
+use eigenfit_core::{Parameter, ParameterSet, Scale};
+
+/// Collects a rotor description; nothing is checked until [`build`](Self::build).
+///
+/// ```
+/// use eigenfit_core::{DenseSolver, EigenSolver, StructuralModel};
+/// use eigenfit_rotor::{BearingSpec, Disk, Material, Rotor};
+///
+/// // The ROSS cross-check rotor: Ø14 mm × 500 mm steel shaft in 10 elements, two point disks,
+/// // 1e5 N/m supports at both ends.
+/// let rotor = Rotor::builder()
+///     .material(Material::steel())
+///     .uniform(0.5, 10)
+///     .diameter(0.014)
+///     .disk(Disk::new(2, 0.4))
+///     .disk(Disk::new(8, 1.35))
+///     .bearing(BearingSpec::new(0, 1e5).named("drive_end"))
+///     .bearing(BearingSpec::new(10, 1e5).named("free_end"))
+///     .build()?;
+/// assert_eq!(rotor.parameters().as_slice()[0].name, "k_drive_end");
+///
+/// let modes = DenseSolver.lowest(&rotor.system_at(&[1e5, 1e5])?, 3)?;
+/// let f = modes.frequencies_hz();
+/// assert!((f[0] - 36.954).abs() < 5e-4 && (f[1] - 81.302).abs() < 5e-4);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RotorBuilder {
+    spec: RotorSpec,
+}
+
+impl Rotor {
+    /// An empty [`RotorBuilder`].
+    pub fn builder() -> RotorBuilder {
+        RotorBuilder::default()
+    }
+}
+
+impl RotorBuilder {
+    /// An empty builder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A builder holding an existing description (e.g. a parsed file), to amend or to build.
+    pub fn from_spec(spec: RotorSpec) -> Self {
+        Self { spec }
+    }
+
+    /// The description collected so far.
+    pub fn spec(&self) -> &RotorSpec {
+        &self.spec
+    }
+
+    /// Adds a material.
+    pub fn material(mut self, material: Material) -> Self {
+        self.spec.materials.push(material);
+        self
+    }
+
+    /// Sets the node positions (m), replacing a uniform mesh.
+    pub fn nodes(mut self, positions: impl Into<Vec<f64>>) -> Self {
+        self.spec.shaft.nodes = Some(positions.into());
+        self.spec.shaft.length = None;
+        self.spec.shaft.elements = None;
+        self
+    }
+
+    /// Sets a uniform mesh of `elements` equal elements over `length` (m), nodes from 0,
+    /// replacing explicit node positions.
+    pub fn uniform(mut self, length: f64, elements: usize) -> Self {
+        self.spec.shaft.nodes = None;
+        self.spec.shaft.length = Some(length);
+        self.spec.shaft.elements = Some(elements);
+        self
+    }
+
+    /// Sets the default outer diameter (m).
+    pub fn diameter(mut self, diameter: f64) -> Self {
+        self.spec.shaft.diameter = Some(diameter);
+        self
+    }
+
+    /// Sets the default inner diameter (m) of a hollow shaft.
+    pub fn inner_diameter(mut self, inner_diameter: f64) -> Self {
+        self.spec.shaft.inner_diameter = Some(inner_diameter);
+        self
+    }
+
+    /// Sets the default material by name.
+    pub fn shaft_material(mut self, name: impl Into<String>) -> Self {
+        self.spec.shaft.material = Some(name.into());
+        self
+    }
+
+    /// Adds a per-element override.
+    pub fn section(mut self, section: Section) -> Self {
+        self.spec.shaft.sections.push(section);
+        self
+    }
+
+    /// Adds a disk.
+    pub fn disk(mut self, disk: Disk) -> Self {
+        self.spec.disks.push(disk);
+        self
+    }
+
+    /// Adds a bearing (parameter `k_<name>`, default name `bearing_<i>`).
+    pub fn bearing(mut self, bearing: BearingSpec) -> Self {
+        self.spec.bearings.push(bearing);
+        self
+    }
+
+    /// Adds a point mass.
+    pub fn point_mass(mut self, point_mass: PointMass) -> Self {
+        self.spec.point_masses.push(point_mass);
+        self
+    }
+
+    /// Validates the description and assembles the parameter-independent matrices.
+    ///
+    /// Checks, in this order: materials, shaft layout and node positions, shaft defaults and
+    /// sections, every element's cross-section, disks, bearings, point masses. The first
+    /// problem found is returned, naming the entry (0-based) and the offending value.
+    pub fn build(self) -> Result<Rotor, RotorError> {
+        let mut spec = self.spec;
+        check_materials(&spec.materials)?;
+        let nodes = node_positions(&spec)?;
+        let elements = resolve_elements(&spec, &nodes)?;
+        let node_count = nodes.len();
+        let node_check = |kind, entry, node| {
+            if node < node_count {
+                Ok(())
+            } else {
+                Err(RotorError::NodeOutOfRange {
+                    kind,
+                    entry,
+                    node,
+                    nodes: node_count,
+                })
+            }
+        };
+        for (i, d) in spec.disks.iter().enumerate() {
+            node_check("disk", i, d.node)?;
+            let at = || format!("disk {i}");
+            positive(at, "mass", d.mass)?;
+            non_negative(at, "diametral_inertia", d.diametral_inertia)?;
+        }
+        let mut bearings: Vec<Bearing> = Vec::with_capacity(spec.bearings.len());
+        for (i, b) in spec.bearings.iter_mut().enumerate() {
+            node_check("bearing", i, b.node)?;
+            let name = b.name.get_or_insert_with(|| format!("bearing_{i}")).clone();
+            let at = || format!("bearing {i} `{name}`");
+            if name.trim().is_empty() {
+                return Err(RotorError::EmptyName {
+                    location: format!("bearing {i}"),
+                });
+            }
+            if let Some(first) = bearings.iter().position(|q| q.name == name) {
+                return Err(RotorError::DuplicateBearing {
+                    name,
+                    first,
+                    second: i,
+                });
+            }
+            if !(b.stiffness.is_finite()
+                && (STIFFNESS_LOWER..=STIFFNESS_UPPER).contains(&b.stiffness))
+            {
+                return Err(RotorError::InvalidValue {
+                    location: at(),
+                    quantity: "stiffness",
+                    value: b.stiffness,
+                    requirement: "finite and within [1e-6, 1e15] N/m",
+                });
+            }
+            non_negative(at, "rotational_stiffness", b.rotational_stiffness)?;
+            bearings.push(Bearing {
+                name,
+                node: b.node,
+                stiffness: b.stiffness,
+                rotational_stiffness: b.rotational_stiffness,
+            });
+        }
+        for (i, pm) in spec.point_masses.iter().enumerate() {
+            node_check("point_mass", i, pm.node)?;
+            positive(|| format!("point_mass {i}"), "mass", pm.mass)?;
+        }
+        let parameters = ParameterSet::new(
+            bearings
+                .iter()
+                .map(|b| {
+                    Parameter::new(format!("k_{}", b.name), "N/m", b.stiffness)
+                        .with_bounds(STIFFNESS_LOWER, STIFFNESS_UPPER)
+                        .with_scale(Scale::Log)
+                })
+                .collect(),
+        )
+        .map_err(RotorError::Parameter)?;
+        Ok(Rotor::from_checked_parts(
+            spec, nodes, elements, bearings, parameters,
+        ))
+    }
+}
+
+fn positive(at: impl FnOnce() -> String, quantity: &'static str, v: f64) -> Result<(), RotorError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(RotorError::InvalidValue {
+            location: at(),
+            quantity,
+            value: v,
+            requirement: "finite and > 0",
+        })
+    }
+}
+
+fn non_negative(
+    at: impl FnOnce() -> String,
+    quantity: &'static str,
+    v: f64,
+) -> Result<(), RotorError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(RotorError::InvalidValue {
+            location: at(),
+            quantity,
+            value: v,
+            requirement: "finite and ≥ 0",
+        })
+    }
+}
+
+fn check_materials(materials: &[Material]) -> Result<(), RotorError> {
+    for (i, m) in materials.iter().enumerate() {
+        if m.name.trim().is_empty() {
+            return Err(RotorError::EmptyName {
+                location: format!("material {i}"),
+            });
+        }
+        if let Some(first) = materials[..i].iter().position(|q| q.name == m.name) {
+            return Err(RotorError::DuplicateMaterial {
+                name: m.name.clone(),
+                first,
+                second: i,
+            });
+        }
+        let at = || format!("material `{}`", m.name);
+        positive(at, "youngs_modulus", m.youngs_modulus)?;
+        positive(at, "density", m.density)?;
+    }
+    Ok(())
+}
+
+/// The node positions from either `nodes` or `length` + `elements`; at least two, increasing.
+fn node_positions(spec: &RotorSpec) -> Result<Vec<f64>, RotorError> {
+    let shaft = &spec.shaft;
+    let nodes = match (&shaft.nodes, shaft.length, shaft.elements) {
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+            return Err(RotorError::ShaftLayout(
+                "give either `nodes` or `length` with `elements`, not both",
+            ))
+        }
+        (Some(nodes), None, None) => {
+            for (i, &x) in nodes.iter().enumerate() {
+                if !x.is_finite() {
+                    return Err(RotorError::InvalidValue {
+                        location: format!("shaft node {i}"),
+                        quantity: "position",
+                        value: x,
+                        requirement: "finite",
+                    });
+                }
+            }
+            nodes.clone()
+        }
+        (None, Some(length), Some(elements)) => {
+            positive(|| "shaft".into(), "length", length)?;
+            if elements == 0 {
+                return Err(RotorError::NoElements);
+            }
+            if elements > MAX_ELEMENTS {
+                return Err(RotorError::TooManyElements {
+                    elements,
+                    max: MAX_ELEMENTS,
+                });
+            }
+            (0..=elements)
+                .map(|i| length * i as f64 / elements as f64)
+                .collect()
+        }
+        (None, Some(_), None) | (None, None, Some(_)) => {
+            return Err(RotorError::ShaftLayout(
+                "`length` and `elements` must be given together",
+            ))
+        }
+        (None, None, None) => {
+            return Err(RotorError::ShaftLayout(
+                "give the node positions `nodes`, or `length` with `elements`",
+            ))
+        }
+    };
+    if nodes.len() < 2 {
+        return Err(RotorError::NoElements);
+    }
+    if nodes.len() - 1 > MAX_ELEMENTS {
+        return Err(RotorError::TooManyElements {
+            elements: nodes.len() - 1,
+            max: MAX_ELEMENTS,
+        });
+    }
+    for (i, w) in nodes.windows(2).enumerate() {
+        if w[1] <= w[0] {
+            return Err(RotorError::NodesNotIncreasing {
+                node: i + 1,
+                position: w[1],
+                previous: w[0],
+            });
+        }
+    }
+    Ok(nodes)
+}
+
+fn material_index(spec: &RotorSpec, location: String, name: &str) -> Result<usize, RotorError> {
+    spec.materials
+        .iter()
+        .position(|m| m.name == name)
+        .ok_or_else(|| RotorError::UnknownMaterial {
+            location,
+            name: name.to_string(),
+            defined: if spec.materials.is_empty() {
+                "none".into()
+            } else {
+                spec.materials
+                    .iter()
+                    .map(|m| format!("`{}`", m.name))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            },
+        })
+}
+
+/// Resolves every element's diameters and material from the shaft defaults and the sections.
+fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>, RotorError> {
+    let shaft = &spec.shaft;
+    let count = nodes.len() - 1;
+    if let Some(d) = shaft.diameter {
+        positive(|| "shaft".into(), "diameter", d)?;
+    }
+    if let Some(d) = shaft.inner_diameter {
+        non_negative(|| "shaft".into(), "inner_diameter", d)?;
+    }
+    let default_material = match &shaft.material {
+        Some(name) => Some(material_index(spec, "shaft".into(), name)?),
+        None if spec.materials.len() == 1 => Some(0),
+        None => None,
+    };
+    // Which section covers each element.
+    let mut owner: Vec<Option<usize>> = vec![None; count];
+    let mut section_material = Vec::with_capacity(shaft.sections.len());
+    for (s, sec) in shaft.sections.iter().enumerate() {
+        let [first, last] = sec.elements;
+        if first > last || last >= count {
+            return Err(RotorError::SectionRange {
+                section: s,
+                first,
+                last,
+                elements: count,
+            });
+        }
+        for (e, slot) in owner.iter_mut().enumerate().take(last + 1).skip(first) {
+            if let Some(prev) = *slot {
+                return Err(RotorError::SectionOverlap {
+                    first: prev,
+                    second: s,
+                    element: e,
+                });
+            }
+            *slot = Some(s);
+        }
+        let at = || format!("shaft section {s}");
+        if let Some(d) = sec.diameter {
+            positive(at, "diameter", d)?;
+        }
+        if let Some(d) = sec.inner_diameter {
+            non_negative(at, "inner_diameter", d)?;
+        }
+        section_material.push(match &sec.material {
+            Some(name) => Some(material_index(spec, at(), name)?),
+            None => None,
+        });
+    }
+    let mut elements = Vec::with_capacity(count);
+    for (e, sec) in owner.iter().enumerate() {
+        let section = sec.map(|s| &shaft.sections[s]);
+        let outer = section
+            .and_then(|s| s.diameter)
+            .or(shaft.diameter)
+            .ok_or(RotorError::MissingDiameter { element: e })?;
+        let inner = section
+            .and_then(|s| s.inner_diameter)
+            .or(shaft.inner_diameter)
+            .unwrap_or(0.0);
+        if inner >= outer {
+            return Err(RotorError::InnerNotBelowOuter {
+                element: e,
+                inner,
+                outer,
+            });
+        }
+        let material = sec
+            .and_then(|s| section_material[s])
+            .or(default_material)
+            .ok_or(RotorError::MissingMaterial { element: e })?;
+        elements.push(ShaftElement {
+            length: nodes[e + 1] - nodes[e],
+            outer_diameter: outer,
+            inner_diameter: inner,
+            material,
+        });
+    }
+    Ok(elements)
+}
