@@ -12,11 +12,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Debug, Parser)]
-#[command(
-    name = "eigenfit",
-    version,
-    about = "Finite-element model updating by eigenvalue sensitivity"
-)]
+#[command(name = "eigenfit", version, about = "Finite-element model updating by eigenvalue sensitivity")]
 struct Cli {
     #[command(subcommand)]
     command: Command,

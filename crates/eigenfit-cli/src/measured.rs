@@ -7,10 +7,9 @@ use std::path::Path;
 /// Reads and validates a measured-data file. Every error names the file and, where it applies,
 /// the line.
 pub fn read(path: &Path) -> Result<Measurement, CliError> {
-    let bytes =
-        std::fs::read(path).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
-    let text = String::from_utf8(bytes)
-        .map_err(|_| input(format!("{}: not a UTF-8 text file", path.display())))?;
+    let bytes = std::fs::read(path).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
+    let text =
+        String::from_utf8(bytes).map_err(|_| input(format!("{}: not a UTF-8 text file", path.display())))?;
     parse(&text).map_err(|e| input(format!("{}:{e}", path.display())))
 }
 
@@ -21,9 +20,8 @@ pub fn parse(text: &str) -> Result<Measurement, String> {
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = lines
-        .next()
-        .ok_or("1: empty file: expected the header `mode,frequency_hz[,std_hz]`")?;
+    let (hline, header) =
+        lines.next().ok_or("1: empty file: expected the header `mode,frequency_hz[,std_hz]`")?;
     let columns: Vec<&str> = header.split(',').map(str::trim).collect();
     let mut col = [None; 3];
     for (i, c) in columns.iter().enumerate() {
@@ -52,19 +50,12 @@ pub fn parse(text: &str) -> Result<Measurement, String> {
     for (line, row) in lines {
         let fields: Vec<&str> = row.split(',').map(str::trim).collect();
         if fields.len() != columns.len() {
-            return Err(format!(
-                "{line}: {} fields, but the header has {}",
-                fields.len(),
-                columns.len()
-            ));
+            return Err(format!("{line}: {} fields, but the header has {}", fields.len(), columns.len()));
         }
         let field = |slot: usize| col[slot].map(|i| fields[i]);
         let number = |slot: usize, name: &str| -> Result<Option<f64>, String> {
             field(slot)
-                .map(|s| {
-                    s.parse::<f64>()
-                        .map_err(|_| format!("{line}: {name} `{s}` is not a number"))
-                })
+                .map(|s| s.parse::<f64>().map_err(|_| format!("{line}: {name} `{s}` is not a number")))
                 .transpose()
         };
         let mode_text = field(0).unwrap_or_default();
@@ -73,38 +64,23 @@ pub fn parse(text: &str) -> Result<Measurement, String> {
         })?;
         let f = number(1, "frequency_hz")?.unwrap_or_default();
         if !(f.is_finite() && f > 0.0) {
-            return Err(format!(
-                "{line}: frequency_hz {f} must be a positive finite number"
-            ));
+            return Err(format!("{line}: frequency_hz {f} must be a positive finite number"));
         }
         let std = number(2, "std_hz")?;
         if let Some(s) = std {
             if !(s.is_finite() && s > 0.0) {
-                return Err(format!(
-                    "{line}: std_hz {s} must be a positive finite number"
-                ));
+                return Err(format!("{line}: std_hz {s} must be a positive finite number"));
             }
         }
         if let Some((first, _)) = modes.iter().find(|(_, m)| m.mode == mode - 1) {
-            return Err(format!(
-                "{line}: mode {mode} is listed twice (first on line {first})"
-            ));
+            return Err(format!("{line}: mode {mode} is listed twice (first on line {first})"));
         }
-        modes.push((
-            line,
-            MeasuredMode {
-                mode: mode - 1,
-                frequency_hz: f,
-                std_hz: std,
-                shape: None,
-            },
-        ));
+        modes.push((line, MeasuredMode { mode: mode - 1, frequency_hz: f, std_hz: std, shape: None }));
     }
     if modes.is_empty() {
         return Err(format!("{hline}: no data rows after the header"));
     }
-    Measurement::new(modes.into_iter().map(|(_, m)| m).collect())
-        .map_err(|e| format!("{hline}: {e}"))
+    Measurement::new(modes.into_iter().map(|(_, m)| m).collect()).map_err(|e| format!("{hline}: {e}"))
 }
 
 #[cfg(test)]
@@ -113,8 +89,7 @@ mod tests {
 
     #[test]
     fn reads_frequencies_and_std() {
-        let m = parse("# rig test\nmode,frequency_hz,std_hz\n1,36.069,0.04\n2, 84.517 ,0.08\n")
-            .unwrap();
+        let m = parse("# rig test\nmode,frequency_hz,std_hz\n1,36.069,0.04\n2, 84.517 ,0.08\n").unwrap();
         assert_eq!(m.len(), 2);
         assert_eq!(m.modes()[1].mode, 1);
         assert_eq!(m.modes()[1].frequency_hz, 84.517);
@@ -123,18 +98,12 @@ mod tests {
 
     #[test]
     fn errors_name_the_line() {
-        assert_eq!(
-            parse("").unwrap_err(),
-            "1: empty file: expected the header `mode,frequency_hz[,std_hz]`"
-        );
+        assert_eq!(parse("").unwrap_err(), "1: empty file: expected the header `mode,frequency_hz[,std_hz]`");
         assert_eq!(
             parse("mode,freq\n1,2\n").unwrap_err(),
             "1: unknown column `freq`; the header must be `mode,frequency_hz[,std_hz]`"
         );
-        assert_eq!(
-            parse("mode,frequency_hz\n1,abc\n").unwrap_err(),
-            "2: frequency_hz `abc` is not a number"
-        );
+        assert_eq!(parse("mode,frequency_hz\n1,abc\n").unwrap_err(), "2: frequency_hz `abc` is not a number");
         assert_eq!(
             parse("mode,frequency_hz\n1,-3\n").unwrap_err(),
             "2: frequency_hz -3 must be a positive finite number"
@@ -155,17 +124,11 @@ mod tests {
             parse("mode,frequency_hz\n0,3\n").unwrap_err(),
             "2: mode `0` must be a whole number ≥ 1 (modes count from 1)"
         );
-        assert_eq!(
-            parse("mode,frequency_hz\n1,3,4\n").unwrap_err(),
-            "2: 3 fields, but the header has 2"
-        );
+        assert_eq!(parse("mode,frequency_hz\n1,3,4\n").unwrap_err(), "2: 3 fields, but the header has 2");
         assert_eq!(
             parse("frequency_hz\n3\n").unwrap_err(),
             "1: missing column `mode`; the header must be `mode,frequency_hz[,std_hz]`"
         );
-        assert_eq!(
-            parse("mode,frequency_hz\n").unwrap_err(),
-            "1: no data rows after the header"
-        );
+        assert_eq!(parse("mode,frequency_hz\n").unwrap_err(), "1: no data rows after the header");
     }
 }

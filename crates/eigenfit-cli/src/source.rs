@@ -10,12 +10,7 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 pub struct ModelArgs {
     /// Rotor model file (TOML, see docs/rotor-model.md).
-    #[arg(
-        long,
-        value_name = "FILE.toml",
-        conflicts_with = "preset",
-        required_unless_present = "preset"
-    )]
+    #[arg(long, value_name = "FILE.toml", conflicts_with = "preset", required_unless_present = "preset")]
     pub model: Option<PathBuf>,
     /// Built-in model: paper-rotor, ross-example.
     #[arg(long, value_name = "NAME")]
@@ -34,10 +29,7 @@ impl ModelArgs {
         }
         let name = self.preset.as_deref().unwrap_or_default();
         let rotor = presets::by_name(name).ok_or_else(|| {
-            input(format!(
-                "unknown preset `{name}`; available: {}",
-                presets::NAMES.join(", ")
-            ))
+            input(format!("unknown preset `{name}`; available: {}", presets::NAMES.join(", ")))
         })?;
         Ok((rotor, name.to_string()))
     }
@@ -49,7 +41,9 @@ impl ModelArgs {
             #[cfg(feature = "lapack")]
             "lapack" => Ok(Box::new(eigenfit_lapack::LapackSolver::default())),
             #[cfg(not(feature = "lapack"))]
-            "lapack" => Err(input("this eigenfit was built without the `lapack` feature; rebuild with --features lapack")),
+            "lapack" => Err(input(
+                "this eigenfit was built without the `lapack` feature; rebuild with --features lapack",
+            )),
             other => Err(input(format!("unknown solver `{other}`; available: dense, lapack"))),
         }
     }
@@ -60,21 +54,14 @@ pub fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>, CliError> {
     text.split(',')
         .enumerate()
         .map(|(i, item)| {
-            let v: f64 = item.trim().parse().map_err(|_| {
-                input(format!(
-                    "{flag}: item {} `{}` is not a number",
-                    i + 1,
-                    item.trim()
-                ))
-            })?;
+            let v: f64 = item
+                .trim()
+                .parse()
+                .map_err(|_| input(format!("{flag}: item {} `{}` is not a number", i + 1, item.trim())))?;
             if v.is_finite() {
                 Ok(v)
             } else {
-                Err(input(format!(
-                    "{flag}: item {} `{}` is not finite",
-                    i + 1,
-                    item.trim()
-                )))
+                Err(input(format!("{flag}: item {} `{}` is not finite", i + 1, item.trim())))
             }
         })
         .collect()
@@ -96,26 +83,17 @@ pub fn parameter_vector(
                 "{flag}: {} values given but the model has {} bearing stiffnesses ({})",
                 values.len(),
                 p.len(),
-                params
-                    .iter()
-                    .map(|q| q.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>().join(", ")
             )));
         }
         p = values;
     }
     for s in sets {
-        let (name, value) = s
-            .split_once('=')
-            .ok_or_else(|| input(format!("--set `{s}`: expected NAME=VALUE")))?;
-        let i = params
-            .index_of(name.trim())
-            .map_err(|e| input(format!("--set: {e}")))?;
+        let (name, value) =
+            s.split_once('=').ok_or_else(|| input(format!("--set `{s}`: expected NAME=VALUE")))?;
+        let i = params.index_of(name.trim()).map_err(|e| input(format!("--set: {e}")))?;
         p[i] = parse_list("--set", value)?[0];
     }
-    params
-        .check(&p)
-        .map_err(|e| input(format!("{flag}: {e}")))?;
+    params.check(&p).map_err(|e| input(format!("{flag}: {e}")))?;
     Ok(p)
 }

@@ -61,9 +61,7 @@ where
     S: EigenSolver + ?Sized,
 {
     let system = model.assemble(target).map_err(|e| e.to_string())?;
-    let modes = solver
-        .lowest(&system, settings.modes)
-        .map_err(|e| e.to_string())?;
+    let modes = solver.lowest(&system, settings.modes).map_err(|e| e.to_string())?;
     let round = |f: f64| match settings.decimals {
         Some(d) => (f * 10f64.powi(d)).round() / 10f64.powi(d),
         None => f,
@@ -72,12 +70,7 @@ where
         .frequencies_hz()
         .into_iter()
         .enumerate()
-        .map(|(k, f)| MeasuredMode {
-            mode: k,
-            frequency_hz: round(f),
-            std_hz: settings.std_hz,
-            shape: None,
-        })
+        .map(|(k, f)| MeasuredMode { mode: k, frequency_hz: round(f), std_hz: settings.std_hz, shape: None })
         .collect();
     Measurement::new(measured).map_err(|e| e.to_string())
 }
@@ -96,10 +89,8 @@ where
 {
     let start = Instant::now();
     let mut s = strategy.build();
-    let outcome = Driver {
-        max_iterations: settings.max_iterations,
-    }
-    .run(problem, s.as_mut(), initial, &mut []);
+    let outcome =
+        Driver { max_iterations: settings.max_iterations }.run(problem, s.as_mut(), initial, &mut []);
     let seconds = start.elapsed().as_secs_f64();
     match outcome {
         Ok(est) => {
@@ -174,9 +165,7 @@ pub fn log_space(lo: f64, hi: f64, n: usize) -> Vec<f64> {
         return vec![lo];
     }
     let (a, b) = (lo.log10(), hi.log10());
-    (0..n)
-        .map(|i| 10f64.powf(a + (b - a) * i as f64 / (n - 1) as f64))
-        .collect()
+    (0..n).map(|i| 10f64.powf(a + (b - a) * i as f64 / (n - 1) as f64)).collect()
 }
 
 /// The full tensor grid of `axis` over `dims` parameters.
@@ -198,9 +187,5 @@ pub fn tensor_grid(axis: &[f64], dims: usize) -> Vec<Vec<f64>> {
 }
 
 fn relative_error(estimate: &[f64], target: &[f64]) -> f64 {
-    estimate
-        .iter()
-        .zip(target)
-        .map(|(e, t)| (e / t - 1.0).abs())
-        .fold(0.0, f64::max)
+    estimate.iter().zip(target).map(|(e, t)| (e / t - 1.0).abs()).fold(0.0, f64::max)
 }

@@ -5,14 +5,17 @@ use crate::solver::{check_count, EigenSolver, SolveError};
 use crate::system::System;
 use nalgebra::{Cholesky, DMatrix, DVector, SymmetricEigen};
 
-/// Dense solver for the lowest modes, accurate to round-off *relative to each eigenvalue*.
+/// Dense solver for the lowest modes, accurate to round-off *relative to each eigenvalue*
+/// when at most half the modes are requested.
 ///
 /// The textbook reduction M = LLᵀ, A = L⁻¹KL⁻ᵀ loses the lowest eigenvalues to round-off of
 /// size ε·λ_max: for a stiff shaft on soft supports (λ_max/λ₁ ≈ 10⁸) that is 10⁻⁸ relative.
 /// This solver reduces the inverted problem instead: with K_σ = K + σM = LLᵀ (σ = 0 when K is
 /// positive definite, a small shift for rigid-body modes), B = L⁻¹ML⁻ᵀ has eigenvalues
 /// μ = 1/(λ + σ), the lowest modes become the largest μ, and their relative accuracy is
-/// ε·λ/λ₁. Φ = L⁻ᵀY/√μ is mass-normalised. Needs no system library; O(n³).
+/// ε·λ/λ₁. Φ = L⁻ᵀY/√μ is mass-normalised. When more than half the modes are requested the
+/// textbook reduction is used instead, which keeps the whole basis M-orthonormal to ε·λ_max.
+/// Needs no system library; O(n³).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct DenseSolver;
 
@@ -27,6 +30,9 @@ impl EigenSolver for DenseSolver {
         // M must be positive definite for the problem to be symmetric-definite at all.
         if Cholesky::new(m.clone()).is_none() {
             return Err(SolveError::MassNotPositiveDefinite { detail: None });
+        }
+        if 2 * count > system.dofs() {
+            return mass_reduction(k, m, count);
         }
         if let Some(chol) = Cholesky::new(k.clone()).filter(well_conditioned) {
             return inverted_solve(&chol, m, 0.0, count);
@@ -47,18 +53,11 @@ impl EigenSolver for DenseSolver {
 /// A Cholesky factor whose pivots do not reveal a (numerically) singular matrix.
 fn well_conditioned(c: &Cholesky<f64, nalgebra::Dyn>) -> bool {
     let d = c.l_dirty().diagonal();
-    let (dmin, dmax) = d.iter().fold((f64::INFINITY, 0.0_f64), |(a, b), &v| {
-        (a.min(v.abs()), b.max(v.abs()))
-    });
+    let (dmin, dmax) = d.iter().fold((f64::INFINITY, 0.0_f64), |(a, b), &v| (a.min(v.abs()), b.max(v.abs())));
     dmin > 1e-7 * dmax
 }
 
-fn shifted(
-    k: &DMatrix<f64>,
-    m: &DMatrix<f64>,
-    sigma: f64,
-    count: usize,
-) -> Result<Modes, SolveError> {
+fn shifted(k: &DMatrix<f64>, m: &DMatrix<f64>, sigma: f64, count: usize) -> Result<Modes, SolveError> {
     let chol = Cholesky::new(k + m * sigma).ok_or(SolveError::Backend {
         backend: "dense",
         detail: "K + σM is not positive definite: K has negative stiffness".into(),
@@ -74,12 +73,8 @@ fn inverted_solve(
     count: usize,
 ) -> Result<Modes, SolveError> {
     let l = chol.l();
-    let x = l
-        .solve_lower_triangular(m)
-        .ok_or_else(|| not_pd("zero pivot in L"))?;
-    let b = l
-        .solve_lower_triangular(&x.transpose())
-        .ok_or_else(|| not_pd("zero pivot in L"))?;
+    let x = l.solve_lower_triangular(m).ok_or_else(|| not_pd("zero pivot in L"))?;
+    let b = l.solve_lower_triangular(&x.transpose()).ok_or_else(|| not_pd("zero pivot in L"))?;
     let b = (&b + b.transpose()) * 0.5;
     let eig = SymmetricEigen::try_new(b, f64::EPSILON, 0).ok_or(SolveError::Backend {
         backend: "dense",
@@ -95,41 +90,46 @@ fn inverted_solve(
             detail: "a reduced eigenvalue is not positive".into(),
         });
     }
-    let eigenvalues = DVector::from_iterator(
-        count,
-        order.iter().map(|&i| 1.0 / eig.eigenvalues[i] - sigma),
-    );
+    let eigenvalues = DVector::from_iterator(count, order.iter().map(|&i| 1.0 / eig.eigenvalues[i] - sigma));
     let y = DMatrix::from_columns(
-        &order
-            .iter()
-            .map(|&i| eig.eigenvectors.column(i) / eig.eigenvalues[i].sqrt())
-            .collect::<Vec<_>>(),
+        &order.iter().map(|&i| eig.eigenvectors.column(i) / eig.eigenvalues[i].sqrt()).collect::<Vec<_>>(),
     );
-    let mut shapes = l
-        .transpose()
-        .solve_upper_triangular(&y)
-        .ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
-    if eigenvalues
-        .iter()
-        .chain(shapes.iter())
-        .any(|v| !v.is_finite())
-    {
-        return Err(SolveError::Backend {
-            backend: "dense",
-            detail: "non-finite result".into(),
-        });
+    let shapes = l.transpose().solve_upper_triangular(&y).ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
+    finish(eigenvalues, shapes)
+}
+
+/// All or most modes: the textbook reduction M = LLᵀ, A = L⁻¹KL⁻ᵀ, accurate to ε·λ_max in
+/// absolute terms for every mode, so the whole basis stays M-orthonormal (modal expansions).
+fn mass_reduction(k: &DMatrix<f64>, m: &DMatrix<f64>, count: usize) -> Result<Modes, SolveError> {
+    let chol = Cholesky::new(m.clone()).ok_or(SolveError::MassNotPositiveDefinite { detail: None })?;
+    let l = chol.l();
+    let x = l.solve_lower_triangular(k).ok_or_else(|| not_pd("zero pivot in L"))?;
+    let a = l.solve_lower_triangular(&x.transpose()).ok_or_else(|| not_pd("zero pivot in L"))?;
+    let a = (&a + a.transpose()) * 0.5;
+    let eig = SymmetricEigen::try_new(a, f64::EPSILON, 0).ok_or(SolveError::Backend {
+        backend: "dense",
+        detail: "symmetric QR iteration did not converge".into(),
+    })?;
+    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    order.truncate(count);
+    let eigenvalues = DVector::from_iterator(count, order.iter().map(|&i| eig.eigenvalues[i]));
+    let y = DMatrix::from_columns(&order.iter().map(|&i| eig.eigenvectors.column(i)).collect::<Vec<_>>());
+    let shapes = l.transpose().solve_upper_triangular(&y).ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
+    finish(eigenvalues, shapes)
+}
+
+/// Rejects non-finite results and applies the sign rule.
+fn finish(eigenvalues: DVector<f64>, mut shapes: DMatrix<f64>) -> Result<Modes, SolveError> {
+    if eigenvalues.iter().chain(shapes.iter()).any(|v| !v.is_finite()) {
+        return Err(SolveError::Backend { backend: "dense", detail: "non-finite result".into() });
     }
     apply_sign_rule(&mut shapes);
-    Ok(Modes {
-        eigenvalues,
-        shapes,
-    })
+    Ok(Modes { eigenvalues, shapes })
 }
 
 fn not_pd(detail: &str) -> SolveError {
-    SolveError::MassNotPositiveDefinite {
-        detail: Some(detail.into()),
-    }
+    SolveError::MassNotPositiveDefinite { detail: Some(detail.into()) }
 }
 
 #[cfg(test)]
@@ -148,35 +148,17 @@ mod tests {
         assert!((modes.eigenvalues[0] - (9.0 - disc) / 4.0).abs() < 1e-13);
         assert!((modes.eigenvalues[1] - (9.0 + disc) / 4.0).abs() < 1e-13);
         let phi = &modes.shapes;
-        assert!(
-            (phi.transpose() * &m * phi - DMatrix::identity(2, 2))
-                .abs()
-                .max()
-                < 1e-13
-        );
+        assert!((phi.transpose() * &m * phi - DMatrix::identity(2, 2)).abs().max() < 1e-13);
         let lam = DMatrix::from_diagonal(&modes.eigenvalues);
         assert!((phi.transpose() * &k * phi - lam).abs().max() < 1e-12);
     }
 
     #[test]
     fn rejects_indefinite_mass_and_bad_counts() {
-        let sys = System::new(
-            DMatrix::identity(2, 2),
-            DMatrix::from_diagonal_element(2, 2, -1.0),
-        )
-        .unwrap();
-        assert!(matches!(
-            DenseSolver.lowest(&sys, 1),
-            Err(SolveError::MassNotPositiveDefinite { .. })
-        ));
+        let sys = System::new(DMatrix::identity(2, 2), DMatrix::from_diagonal_element(2, 2, -1.0)).unwrap();
+        assert!(matches!(DenseSolver.lowest(&sys, 1), Err(SolveError::MassNotPositiveDefinite { .. })));
         let sys = System::new(DMatrix::identity(2, 2), DMatrix::identity(2, 2)).unwrap();
-        assert_eq!(
-            DenseSolver.lowest(&sys, 3),
-            Err(SolveError::TooManyModes {
-                requested: 3,
-                available: 2
-            })
-        );
+        assert_eq!(DenseSolver.lowest(&sys, 3), Err(SolveError::TooManyModes { requested: 3, available: 2 }));
         assert_eq!(DenseSolver.lowest(&sys, 0), Err(SolveError::NoModes));
     }
 

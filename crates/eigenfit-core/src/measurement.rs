@@ -18,12 +18,7 @@ pub struct MeasuredMode {
 impl MeasuredMode {
     /// A frequency without uncertainty or shape.
     pub fn new(mode: usize, frequency_hz: f64) -> Self {
-        Self {
-            mode,
-            frequency_hz,
-            std_hz: None,
-            shape: None,
-        }
+        Self { mode, frequency_hz, std_hz: None, shape: None }
     }
 
     /// Sets the standard deviation in Hz.
@@ -74,17 +69,11 @@ impl Measurement {
         let shape_len = modes.iter().find_map(|m| m.shape.as_ref().map(Vec::len));
         for (i, m) in modes.iter().enumerate() {
             if !(m.frequency_hz.is_finite() && m.frequency_hz > 0.0) {
-                return Err(MeasurementError::BadFrequency {
-                    mode: m.mode,
-                    value: m.frequency_hz,
-                });
+                return Err(MeasurementError::BadFrequency { mode: m.mode, value: m.frequency_hz });
             }
             match m.std_hz {
                 Some(s) if !(s.is_finite() && s > 0.0) => {
-                    return Err(MeasurementError::BadStd {
-                        mode: m.mode,
-                        value: s,
-                    })
+                    return Err(MeasurementError::BadStd { mode: m.mode, value: s })
                 }
                 None if with_std > 0 => return Err(MeasurementError::MixedStd { mode: m.mode }),
                 _ => {}
@@ -94,10 +83,7 @@ impl Measurement {
             }
             if let Some(s) = &m.shape {
                 if Some(s.len()) != shape_len || s.is_empty() {
-                    return Err(MeasurementError::BadShape {
-                        mode: m.mode,
-                        why: "lengths differ".into(),
-                    });
+                    return Err(MeasurementError::BadShape { mode: m.mode, why: "lengths differ".into() });
                 }
                 if s.iter().any(|v| !v.is_finite()) {
                     return Err(MeasurementError::BadShape {
@@ -112,13 +98,7 @@ impl Measurement {
 
     /// Convenience: frequencies of modes 0, 1, … without uncertainty.
     pub fn from_frequencies(frequencies_hz: &[f64]) -> Result<Self, MeasurementError> {
-        Self::new(
-            frequencies_hz
-                .iter()
-                .enumerate()
-                .map(|(i, &f)| MeasuredMode::new(i, f))
-                .collect(),
-        )
+        Self::new(frequencies_hz.iter().enumerate().map(|(i, &f)| MeasuredMode::new(i, f)).collect())
     }
 
     /// The modes, sorted by mode number.
@@ -158,35 +138,16 @@ mod tests {
 
     #[test]
     fn validation_names_the_mode() {
-        let e = Measurement::new(vec![
-            MeasuredMode::new(0, 1.0),
-            MeasuredMode::new(1, f64::NAN),
-        ])
-        .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "mode 1: frequency NaN Hz must be a positive finite number"
-        );
-        let e = Measurement::new(vec![MeasuredMode::new(0, 1.0), MeasuredMode::new(0, 2.0)])
-            .unwrap_err();
+        let e =
+            Measurement::new(vec![MeasuredMode::new(0, 1.0), MeasuredMode::new(1, f64::NAN)]).unwrap_err();
+        assert_eq!(e.to_string(), "mode 1: frequency NaN Hz must be a positive finite number");
+        let e = Measurement::new(vec![MeasuredMode::new(0, 1.0), MeasuredMode::new(0, 2.0)]).unwrap_err();
         assert_eq!(e.to_string(), "mode 0 is listed twice");
         let e = Measurement::new(vec![MeasuredMode::new(0, 1.0).with_std(0.0)]).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "mode 0: standard deviation 0 Hz must be a positive finite number"
-        );
-        let e = Measurement::new(vec![
-            MeasuredMode::new(0, 1.0).with_std(0.1),
-            MeasuredMode::new(1, 2.0),
-        ])
-        .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "mode 1 has no standard deviation but others do: give all or none"
-        );
-        assert_eq!(
-            Measurement::new(vec![]).unwrap_err(),
-            MeasurementError::Empty
-        );
+        assert_eq!(e.to_string(), "mode 0: standard deviation 0 Hz must be a positive finite number");
+        let e = Measurement::new(vec![MeasuredMode::new(0, 1.0).with_std(0.1), MeasuredMode::new(1, 2.0)])
+            .unwrap_err();
+        assert_eq!(e.to_string(), "mode 1 has no standard deviation but others do: give all or none");
+        assert_eq!(Measurement::new(vec![]).unwrap_err(), MeasurementError::Empty);
     }
 }

@@ -91,10 +91,7 @@ pub fn finite_difference_derivative<M: StructuralModel + ?Sized>(
     i: usize,
 ) -> Result<SystemDerivative, ModelError> {
     let params = model.parameters();
-    let par = params.get(i).ok_or(ModelError::ParameterIndex {
-        index: i,
-        count: params.len(),
-    })?;
+    let par = params.get(i).ok_or(ModelError::ParameterIndex { index: i, count: params.len() })?;
     params.check(p)?;
     let h = if p[i] != 0.0 { 1e-6 * p[i].abs() } else { 1e-6 };
     let up = (p[i] + h).min(par.upper);

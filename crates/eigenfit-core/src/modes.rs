@@ -21,10 +21,7 @@ impl Modes {
 
     /// Natural frequencies in Hz.
     pub fn frequencies_hz(&self) -> Vec<f64> {
-        self.eigenvalues
-            .iter()
-            .map(|&l| eigenvalue_to_hz(l))
-            .collect()
+        self.eigenvalues.iter().map(|&l| eigenvalue_to_hz(l)).collect()
     }
 
     /// Mode shape k as a slice of length n.

@@ -59,16 +59,10 @@ impl Parameter {
             return r;
         }
         match self.scale {
-            Scale::Log => (
-                self.lower.max(self.nominal * 1e-4),
-                self.upper.min(self.nominal * 1e4),
-            ),
+            Scale::Log => (self.lower.max(self.nominal * 1e-4), self.upper.min(self.nominal * 1e4)),
             Scale::Linear => {
                 let w = 10.0 * self.nominal.abs().max(1.0);
-                (
-                    self.lower.max(self.nominal - w),
-                    self.upper.min(self.nominal + w),
-                )
+                (self.lower.max(self.nominal - w), self.upper.min(self.nominal + w))
             }
         }
     }
@@ -113,10 +107,7 @@ impl Parameter {
     /// Checks that `value` is finite and within the bounds.
     pub fn check(&self, value: f64) -> Result<(), ParameterError> {
         if !value.is_finite() {
-            return Err(ParameterError::NonFinite {
-                name: self.name.clone(),
-                value,
-            });
+            return Err(ParameterError::NonFinite { name: self.name.clone(), value });
         }
         if value < self.lower || value > self.upper {
             return Err(ParameterError::OutOfBounds {
@@ -142,23 +133,13 @@ pub enum ParameterError {
     EmptyName(usize),
     /// Bounds are NaN or reversed, or a log parameter allows values ≤ 0.
     #[error("parameter `{name}`: bounds [{lower}, {upper}] are invalid ({why})")]
-    BadBounds {
-        name: String,
-        lower: f64,
-        upper: f64,
-        why: &'static str,
-    },
+    BadBounds { name: String, lower: f64, upper: f64, why: &'static str },
     /// A value is NaN or infinite.
     #[error("parameter `{name}` = {value}: must be finite")]
     NonFinite { name: String, value: f64 },
     /// A value lies outside its bounds.
     #[error("parameter `{name}` = {value} lies outside its bounds [{lower}, {upper}]")]
-    OutOfBounds {
-        name: String,
-        value: f64,
-        lower: f64,
-        upper: f64,
-    },
+    OutOfBounds { name: String, value: f64, lower: f64, upper: f64 },
     /// A parameter vector has the wrong length.
     #[error("expected {expected} parameter values, got {got}")]
     Count { expected: usize, got: usize },
@@ -183,12 +164,8 @@ impl ParameterSet {
             if params[..i].iter().any(|q| q.name == p.name) {
                 return Err(ParameterError::DuplicateName(p.name.clone()));
             }
-            let bad = |why| ParameterError::BadBounds {
-                name: p.name.clone(),
-                lower: p.lower,
-                upper: p.upper,
-                why,
-            };
+            let bad =
+                |why| ParameterError::BadBounds { name: p.name.clone(), lower: p.lower, upper: p.upper, why };
             if p.lower.is_nan() || p.upper.is_nan() || p.lower > p.upper {
                 return Err(bad("lower must not exceed upper"));
             }
@@ -241,15 +218,9 @@ impl ParameterSet {
     /// Checks a full parameter vector: length, finiteness, bounds.
     pub fn check(&self, values: &[f64]) -> Result<(), ParameterError> {
         if values.len() != self.params.len() {
-            return Err(ParameterError::Count {
-                expected: self.params.len(),
-                got: values.len(),
-            });
+            return Err(ParameterError::Count { expected: self.params.len(), got: values.len() });
         }
-        self.params
-            .iter()
-            .zip(values)
-            .try_for_each(|(p, &v)| p.check(v))
+        self.params.iter().zip(values).try_for_each(|(p, &v)| p.check(v))
     }
 }
 
@@ -259,9 +230,7 @@ mod tests {
 
     #[test]
     fn validation_names_the_parameter() {
-        let k = Parameter::new("k1", "N/m", 1e5)
-            .with_bounds(0.0, 1e12)
-            .with_scale(Scale::Log);
+        let k = Parameter::new("k1", "N/m", 1e5).with_bounds(0.0, 1e12).with_scale(Scale::Log);
         assert_eq!(
             ParameterSet::new(vec![k]).unwrap_err().to_string(),
             "parameter `k1`: bounds [0, 1000000000000] are invalid (a log-scale parameter needs a positive lower bound)"
@@ -276,17 +245,8 @@ mod tests {
             set.check(&[3.0]).unwrap_err().to_string(),
             "parameter `a` = 3 lies outside its bounds [0, 2]"
         );
-        assert_eq!(
-            set.check(&[]).unwrap_err(),
-            ParameterError::Count {
-                expected: 1,
-                got: 0
-            }
-        );
-        assert!(matches!(
-            set.check(&[f64::NAN]),
-            Err(ParameterError::NonFinite { .. })
-        ));
+        assert_eq!(set.check(&[]).unwrap_err(), ParameterError::Count { expected: 1, got: 0 });
+        assert!(matches!(set.check(&[f64::NAN]), Err(ParameterError::NonFinite { .. })));
     }
 
     #[test]

@@ -84,10 +84,7 @@ impl Linearisation {
 
     /// Largest |f_model − f_measured| in Hz (the paper's stopping test).
     pub fn max_abs_diff_hz(&self) -> f64 {
-        self.frequencies_hz
-            .iter()
-            .zip(&self.measured_hz)
-            .fold(0.0, |m, (a, b)| f64::max(m, (a - b).abs()))
+        self.frequencies_hz.iter().zip(&self.measured_hz).fold(0.0, |m, (a, b)| f64::max(m, (a - b).abs()))
     }
 
     /// Largest |f_model − f_measured| / f_measured.
@@ -116,13 +113,7 @@ pub struct Problem<M, S> {
 impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
     /// A problem with relative residuals and order pairing.
     pub fn new(model: M, solver: S, measured: Measurement) -> Self {
-        Self {
-            model,
-            solver,
-            measured,
-            kind: ResidualKind::default(),
-            pairing: Pairing::Order,
-        }
+        Self { model, solver, measured, kind: ResidualKind::default(), pairing: Pairing::Order }
     }
 
     /// Sets the residual kind.
@@ -147,10 +138,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
         let needed = self.measured.modes_needed();
         let dofs = self.model.dofs();
         if needed > dofs {
-            return Err(ResidualError::TooFewModelModes {
-                needed,
-                available: dofs,
-            });
+            return Err(ResidualError::TooFewModelModes { needed, available: dofs });
         }
         let count = match self.pairing {
             Pairing::Order => needed,
@@ -180,9 +168,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             lin.measured_eigenvalues[row] = hz_to_eigenvalue(fm);
             lin.frequencies_hz[row] = f;
             lin.measured_hz[row] = fm;
-            lin.eigenvalue_jacobian
-                .row_mut(row)
-                .copy_from(&sens.eigenvalues.row(k));
+            lin.eigenvalue_jacobian.row_mut(row).copy_from(&sens.eigenvalues.row(k));
             // Residual value, Jacobian row and weight in the chosen quantity.
             let (r, scale, sigma) = match self.kind {
                 ResidualKind::Eigenvalue => (
@@ -190,23 +176,15 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
                     1.0,
                     meas.std_hz.map_or(1.0, |s| 8.0 * PI * PI * fm * s),
                 ),
-                ResidualKind::FrequencyHz => (
-                    fm - f,
-                    1.0 / (8.0 * PI * PI * f),
-                    meas.std_hz.unwrap_or(1.0),
-                ),
+                ResidualKind::FrequencyHz => (fm - f, 1.0 / (8.0 * PI * PI * f), meas.std_hz.unwrap_or(1.0)),
                 // ln(f_m/f): the relative difference to first order, and linear in ln k where
                 // the supports dominate (f ∝ √k), which makes log-stiffness steps nearly exact.
-                ResidualKind::Relative => (
-                    (fm / f).ln(),
-                    1.0 / (2.0 * lambda),
-                    meas.std_hz.map_or(1.0, |s| s / fm),
-                ),
+                ResidualKind::Relative => {
+                    ((fm / f).ln(), 1.0 / (2.0 * lambda), meas.std_hz.map_or(1.0, |s| s / fm))
+                }
             };
             lin.residual[row] = r / sigma;
-            lin.jacobian
-                .row_mut(row)
-                .copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));
+            lin.jacobian.row_mut(row).copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));
         }
         Ok(lin)
     }
@@ -220,15 +198,13 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
                     .modes()
                     .iter()
                     .map(|m| {
-                        m.shape.as_ref().ok_or_else(|| {
-                            ResidualError::Mac(format!("mode {} has no shape", m.mode))
-                        })
+                        m.shape
+                            .as_ref()
+                            .ok_or_else(|| ResidualError::Mac(format!("mode {} has no shape", m.mode)))
                     })
                     .collect::<Result<_, _>>()?;
                 if let Some(bad) = sensor_dofs.iter().find(|&&d| d >= self.model.dofs()) {
-                    return Err(ResidualError::Mac(format!(
-                        "sensor DOF {bad} does not exist in the model"
-                    )));
+                    return Err(ResidualError::Mac(format!("sensor DOF {bad} does not exist in the model")));
                 }
                 if shapes.iter().any(|s| s.len() != sensor_dofs.len()) {
                     return Err(ResidualError::Mac(format!(
@@ -237,12 +213,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
                     )));
                 }
                 let model_at_sensors: Vec<Vec<f64>> = (0..sens.modes.count())
-                    .map(|k| {
-                        sensor_dofs
-                            .iter()
-                            .map(|&d| sens.modes.shapes[(d, k)])
-                            .collect()
-                    })
+                    .map(|k| sensor_dofs.iter().map(|&d| sens.modes.shapes[(d, k)]).collect())
                     .collect();
                 let mut taken = vec![false; model_at_sensors.len()];
                 let mut out = Vec::with_capacity(shapes.len());
@@ -252,9 +223,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
                         .max_by(|&a, &b| {
                             mac(s, &model_at_sensors[a]).total_cmp(&mac(s, &model_at_sensors[b]))
                         })
-                        .ok_or_else(|| {
-                            ResidualError::Mac("more measured modes than model modes".into())
-                        })?;
+                        .ok_or_else(|| ResidualError::Mac("more measured modes than model modes".into()))?;
                     taken[best] = true;
                     out.push(best);
                 }

@@ -28,13 +28,7 @@ pub enum SensitivityError {
         "modes {mode} and {other} have (nearly) repeated eigenvalues {lambda_mode:e} and {lambda_other:e} \
          (relative gap {relative_gap:e}): the derivative of an individual mode is not defined there"
     )]
-    RepeatedEigenvalue {
-        mode: usize,
-        other: usize,
-        lambda_mode: f64,
-        lambda_other: f64,
-        relative_gap: f64,
-    },
+    RepeatedEigenvalue { mode: usize, other: usize, lambda_mode: f64, lambda_other: f64, relative_gap: f64 },
     /// A frequency sensitivity of a zero-frequency (rigid-body) mode.
     #[error("mode {mode} has λ = {lambda:e} ≤ 0: its frequency sensitivity is undefined")]
     ZeroFrequency { mode: usize, lambda: f64 },
@@ -56,18 +50,10 @@ pub enum SensitivityError {
 ///
 /// Two eigenvalues count as repeated when |λₖ − λₗ| ≤ `tolerance`·max(|λₖ|, |λₗ|) + `floor`;
 /// `floor` absorbs round-off around λ = 0 (rigid-body modes), see [`noise_floor`].
-pub fn check_distinct(
-    modes: &Modes,
-    k: usize,
-    tolerance: f64,
-    floor: f64,
-) -> Result<(), SensitivityError> {
+pub fn check_distinct(modes: &Modes, k: usize, tolerance: f64, floor: f64) -> Result<(), SensitivityError> {
     let lam = &modes.eigenvalues;
     if k >= lam.len() {
-        return Err(SensitivityError::ModeIndex {
-            mode: k,
-            count: lam.len(),
-        });
+        return Err(SensitivityError::ModeIndex { mode: k, count: lam.len() });
     }
     for l in 0..lam.len() {
         if l == k {
@@ -121,12 +107,7 @@ impl Sensitivities {
     ///
     /// One extra mode is solved (when the model has one) so that the highest requested mode is
     /// checked against its upper neighbour too.
-    pub fn compute<M, S>(
-        model: &M,
-        solver: &S,
-        p: &[f64],
-        count: usize,
-    ) -> Result<Self, SensitivityError>
+    pub fn compute<M, S>(model: &M, solver: &S, p: &[f64], count: usize) -> Result<Self, SensitivityError>
     where
         M: StructuralModel + ?Sized,
         S: EigenSolver + ?Sized,
@@ -163,11 +144,7 @@ impl Sensitivities {
             let factor = 1.0 / (8.0 * std::f64::consts::PI.powi(2) * f);
             df.row_mut(k).copy_from(&(dl.row(k) * factor));
         }
-        Ok(Self {
-            modes,
-            eigenvalues: dl,
-            frequencies_hz: df,
-        })
+        Ok(Self { modes, eigenvalues: dl, frequencies_hz: df })
     }
 }
 
@@ -214,8 +191,7 @@ pub fn eigenvector_derivative_nelson(
     let dlk = eigenvalue_derivative(modes, k, d);
     let m_phi = system.mass() * &phi;
     let mut rhs = &m_phi * dlk;
-    d.stiffness
-        .mul_add(-1.0, phi.as_slice(), rhs.as_mut_slice());
+    d.stiffness.mul_add(-1.0, phi.as_slice(), rhs.as_mut_slice());
     d.mass.mul_add(lk, phi.as_slice(), rhs.as_mut_slice());
     let mut a = system.stiffness() - system.mass() * lk;
     let pivot = phi.iamax();
@@ -223,10 +199,7 @@ pub fn eigenvector_derivative_nelson(
     a.column_mut(pivot).fill(0.0);
     a[(pivot, pivot)] = 1.0;
     rhs[pivot] = 0.0;
-    let v = a
-        .lu()
-        .solve(&rhs)
-        .ok_or(SensitivityError::Singular { mode: k })?;
+    let v = a.lu().solve(&rhs).ok_or(SensitivityError::Singular { mode: k })?;
     if v.iter().any(|x| !x.is_finite()) {
         return Err(SensitivityError::Singular { mode: k });
     }
@@ -253,15 +226,9 @@ mod tests {
         let (_, modes) = chain();
         let mut dk = SparseSymmetric::zeros(3);
         dk.add(1, 1, 1.0);
-        let d = SystemDerivative {
-            stiffness: dk,
-            mass: SparseSymmetric::zeros(3),
-        };
+        let d = SystemDerivative { stiffness: dk, mass: SparseSymmetric::zeros(3) };
         for k in 0..3 {
-            assert_eq!(
-                eigenvalue_derivative(&modes, k, &d),
-                modes.shapes[(1, k)].powi(2)
-            );
+            assert_eq!(eigenvalue_derivative(&modes, k, &d), modes.shapes[(1, k)].powi(2));
         }
     }
 
@@ -273,17 +240,11 @@ mod tests {
         dk.add(2, 2, 1.0);
         let mut dm = SparseSymmetric::zeros(3);
         dm.add(1, 1, 0.7);
-        let d = SystemDerivative {
-            stiffness: dk,
-            mass: dm,
-        };
+        let d = SystemDerivative { stiffness: dk, mass: dm };
         for k in 0..3 {
             let a = eigenvector_derivative_nelson(&sys, &modes, k, &d).unwrap();
             let b = eigenvector_derivative_modal(&modes, k, &d, 0.0).unwrap();
-            assert!(
-                (&a - &b).amax() < 1e-12 * a.amax().max(1.0),
-                "mode {k}: {a} vs {b}"
-            );
+            assert!((&a - &b).amax() < 1e-12 * a.amax().max(1.0), "mode {k}: {a} vs {b}");
         }
     }
 
@@ -293,16 +254,6 @@ mod tests {
         let modes = DenseSolver.lowest(&sys, 2).unwrap();
         let d = SystemDerivative::zeros(2);
         let err = eigenvector_derivative_nelson(&sys, &modes, 0, &d).unwrap_err();
-        assert!(
-            matches!(
-                err,
-                SensitivityError::RepeatedEigenvalue {
-                    mode: 0,
-                    other: 1,
-                    ..
-                }
-            ),
-            "{err}"
-        );
+        assert!(matches!(err, SensitivityError::RepeatedEigenvalue { mode: 0, other: 1, .. }), "{err}");
     }
 }

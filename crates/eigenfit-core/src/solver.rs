@@ -19,10 +19,7 @@ pub enum SolveError {
     NoModes,
     /// The backend produced NaN or did not converge.
     #[error("eigen-solver `{backend}` failed: {detail}")]
-    Backend {
-        backend: &'static str,
-        detail: String,
-    },
+    Backend { backend: &'static str, detail: String },
 }
 
 /// Computes the lowest modes of K φ = λ M φ.
@@ -52,10 +49,7 @@ pub fn check_count(system: &System, count: usize) -> Result<(), SolveError> {
         return Err(SolveError::NoModes);
     }
     if count > system.dofs() {
-        return Err(SolveError::TooManyModes {
-            requested: count,
-            available: system.dofs(),
-        });
+        return Err(SolveError::TooManyModes { requested: count, available: system.dofs() });
     }
     Ok(())
 }

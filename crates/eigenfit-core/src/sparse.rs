@@ -15,10 +15,7 @@ pub struct SparseSymmetric {
 impl SparseSymmetric {
     /// An all-zero n×n matrix.
     pub fn zeros(dim: usize) -> Self {
-        Self {
-            dim,
-            entries: Vec::new(),
-        }
+        Self { dim, entries: Vec::new() }
     }
 
     /// Dimension n.
@@ -41,11 +38,7 @@ impl SparseSymmetric {
     /// # Panics
     /// When an index is out of range: that is a bug in the model plugin, not user input.
     pub fn add(&mut self, i: usize, j: usize, value: f64) {
-        assert!(
-            i < self.dim && j < self.dim,
-            "entry ({i}, {j}) outside {0}×{0}",
-            self.dim
-        );
+        assert!(i < self.dim && j < self.dim, "entry ({i}, {j}) outside {0}×{0}", self.dim);
         let (r, c) = if i <= j { (i, j) } else { (j, i) };
         self.entries.push((r, c, value));
     }
@@ -71,13 +64,7 @@ impl SparseSymmetric {
     pub fn bilinear(&self, x: &[f64], y: &[f64]) -> f64 {
         self.entries
             .iter()
-            .map(|&(i, j, v)| {
-                if i == j {
-                    v * x[i] * y[i]
-                } else {
-                    v * (x[i] * y[j] + x[j] * y[i])
-                }
-            })
+            .map(|&(i, j, v)| if i == j { v * x[i] * y[i] } else { v * (x[i] * y[j] + x[j] * y[i]) })
             .sum()
     }
 

@@ -58,11 +58,7 @@ pub struct Uncertainty {
 
 /// Uncertainty at the estimate `at` (a converged linearisation whose residual is weighted by
 /// the measurement standard deviations). Returns `None` when the data carry no std.
-pub fn uncertainty(
-    problem: &dyn Evaluate,
-    at: &Linearisation,
-    has_std: bool,
-) -> Option<Uncertainty> {
+pub fn uncertainty(problem: &dyn Evaluate, at: &Linearisation, has_std: bool) -> Option<Uncertainty> {
     if !has_std {
         return None;
     }
@@ -73,11 +69,7 @@ pub fn uncertainty(
     let mut singular_values: Vec<f64> = svd.singular_values.iter().copied().collect();
     singular_values.sort_by(|a, b| b.total_cmp(a));
     let smin = singular_values.last().copied().unwrap_or(0.0);
-    let condition_number = if smin > 0.0 {
-        singular_values[0] / smin
-    } else {
-        f64::INFINITY
-    };
+    let condition_number = if smin > 0.0 { singular_values[0] / smin } else { f64::INFINITY };
     // Scaled covariance (JsᵀJs)⁻¹ via a pseudo-inverse so a rank-deficient Jacobian gives ∞, not NaN.
     let info = js.transpose() * &js;
     let scaled_cov = info
@@ -85,11 +77,7 @@ pub fn uncertainty(
         .try_inverse()
         .filter(|c| c.iter().all(|v| v.is_finite()) && (0..np).all(|i| c[(i, i)] > 0.0))
         .unwrap_or_else(|| DMatrix::from_diagonal_element(np, np, f64::INFINITY));
-    let jac: Vec<f64> = params
-        .iter()
-        .zip(&at.parameters)
-        .map(|(p, &v)| p.scale_derivative(v))
-        .collect();
+    let jac: Vec<f64> = params.iter().zip(&at.parameters).map(|(p, &v)| p.scale_derivative(v)).collect();
     let covariance = DMatrix::from_fn(np, np, |i, j| scaled_cov[(i, j)] * jac[i] * jac[j]);
     let mut intervals = Vec::with_capacity(np);
     let mut identifiability = Vec::with_capacity(np);
@@ -97,10 +85,7 @@ pub fn uncertainty(
         let s = par.to_scaled(at.parameters[i]);
         let sigma = scaled_cov[(i, i)].sqrt();
         if sigma.is_finite() && sigma <= PROFILE_TRIGGER {
-            intervals.push([
-                par.from_scaled(s - Z_95 * sigma),
-                par.from_scaled(s + Z_95 * sigma),
-            ]);
+            intervals.push([par.from_scaled(s - Z_95 * sigma), par.from_scaled(s + Z_95 * sigma)]);
             identifiability.push(Identifiability::Determined);
             continue;
         }
@@ -114,13 +99,7 @@ pub fn uncertainty(
             (None, None) => Identifiability::Undetermined,
         });
     }
-    Some(Uncertainty {
-        covariance,
-        intervals,
-        singular_values,
-        condition_number,
-        identifiability,
-    })
+    Some(Uncertainty { covariance, intervals, singular_values, condition_number, identifiability })
 }
 
 /// χ² after refitting every other parameter with parameter `i` held at `value`.
@@ -129,9 +108,7 @@ fn profile_chi2(problem: &dyn Evaluate, at: &Linearisation, i: usize, value: f64
     p[i] = value;
     let fixed = (0..p.len()).map(|j| j == i).collect();
     let mut damped = Damped::default().with_fixed(fixed).with_max_restarts(0);
-    let est = Driver { max_iterations: 60 }
-        .run(problem, &mut damped, &p, &mut [])
-        .ok()?;
+    let est = Driver { max_iterations: 60 }.run(problem, &mut damped, &p, &mut []).ok()?;
     Some(2.0 * est.last.cost())
 }
 
@@ -145,13 +122,8 @@ fn profile_bound(problem: &dyn Evaluate, at: &Linearisation, i: usize, dir: f64)
     }
     let chi2_min = 2.0 * at.cost();
     let exceeds = |s: f64| {
-        profile_chi2(
-            problem,
-            at,
-            i,
-            par.from_scaled(s).clamp(par.lower, par.upper),
-        )
-        .is_none_or(|c| c - chi2_min > CHI2_95_1DOF)
+        profile_chi2(problem, at, i, par.from_scaled(s).clamp(par.lower, par.upper))
+            .is_none_or(|c| c - chi2_min > CHI2_95_1DOF)
     };
     let s_hat = par.to_scaled(at.parameters[i]);
     let s_limit = par.to_scaled(limit);

@@ -9,35 +9,17 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum SystemError {
     /// K or M is not square, or they differ in size.
-    #[error(
-        "K is {k_rows}×{k_cols} and M is {m_rows}×{m_cols}: both must be the same square size"
-    )]
-    Shape {
-        k_rows: usize,
-        k_cols: usize,
-        m_rows: usize,
-        m_cols: usize,
-    },
+    #[error("K is {k_rows}×{k_cols} and M is {m_rows}×{m_cols}: both must be the same square size")]
+    Shape { k_rows: usize, k_cols: usize, m_rows: usize, m_cols: usize },
     /// The system has no degree of freedom.
     #[error("the system has no degree of freedom")]
     Empty,
     /// An entry is NaN or infinite.
     #[error("{matrix}[{row}, {col}] is {value}: every entry must be finite")]
-    NonFinite {
-        matrix: &'static str,
-        row: usize,
-        col: usize,
-        value: f64,
-    },
+    NonFinite { matrix: &'static str, row: usize, col: usize, value: f64 },
     /// A matrix is not symmetric.
     #[error("{matrix} is not symmetric: [{row}, {col}] = {a} but [{col}, {row}] = {b}")]
-    NotSymmetric {
-        matrix: &'static str,
-        row: usize,
-        col: usize,
-        a: f64,
-        b: f64,
-    },
+    NotSymmetric { matrix: &'static str, row: usize, col: usize, a: f64, b: f64 },
 }
 
 /// Stiffness K and mass M of a structure (n×n, symmetric; M positive definite for a solve).
@@ -94,23 +76,12 @@ fn check_matrix(name: &'static str, a: &DMatrix<f64>) -> Result<(), SystemError>
         for i in 0..a.nrows() {
             let v = a[(i, j)];
             if !v.is_finite() {
-                return Err(SystemError::NonFinite {
-                    matrix: name,
-                    row: i,
-                    col: j,
-                    value: v,
-                });
+                return Err(SystemError::NonFinite { matrix: name, row: i, col: j, value: v });
             }
             if i < j {
                 let w = a[(j, i)];
                 if (v - w).abs() > 1e-12 * scale {
-                    return Err(SystemError::NotSymmetric {
-                        matrix: name,
-                        row: i,
-                        col: j,
-                        a: v,
-                        b: w,
-                    });
+                    return Err(SystemError::NotSymmetric { matrix: name, row: i, col: j, a: v, b: w });
                 }
             }
         }
@@ -130,10 +101,7 @@ pub struct SystemDerivative {
 impl SystemDerivative {
     /// Zero derivative of an n-DOF system.
     pub fn zeros(dim: usize) -> Self {
-        Self {
-            stiffness: SparseSymmetric::zeros(dim),
-            mass: SparseSymmetric::zeros(dim),
-        }
+        Self { stiffness: SparseSymmetric::zeros(dim), mass: SparseSymmetric::zeros(dim) }
     }
 
     /// φᵀ(∂K − λ ∂M)ψ: the building block of every eigen-sensitivity.
@@ -162,20 +130,9 @@ mod tests {
         let k = DMatrix::from_row_slice(2, 2, &[f64::NAN, 0.0, 0.0, 1.0]);
         assert!(matches!(
             System::new(k, m.clone()),
-            Err(SystemError::NonFinite {
-                matrix: "K",
-                row: 0,
-                col: 0,
-                ..
-            })
+            Err(SystemError::NonFinite { matrix: "K", row: 0, col: 0, .. })
         ));
-        assert!(matches!(
-            System::new(DMatrix::identity(3, 3), m),
-            Err(SystemError::Shape { .. })
-        ));
-        assert_eq!(
-            System::new(DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)),
-            Err(SystemError::Empty)
-        );
+        assert!(matches!(System::new(DMatrix::identity(3, 3), m), Err(SystemError::Shape { .. })));
+        assert_eq!(System::new(DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)), Err(SystemError::Empty));
     }
 }

@@ -26,8 +26,7 @@ pub(crate) fn sygvd(n: usize, k: &[f64], m: &[f64]) -> Result<(Vec<f64>, Vec<f64
     // work[0] and iwork[0].
     unsafe {
         lapack::dsygvd(
-            &ITYPE, b'V', UPLO, ni, &mut a, ni, &mut b, ni, &mut w, &mut work, -1, &mut iwork, -1,
-            &mut info,
+            &ITYPE, b'V', UPLO, ni, &mut a, ni, &mut b, ni, &mut w, &mut work, -1, &mut iwork, -1, &mut info,
         );
     }
     check_info("dsygvd", info, n, None)?;
@@ -85,8 +84,8 @@ pub(crate) fn sygvx(
     // iwork has 5n and ifail n entries; a query (LWORK = -1) writes only work[0].
     unsafe {
         lapack::dsygvx(
-            &ITYPE, b'V', b'I', UPLO, ni, &mut a, ni, &mut b, ni, 0.0, 0.0, 1, iu, abstol,
-            &mut found, &mut w, &mut z, ni, &mut work, -1, &mut iwork, &mut ifail, &mut info,
+            &ITYPE, b'V', b'I', UPLO, ni, &mut a, ni, &mut b, ni, 0.0, 0.0, 1, iu, abstol, &mut found,
+            &mut w, &mut z, ni, &mut work, -1, &mut iwork, &mut ifail, &mut info,
         );
     }
     check_info("dsygvx", info, n, None)?;
@@ -122,9 +121,7 @@ pub(crate) fn sygvx(
     }
     check_info("dsygvx", info, n, Some(&ifail))?;
     if usize::try_from(found) != Ok(count) {
-        return Err(backend(format!(
-            "dsygvx returned {found} eigenpairs, {count} were requested"
-        )));
+        return Err(backend(format!("dsygvx returned {found} eigenpairs, {count} were requested")));
     }
     w.truncate(count);
     Ok((w, z))
@@ -133,10 +130,7 @@ pub(crate) fn sygvx(
 /// Maps LAPACK's `info` for `dsygvd` / `dsygvx` (with `ifail` for the latter).
 fn check_info(routine: &str, info: i32, n: usize, ifail: Option<&[i32]>) -> Result<(), SolveError> {
     let Ok(i) = usize::try_from(info) else {
-        return Err(backend(format!(
-            "{routine}: argument {} had an illegal value",
-            -i64::from(info)
-        )));
+        return Err(backend(format!("{routine}: argument {} had an illegal value", -i64::from(info))));
     };
     if i == 0 {
         Ok(())
@@ -149,36 +143,22 @@ fn check_info(routine: &str, info: i32, n: usize, ifail: Option<&[i32]>) -> Resu
         })
     } else if let Some(ifail) = ifail {
         let which: Vec<i32> = ifail.iter().take(i).copied().collect();
-        Err(backend(format!(
-            "{routine}: {i} eigenvector(s) failed to converge (indices {which:?})"
-        )))
+        Err(backend(format!("{routine}: {i} eigenvector(s) failed to converge (indices {which:?})")))
     } else {
-        Err(backend(format!(
-            "{routine}: the eigensolver failed to converge (info = {info})"
-        )))
+        Err(backend(format!("{routine}: the eigensolver failed to converge (info = {info})")))
     }
 }
 
 /// Workspace length: the queried optimum, at least the documented minimum.
 fn workspace(queried: f64, minimum: usize, what: &str) -> Result<usize, SolveError> {
     // Optimal sizes come back as doubles; round up and reject nonsense.
-    let q = if queried.is_finite() && queried > 0.0 {
-        queried.ceil()
-    } else {
-        0.0
-    };
+    let q = if queried.is_finite() && queried > 0.0 { queried.ceil() } else { 0.0 };
     if q > i32::MAX as f64 {
-        return Err(backend(format!(
-            "{what} = {q} exceeds LAPACK's 32-bit integer range"
-        )));
+        return Err(backend(format!("{what} = {q} exceeds LAPACK's 32-bit integer range")));
     }
     Ok((q as usize).max(minimum))
 }
 
 fn lapack_int(v: usize, what: &str) -> Result<i32, SolveError> {
-    i32::try_from(v).map_err(|_| {
-        backend(format!(
-            "{what} = {v} exceeds LAPACK's 32-bit integer range"
-        ))
-    })
+    i32::try_from(v).map_err(|_| backend(format!("{what} = {v} exceeds LAPACK's 32-bit integer range")))
 }

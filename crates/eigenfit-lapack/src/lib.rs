@@ -143,22 +143,12 @@ impl EigenSolver for LapackSolver {
     fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
         check_count(system, count)?;
         let n = system.dofs();
-        solve(
-            system.stiffness(),
-            system.mass(),
-            count,
-            self.method.resolve(n, count),
-        )
+        solve(system.stiffness(), system.mass(), count, self.method.resolve(n, count))
     }
 }
 
 /// The lowest `count` modes of (K, M) with the given driver (`All` or `Subset`).
-fn solve(
-    k: &DMatrix<f64>,
-    m: &DMatrix<f64>,
-    count: usize,
-    method: Method,
-) -> Result<Modes, SolveError> {
+fn solve(k: &DMatrix<f64>, m: &DMatrix<f64>, count: usize, method: Method) -> Result<Modes, SolveError> {
     // `System::new` rejects non-finite entries; a NaN must never reach LAPACK regardless.
     if k.iter().chain(m.iter()).any(|v| !v.is_finite()) {
         return Err(backend("K or M has a non-finite entry".into()));
@@ -183,22 +173,14 @@ fn solve(
     let mut shapes = DMatrix::from_iterator(
         n,
         count,
-        order
-            .iter()
-            .flat_map(|&j| vectors[j * n..(j + 1) * n].iter().copied()),
+        order.iter().flat_map(|&j| vectors[j * n..(j + 1) * n].iter().copied()),
     );
     apply_sign_rule(&mut shapes);
-    Ok(Modes {
-        eigenvalues,
-        shapes,
-    })
+    Ok(Modes { eigenvalues, shapes })
 }
 
 fn backend(detail: String) -> SolveError {
-    SolveError::Backend {
-        backend: BACKEND,
-        detail,
-    }
+    SolveError::Backend { backend: BACKEND, detail }
 }
 
 #[cfg(test)]
@@ -210,17 +192,8 @@ mod tests {
         let k = DMatrix::from_row_slice(2, 2, &[f64::NAN, 0.0, 0.0, 1.0]);
         let m = DMatrix::identity(2, 2);
         for method in [Method::All, Method::Subset] {
-            assert!(matches!(
-                solve(&k, &m, 1, method),
-                Err(SolveError::Backend {
-                    backend: "lapack",
-                    ..
-                })
-            ));
-            assert!(matches!(
-                solve(&m, &k, 1, method),
-                Err(SolveError::Backend { .. })
-            ));
+            assert!(matches!(solve(&k, &m, 1, method), Err(SolveError::Backend { backend: "lapack", .. })));
+            assert!(matches!(solve(&m, &k, 1, method), Err(SolveError::Backend { .. })));
         }
     }
 
@@ -231,20 +204,13 @@ mod tests {
         for method in [Method::All, Method::Subset] {
             let sys = System::new(k.clone(), m.clone()).unwrap();
             let r = LapackSolver::new(method).lowest(&sys, 2);
-            assert!(
-                matches!(r, Err(SolveError::Backend { .. })),
-                "{method:?}: {r:?}"
-            );
+            assert!(matches!(r, Err(SolveError::Backend { .. })), "{method:?}: {r:?}");
         }
     }
 
     #[test]
     fn single_dof_on_both_paths() {
-        let sys = System::new(
-            DMatrix::from_element(1, 1, 4.0),
-            DMatrix::from_element(1, 1, 2.0),
-        )
-        .unwrap();
+        let sys = System::new(DMatrix::from_element(1, 1, 4.0), DMatrix::from_element(1, 1, 2.0)).unwrap();
         for method in [Method::All, Method::Subset] {
             let modes = LapackSolver::new(method).lowest(&sys, 1).unwrap();
             assert!((modes.eigenvalues[0] - 2.0).abs() < 1e-15);

@@ -84,12 +84,7 @@ fn beam_chain(n: usize) -> System {
     for i in 0..n as isize {
         let x = i as f64;
         add(&mut k, &[i], &[1.0], 1.0 / taper(x)); // foundation
-        add(
-            &mut k,
-            &[i - 1, i, i + 1],
-            &[1.0, -2.0, 1.0],
-            0.25 * taper(x),
-        ); // bending
+        add(&mut k, &[i - 1, i, i + 1], &[1.0, -2.0, 1.0], 0.25 * taper(x)); // bending
     }
     for i in -1..n as isize {
         let x = i as f64 + 0.5;
@@ -128,12 +123,7 @@ fn cantilever(elements: usize) -> System {
     let mut m = DMatrix::zeros(n, n);
     for e in 0..elements {
         // Global DOFs of node e are 2(e-1), 2(e-1)+1; node 0 is clamped.
-        let dofs = [
-            2 * e as isize - 2,
-            2 * e as isize - 1,
-            2 * e as isize,
-            2 * e as isize + 1,
-        ];
+        let dofs = [2 * e as isize - 2, 2 * e as isize - 1, 2 * e as isize, 2 * e as isize + 1];
         for p in 0..4 {
             for q in 0..4 {
                 if dofs[p] >= 0 && dofs[q] >= 0 {
@@ -197,11 +187,7 @@ fn identities(system: &System, modes: &Modes) -> (f64, f64) {
 fn check_conventions(modes: &Modes, count: usize, n: usize) {
     assert_eq!(modes.count(), count);
     assert_eq!(modes.shapes.shape(), (n, count));
-    assert!(modes
-        .eigenvalues
-        .as_slice()
-        .windows(2)
-        .all(|w| w[0] <= w[1]));
+    assert!(modes.eigenvalues.as_slice().windows(2).all(|w| w[0] <= w[1]));
     // Sign rule: the first largest-magnitude entry of every column is positive.
     for col in modes.shapes.column_iter() {
         let max = col.amax();
@@ -218,16 +204,8 @@ fn bound(n: usize, lambda_max: f64) -> f64 {
 
 /// Distance from λⱼ to its nearest neighbour in the full spectrum.
 fn gap(lambda: &DVector<f64>, j: usize) -> f64 {
-    let below = if j > 0 {
-        lambda[j] - lambda[j - 1]
-    } else {
-        f64::INFINITY
-    };
-    let above = if j + 1 < lambda.len() {
-        lambda[j + 1] - lambda[j]
-    } else {
-        f64::INFINITY
-    };
+    let below = if j > 0 { lambda[j] - lambda[j - 1] } else { f64::INFINITY };
+    let above = if j + 1 < lambda.len() { lambda[j + 1] - lambda[j] } else { f64::INFINITY };
     below.min(above)
 }
 
@@ -300,10 +278,7 @@ fn beam_chains_agree_with_dense_on_every_mode() {
         // The sign rule makes the two backends' shapes identical, not merely equal up to sign.
         assert_eq!(d.sign_flips, 0, "n = {n}");
         let (ortho, stiff) = identities(&system, &all);
-        assert!(
-            ortho < 1e-12 && stiff < 1e-12,
-            "n = {n}: {ortho:e} {stiff:e}"
-        );
+        assert!(ortho < 1e-12 && stiff < 1e-12, "n = {n}: {ortho:e} {stiff:e}");
     }
 }
 
@@ -329,21 +304,12 @@ fn subset_path_agrees_with_full_path_and_dense_on_chains() {
             check_conventions(&subset, count, n);
             for (other, full) in [("all", &all_full), ("dense", &dense_full)] {
                 let d = compare(&subset, &truncate(full, count), count);
-                assert!(
-                    d.eigenvalue_rel < 1e-10,
-                    "n = {n}, count = {count}, {other}: {d:?}"
-                );
-                assert!(
-                    d.shape_rel < 1e-8,
-                    "n = {n}, count = {count}, {other}: {d:?}"
-                );
+                assert!(d.eigenvalue_rel < 1e-10, "n = {n}, count = {count}, {other}: {d:?}");
+                assert!(d.shape_rel < 1e-8, "n = {n}, count = {count}, {other}: {d:?}");
                 assert_eq!(d.sign_flips, 0, "n = {n}, count = {count}, {other}");
             }
             let (ortho, stiff) = identities(&system, &subset);
-            assert!(
-                ortho < 1e-12 && stiff < 1e-12,
-                "n = {n}: {ortho:e} {stiff:e}"
-            );
+            assert!(ortho < 1e-12 && stiff < 1e-12, "n = {n}: {ortho:e} {stiff:e}");
         }
     }
 }
@@ -376,10 +342,7 @@ fn stiff_cantilever_agrees_to_the_conditioning_bound() {
             assert!(diff < tol, "n = {n}, λ{j}: |Δ| = {diff:e} > {tol:e}");
         }
         for j in 0..10 {
-            assert!(
-                (subset.eigenvalues[j] - lam[j]).abs() < tol,
-                "n = {n}, λ{j}"
-            );
+            assert!((subset.eigenvalues[j] - lam[j]).abs() < tol, "n = {n}, λ{j}");
             for modes in [&all, &subset] {
                 let (a, b) = (modes.shapes.column(j), dense.shapes.column(j));
                 let diff = (a - b).amax() / b.amax();
@@ -389,16 +352,10 @@ fn stiff_cantilever_agrees_to_the_conditioning_bound() {
         }
         // Both drivers share the reduction and tridiagonalisation, so they agree more closely.
         let d = compare(&subset, &ALL.lowest(&system, 10).unwrap(), 10);
-        assert!(
-            d.eigenvalue_rel < 1e-9 && d.shape_rel < 1e-9,
-            "n = {n}: {d:?}"
-        );
+        assert!(d.eigenvalue_rel < 1e-9 && d.shape_rel < 1e-9, "n = {n}: {d:?}");
         for modes in [&all, &subset] {
             let (ortho, stiff) = identities(&system, modes);
-            assert!(
-                ortho < 1e-12 && stiff < 1e-12,
-                "n = {n}: {ortho:e} {stiff:e}"
-            );
+            assert!(ortho < 1e-12 && stiff < 1e-12, "n = {n}: {ortho:e} {stiff:e}");
         }
     }
 }
@@ -427,10 +384,7 @@ fn double_eigenvalues_give_orthonormal_bases_of_the_same_eigenspaces() {
         let modes = solver.lowest(&system, count).unwrap();
         check_conventions(&modes, count, n);
         let (ortho, stiff) = identities(&system, &modes);
-        assert!(
-            ortho < 1e-12 && stiff < 1e-12,
-            "{solver:?}: {ortho:e} {stiff:e}"
-        );
+        assert!(ortho < 1e-12 && stiff < 1e-12, "{solver:?}: {ortho:e} {stiff:e}");
         for j in 0..count {
             let rel = (modes.eigenvalues[j] - dense.eigenvalues[j]).abs() / dense.eigenvalues[j];
             assert!(rel < 1e-10, "{solver:?} λ{j}: {rel:e}");
@@ -470,16 +424,9 @@ fn rigid_body_mode_of_a_free_free_chain() {
     let lambda_max = dense.eigenvalues[n - 1];
     for solver in [ALL, SUBSET] {
         let modes = solver.lowest(&system, 3).unwrap();
-        assert!(
-            modes.eigenvalues[0].abs() < 1e-13 * lambda_max,
-            "{solver:?}"
-        );
+        assert!(modes.eigenvalues[0].abs() < 1e-13 * lambda_max, "{solver:?}");
         let rigid = 1.0 / (n as f64).sqrt();
-        assert!(modes
-            .shapes
-            .column(0)
-            .iter()
-            .all(|&v| (v - rigid).abs() < 1e-12));
+        assert!(modes.shapes.column(0).iter().all(|&v| (v - rigid).abs() < 1e-12));
         for j in 0..3 {
             assert!((modes.eigenvalues[j] - dense.eigenvalues[j]).abs() < bound(n, lambda_max));
         }
@@ -500,16 +447,12 @@ fn mass_not_positive_definite_is_a_typed_error_naming_the_minor() {
     indefinite[(1, 0)] = 2.0;
     for (m, order) in [(negative, 4), (massless, 1), (indefinite, 2)] {
         let system = System::new(k.clone(), m).unwrap();
-        assert!(matches!(
-            DenseSolver.lowest(&system, 2),
-            Err(SolveError::MassNotPositiveDefinite { .. })
-        ));
+        assert!(matches!(DenseSolver.lowest(&system, 2), Err(SolveError::MassNotPositiveDefinite { .. })));
         for solver in [ALL, SUBSET, LapackSolver::default()] {
             match solver.lowest(&system, 2) {
-                Err(SolveError::MassNotPositiveDefinite { detail: Some(d) }) => assert!(
-                    d.contains(&format!("leading minor of order {order} of M")),
-                    "{solver:?}: {d}"
-                ),
+                Err(SolveError::MassNotPositiveDefinite { detail: Some(d) }) => {
+                    assert!(d.contains(&format!("leading minor of order {order} of M")), "{solver:?}: {d}")
+                }
                 other => panic!("{solver:?}: expected MassNotPositiveDefinite, got {other:?}"),
             }
         }
@@ -521,13 +464,7 @@ fn bad_counts_are_rejected_like_dense() {
     let system = beam_chain(5);
     for solver in [ALL, SUBSET, LapackSolver::default()] {
         assert_eq!(solver.lowest(&system, 0), Err(SolveError::NoModes));
-        assert_eq!(
-            solver.lowest(&system, 6),
-            Err(SolveError::TooManyModes {
-                requested: 6,
-                available: 5
-            })
-        );
+        assert_eq!(solver.lowest(&system, 6), Err(SolveError::TooManyModes { requested: 6, available: 5 }));
         assert_eq!(solver.lowest(&system, 6), DenseSolver.lowest(&system, 6));
     }
 }

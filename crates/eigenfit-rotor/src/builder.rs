@@ -138,12 +138,7 @@ impl RotorBuilder {
             if node < node_count {
                 Ok(())
             } else {
-                Err(RotorError::NodeOutOfRange {
-                    kind,
-                    entry,
-                    node,
-                    nodes: node_count,
-                })
+                Err(RotorError::NodeOutOfRange { kind, entry, node, nodes: node_count })
             }
         };
         for (i, d) in spec.disks.iter().enumerate() {
@@ -158,20 +153,12 @@ impl RotorBuilder {
             let name = b.name.get_or_insert_with(|| format!("bearing_{i}")).clone();
             let at = || format!("bearing {i} `{name}`");
             if name.trim().is_empty() {
-                return Err(RotorError::EmptyName {
-                    location: format!("bearing {i}"),
-                });
+                return Err(RotorError::EmptyName { location: format!("bearing {i}") });
             }
             if let Some(first) = bearings.iter().position(|q| q.name == name) {
-                return Err(RotorError::DuplicateBearing {
-                    name,
-                    first,
-                    second: i,
-                });
+                return Err(RotorError::DuplicateBearing { name, first, second: i });
             }
-            if !(b.stiffness.is_finite()
-                && (STIFFNESS_LOWER..=STIFFNESS_UPPER).contains(&b.stiffness))
-            {
+            if !(b.stiffness.is_finite() && (STIFFNESS_LOWER..=STIFFNESS_UPPER).contains(&b.stiffness)) {
                 return Err(RotorError::InvalidValue {
                     location: at(),
                     quantity: "stiffness",
@@ -202,9 +189,7 @@ impl RotorBuilder {
                 .collect(),
         )
         .map_err(RotorError::Parameter)?;
-        Ok(Rotor::from_checked_parts(
-            spec, nodes, elements, bearings, parameters,
-        ))
+        Ok(Rotor::from_checked_parts(spec, nodes, elements, bearings, parameters))
     }
 }
 
@@ -212,45 +197,25 @@ fn positive(at: impl FnOnce() -> String, quantity: &'static str, v: f64) -> Resu
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(RotorError::InvalidValue {
-            location: at(),
-            quantity,
-            value: v,
-            requirement: "finite and > 0",
-        })
+        Err(RotorError::InvalidValue { location: at(), quantity, value: v, requirement: "finite and > 0" })
     }
 }
 
-fn non_negative(
-    at: impl FnOnce() -> String,
-    quantity: &'static str,
-    v: f64,
-) -> Result<(), RotorError> {
+fn non_negative(at: impl FnOnce() -> String, quantity: &'static str, v: f64) -> Result<(), RotorError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {
-        Err(RotorError::InvalidValue {
-            location: at(),
-            quantity,
-            value: v,
-            requirement: "finite and ≥ 0",
-        })
+        Err(RotorError::InvalidValue { location: at(), quantity, value: v, requirement: "finite and ≥ 0" })
     }
 }
 
 fn check_materials(materials: &[Material]) -> Result<(), RotorError> {
     for (i, m) in materials.iter().enumerate() {
         if m.name.trim().is_empty() {
-            return Err(RotorError::EmptyName {
-                location: format!("material {i}"),
-            });
+            return Err(RotorError::EmptyName { location: format!("material {i}") });
         }
         if let Some(first) = materials[..i].iter().position(|q| q.name == m.name) {
-            return Err(RotorError::DuplicateMaterial {
-                name: m.name.clone(),
-                first,
-                second: i,
-            });
+            return Err(RotorError::DuplicateMaterial { name: m.name.clone(), first, second: i });
         }
         let at = || format!("material `{}`", m.name);
         positive(at, "youngs_modulus", m.youngs_modulus)?;
@@ -264,9 +229,7 @@ fn node_positions(spec: &RotorSpec) -> Result<Vec<f64>, RotorError> {
     let shaft = &spec.shaft;
     let nodes = match (&shaft.nodes, shaft.length, shaft.elements) {
         (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
-            return Err(RotorError::ShaftLayout(
-                "give either `nodes` or `length` with `elements`, not both",
-            ))
+            return Err(RotorError::ShaftLayout("give either `nodes` or `length` with `elements`, not both"))
         }
         (Some(nodes), None, None) => {
             for (i, &x) in nodes.iter().enumerate() {
@@ -287,19 +250,12 @@ fn node_positions(spec: &RotorSpec) -> Result<Vec<f64>, RotorError> {
                 return Err(RotorError::NoElements);
             }
             if elements > MAX_ELEMENTS {
-                return Err(RotorError::TooManyElements {
-                    elements,
-                    max: MAX_ELEMENTS,
-                });
+                return Err(RotorError::TooManyElements { elements, max: MAX_ELEMENTS });
             }
-            (0..=elements)
-                .map(|i| length * i as f64 / elements as f64)
-                .collect()
+            (0..=elements).map(|i| length * i as f64 / elements as f64).collect()
         }
         (None, Some(_), None) | (None, None, Some(_)) => {
-            return Err(RotorError::ShaftLayout(
-                "`length` and `elements` must be given together",
-            ))
+            return Err(RotorError::ShaftLayout("`length` and `elements` must be given together"))
         }
         (None, None, None) => {
             return Err(RotorError::ShaftLayout(
@@ -311,40 +267,26 @@ fn node_positions(spec: &RotorSpec) -> Result<Vec<f64>, RotorError> {
         return Err(RotorError::NoElements);
     }
     if nodes.len() - 1 > MAX_ELEMENTS {
-        return Err(RotorError::TooManyElements {
-            elements: nodes.len() - 1,
-            max: MAX_ELEMENTS,
-        });
+        return Err(RotorError::TooManyElements { elements: nodes.len() - 1, max: MAX_ELEMENTS });
     }
     for (i, w) in nodes.windows(2).enumerate() {
         if w[1] <= w[0] {
-            return Err(RotorError::NodesNotIncreasing {
-                node: i + 1,
-                position: w[1],
-                previous: w[0],
-            });
+            return Err(RotorError::NodesNotIncreasing { node: i + 1, position: w[1], previous: w[0] });
         }
     }
     Ok(nodes)
 }
 
 fn material_index(spec: &RotorSpec, location: String, name: &str) -> Result<usize, RotorError> {
-    spec.materials
-        .iter()
-        .position(|m| m.name == name)
-        .ok_or_else(|| RotorError::UnknownMaterial {
-            location,
-            name: name.to_string(),
-            defined: if spec.materials.is_empty() {
-                "none".into()
-            } else {
-                spec.materials
-                    .iter()
-                    .map(|m| format!("`{}`", m.name))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            },
-        })
+    spec.materials.iter().position(|m| m.name == name).ok_or_else(|| RotorError::UnknownMaterial {
+        location,
+        name: name.to_string(),
+        defined: if spec.materials.is_empty() {
+            "none".into()
+        } else {
+            spec.materials.iter().map(|m| format!("`{}`", m.name)).collect::<Vec<_>>().join(", ")
+        },
+    })
 }
 
 /// Resolves every element's diameters and material from the shaft defaults and the sections.
@@ -368,20 +310,11 @@ fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>
     for (s, sec) in shaft.sections.iter().enumerate() {
         let [first, last] = sec.elements;
         if first > last || last >= count {
-            return Err(RotorError::SectionRange {
-                section: s,
-                first,
-                last,
-                elements: count,
-            });
+            return Err(RotorError::SectionRange { section: s, first, last, elements: count });
         }
         for (e, slot) in owner.iter_mut().enumerate().take(last + 1).skip(first) {
             if let Some(prev) = *slot {
-                return Err(RotorError::SectionOverlap {
-                    first: prev,
-                    second: s,
-                    element: e,
-                });
+                return Err(RotorError::SectionOverlap { first: prev, second: s, element: e });
             }
             *slot = Some(s);
         }
@@ -404,16 +337,9 @@ fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>
             .and_then(|s| s.diameter)
             .or(shaft.diameter)
             .ok_or(RotorError::MissingDiameter { element: e })?;
-        let inner = section
-            .and_then(|s| s.inner_diameter)
-            .or(shaft.inner_diameter)
-            .unwrap_or(0.0);
+        let inner = section.and_then(|s| s.inner_diameter).or(shaft.inner_diameter).unwrap_or(0.0);
         if inner >= outer {
-            return Err(RotorError::InnerNotBelowOuter {
-                element: e,
-                inner,
-                outer,
-            });
+            return Err(RotorError::InnerNotBelowOuter { element: e, inner, outer });
         }
         let material = sec
             .and_then(|s| section_material[s])

@@ -82,9 +82,7 @@ pub enum RotorError {
         previous: f64,
     },
     /// A hollow element whose bore is not smaller than its outer diameter.
-    #[error(
-        "element {element}: inner diameter {inner} m must be smaller than the outer diameter {outer} m"
-    )]
+    #[error("element {element}: inner diameter {inner} m must be smaller than the outer diameter {outer} m")]
     InnerNotBelowOuter {
         /// The element.
         element: usize,

@@ -45,11 +45,7 @@ pub struct Material {
 impl Material {
     /// A material called `name` with Young's modulus `youngs_modulus` (Pa) and `density` (kg/m³).
     pub fn new(name: impl Into<String>, youngs_modulus: f64, density: f64) -> Self {
-        Self {
-            name: name.into(),
-            youngs_modulus,
-            density,
-        }
+        Self { name: name.into(), youngs_modulus, density }
     }
 
     /// Structural steel as in the paper and the ROSS cross-check: E = 2.1e11 Pa, ρ = 7850 kg/m³.
@@ -108,12 +104,7 @@ pub struct Section {
 impl Section {
     /// A section covering elements `first..=last` that overrides nothing yet.
     pub fn new(first: usize, last: usize) -> Self {
-        Self {
-            elements: [first, last],
-            diameter: None,
-            inner_diameter: None,
-            material: None,
-        }
+        Self { elements: [first, last], diameter: None, inner_diameter: None, material: None }
     }
 
     /// Sets the outer diameter (m).
@@ -156,11 +147,7 @@ pub struct Disk {
 impl Disk {
     /// A point disk of `mass` (kg) at `node`.
     pub fn new(node: usize, mass: f64) -> Self {
-        Self {
-            node,
-            mass,
-            diametral_inertia: 0.0,
-        }
+        Self { node, mass, diametral_inertia: 0.0 }
     }
 
     /// Sets the diametral moment of inertia (kg·m²).
@@ -206,12 +193,7 @@ pub struct BearingSpec {
 impl BearingSpec {
     /// An unnamed bearing of translational `stiffness` (N/m) at `node`.
     pub fn new(node: usize, stiffness: f64) -> Self {
-        Self {
-            name: None,
-            node,
-            stiffness,
-            rotational_stiffness: 0.0,
-        }
+        Self { name: None, node, stiffness, rotational_stiffness: 0.0 }
     }
 
     /// Sets the name (the parameter becomes `k_<name>`).
@@ -240,10 +222,8 @@ impl Rotor {
     /// Reads and validates a rotor from a TOML file; parse errors name the file.
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<Self, RotorError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| RotorError::Io {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| RotorError::Io { path: path.to_path_buf(), message: e.to_string() })?;
         parse(&text, Some(path))?.build()
     }
 
@@ -270,12 +250,7 @@ fn parse(text: &str, path: Option<&Path>) -> Result<RotorBuilder, RotorError> {
             Err(match e.span() {
                 Some(span) => {
                     let (line, column) = line_column(text, span.start);
-                    RotorError::Parse {
-                        path,
-                        line,
-                        column,
-                        message,
-                    }
+                    RotorError::Parse { path, line, column, message }
                 }
                 None => RotorError::ParseUnplaced { path, message },
             })

@@ -2,9 +2,7 @@
 
 use crate::element;
 use crate::file::{Disk, Material, PointMass, RotorSpec};
-use eigenfit_core::{
-    ModelError, ParameterSet, SparseSymmetric, StructuralModel, System, SystemDerivative,
-};
+use eigenfit_core::{ModelError, ParameterSet, SparseSymmetric, StructuralModel, System, SystemDerivative};
 use nalgebra::{DMatrix, Matrix4};
 
 /// Lower bound of every bearing-stiffness parameter (N/m): positive, as the log scale needs.
@@ -80,8 +78,8 @@ impl Rotor {
         let mut m = DMatrix::zeros(n, n);
         for (e, el) in elements.iter().enumerate() {
             let mat = &spec.materials[el.material];
-            let ei = mat.youngs_modulus
-                * element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
+            let ei =
+                mat.youngs_modulus * element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
             let rho_a = mat.density * element::area(el.outer_diameter, el.inner_diameter);
             add_element(&mut k, e, &element::stiffness(ei, el.length));
             add_element(&mut m, e, &element::consistent_mass(rho_a, el.length));
@@ -96,15 +94,7 @@ impl Rotor {
         for b in &bearings {
             k[(2 * b.node + 1, 2 * b.node + 1)] += b.rotational_stiffness;
         }
-        Self {
-            spec,
-            nodes,
-            elements,
-            bearings,
-            parameters,
-            base_stiffness: k,
-            base_mass: m,
-        }
+        Self { spec, nodes, elements, bearings, parameters, base_stiffness: k, base_mass: m }
     }
 
     /// Node positions along the shaft (m), strictly increasing.
@@ -212,10 +202,10 @@ impl StructuralModel for Rotor {
 
     /// Exact: ∂K/∂kᵢ has the single entry 1 at the bearing's displacement DOF; ∂M/∂kᵢ = 0.
     fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
-        let b = self.bearings.get(i).ok_or(ModelError::ParameterIndex {
-            index: i,
-            count: self.bearings.len(),
-        })?;
+        let b = self
+            .bearings
+            .get(i)
+            .ok_or(ModelError::ParameterIndex { index: i, count: self.bearings.len() })?;
         self.parameters.check(p)?;
         let mut d = SystemDerivative::zeros(self.dofs());
         let j = Self::displacement_dof(b.node);
@@ -296,10 +286,7 @@ mod tests {
         let d = r.derivative(&[1e6, 2e6], 1).unwrap();
         assert_eq!(d.stiffness.entries(), &[(6, 6, 1.0)]);
         assert!(d.mass.is_empty());
-        assert!(matches!(
-            r.derivative(&[1e6], 0),
-            Err(ModelError::Parameter(_))
-        ));
+        assert!(matches!(r.derivative(&[1e6], 0), Err(ModelError::Parameter(_))));
     }
 
     #[test]

@@ -19,10 +19,7 @@ fn uniform(length: f64, elements: usize, diameter: f64, k: f64) -> Rotor {
 }
 
 fn frequencies(rotor: &Rotor, count: usize) -> Vec<f64> {
-    DenseSolver
-        .lowest(&rotor.nominal_system().unwrap(), count)
-        .unwrap()
-        .frequencies_hz()
+    DenseSolver.lowest(&rotor.nominal_system().unwrap(), count).unwrap().frequencies_hz()
 }
 
 #[test]
@@ -31,9 +28,7 @@ fn stiffly_supported_beam_converges_to_pinned_pinned() {
     // N/m are ~1e7 × the beam's own stiffness 48EI/L³ ≈ 7.6e4 N/m: pinned to ~1e-7 relative.
     let (l, d) = (0.5, 0.014);
     let c = (E * element::second_moment_of_area(d, 0.0) / (RHO * element::area(d, 0.0))).sqrt();
-    let exact: Vec<f64> = (1..=3)
-        .map(|n| (n as f64 * PI / l).powi(2) * c / (2.0 * PI))
-        .collect();
+    let exact: Vec<f64> = (1..=3).map(|n| (n as f64 * PI / l).powi(2) * c / (2.0 * PI)).collect();
     let mut previous_error = [f64::INFINITY; 3];
     for elements in [4, 8, 16, 32] {
         let f = frequencies(&uniform(l, elements, d, 1e12), 3);
@@ -41,17 +36,11 @@ fn stiffly_supported_beam_converges_to_pinned_pinned() {
             let err = (f[n] - exact[n]) / exact[n];
             // Consistent-mass Hermite elements converge from above, at O(h⁴).
             assert!(err > -1e-6, "{elements} elements, mode {n}: {err:e}");
-            assert!(
-                err < previous_error[n],
-                "not converging: {elements}, mode {n}"
-            );
+            assert!(err < previous_error[n], "not converging: {elements}, mode {n}");
             previous_error[n] = err;
         }
     }
-    assert!(
-        previous_error.iter().all(|&e| e < 1e-5),
-        "{previous_error:?}"
-    );
+    assert!(previous_error.iter().all(|&e| e < 1e-5), "{previous_error:?}");
 }
 
 #[test]
@@ -69,15 +58,7 @@ fn soft_springs_give_the_rigid_bounce_frequency() {
     let f = frequencies(&rotor, 2);
     let bounce = (2.0 * k / m).sqrt() / (2.0 * PI);
     let rocking = (2.0 * k * (l / 2.0).powi(2) / (m * l * l / 12.0)).sqrt() / (2.0 * PI);
-    assert!(
-        (f[0] - bounce).abs() < 1e-6 * bounce,
-        "{} vs {bounce}",
-        f[0]
-    );
+    assert!((f[0] - bounce).abs() < 1e-6 * bounce, "{} vs {bounce}", f[0]);
     // Rocking with J = mL²/12 ignores the section's rotary inertia, which EB omits as well.
-    assert!(
-        (f[1] - rocking).abs() < 1e-6 * rocking,
-        "{} vs {rocking}",
-        f[1]
-    );
+    assert!((f[1] - rocking).abs() < 1e-6 * rocking, "{} vs {rocking}", f[1]);
 }

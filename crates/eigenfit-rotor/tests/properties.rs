@@ -19,9 +19,7 @@
 //! only, so it cannot hide a wrong analytic value; the tests require at least a third of the pairs to be compared.
 
 use eigenfit_core::sensitivity::{eigenvalue_derivative, eigenvector_derivative_nelson};
-use eigenfit_core::{
-    finite_difference_derivative, DenseSolver, EigenSolver, Modes, StructuralModel,
-};
+use eigenfit_core::{finite_difference_derivative, DenseSolver, EigenSolver, Modes, StructuralModel};
 use eigenfit_rotor::{BearingSpec, Disk, Material, Rotor, Section};
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -44,10 +42,7 @@ impl RandomRotor {
         for l in &self.lengths {
             nodes.push(nodes.last().unwrap() + l);
         }
-        let mut b = Rotor::builder()
-            .material(Material::steel())
-            .nodes(nodes)
-            .diameter(self.diameters[0]);
+        let mut b = Rotor::builder().material(Material::steel()).nodes(nodes).diameter(self.diameters[0]);
         for (e, &d) in self.diameters.iter().enumerate().skip(1) {
             b = b.section(Section::new(e, e).diameter(d));
         }
@@ -69,9 +64,7 @@ fn random_rotor() -> impl Strategy<Value = RandomRotor> {
             prop::collection::vec(0.005..0.05f64, elements),
             prop::collection::vec((0..nodes, 0.05..5.0f64, 0.0..1e-3f64), 0..=3),
             (2usize..=3)
-                .prop_flat_map(move |count| {
-                    prop::sample::subsequence((0..nodes).collect::<Vec<_>>(), count)
-                })
+                .prop_flat_map(move |count| prop::sample::subsequence((0..nodes).collect::<Vec<_>>(), count))
                 .prop_flat_map(|at| {
                     let count = at.len();
                     (Just(at), prop::collection::vec(2.0..9.0f64, count))
@@ -81,11 +74,7 @@ fn random_rotor() -> impl Strategy<Value = RandomRotor> {
                 lengths,
                 diameters,
                 disks,
-                bearings: at
-                    .into_iter()
-                    .zip(log_k)
-                    .map(|(n, e)| (n, 10f64.powf(e)))
-                    .collect(),
+                bearings: at.into_iter().zip(log_k).map(|(n, e)| (n, 10f64.powf(e))).collect(),
             })
     })
 }
@@ -99,11 +88,7 @@ fn solve_all(rotor: &Rotor, p: &[f64]) -> Modes {
 fn relative_gap(lam: &DVector<f64>, k: usize) -> f64 {
     let rel = |l: usize| (lam[k] - lam[l]).abs() / lam[k].abs().max(lam[l].abs());
     let below = if k > 0 { rel(k - 1) } else { f64::INFINITY };
-    let above = if k + 1 < lam.len() {
-        rel(k + 1)
-    } else {
-        f64::INFINITY
-    };
+    let above = if k + 1 < lam.len() { rel(k + 1) } else { f64::INFINITY };
     below.min(above)
 }
 
@@ -147,10 +132,7 @@ fn converged(stencils: &[DMatrix<f64>], x: f64, k: usize, noise: f64) -> Option<
 /// nothing), floored at 4ε·|f(x)| — the scatter of re-solved eigenpairs, measured, not bounded.
 fn measured_noise(f: impl Fn(f64) -> DMatrix<f64>, x: f64) -> Vec<f64> {
     let centre = f(x);
-    let mut noise: Vec<f64> = centre
-        .column_iter()
-        .map(|c| 4.0 * f64::EPSILON * c.amax())
-        .collect();
+    let mut noise: Vec<f64> = centre.column_iter().map(|c| 4.0 * f64::EPSILON * c.amax()).collect();
     for m in 1..=6 {
         let d = 1e-9 * x * m as f64;
         let second = f(x + d) - &centre * 2.0 + f(x - d);
@@ -164,25 +146,16 @@ fn measured_noise(f: impl Fn(f64) -> DMatrix<f64>, x: f64) -> Vec<f64> {
 /// How many modes of each random rotor are compared (the ones an update fits).
 const MODES: usize = 6;
 
-fn run(
-    name: &str,
-    test: impl Fn(&RandomRotor, &Cell<(usize, usize)>) -> Result<(), TestCaseError>,
-) {
+fn run(name: &str, test: impl Fn(&RandomRotor, &Cell<(usize, usize)>) -> Result<(), TestCaseError>) {
     let counts = Cell::new((0usize, 0usize)); // (compared, skipped)
                                               // A fixed seed: the comparison counts below are then reproducible.
     let mut runner = TestRunner::new_with_rng(
-        Config {
-            cases: CASES,
-            failure_persistence: None,
-            ..Config::default()
-        },
+        Config { cases: CASES, failure_persistence: None, ..Config::default() },
         TestRng::deterministic_rng(RngAlgorithm::ChaCha),
     );
     runner.run(&random_rotor(), |r| test(&r, &counts)).unwrap();
     let (compared, skipped) = counts.get();
-    eprintln!(
-        "{name}: compared {compared}, skipped {skipped} (FD not converged or modes too close)"
-    );
+    eprintln!("{name}: compared {compared}, skipped {skipped} (FD not converged or modes too close)");
     // With the fixed seed, of 972 (mode, bearing) pairs dλ/dk compares 657 and dφ/dk 678 with the
     // inverted (K-Cholesky) DenseSolver; 492 and 513 with the textbook M-Cholesky one, whose
     // round-off is ε·λ_max absolute. The skipped pairs are noise-dominated (soft supports next to
@@ -217,24 +190,16 @@ fn mass_orthonormal_and_diagonalising() {
         for k in 0..m {
             for l in 0..m {
                 let tol = 1e-10 + 100.0 * f64::EPSILON * lam[k].max(lam[l]) / lam[0];
-                prop_assert!(
-                    mtm[(k, l)].abs() <= tol,
-                    "(ΦᵀMΦ − I)[{k}, {l}] = {:e} > {tol:e}",
-                    mtm[(k, l)]
-                );
+                prop_assert!(mtm[(k, l)].abs() <= tol, "(ΦᵀMΦ − I)[{k}, {l}] = {:e} > {tol:e}", mtm[(k, l)]);
             }
         }
         let ktk = phi.transpose() * sys.stiffness() * phi;
         let err_k = (&ktk - DMatrix::from_diagonal(&modes.eigenvalues)).amax();
         // ΦᵀKΦ carries round-off of order ε·‖K‖/‖M‖ (the top of the spectrum), whatever the
         // backend: scale by max Kᵢᵢ/Mᵢᵢ, a solver-independent estimate of λ_max.
-        let lambda_scale = (0..sys.dofs())
-            .map(|i| sys.stiffness()[(i, i)] / sys.mass()[(i, i)])
-            .fold(0.0, f64::max);
-        prop_assert!(
-            err_k < 1e-9 * lambda_scale,
-            "ΦᵀKΦ − Λ: {err_k:e} (scale {lambda_scale:e})"
-        );
+        let lambda_scale =
+            (0..sys.dofs()).map(|i| sys.stiffness()[(i, i)] / sys.mass()[(i, i)]).fold(0.0, f64::max);
+        prop_assert!(err_k < 1e-9 * lambda_scale, "ΦᵀKΦ − Λ: {err_k:e} (scale {lambda_scale:e})");
         prop_assert!(modes.eigenvalues[0] > 0.0, "supported rotor has λ₁ > 0");
         tally(counts, true);
         Ok(())

@@ -22,15 +22,10 @@ fn ross_rotor() -> Rotor {
 const ROSS: [(f64, f64); 3] = [(36.954, 5e-4), (81.302, 5e-4), (302.94, 5e-3)];
 
 fn assert_ross(rotor: &Rotor) {
-    let modes = DenseSolver
-        .lowest(&rotor.nominal_system().unwrap(), 3)
-        .unwrap();
+    let modes = DenseSolver.lowest(&rotor.nominal_system().unwrap(), 3).unwrap();
     let f = modes.frequencies_hz();
     for (k, (fi, (r, half))) in f.iter().zip(ROSS).enumerate() {
-        assert!(
-            (fi - r).abs() <= half,
-            "mode {k}: {fi} Hz vs ROSS {r} Hz (allowed ±{half})"
-        );
+        assert!((fi - r).abs() <= half, "mode {k}: {fi} Hz vs ROSS {r} Hz (allowed ±{half})");
     }
 }
 

@@ -38,21 +38,8 @@ fn valid_file_parses() {
 fn syntax_error_has_line_and_column() {
     let text = VALID.replace("mass = 0.4", "mass = = 0.4");
     let err = Rotor::from_toml_str(&text).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            RotorError::Parse {
-                line: 14,
-                column: 8,
-                ..
-            }
-        ),
-        "{err:?}"
-    );
-    assert_eq!(
-        err.to_string(),
-        "line 14, column 8: invalid string\nexpected `\"`, `'`"
-    );
+    assert!(matches!(err, RotorError::Parse { line: 14, column: 8, .. }), "{err:?}");
+    assert_eq!(err.to_string(), "line 14, column 8: invalid string\nexpected `\"`, `'`");
 }
 
 #[test]
@@ -86,10 +73,7 @@ fn missing_field_is_named_with_position() {
 #[test]
 fn wrong_type_is_placed() {
     let text = VALID.replace("node = 2", "node = -2");
-    assert_eq!(
-        error(&text),
-        "line 13, column 8: invalid value: integer `-2`, expected usize"
-    );
+    assert_eq!(error(&text), "line 13, column 8: invalid value: integer `-2`, expected usize");
 }
 
 #[test]
@@ -97,40 +81,25 @@ fn file_errors_name_the_file() {
     let dir = std::env::temp_dir().join(format!("eigenfit-rotor-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("bad.toml");
-    std::fs::write(
-        &path,
-        VALID.replace("density = 7850.0", "density = \"heavy\""),
-    )
-    .unwrap();
+    std::fs::write(&path, VALID.replace("density = 7850.0", "density = \"heavy\"")).unwrap();
     let err = Rotor::from_toml_file(&path).unwrap_err().to_string();
     assert_eq!(
         err,
-        format!(
-            "{}: line 5, column 11: invalid type: string \"heavy\", expected f64",
-            path.display()
-        )
+        format!("{}: line 5, column 11: invalid type: string \"heavy\", expected f64", path.display())
     );
     std::fs::remove_dir_all(&dir).unwrap();
     let missing = dir.join("missing.toml");
     let err = Rotor::from_toml_file(&missing).unwrap_err();
     assert!(matches!(err, RotorError::Io { .. }), "{err:?}");
-    assert!(err
-        .to_string()
-        .starts_with(&format!("cannot read `{}`: ", missing.display())));
+    assert!(err.to_string().starts_with(&format!("cannot read `{}`: ", missing.display())));
 }
 
 #[test]
 fn validation_errors_come_through_the_file() {
     let text = VALID.replace("node = 2", "node = 11");
-    assert_eq!(
-        error(&text),
-        "disk 0 is at node 11, but the shaft has nodes 0–10"
-    );
+    assert_eq!(error(&text), "disk 0 is at node 11, but the shaft has nodes 0–10");
     let text = VALID.replace("density = 7850.0", "density = nan");
-    assert_eq!(
-        error(&text),
-        "material `steel`: density = NaN is invalid: it must be finite and > 0"
-    );
+    assert_eq!(error(&text), "material `steel`: density = NaN is invalid: it must be finite and > 0");
 }
 
 #[test]
@@ -146,11 +115,7 @@ fn round_trip_keeps_everything() {
         .section(Section::new(4, 4).inner_diameter(0.0))
         .disk(Disk::new(2, 0.7).with_diametral_inertia(1.5e-3))
         .point_mass(PointMass::new(5, 0.05))
-        .bearing(
-            BearingSpec::new(0, 2e6)
-                .named("drive_end")
-                .with_rotational_stiffness(300.0),
-        )
+        .bearing(BearingSpec::new(0, 2e6).named("drive_end").with_rotational_stiffness(300.0))
         .bearing(BearingSpec::new(5, 3.5e5))
         .build()
         .unwrap();
@@ -160,10 +125,7 @@ fn round_trip_keeps_everything() {
     // Default names are written out, so the parameters keep their names.
     assert!(text.contains("name = \"bearing_1\""), "{text}");
     assert_eq!(back.to_toml_string().unwrap(), text);
-    assert_eq!(
-        back.nominal_system().unwrap(),
-        rotor.nominal_system().unwrap()
-    );
+    assert_eq!(back.nominal_system().unwrap(), rotor.nominal_system().unwrap());
 }
 
 #[test]

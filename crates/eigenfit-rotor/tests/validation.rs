@@ -1,8 +1,6 @@
 //! One test per error class, asserting the exact message the user sees.
 
-use eigenfit_rotor::{
-    BearingSpec, Disk, Material, PointMass, Rotor, RotorBuilder, RotorError, Section,
-};
+use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorBuilder, RotorError, Section};
 
 /// A valid rotor to break one thing at a time: 4 elements of 0.1 m.
 fn base() -> RotorBuilder {
@@ -45,10 +43,7 @@ fn non_finite_and_non_positive_values() {
     );
     assert_eq!(
         message(
-            Rotor::builder()
-                .material(Material::new("steel", 2.1e11, 0.0))
-                .uniform(0.4, 4)
-                .diameter(0.014)
+            Rotor::builder().material(Material::new("steel", 2.1e11, 0.0)).uniform(0.4, 4).diameter(0.014)
         ),
         "material `steel`: density = 0 is invalid: it must be finite and > 0"
     );
@@ -101,10 +96,7 @@ fn node_positions_must_increase() {
 
 #[test]
 fn entries_at_missing_nodes() {
-    assert_eq!(
-        message(base().disk(Disk::new(5, 1.0))),
-        "disk 1 is at node 5, but the shaft has nodes 0–4"
-    );
+    assert_eq!(message(base().disk(Disk::new(5, 1.0))), "disk 1 is at node 5, but the shaft has nodes 0–4");
     assert_eq!(
         message(base().bearing(BearingSpec::new(7, 1e5))),
         "bearing 2 is at node 7, but the shaft has nodes 0–4"
@@ -121,14 +113,8 @@ fn shaft_without_elements() {
         message(base().nodes(vec![0.0])),
         "the shaft has no element: give at least two node positions, or `elements` ≥ 1"
     );
-    assert_eq!(
-        message(base().uniform(0.5, 0)),
-        message(base().nodes(vec![]))
-    );
-    assert_eq!(
-        base().uniform(0.5, 0).build().unwrap_err(),
-        RotorError::NoElements
-    );
+    assert_eq!(message(base().uniform(0.5, 0)), message(base().nodes(vec![])));
+    assert_eq!(base().uniform(0.5, 0).build().unwrap_err(), RotorError::NoElements);
 }
 
 #[test]
@@ -229,11 +215,7 @@ fn sections() {
         "shaft section 0: elements [2, 1] are invalid: the shaft has elements 0–3 and the range is reversed"
     );
     assert_eq!(
-        message(
-            base()
-                .section(Section::new(0, 1))
-                .section(Section::new(1, 3))
-        ),
+        message(base().section(Section::new(0, 1)).section(Section::new(1, 3))),
         "shaft sections 0 and 1 both cover element 1"
     );
 }

@@ -57,10 +57,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         (None, Some(n)) if n >= 2 => {
             let r = parse_list("--range", &args.range.replace(':', ","))?;
             if r.len() != 2 || !(r[0] > 0.0 && r[1] > r[0]) {
-                return Err(input(format!(
-                    "--range `{}`: expected FROM:TO with 0 < FROM < TO",
-                    args.range
-                )));
+                return Err(input(format!("--range `{}`: expected FROM:TO with 0 < FROM < TO", args.range)));
             }
             tensor_grid(&log_space(r[0], r[1], n), np)
         }
@@ -80,9 +77,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         .collect::<Result<Vec<_>, _>>()?;
     if let Some(s) = args.std_hz {
         if !(s.is_finite() && s > 0.0) {
-            return Err(input(format!(
-                "--std-hz {s}: must be a positive finite number"
-            )));
+            return Err(input(format!("--std-hz {s}: must be a positive finite number")));
         }
     }
     let settings = CompareSettings {
@@ -91,16 +86,8 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         std_hz: args.std_hz,
         max_iterations: args.max_iterations,
     };
-    let runs = run_grid(
-        &rotor,
-        &solver.as_ref(),
-        &targets,
-        &initials,
-        &strategies,
-        &settings,
-        |_| {},
-    )
-    .map_err(|e| input(format!("reference data: {e}")))?;
+    let runs = run_grid(&rotor, &solver.as_ref(), &targets, &initials, &strategies, &settings, |_| {})
+        .map_err(|e| input(format!("reference data: {e}")))?;
     let summary = summarise(&runs, &targets, &strategies);
     if args.json {
         let runs_json: Vec<Value> = runs.iter().map(run_json).collect();
@@ -188,10 +175,7 @@ fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKi
     let mut out = Vec::new();
     for t in targets {
         for &s in strategies {
-            let group: Vec<&CompareRun> = runs
-                .iter()
-                .filter(|r| &r.target == t && r.strategy == s)
-                .collect();
+            let group: Vec<&CompareRun> = runs.iter().filter(|r| &r.target == t && r.strategy == s).collect();
             let conv: Vec<&&CompareRun> = group.iter().filter(|r| r.converged).collect();
             let mut iters: Vec<usize> = conv.iter().map(|r| r.iterations).collect();
             iters.sort_unstable();

@@ -5,9 +5,7 @@ use crate::measured;
 use crate::source::{parameter_vector, ModelArgs};
 use clap::Args;
 use eigenfit_core::statistics::uncertainty;
-use eigenfit_core::{
-    Driver, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel,
-};
+use eigenfit_core::{Driver, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
 
@@ -42,19 +40,14 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let solver = args.model.solver()?;
     let measurement = measured::read(&args.measured)?;
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
-        input(format!(
-            "unknown strategy `{}`; available: newton, p-step, damped",
-            args.strategy
-        ))
+        input(format!("unknown strategy `{}`; available: newton, p-step, damped", args.strategy))
     })?;
     let kind = match args.residual.as_str() {
         "relative" => ResidualKind::Relative,
         "hz" => ResidualKind::FrequencyHz,
         "eigenvalue" => ResidualKind::Eigenvalue,
         other => {
-            return Err(input(format!(
-                "unknown residual `{other}`; available: relative, hz, eigenvalue"
-            )))
+            return Err(input(format!("unknown residual `{other}`; available: relative, hz, eigenvalue")))
         }
     };
     let initial = parameter_vector(&rotor, "--initial", args.initial.as_deref(), &[])?;
@@ -77,11 +70,9 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let has_std = measurement.has_std();
     let problem = Problem::new(&rotor, solver.as_ref(), measurement).with_kind(kind);
     let mut strategy = strategy_kind.build();
-    let estimate = Driver {
-        max_iterations: args.max_iterations,
-    }
-    .run(&problem, strategy.as_mut(), &initial, &mut [])
-    .map_err(|e| input(e.to_string()))?;
+    let estimate = Driver { max_iterations: args.max_iterations }
+        .run(&problem, strategy.as_mut(), &initial, &mut [])
+        .map_err(|e| input(e.to_string()))?;
     let unc = if estimate.termination.is_converged() {
         uncertainty(&problem, &estimate.last, has_std)
     } else {
@@ -113,16 +104,12 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         });
         if let Some(u) = &unc {
             out["intervals"] = Value::Object(obj(u.intervals.iter().map(|i| json!(i)).collect()));
-            out["identifiable"] = Value::Object(obj(u
-                .identifiability
-                .iter()
-                .map(identifiability_json)
-                .collect()));
+            out["identifiable"] =
+                Value::Object(obj(u.identifiability.iter().map(identifiability_json).collect()));
             out["singular_values"] = json!(u.singular_values);
             out["condition_number"] = json!(u.condition_number);
-            out["standard_deviations"] = Value::Object(obj((0..np)
-                .map(|i| json!(u.covariance[(i, i)].sqrt()))
-                .collect()));
+            out["standard_deviations"] =
+                Value::Object(obj((0..np).map(|i| json!(u.covariance[(i, i)].sqrt())).collect()));
         }
         println!("{out}");
     } else {
@@ -150,27 +137,11 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 },
                 None => "(no std given)".to_string(),
             };
-            println!(
-                "{n:<20}{:>16.4e}{:>16.6e}{interval:>30}",
-                initial[i], estimate.parameters[i]
-            );
+            println!("{n:<20}{:>16.4e}{:>16.6e}{interval:>30}", initial[i], estimate.parameters[i]);
         }
-        println!(
-            "{:>6}{:>16}{:>16}{:>14}",
-            "mode", "measured [Hz]", "model [Hz]", "diff [Hz]"
-        );
-        for (k, (m, f)) in estimate
-            .last
-            .measured_hz
-            .iter()
-            .zip(&estimate.last.frequencies_hz)
-            .enumerate()
-        {
-            println!(
-                "{:>6}{m:>16.6}{f:>16.6}{:>14.2e}",
-                problem.measured.modes()[k].mode + 1,
-                f - m
-            );
+        println!("{:>6}{:>16}{:>16}{:>14}", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]");
+        for (k, (m, f)) in estimate.last.measured_hz.iter().zip(&estimate.last.frequencies_hz).enumerate() {
+            println!("{:>6}{m:>16.6}{f:>16.6}{:>14.2e}", problem.measured.modes()[k].mode + 1, f - m);
         }
         if let Some(u) = &unc {
             println!(

@@ -48,14 +48,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             rows.push((k, frequencies(&rotor, solver.as_ref(), &p, args.modes)?));
         }
         if args.json {
-            let sweep: Vec<_> = rows
-                .iter()
-                .map(|(k, f)| json!({"stiffness": k, "frequencies_hz": f}))
-                .collect();
-            println!(
-                "{}",
-                json!({"model": label, "solver": solver.name(), "sweep": sweep})
-            );
+            let sweep: Vec<_> =
+                rows.iter().map(|(k, f)| json!({"stiffness": k, "frequencies_hz": f})).collect();
+            println!("{}", json!({"model": label, "solver": solver.name(), "sweep": sweep}));
         } else {
             println!("{label}: natural frequencies against support stiffness (all bearings equal)");
             print!("{:>14}", "k [N/m]");
@@ -72,11 +67,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
     let f = frequencies(&rotor, solver.as_ref(), &p, args.modes)?;
     if args.json {
-        let params: serde_json::Map<_, _> = names
-            .iter()
-            .cloned()
-            .zip(p.iter().map(|&v| json!(v)))
-            .collect();
+        let params: serde_json::Map<_, _> = names.iter().cloned().zip(p.iter().map(|&v| json!(v))).collect();
         println!(
             "{}",
             json!({"model": label, "solver": solver.name(), "parameters": params, "frequencies_hz": f})
@@ -101,19 +92,13 @@ fn frequencies(
     modes: usize,
 ) -> Result<Vec<f64>, CliError> {
     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-    let m = solver
-        .lowest(&system, modes)
-        .map_err(|e| CliError::Failure(e.to_string()))?;
+    let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
     Ok(m.frequencies_hz())
 }
 
 fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
     let parts: Vec<&str> = text.split(':').collect();
-    let bad = || {
-        input(format!(
-            "--sweep `{text}`: expected FROM:TO:COUNT with 0 < FROM < TO and COUNT ≥ 2"
-        ))
-    };
+    let bad = || input(format!("--sweep `{text}`: expected FROM:TO:COUNT with 0 < FROM < TO and COUNT ≥ 2"));
     if parts.len() != 3 {
         return Err(bad());
     }
@@ -124,7 +109,5 @@ fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
         return Err(bad());
     }
     let (la, lb) = (a.log10(), b.log10());
-    Ok((0..count)
-        .map(|i| 10f64.powf(la + (lb - la) * i as f64 / (count - 1) as f64))
-        .collect())
+    Ok((0..count).map(|i| 10f64.powf(la + (lb - la) * i as f64 / (count - 1) as f64)).collect())
 }

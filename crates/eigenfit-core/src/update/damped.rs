@@ -115,15 +115,9 @@ impl Damped {
 
     /// The point reached does not fit: restart from the best untried seed, or end with the best
     /// point found.
-    fn restart(
-        &mut self,
-        problem: &dyn Evaluate,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError> {
+    fn restart(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError> {
         self.remember(current);
-        let seeds = self
-            .seeds
-            .get_or_insert_with(|| ranked_seeds(problem, &current.parameters, &self.fixed));
+        let seeds = self.seeds.get_or_insert_with(|| ranked_seeds(problem, &current.parameters, &self.fixed));
         let mut evaluations = 0;
         while self.restarts < self.max_restarts && !seeds.is_empty() {
             let p = seeds.remove(0);
@@ -134,30 +128,19 @@ impl Damped {
                 self.nu = 2.0;
                 self.stuck_for = 0;
                 self.recent_cost = next.cost();
-                return Ok(Step {
-                    next,
-                    status: StepStatus::Continue,
-                    evaluations,
-                });
+                return Ok(Step { next, status: StepStatus::Continue, evaluations });
             }
         }
         let best = self.best.clone().unwrap_or_else(|| current.clone());
-        Ok(Step {
-            next: best,
-            status: StepStatus::Converged,
-            evaluations,
-        })
+        Ok(Step { next: best, status: StepStatus::Converged, evaluations })
     }
 }
 
 /// Coarse log grid over each free parameter's search range, ranked by residual (lowest first).
 fn ranked_seeds(problem: &dyn Evaluate, around: &[f64], fixed: &[bool]) -> Vec<Vec<f64>> {
     let params = problem.parameters();
-    let per_axis = seeds_per_axis(
-        (0..params.len())
-            .filter(|&i| !fixed.get(i).copied().unwrap_or(false))
-            .count(),
-    );
+    let per_axis =
+        seeds_per_axis((0..params.len()).filter(|&i| !fixed.get(i).copied().unwrap_or(false)).count());
     let axes: Vec<Vec<f64>> = params
         .iter()
         .enumerate()
@@ -167,9 +150,7 @@ fn ranked_seeds(problem: &dyn Evaluate, around: &[f64], fixed: &[bool]) -> Vec<V
             }
             let (lo, hi) = p.search_range();
             let (a, b) = (p.to_scaled(lo), p.to_scaled(hi));
-            (0..per_axis)
-                .map(|k| p.from_scaled(a + (b - a) * (k as f64 + 0.5) / per_axis as f64))
-                .collect()
+            (0..per_axis).map(|k| p.from_scaled(a + (b - a) * (k as f64 + 0.5) / per_axis as f64)).collect()
         })
         .collect();
     let mut points: Vec<Vec<f64>> = vec![Vec::new()];
@@ -199,8 +180,7 @@ fn ranked_seeds(problem: &dyn Evaluate, around: &[f64], fixed: &[bool]) -> Vec<V
 pub fn scaled_jacobian(params: &ParameterSet, lin: &Linearisation) -> DMatrix<f64> {
     let mut js = lin.jacobian.clone();
     for (i, par) in params.iter().enumerate() {
-        js.column_mut(i)
-            .scale_mut(par.scale_derivative(lin.parameters[i]));
+        js.column_mut(i).scale_mut(par.scale_derivative(lin.parameters[i]));
     }
     js
 }
@@ -210,14 +190,8 @@ impl UpdateStrategy for Damped {
         "damped"
     }
 
-    fn start(
-        &mut self,
-        problem: &dyn Evaluate,
-        initial: &Linearisation,
-    ) -> Result<(), UpdateError> {
-        let free = (0..problem.parameters().len())
-            .filter(|&i| self.is_free(i))
-            .count();
+    fn start(&mut self, problem: &dyn Evaluate, initial: &Linearisation) -> Result<(), UpdateError> {
+        let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
         if initial.residual.len() < free {
             return Err(UpdateError::Setup(format!(
                 "damped least squares needs at least as many measured modes as free parameters: {} modes, {free} parameters",
@@ -238,14 +212,8 @@ impl UpdateStrategy for Damped {
         lin.max_rel_diff() <= self.residual_tolerance
     }
 
-    fn step(
-        &mut self,
-        problem: &dyn Evaluate,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError> {
-        let free = (0..problem.parameters().len())
-            .filter(|&i| self.is_free(i))
-            .count();
+    fn step(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError> {
+        let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
         // Far from the data at the start (a frequency off by more than FAR_START): begin from
         // the best point of the coarse grid instead, when it fits better.
         if self.seeds.is_none() && self.max_restarts > 0 && current.max_rel_diff() > FAR_START {
@@ -261,11 +229,7 @@ impl UpdateStrategy for Damped {
                 if next.cost() < current.cost() {
                     self.remember(current);
                     self.recent_cost = next.cost();
-                    return Ok(Step {
-                        next,
-                        status: StepStatus::Continue,
-                        evaluations: evaluations + 1,
-                    });
+                    return Ok(Step { next, status: StepStatus::Continue, evaluations: evaluations + 1 });
                 }
             }
         }
@@ -273,11 +237,7 @@ impl UpdateStrategy for Damped {
             Ok(Some(step)) => {
                 let next = step.next;
                 if self.converged(&next) {
-                    return Ok(Step {
-                        next,
-                        status: StepStatus::Converged,
-                        evaluations: step.evaluations,
-                    });
+                    return Ok(Step { next, status: StepStatus::Converged, evaluations: step.evaluations });
                 }
                 // Plateau watch: a long run of negligible progress on a point that does not fit.
                 if next.cost() < 0.999 * self.recent_cost {
@@ -291,11 +251,7 @@ impl UpdateStrategy for Damped {
                     restarted.evaluations += step.evaluations;
                     return Ok(restarted);
                 }
-                Ok(Step {
-                    next,
-                    status: StepStatus::Continue,
-                    evaluations: step.evaluations,
-                })
+                Ok(Step { next, status: StepStatus::Continue, evaluations: step.evaluations })
             }
             // Stationary, or no step reduces the residual: done if the fit is good, else restart.
             Ok(None) | Err(UpdateError::Stalled(_))
@@ -303,11 +259,7 @@ impl UpdateStrategy for Damped {
             {
                 self.remember(current);
                 let best = self.best.clone().unwrap_or_else(|| current.clone());
-                Ok(Step {
-                    next: best,
-                    status: StepStatus::Converged,
-                    evaluations: 0,
-                })
+                Ok(Step { next: best, status: StepStatus::Converged, evaluations: 0 })
             }
             Ok(None) | Err(UpdateError::Stalled(_)) => self.restart(problem, current),
             Err(e) => Err(e),
@@ -326,11 +278,7 @@ impl Damped {
         let np = params.len();
         let js = scaled_jacobian(params, current);
         let g_full = js.transpose() * &current.residual;
-        let s0: Vec<f64> = params
-            .iter()
-            .zip(&current.parameters)
-            .map(|(p, &v)| p.to_scaled(v))
-            .collect();
+        let s0: Vec<f64> = params.iter().zip(&current.parameters).map(|(p, &v)| p.to_scaled(v)).collect();
         let (lo, hi) = scaled_bounds(params);
         // Active set: a parameter on a bound whose gradient pushes outward stays there this step.
         let free: Vec<bool> = (0..np)
@@ -404,18 +352,11 @@ impl Damped {
                 let rho = actual / predicted;
                 self.mu *= f64::max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0).powi(3));
                 self.nu = 2.0;
-                return Ok(Some(Step {
-                    next: trial,
-                    status: StepStatus::Continue,
-                    evaluations,
-                }));
+                return Ok(Some(Step { next: trial, status: StepStatus::Continue, evaluations }));
             }
             self.reject();
         }
-        Err(UpdateError::Stalled(format!(
-            "no acceptable step in {} trials",
-            self.max_trials
-        )))
+        Err(UpdateError::Stalled(format!("no acceptable step in {} trials", self.max_trials)))
     }
 
     fn reject(&mut self) {
@@ -429,16 +370,8 @@ fn scaled_bounds(params: &ParameterSet) -> (Vec<f64>, Vec<f64>) {
     params
         .iter()
         .map(|p| {
-            let lo = if p.lower.is_finite() {
-                p.to_scaled(p.lower)
-            } else {
-                f64::NEG_INFINITY
-            };
-            let hi = if p.upper.is_finite() {
-                p.to_scaled(p.upper)
-            } else {
-                f64::INFINITY
-            };
+            let lo = if p.lower.is_finite() { p.to_scaled(p.lower) } else { f64::NEG_INFINITY };
+            let hi = if p.upper.is_finite() { p.to_scaled(p.upper) } else { f64::INFINITY };
             (lo, hi)
         })
         .unzip()

@@ -105,9 +105,7 @@ pub struct Driver {
 
 impl Default for Driver {
     fn default() -> Self {
-        Self {
-            max_iterations: 1000,
-        }
+        Self { max_iterations: 1000 }
     }
 }
 
@@ -122,10 +120,7 @@ impl Driver {
         initial: &[f64],
         observers: &mut [&mut dyn Observer],
     ) -> Result<Estimate, UpdateError> {
-        problem
-            .parameters()
-            .check(initial)
-            .map_err(|e| UpdateError::Setup(e.to_string()))?;
+        problem.parameters().check(initial).map_err(|e| UpdateError::Setup(e.to_string()))?;
         let mut current = problem.linearise(initial)?;
         strategy.start(problem, &current)?;
         let mut history = vec![IterationRecord::new(0, &current)];

@@ -79,16 +79,11 @@ pub trait UpdateStrategy {
     /// Name for reports, e.g. `newton`.
     fn name(&self) -> &'static str;
     /// Resets internal state before a run starting at `initial`.
-    fn start(&mut self, problem: &dyn Evaluate, initial: &Linearisation)
-        -> Result<(), UpdateError>;
+    fn start(&mut self, problem: &dyn Evaluate, initial: &Linearisation) -> Result<(), UpdateError>;
     /// Whether `lin` already satisfies the convergence test (checked at the start).
     fn converged(&self, lin: &Linearisation) -> bool;
     /// Takes one step.
-    fn step(
-        &mut self,
-        problem: &dyn Evaluate,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError>;
+    fn step(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError>;
 }
 
 /// Solves the paper's eq. 28, S Δk = Δλ, on the first N modes (N = number of parameters, as in
@@ -111,12 +106,7 @@ pub(crate) fn newton_point(
         .solve(&dlambda)
         .filter(|d| d.iter().all(|v| v.is_finite()))
         .ok_or_else(|| UpdateError::Stalled("the sensitivity matrix is singular".into()))?;
-    Ok(current
-        .parameters
-        .iter()
-        .zip(dk.iter())
-        .map(|(k, d)| k + d)
-        .collect())
+    Ok(current.parameters.iter().zip(dk.iter()).map(|(k, d)| k + d).collect())
 }
 
 /// Largest |f_model − f_measured| (Hz) over the first N modes, N = number of parameters: the
@@ -130,17 +120,9 @@ pub(crate) fn square_max_diff_hz(lin: &Linearisation) -> f64 {
 }
 
 /// Linearises at `p`, turning a point outside the bounds or a failed model into `Diverged`.
-pub(crate) fn evaluate_or_diverge(
-    problem: &dyn Evaluate,
-    p: &[f64],
-) -> Result<Linearisation, UpdateError> {
-    problem
-        .parameters()
-        .check(p)
-        .map_err(|e| UpdateError::Diverged(e.to_string()))?;
-    problem
-        .linearise(p)
-        .map_err(|e| UpdateError::Diverged(e.to_string()))
+pub(crate) fn evaluate_or_diverge(problem: &dyn Evaluate, p: &[f64]) -> Result<Linearisation, UpdateError> {
+    problem.parameters().check(p).map_err(|e| UpdateError::Diverged(e.to_string()))?;
+    problem.linearise(p).map_err(|e| UpdateError::Diverged(e.to_string()))
 }
 
 /// The built-in strategies, by name.
@@ -156,11 +138,7 @@ pub enum StrategyKind {
 
 impl StrategyKind {
     /// Every built-in strategy.
-    pub const ALL: [StrategyKind; 3] = [
-        StrategyKind::Newton,
-        StrategyKind::PStep,
-        StrategyKind::Damped,
-    ];
+    pub const ALL: [StrategyKind; 3] = [StrategyKind::Newton, StrategyKind::PStep, StrategyKind::Damped];
 
     /// The name used on the command line and in reports.
     pub fn name(self) -> &'static str {

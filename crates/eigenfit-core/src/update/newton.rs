@@ -34,22 +34,10 @@ impl UpdateStrategy for Newton {
         square_max_diff_hz(lin) < self.tolerance_hz
     }
 
-    fn step(
-        &mut self,
-        problem: &dyn Evaluate,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError> {
+    fn step(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError> {
         let p = newton_point(current, &current.measured_eigenvalues)?;
         let next = evaluate_or_diverge(problem, &p)?;
-        let status = if self.converged(&next) {
-            StepStatus::Converged
-        } else {
-            StepStatus::Continue
-        };
-        Ok(Step {
-            next,
-            status,
-            evaluations: 1,
-        })
+        let status = if self.converged(&next) { StepStatus::Converged } else { StepStatus::Continue };
+        Ok(Step { next, status, evaluations: 1 })
     }
 }

@@ -67,11 +67,7 @@ impl UpdateStrategy for PStep {
     fn start(&mut self, _: &dyn Evaluate, initial: &Linearisation) -> Result<(), UpdateError> {
         newton_point(initial, &initial.measured_eigenvalues)?;
         self.start_eigenvalues = initial.model_eigenvalues.clone();
-        self.stages = if square_max_diff_hz(initial) > self.split_above_hz {
-            self.parts
-        } else {
-            1
-        };
+        self.stages = if square_max_diff_hz(initial) > self.split_above_hz { self.parts } else { 1 };
         self.stage = 1;
         Ok(())
     }
@@ -80,11 +76,7 @@ impl UpdateStrategy for PStep {
         square_max_diff_hz(lin) < self.tolerance_hz
     }
 
-    fn step(
-        &mut self,
-        problem: &dyn Evaluate,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError> {
+    fn step(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError> {
         let p = newton_point(current, &self.target(current))?;
         let next = evaluate_or_diverge(problem, &p)?;
         // Advance through every stage whose target the new point already meets.
@@ -96,10 +88,6 @@ impl UpdateStrategy for PStep {
         } else {
             StepStatus::Continue
         };
-        Ok(Step {
-            next,
-            status,
-            evaluations: 1,
-        })
+        Ok(Step { next, status, evaluations: 1 })
     }
 }
