@@ -3,10 +3,13 @@
 
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::residual::Problem;
-use crate::statistics::{uncertainty, Identifiability};
+use crate::statistics::{alternative_solutions, uncertainty, Identifiability};
 use crate::update::{Driver, StrategyKind};
 use crate::{EigenSolver, StructuralModel};
 use std::time::Instant;
+
+/// Local fits tried when looking for other solutions of a damped run.
+const ALTERNATIVE_STARTS: usize = 6;
 
 /// How the reference data are made and how each run is limited.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,6 +50,9 @@ pub struct CompareRun {
     pub seconds: f64,
     /// Per parameter, whether the data determine it (damped runs with `std_hz` only).
     pub identifiability: Option<Vec<Identifiability>>,
+    /// Other parameter vectors that fit the data equally well (damped runs only): when not
+    /// empty, the data cannot choose between them and the estimate.
+    pub alternatives: Vec<Vec<f64>>,
 }
 
 /// Reference data: the lowest `modes` frequencies of `model` at `target`, optionally rounded.
@@ -99,7 +105,13 @@ where
                 .then(|| uncertainty(problem, &est.last, problem.measured.has_std()))
                 .flatten()
                 .map(|u| u.identifiability);
+            let alternatives = if converged && strategy == StrategyKind::Damped {
+                alternative_solutions(problem, &est.last, ALTERNATIVE_STARTS)
+            } else {
+                Vec::new()
+            };
             CompareRun {
+                alternatives,
                 strategy,
                 target: target.to_vec(),
                 initial: initial.to_vec(),
@@ -125,6 +137,7 @@ where
             relative_error: relative_error(initial, target),
             seconds,
             identifiability: None,
+            alternatives: Vec::new(),
         },
     }
 }

@@ -43,7 +43,7 @@ pub use residual::{Linearisation, Pairing, Problem, ResidualError, ResidualKind}
 pub use sensitivity::{Sensitivities, SensitivityError};
 pub use solver::{EigenSolver, SolveError};
 pub use sparse::SparseSymmetric;
-pub use statistics::{uncertainty, Identifiability, Uncertainty};
+pub use statistics::{alternative_solutions, uncertainty, Identifiability, Uncertainty};
 pub use system::{System, SystemDerivative, SystemError};
 pub use update::{
     Damped, Driver, Estimate, Newton, PStep, StrategyKind, Termination, UpdateError, UpdateStrategy,

@@ -91,41 +91,48 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     let summary = summarise(&runs, &targets, &strategies);
     if args.json {
         let runs_json: Vec<Value> = runs.iter().map(run_json).collect();
+        let summary_json: Vec<Value> = summary.iter().map(Summary::to_json).collect();
         println!(
             "{}",
-            json!({"model": label, "solver": solver.name(), "decimals": args.decimals, "std_hz": args.std_hz,
-                   "runs": runs_json, "summary": summary})
+            json!({"model": label, "solver": solver.name(), "modes": settings.modes, "decimals": args.decimals,
+                   "std_hz": args.std_hz, "runs": runs_json, "summary": summary_json})
         );
     } else {
         println!(
-            "{label}: {} runs ({} targets × {} initial guesses × {} strategies)",
+            "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",
             runs.len(),
             targets.len(),
             initials.len(),
-            strategies.len()
+            strategies.len(),
+            settings.modes
         );
         println!(
-            "{:<22}{:<10}{:>12}{:>14}{:>14}{:>16}",
-            "target [N/m]", "strategy", "converged", "median iter", "max iter", "max rel error"
+            "{:<16}{:<9}{:>11}{:>12}{:>8}{:>8}{:>15}{:>11}",
+            "target [N/m]",
+            "strategy",
+            "converged",
+            "err ≤ 1e-6",
+            "median",
+            "max",
+            "max rel err",
+            "ambiguous"
         );
         for s in &summary {
+            let target: Vec<String> = s.target.iter().map(|v| format!("{v:.0e}")).collect();
+            let fmt = |v: Option<usize>| v.map_or("-".to_string(), |v| v.to_string());
             println!(
-                "{:<22}{:<10}{:>12}{:>14}{:>14}{:>16.2e}",
-                s["target"]
-                    .as_array()
-                    .map(|t| t
-                        .iter()
-                        .map(|v| format!("{:.0e}", v.as_f64().unwrap_or(f64::NAN)))
-                        .collect::<Vec<_>>()
-                        .join(":"))
-                    .unwrap_or_default(),
-                s["strategy"].as_str().unwrap_or_default(),
-                format!("{}/{}", s["converged"], s["runs"]),
-                s["median_iterations"].to_string(),
-                s["max_iterations"].to_string(),
-                s["max_relative_error"].as_f64().unwrap_or(f64::NAN),
+                "{:<16}{:<9}{:>11}{:>12}{:>8}{:>8}{:>15.2e}{:>11}",
+                target.join(":"),
+                s.strategy.name(),
+                format!("{}/{}", s.converged, s.runs),
+                s.within_1e6,
+                fmt(s.median_iterations),
+                fmt(s.max_iterations),
+                s.max_relative_error,
+                s.ambiguous
             );
         }
+        println!("(median/max: iterations of the converged runs; ambiguous: converged runs whose data also fit another solution)");
     }
     Ok(())
 }
@@ -157,6 +164,9 @@ fn run_json(r: &CompareRun) -> Value {
         "relative_error": r.relative_error,
         "seconds": r.seconds,
     });
+    if r.strategy == StrategyKind::Damped && r.converged {
+        v["alternative_solutions"] = json!(r.alternatives);
+    }
     if let Some(ids) = &r.identifiability {
         v["identifiable"] = ids
             .iter()
@@ -171,7 +181,36 @@ fn run_json(r: &CompareRun) -> Value {
     v
 }
 
-fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKind]) -> Vec<Value> {
+/// Per target and strategy: how many runs converged, how fast, how accurately.
+struct Summary {
+    target: Vec<f64>,
+    strategy: StrategyKind,
+    runs: usize,
+    converged: usize,
+    within_1e6: usize,
+    ambiguous: usize,
+    median_iterations: Option<usize>,
+    max_iterations: Option<usize>,
+    max_relative_error: f64,
+}
+
+impl Summary {
+    fn to_json(&self) -> Value {
+        json!({
+            "target": self.target,
+            "strategy": self.strategy.name(),
+            "runs": self.runs,
+            "converged": self.converged,
+            "converged_within_1e-6": self.within_1e6,
+            "ambiguous": self.ambiguous,
+            "median_iterations": self.median_iterations,
+            "max_iterations": self.max_iterations,
+            "max_relative_error": self.max_relative_error,
+        })
+    }
+}
+
+fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKind]) -> Vec<Summary> {
     let mut out = Vec::new();
     for t in targets {
         for &s in strategies {
@@ -179,16 +218,17 @@ fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKi
             let conv: Vec<&&CompareRun> = group.iter().filter(|r| r.converged).collect();
             let mut iters: Vec<usize> = conv.iter().map(|r| r.iterations).collect();
             iters.sort_unstable();
-            let median = (!iters.is_empty()).then(|| iters[iters.len() / 2]);
-            out.push(json!({
-                "target": t,
-                "strategy": s.name(),
-                "runs": group.len(),
-                "converged": conv.len(),
-                "median_iterations": median,
-                "max_iterations": iters.last(),
-                "max_relative_error": conv.iter().map(|r| r.relative_error).fold(0.0, f64::max),
-            }));
+            out.push(Summary {
+                target: t.clone(),
+                strategy: s,
+                runs: group.len(),
+                converged: conv.len(),
+                within_1e6: conv.iter().filter(|r| r.relative_error <= 1e-6).count(),
+                ambiguous: conv.iter().filter(|r| !r.alternatives.is_empty()).count(),
+                median_iterations: (!iters.is_empty()).then(|| iters[iters.len() / 2]),
+                max_iterations: iters.last().copied(),
+                max_relative_error: conv.iter().map(|r| r.relative_error).fold(0.0, f64::max),
+            });
         }
     }
     out

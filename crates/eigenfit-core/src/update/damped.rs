@@ -137,7 +137,7 @@ impl Damped {
 }
 
 /// Coarse log grid over each free parameter's search range, ranked by residual (lowest first).
-fn ranked_seeds(problem: &dyn Evaluate, around: &[f64], fixed: &[bool]) -> Vec<Vec<f64>> {
+pub(crate) fn ranked_seeds(problem: &dyn Evaluate, around: &[f64], fixed: &[bool]) -> Vec<Vec<f64>> {
     let params = problem.parameters();
     let per_axis =
         seeds_per_axis((0..params.len()).filter(|&i| !fixed.get(i).copied().unwrap_or(false)).count());
