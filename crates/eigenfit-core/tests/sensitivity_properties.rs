@@ -27,7 +27,7 @@ use eigenfit_core::sensitivity::{
 };
 use eigenfit_core::{
     eigenvalue_to_hz, finite_difference_derivative, DenseSolver, EigenSolver, Modes, Sensitivities,
-    SensitivityError, StructuralModel,
+    SensitivityError, StructuralModel, System,
 };
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -47,53 +47,91 @@ const CASES: u32 = 256;
 /// 1e-5 leaves a margin of ≥ 25× over both it and the largest observed error.
 const FD_TOL: f64 = 1e-5;
 
+/// Largest ε·λmax/(λₖ·gap²) for which an eigenvector is compared with FD (see
+/// `check_eigenvector_derivatives`).
+const MAX_FD_ROUNDOFF: f64 = 1e-9;
+
 // ---------------------------------------------------------------------------------------------
 // 1. ΦᵀMΦ = I, ΦᵀKΦ = Λ, λ ascending, sign rule.
 // ---------------------------------------------------------------------------------------------
 
-/// The paper's eqs. 2a/2b for the dense solver, to round-off.
+/// Eqs. 2a/2b and the solver contract for one solve of `count` modes (label: which path).
 ///
-/// Tolerances: the Cholesky reduction is backward stable, so ΦᵀMΦ − I is O(n·ε·κ(M)) with
-/// κ(M) ≲ 10³ here → 1e-10 leaves a margin of ≳ 10³ (observed ≤ 5e-15); ΦᵀKΦ − Λ is O(n·ε·λmax) in absolute terms, so
-/// it is checked to 1e-10·λmax (the ‖K‖/‖M‖ scale), and likewise the residual Kφ − λMφ.
+/// Tolerances: the reductions are backward stable, so ΦᵀMΦ − I is O(n·ε·κ) with κ ≲ 10³ here,
+/// checked to 1e-10 (observed ≤ 1e-14); ΦᵀKΦ − Λ and the residual KΦ − MΦΛ are O(n·ε·λmax) in
+/// absolute terms, so they are checked to 1e-10·λmax (the ‖K‖/‖M‖ scale).
+fn check_solve(sys: &System, modes: &Modes, label: &'static str, worst: &Worst) -> TestCaseResult {
+    let (k, m) = (sys.stiffness(), sys.mass());
+    let c = modes.count();
+    let phi = &modes.shapes;
+    let lam = &modes.eigenvalues;
+    let lmax = lam.amax();
+    let orth = (phi.transpose() * m * phi - DMatrix::identity(c, c)).amax();
+    worst.note(label_of(label, "|ΦᵀMΦ − I|max"), orth);
+    prop_assert!(orth < 1e-10, "{label}: ΦᵀMΦ − I = {orth:e}");
+
+    let diag = (phi.transpose() * k * phi - DMatrix::from_diagonal(lam)).amax() / lmax;
+    worst.note(label_of(label, "|ΦᵀKΦ − Λ|max / λmax"), diag);
+    prop_assert!(diag < 1e-10, "{label}: ΦᵀKΦ − Λ = {diag:e}·λmax");
+
+    let resid = (k * phi - m * phi * DMatrix::from_diagonal(lam)).amax() / (k.amax() * phi.amax());
+    worst.note(label_of(label, "|KΦ − MΦΛ|max / (|K|max |Φ|max)"), resid);
+    prop_assert!(resid < 1e-10, "{label}: residual {resid:e}");
+
+    prop_assert!(lam[0] > 0.0, "{label}: K and M are SPD: λ₀ = {}", lam[0]);
+    for w in lam.as_slice().windows(2) {
+        prop_assert!(w[0] <= w[1], "{label}: not ascending: {lam}");
+    }
+    for (c, col) in phi.column_iter().enumerate() {
+        let max = col.amax();
+        let pivot = col.iter().position(|v| v.abs() >= max * (1.0 - 1e-6)).unwrap();
+        prop_assert!(col[pivot] > 0.0, "{label}: sign rule broken in column {c}: {col}");
+    }
+    Ok(())
+}
+
+/// `Worst` keys are `&'static str`: the two solve paths get fixed labels.
+fn label_of(path: &'static str, metric: &'static str) -> &'static str {
+    match (path, metric) {
+        ("all modes", m) => m,
+        (_, "|ΦᵀMΦ − I|max") => "lowest n/2: |ΦᵀMΦ − I|max",
+        (_, "|ΦᵀKΦ − Λ|max / λmax") => "lowest n/2: |ΦᵀKΦ − Λ|max / λmax",
+        (_, _) => "lowest n/2: |KΦ − MΦΛ|max / (|K|max |Φ|max)",
+    }
+}
+
+/// Property 1: the paper's eqs. 2a/2b, ascending λ and the sign rule, for a solve of all n modes
+/// and of the lowest n/2 (the dense solver takes a different reduction for each); and the two
+/// solves agree to round-off — λ to 1e-12·λmax, well-separated mode shapes to
+/// 1e-13·λmax/(λₖ·gap) (the eigenvector perturbation bound, scaled).
 #[test]
 fn modes_are_mass_normalised_ascending_and_sign_fixed() {
     check("identities", file!(), cases(CASES), spec(MAX_N), |spec, worst| {
         let model = RandomModel::from_spec(&spec);
         let (sys, modes) = all_modes(&model, &model.point);
-        let (k, m) = (sys.stiffness(), sys.mass());
+        check_solve(&sys, &modes, "all modes", worst)?;
         let n = sys.dofs();
-        let phi = &modes.shapes;
-        let lam = &modes.eigenvalues;
-        let lmax = lam.amax();
+        let half = (n / 2).max(1);
+        let some = DenseSolver.lowest(&sys, half).unwrap();
+        prop_assert_eq!(some.count(), half);
+        check_solve(&sys, &some, "lowest n/2", worst)?;
 
-        let orth = (phi.transpose() * m * phi - DMatrix::identity(n, n)).amax();
-        worst.note("|ΦᵀMΦ − I|max", orth);
-        prop_assert!(orth < 1e-10, "ΦᵀMΦ − I = {orth:e}");
-
-        let diag = (phi.transpose() * k * phi - DMatrix::from_diagonal(lam)).amax() / lmax;
-        worst.note("|ΦᵀKΦ − Λ|max / λmax", diag);
-        prop_assert!(diag < 1e-10, "ΦᵀKΦ − Λ = {diag:e}·λmax");
-
-        let resid = (k * phi - m * phi * DMatrix::from_diagonal(lam)).amax() / (k.amax() * phi.amax());
-        worst.note("|KΦ − MΦΛ|max / (|K|max |Φ|max)", resid);
-        prop_assert!(resid < 1e-10, "residual {resid:e}");
-
-        prop_assert!(lam[0] > 0.0, "K and M are SPD: λ₀ = {}", lam[0]);
-        for w in lam.as_slice().windows(2) {
-            prop_assert!(w[0] <= w[1], "not ascending: {lam}");
+        let lmax = modes.eigenvalues.amax();
+        for kk in 0..half {
+            let dl = (some.eigenvalues[kk] - modes.eigenvalues[kk]).abs() / lmax;
+            worst.note("λ(lowest n/2) − λ(all) / λmax", dl);
+            prop_assert!(dl < 1e-12, "mode {kk}: λ differs by {dl:e}·λmax");
+            let gap = relative_gap(&modes.eigenvalues, kk);
+            if gap < MIN_RELATIVE_GAP {
+                continue;
+            }
+            let (a, b) = (some.shapes.column(kk), modes.shapes.column(kk));
+            let b = if a.dot(&b) < 0.0 { -b } else { b.into_owned() };
+            let bound = lmax / (modes.eigenvalues[kk] * gap);
+            let e = (a - &b).amax() / b.amax() / bound;
+            worst.note("|φ(lowest n/2) − φ(all)| / (λmax/(λₖ·gap))", e);
+            prop_assert!(e < 1e-13, "mode {kk}: shapes differ by {e:e}×bound");
         }
-        for (c, col) in phi.column_iter().enumerate() {
-            let max = col.amax();
-            let pivot = col.iter().position(|v| v.abs() >= max * (1.0 - 1e-6)).unwrap();
-            prop_assert!(col[pivot] > 0.0, "sign rule broken in column {c}: {col}");
-        }
-
-        // The lowest m modes are the leading columns of the full solve.
-        let m_lowest = (n / 2).max(1);
-        let some = DenseSolver.lowest(&sys, m_lowest).unwrap();
-        prop_assert_eq!(some.count(), m_lowest);
-        prop_assert_eq!(&some.eigenvalues, &lam.rows(0, m_lowest).into_owned());
         Ok(())
     });
 }
@@ -124,7 +162,12 @@ fn check_eigenvalue_sensitivities(
     prop_assert_eq!(sens.modes.count(), count);
     prop_assert_eq!(sens.eigenvalues.shape(), (count, p.len()));
     prop_assert_eq!(sens.frequencies_hz.shape(), (count, p.len()));
-    prop_assert_eq!(&sens.modes.eigenvalues, &full.eigenvalues.rows(0, count).into_owned());
+    // `compute` solves count + 1 modes, possibly by another reduction than the full solve.
+    let lmax = full.eigenvalues.amax();
+    for kk in 0..count {
+        let dl = (sens.modes.eigenvalues[kk] - full.eigenvalues[kk]).abs() / lmax;
+        prop_assert!(dl < 1e-12, "mode {kk}: λ differs from the full solve by {dl:e}·λmax");
+    }
 
     let n = full.count();
     // λ₀…λₙ₋₁ then f₀…fₙ₋₁ at q, for one FD sweep per parameter.
@@ -156,8 +199,12 @@ fn check_eigenvalue_sensitivities(
             worst.note("df/dp vs FD", ef);
             prop_assert!(el < FD_TOL, "mode {k} param {i}: dλ {dl:e} vs FD {:e}", fd[0]);
             prop_assert!(ef < FD_TOL, "mode {k} param {i}: df {df:e} vs FD {:e}", fd[1]);
-            // The two are tied by df = dλ / (8π² f) exactly.
-            let tie = (df * 8.0 * std::f64::consts::PI.powi(2) * f - dl).abs() / dl.abs().max(lam / pi.abs());
+            // The two are tied by df = dλ / (8π² f) exactly, f from compute's own λ (its solve
+            // may differ from the full one by round-off ~ε·λmax).
+            let f_own = eigenvalue_to_hz(sens.modes.eigenvalues[k]);
+            let tie =
+                (df * 8.0 * std::f64::consts::PI.powi(2) * f_own - dl).abs() / dl.abs().max(lam / pi.abs());
+            worst.note("df·8π²f − dλ (relative)", tie);
             prop_assert!(tie < 1e-12, "df/dλ relation off by {tie:e}");
         }
     }
@@ -229,11 +276,20 @@ fn eigenvalue_sensitivities_of_close_pairs_match_finite_differences() {
 
 /// dφₖ/dpᵢ by Nelson and by the modal expansion over ALL modes (eq. 22 generalised) against a
 /// Richardson central difference of the re-solved, mass-normalised, sign-aligned mode; Nelson vs
-/// modal to 1e-8 (both are exact, they differ only by round-off ~ ε·λmax/(λₖ·gap)); and two exact
-/// identities of the derivative, independent of any FD:
+/// modal to 1e-8 + 100·ε·κₖ (both are exact; each carries the eigenvector round-off ε·κₖ,
+/// κₖ = λmax/(λₖ·gap), observed ≤ 18·ε·κₖ apart); and two exact identities of the derivative,
+/// independent of any FD:
 ///
 /// * differentiated normalisation (eq. 6 with ∂M ≠ 0): 2 φₖᵀM dφₖ + φₖᵀ∂Mφₖ = 0,
 /// * differentiated eigen-equation: (K − λₖM) dφₖ = −(∂K − λₖ∂M − dλₖ M) φₖ.
+///
+/// The FD comparison needs a second "well conditioned" clause besides the gap: a re-solved
+/// eigenvector carries round-off ε·κₖ, the Richardson truncation error is ~(h/gap)⁴ relative
+/// to the coupling, and balancing the two gives a best achievable FD accuracy of
+/// ~C·rₖ^{4/5} with rₖ = ε·κₖ/gap = ε·λmax/(λₖ·gap²) (fitted C ≤ 50 over 6·10⁵ modes). A mode
+/// with rₖ > [`MAX_FD_ROUNDOFF`] is therefore not compared with FD (it still gets the Nelson vs
+/// modal and identity checks): measured, that keeps 93 % of the close-pair modes and all of the
+/// random family, with a worst FD error of 2.2e-7 against 7.7e-6 without the clause.
 fn check_eigenvector_derivatives(model: &impl StructuralModel, p: &[f64], worst: &Worst) -> TestCaseResult {
     let (sys, modes) = all_modes(model, p);
     let (k_mat, m_mat) = (sys.stiffness(), sys.mass());
@@ -250,9 +306,15 @@ fn check_eigenvector_derivatives(model: &impl StructuralModel, p: &[f64], worst:
             continue;
         }
         worst.note("tested modes: 1 / smallest gap", 1.0 / gap);
-        tested += 1;
         let phi = modes.shapes.column(k).into_owned();
         let lam = modes.eigenvalues[k];
+        let kappa = modes.eigenvalues.amax() / (lam.abs() * gap);
+        let fd_resolvable = f64::EPSILON * kappa / gap <= MAX_FD_ROUNDOFF;
+        if fd_resolvable {
+            tested += 1;
+        } else {
+            worst.note("FD-unresolvable modes: largest ε·κ/gap", f64::EPSILON * kappa / gap);
+        }
         for (i, &pi) in p.iter().enumerate() {
             let d = model.derivative(p, i).unwrap();
             let nelson = eigenvector_derivative_nelson(&sys, &modes, k, &d)
@@ -265,27 +327,18 @@ fn check_eigenvector_derivatives(model: &impl StructuralModel, p: &[f64], worst:
             let en = (&nelson - &fd).amax() / scale;
             let em = (&modal - &fd).amax() / scale;
             let nm = (&nelson - &modal).amax() / scale;
-            worst.note("Nelson vs FD", en);
-            if let Ok(path) = std::env::var("TMP_DUMP") {
-                use std::io::Write;
-                let mut f = std::fs::OpenOptions::new().append(true).create(true).open(path).unwrap();
-                writeln!(
-                    f,
-                    "{} {} {} {} {} {}",
-                    modes.eigenvalues.amax() / lam,
-                    gap,
-                    en,
-                    nm,
-                    n,
-                    nelson.amax() * pi.abs() / phi.amax()
-                )
-                .unwrap();
-            }
-            worst.note("full modal vs FD", em);
             worst.note("Nelson vs full modal", nm);
-            prop_assert!(en < FD_TOL, "Nelson mode {k} param {i}: {en:e}");
-            prop_assert!(em < FD_TOL, "modal mode {k} param {i}: {em:e}");
-            prop_assert!(nm < 1e-8, "Nelson vs modal mode {k} param {i}: {nm:e}");
+            worst.note("Nelson vs full modal / (ε·κ)", nm / (f64::EPSILON * kappa));
+            prop_assert!(
+                nm < 1e-8 + 100.0 * f64::EPSILON * kappa,
+                "Nelson vs modal mode {k} param {i}: {nm:e} (κ = {kappa:e})"
+            );
+            if fd_resolvable {
+                worst.note("Nelson vs FD", en);
+                worst.note("full modal vs FD", em);
+                prop_assert!(en < FD_TOL, "Nelson mode {k} param {i}: {en:e}");
+                prop_assert!(em < FD_TOL, "modal mode {k} param {i}: {em:e}");
+            }
 
             let dm = d.mass.to_dense();
             let dk = d.stiffness.to_dense();
@@ -302,7 +355,7 @@ fn check_eigenvector_derivatives(model: &impl StructuralModel, p: &[f64], worst:
             prop_assert!(e_eq < 1e-9, "differentiated eigen-equation {e_eq:e}");
         }
     }
-    prop_assume!(tested > 0, "no well-separated mode");
+    prop_assume!(tested > 0, "no FD-resolvable mode");
     Ok(())
 }
 

@@ -41,6 +41,9 @@ pub struct CompareArgs {
     /// Iteration limit per run.
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: usize,
+    /// Also print a convergence map per target and strategy (grid runs with two parameters).
+    #[arg(long)]
+    pub maps: bool,
     /// Print one JSON object (`runs` array and `summary`) instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -133,6 +136,9 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             );
         }
         println!("(median/max: iterations of the converged runs; ambiguous: converged runs whose data also fit another solution)");
+        if args.maps && np == 2 {
+            print_maps(&runs, &targets, &strategies);
+        }
     }
     Ok(())
 }
@@ -232,4 +238,38 @@ fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKi
         }
     }
     out
+}
+
+/// Convergence maps: one character per initial guess, K1 down the rows, K2 across.
+fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKind]) {
+    let mut k1: Vec<f64> = runs.iter().map(|r| r.initial[0]).collect();
+    k1.sort_by(f64::total_cmp);
+    k1.dedup();
+    println!(
+        "\nmaps: ● converged to the target (rel. error ≤ 1e-6), ○ converged elsewhere, · no convergence"
+    );
+    for t in targets {
+        for &s in strategies {
+            let target: Vec<String> = t.iter().map(|v| format!("{v:.0e}")).collect();
+            println!(
+                "\n{} from K1 (rows, {:.0e} → {:.0e}) × K2 (columns), target {}",
+                s.name(),
+                k1[0],
+                k1[k1.len() - 1],
+                target.join(":")
+            );
+            for &a in &k1 {
+                let row: String = runs
+                    .iter()
+                    .filter(|r| &r.target == t && r.strategy == s && r.initial[0] == a)
+                    .map(|r| match (r.converged, r.relative_error <= 1e-6) {
+                        (true, true) => '●',
+                        (true, false) => '○',
+                        _ => '·',
+                    })
+                    .collect();
+                println!("  {a:>8.1e}  {row}");
+            }
+        }
+    }
 }
