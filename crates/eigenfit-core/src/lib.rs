@@ -46,7 +46,8 @@ pub use sparse::SparseSymmetric;
 pub use statistics::{alternative_solutions, uncertainty, Identifiability, Uncertainty};
 pub use system::{System, SystemDerivative, SystemError};
 pub use update::{
-    Damped, Driver, Estimate, Newton, PStep, StrategyKind, Termination, UpdateError, UpdateStrategy,
+    Damped, Driver, Estimate, IterationRecordSink, Newton, PStep, StrategyKind, Termination, UpdateError,
+    UpdateStrategy,
 };
 
 /// Converts an eigenvalue λ = ω² (rad/s)² to a frequency in Hz.

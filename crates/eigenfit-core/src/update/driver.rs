@@ -163,3 +163,16 @@ impl Driver {
         })
     }
 }
+
+/// An [`Observer`] that keeps every record (tests, plots).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct IterationRecordSink {
+    /// The records seen, in order.
+    pub records: Vec<IterationRecord>,
+}
+
+impl Observer for IterationRecordSink {
+    fn observe(&mut self, record: &IterationRecord) {
+        self.records.push(record.clone());
+    }
+}

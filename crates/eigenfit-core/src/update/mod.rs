@@ -8,9 +8,11 @@ pub(crate) mod damped;
 mod driver;
 mod newton;
 mod pstep;
+#[cfg(test)]
+mod tests;
 
 pub use damped::Damped;
-pub use driver::{Driver, Estimate, IterationRecord, Observer, Termination};
+pub use driver::{Driver, Estimate, IterationRecord, IterationRecordSink, Observer, Termination};
 pub use newton::Newton;
 pub use pstep::PStep;
 

@@ -1,0 +1,108 @@
+//! Strategy and driver tests on a two-mass chain whose answer is known exactly.
+
+use super::*;
+use crate::{
+    DenseSolver, EigenSolver, IterationRecordSink, MeasuredMode, Measurement, ModelError, Parameter,
+    ParameterSet, Problem, Scale, System,
+};
+use nalgebra::DMatrix;
+
+/// ground –k₁– m₁ –k₂– m₂, m = (1, 2) kg; stiffnesses around 1e4 N/m give modes of 10–30 Hz.
+struct Chain(ParameterSet);
+
+impl Chain {
+    fn new() -> Self {
+        let k = |name: &str| Parameter::new(name, "N/m", 1e4).with_bounds(1e-3, 1e9).with_scale(Scale::Log);
+        Self(ParameterSet::new(vec![k("k1"), k("k2")]).unwrap())
+    }
+}
+
+impl StructuralModel for Chain {
+    fn parameters(&self) -> &ParameterSet {
+        &self.0
+    }
+    fn dofs(&self) -> usize {
+        2
+    }
+    fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+        self.0.check(p)?;
+        let k = DMatrix::from_row_slice(2, 2, &[p[0] + p[1], -p[1], -p[1], p[1]]);
+        Ok(System::new(k, DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 2.0])))?)
+    }
+}
+
+fn problem(truth: &[f64]) -> Problem<Chain, DenseSolver> {
+    let chain = Chain::new();
+    let f = DenseSolver.lowest(&chain.assemble(truth).unwrap(), 2).unwrap().frequencies_hz();
+    Problem::new(chain, DenseSolver, Measurement::from_frequencies(&f).unwrap())
+}
+
+#[test]
+fn every_strategy_recovers_the_chain_from_a_nearby_start() {
+    let p = problem(&[3e4, 1e4]);
+    for kind in StrategyKind::ALL {
+        let est = Driver::default().run(&p, kind.build().as_mut(), &[2.5e4, 1.3e4], &mut []).unwrap();
+        assert!(est.termination.is_converged(), "{}: {}", kind.name(), est.termination);
+        // Paper strategies stop at 0.01 Hz; damped fits to round-off.
+        let tol = if kind == StrategyKind::Damped { 1e-8 } else { 1e-2 };
+        assert!((est.parameters[0] / 3e4 - 1.0).abs() < tol, "{}: {:?}", kind.name(), est.parameters);
+        assert!((est.parameters[1] / 1e4 - 1.0).abs() < tol, "{}: {:?}", kind.name(), est.parameters);
+        assert_eq!(est.history.len(), est.iterations + 1);
+    }
+}
+
+#[test]
+fn newton_leaving_the_physical_range_is_reported_as_diverged_with_history() {
+    // Two nearly equal frequencies no positive pair of springs can produce: the chain's
+    // eigenvalue ratio is bounded away from 1, so the linear steps drive a stiffness negative.
+    let p = Problem::new(Chain::new(), DenseSolver, Measurement::from_frequencies(&[10.0, 10.5]).unwrap());
+    let est = Driver::default().run(&p, &mut Newton::default(), &[1e4, 1e4], &mut []).unwrap();
+    assert!(matches!(est.termination, Termination::Diverged(_)), "{}", est.termination);
+    assert!(!est.history.is_empty());
+    // The estimate is the last good iterate, not the rejected one.
+    assert_eq!(est.parameters, est.history.last().unwrap().parameters);
+}
+
+#[test]
+fn damped_converges_from_far_away() {
+    let p = problem(&[3e4, 1e4]);
+    let est = Driver::default().run(&p, &mut Damped::default(), &[5e8, 2e-2], &mut []).unwrap();
+    assert!(est.termination.is_converged(), "{}", est.termination);
+    assert!(est.last.max_rel_diff() < 1e-10);
+}
+
+#[test]
+fn iteration_limit_keeps_the_last_iterate() {
+    let p = problem(&[3e4, 1e4]);
+    let est = Driver { max_iterations: 1 }.run(&p, &mut PStep::default(), &[3e5, 1e3], &mut []).unwrap();
+    assert_eq!(est.termination, Termination::IterationLimit);
+    assert_eq!(est.iterations, 1);
+    assert_eq!(est.parameters, est.history[1].parameters);
+}
+
+#[test]
+fn strategies_refuse_too_few_modes() {
+    let chain = Chain::new();
+    let one = Measurement::new(vec![MeasuredMode::new(0, 10.0)]).unwrap();
+    let p = Problem::new(chain, DenseSolver, one);
+    for kind in StrategyKind::ALL {
+        let err = Driver::default().run(&p, kind.build().as_mut(), &[1e4, 1e4], &mut []).unwrap_err();
+        assert!(matches!(err, UpdateError::Setup(_)), "{}: {err}", kind.name());
+    }
+}
+
+#[test]
+fn observers_see_every_iteration() {
+    let p = problem(&[3e4, 1e4]);
+    let mut sink = IterationRecordSink::default();
+    let est = Driver::default().run(&p, &mut Damped::default(), &[1e3, 1e3], &mut [&mut sink]).unwrap();
+    assert_eq!(sink.records, est.history);
+}
+
+#[test]
+fn strategy_names_round_trip() {
+    for kind in StrategyKind::ALL {
+        assert_eq!(StrategyKind::from_name(kind.name()), Some(kind));
+    }
+    assert_eq!(StrategyKind::from_name("gauss"), None);
+}
