@@ -25,6 +25,7 @@ pub mod dense;
 pub mod measurement;
 pub mod model;
 pub mod modes;
+pub mod multi;
 pub mod parameters;
 pub mod residual;
 pub mod sensitivity;

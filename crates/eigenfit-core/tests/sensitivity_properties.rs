@@ -103,7 +103,7 @@ fn label_of(path: &'static str, metric: &'static str) -> &'static str {
 /// Property 1: the paper's eqs. 2a/2b, ascending λ and the sign rule, for a solve of all n modes
 /// and of the lowest n/2 (the dense solver takes a different reduction for each); and the two
 /// solves agree to round-off — λ to 1e-12·λmax, well-separated mode shapes to
-/// 1e-13·λmax/(λₖ·gap) (the eigenvector perturbation bound, scaled).
+/// 1e-12·λmax/(λₖ·gap) (the eigenvector perturbation bound with a ~4500·ε constant).
 #[test]
 fn modes_are_mass_normalised_ascending_and_sign_fixed() {
     check("identities", file!(), cases(CASES), spec(MAX_N), |spec, worst| {
@@ -130,7 +130,7 @@ fn modes_are_mass_normalised_ascending_and_sign_fixed() {
             let bound = lmax / (modes.eigenvalues[kk] * gap);
             let e = (a - &b).amax() / b.amax() / bound;
             worst.note("|φ(lowest n/2) − φ(all)| / (λmax/(λₖ·gap))", e);
-            prop_assert!(e < 1e-13, "mode {kk}: shapes differ by {e:e}×bound");
+            prop_assert!(e < 1e-12, "mode {kk}: shapes differ by {e:e}×bound");
         }
         Ok(())
     });
