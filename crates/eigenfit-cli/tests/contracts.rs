@@ -1,0 +1,124 @@
+//! The JSON contracts other tools rely on (issues: foundation, strategies).
+
+use serde_json::Value;
+use std::process::Command;
+
+fn eigenfit(args: &[&str]) -> (i32, Value) {
+    let out = Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs");
+    let stdout = String::from_utf8(out.stdout).expect("utf-8");
+    let json = serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}: {stdout}"));
+    (out.status.code().unwrap_or(-1), json)
+}
+
+fn temp_file(name: &str, text: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("eigenfit-contracts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn simulate_prints_ascending_frequencies() {
+    let (code, v) = eigenfit(&[
+        "simulate",
+        "--preset",
+        "paper-rotor",
+        "--stiffness",
+        "1e5,1e5",
+        "--modes",
+        "3",
+        "--json",
+    ]);
+    assert_eq!(code, 0);
+    let f: Vec<f64> = v["frequencies_hz"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    assert_eq!(f.len(), 3);
+    assert!(f.windows(2).all(|w| w[0] < w[1]));
+    // Full precision, and the paper's Table 1 value at 1e5 N/m (36.069 Hz) within 3%.
+    assert!((f[0] / 36.069 - 1.0).abs() < 0.03);
+    assert_ne!(f[0], (f[0] * 1e3).round() / 1e3);
+}
+
+#[test]
+fn ross_example_matches_ross() {
+    let (_, v) = eigenfit(&["simulate", "--preset", "ross-example", "--modes", "3", "--json"]);
+    let f: Vec<f64> = v["frequencies_hz"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    for (got, want) in f.iter().zip([36.954, 81.302, 302.94]) {
+        let digits = if want > 100.0 { 1e2 } else { 1e3 };
+        assert_eq!((got * digits).round() / digits, want);
+    }
+}
+
+#[test]
+fn estimate_reports_parameters_frequencies_and_intervals() {
+    let csv = temp_file("m.csv", "mode,frequency_hz,std_hz\n1,36.107,0.036\n2,84.066,0.084\n3,305.649,0.3\n");
+    let (code, v) = eigenfit(&[
+        "estimate",
+        "--preset",
+        "paper-rotor",
+        "--measured",
+        csv.to_str().unwrap(),
+        "--strategy",
+        "damped",
+        "--initial",
+        "1e2,1e2",
+        "--json",
+    ]);
+    assert_eq!(code, 0);
+    assert_eq!(v["converged"], true);
+    assert!(v["iterations"].as_u64().unwrap() >= 1);
+    let k1 = v["parameters"]["k_K1"].as_f64().unwrap();
+    assert!((k1 / 1e5 - 1.0).abs() < 0.01, "{k1}");
+    assert_eq!(v["frequencies_hz"].as_array().unwrap().len(), 3);
+    let iv = v["intervals"]["k_K1"].as_array().unwrap();
+    assert!(iv[0].as_f64().unwrap() < 1e5 && 1e5 < iv[1].as_f64().unwrap());
+}
+
+#[test]
+fn estimate_that_does_not_converge_exits_with_3_and_still_reports() {
+    let csv = temp_file("far.csv", "mode,frequency_hz\n1,36.107\n2,84.066\n");
+    let (code, v) = eigenfit(&[
+        "estimate",
+        "--preset",
+        "paper-rotor",
+        "--measured",
+        csv.to_str().unwrap(),
+        "--strategy",
+        "newton",
+        "--initial",
+        "1e8,1e8",
+        "--json",
+    ]);
+    assert_eq!(code, 3);
+    assert_eq!(v["converged"], false);
+    assert!(v["parameters"]["k_K2"].is_number());
+}
+
+#[test]
+fn compare_prints_one_run_per_cell() {
+    let (code, v) = eigenfit(&[
+        "compare",
+        "--preset",
+        "paper-rotor",
+        "--targets",
+        "1e5:1e5,1e5:1e3",
+        "--grid",
+        "3",
+        "--strategies",
+        "newton,p-step,damped",
+        "--json",
+    ]);
+    assert_eq!(code, 0);
+    let runs = v["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2 * 9 * 3);
+    for r in runs {
+        for key in ["strategy", "target", "initial", "converged", "iterations", "estimate"] {
+            assert!(!r[key].is_null(), "missing {key} in {r}");
+        }
+        assert_eq!(r["target"].as_array().unwrap().len(), 2);
+        assert_eq!(r["estimate"].as_array().unwrap().len(), 2);
+        if r["strategy"] == "damped" {
+            assert_eq!(r["converged"], true, "{r}");
+        }
+    }
+}
