@@ -22,6 +22,7 @@
 
 pub mod compare;
 pub mod dense;
+pub mod discovery;
 pub mod measurement;
 pub mod model;
 pub mod modes;

@@ -63,6 +63,12 @@ pub trait StructuralModel {
     fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
         finite_difference_derivative(self, p, i)
     }
+
+    /// Physical effects this model may be missing, for the discovery workflow
+    /// ([`discovery`](crate::discovery)). None by default.
+    fn candidates(&self) -> Vec<crate::discovery::Candidate> {
+        Vec::new()
+    }
 }
 
 impl<T: StructuralModel + ?Sized> StructuralModel for &T {
@@ -77,6 +83,9 @@ impl<T: StructuralModel + ?Sized> StructuralModel for &T {
     }
     fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
         (**self).derivative(p, i)
+    }
+    fn candidates(&self) -> Vec<crate::discovery::Candidate> {
+        (**self).candidates()
     }
 }
 

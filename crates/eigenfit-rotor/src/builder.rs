@@ -189,7 +189,7 @@ impl RotorBuilder {
                 .collect(),
         )
         .map_err(RotorError::Parameter)?;
-        Ok(Rotor::from_checked_parts(spec, nodes, elements, bearings, parameters))
+        Rotor::from_checked_parts(spec, nodes, elements, bearings, parameters).apply_effects()
     }
 }
 

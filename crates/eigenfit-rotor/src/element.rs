@@ -49,9 +49,45 @@ pub fn consistent_mass(rho_a: f64, l: f64) -> Matrix4<f64> {
     m * c
 }
 
+/// Poisson's ratio assumed for shear deformation (steel).
+pub const POISSON_RATIO: f64 = 0.3;
+
+/// Cowper's shear coefficient κ of a circular annulus with inner/outer diameter ratio `ratio`:
+/// κ = 6(1+ν)(1+m²)² / ((7+6ν)(1+m²)² + (20+12ν)m²), which is 6(1+ν)/(7+6ν) for a solid section.
+pub fn shear_coefficient(ratio: f64, poisson: f64) -> f64 {
+    let m2 = ratio * ratio;
+    let a = (1.0 + m2).powi(2);
+    6.0 * (1.0 + poisson) * a / ((7.0 + 6.0 * poisson) * a + (20.0 + 12.0 * poisson) * m2)
+}
+
+/// Stiffness matrix of a Timoshenko element (bending plus shear deformation) with shear
+/// parameter Φ = 12EI/(κGAL²):
+///
+/// K = EI/((1+Φ)L³) [[12, 6L, −12, 6L], [6L, (4+Φ)L², −6L, (2−Φ)L²], [−12, −6L, 12, −6L],
+/// [6L, (2−Φ)L², −6L, (4+Φ)L²]]; Φ = 0 gives the Euler–Bernoulli matrix.
+pub fn timoshenko_stiffness(ei: f64, phi: f64, l: f64) -> Matrix4<f64> {
+    let c = ei / ((1.0 + phi) * l.powi(3));
+    let l2 = l * l;
+    #[rustfmt::skip]
+    let k = Matrix4::new(
+        12.0,     6.0 * l,               -12.0,    6.0 * l,
+        6.0 * l,  (4.0 + phi) * l2,      -6.0 * l, (2.0 - phi) * l2,
+        -12.0,    -6.0 * l,              12.0,     -6.0 * l,
+        6.0 * l,  (2.0 - phi) * l2,      -6.0 * l, (4.0 + phi) * l2,
+    );
+    k * c
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn timoshenko_reduces_to_euler_bernoulli_without_shear() {
+        assert!((timoshenko_stiffness(3.0e2, 0.0, 0.07) - stiffness(3.0e2, 0.07)).amax() < 1e-6);
+        // Solid circle, ν = 0.3: κ = 7.8/8.8.
+        assert!((shear_coefficient(0.0, 0.3) - 7.8 / 8.8).abs() < 1e-15);
+    }
     use nalgebra::Vector4;
 
     #[test]

@@ -54,6 +54,16 @@ pub enum RotorError {
         /// What it must be, e.g. `finite and > 0`.
         requirement: &'static str,
     },
+    /// An `[[effect]]` entry names an unknown kind or a bad location.
+    #[error("effect {entry} `{kind}`: {why}")]
+    Effect {
+        /// 0-based index of the entry.
+        entry: usize,
+        /// Its kind as written.
+        kind: String,
+        /// What is wrong.
+        why: String,
+    },
     /// The shaft has no element.
     #[error("the shaft has no element: give at least two node positions, or `elements` ≥ 1")]
     NoElements,

@@ -28,6 +28,9 @@ pub struct RotorSpec {
     /// `[[point_mass]]` tables.
     #[serde(default, rename = "point_mass", skip_serializing_if = "Vec::is_empty")]
     pub point_masses: Vec<PointMass>,
+    /// `[[effect]]` tables: effects switched on (see [`crate::effects`]).
+    #[serde(default, rename = "effect", skip_serializing_if = "Vec::is_empty")]
+    pub effects: Vec<crate::effects::EffectSpec>,
 }
 
 /// A named isotropic material (`[[material]]`).

@@ -52,6 +52,7 @@
 //! ```
 
 mod builder;
+pub mod effects;
 pub mod element;
 mod error;
 mod file;
@@ -59,6 +60,7 @@ mod model;
 pub mod presets;
 
 pub use builder::RotorBuilder;
+pub use effects::EffectSpec;
 pub use error::RotorError;
 pub use file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section, ShaftSpec};
 pub use model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};

@@ -1,7 +1,10 @@
 //! The checked [`Rotor`] and its [`StructuralModel`] implementation.
 
+use crate::effects::{self, EffectSpec};
 use crate::element;
+use crate::error::RotorError;
 use crate::file::{Disk, Material, PointMass, RotorSpec};
+use crate::RotorBuilder;
 use eigenfit_core::{ModelError, ParameterSet, SparseSymmetric, StructuralModel, System, SystemDerivative};
 use nalgebra::{DMatrix, Matrix4};
 
@@ -97,6 +100,46 @@ impl Rotor {
         Self { spec, nodes, elements, bearings, parameters, base_stiffness: k, base_mass: m }
     }
 
+    /// Adds the `[[effect]]` entries of the description to the parameter-independent matrices.
+    pub(crate) fn apply_effects(mut self) -> Result<Self, RotorError> {
+        let effects = self.spec.effects.clone();
+        for (i, e) in effects.iter().enumerate() {
+            let value = effects::check_value(e, i)?;
+            let (dk, dm) = effects::unit_contribution(&self.parts(), e, i)?;
+            add_sparse(&mut self.base_stiffness, &dk, value);
+            add_sparse(&mut self.base_mass, &dm, value);
+        }
+        Ok(self)
+    }
+
+    /// The parts effect contributions are computed from.
+    pub(crate) fn parts(&self) -> effects::Parts<'_> {
+        effects::Parts {
+            nodes: self.nodes.len(),
+            elements: &self.elements,
+            bearings: &self.bearings,
+            disk_nodes: self.spec.disks.iter().map(|d| d.node).collect(),
+            materials: &self.spec.materials,
+        }
+    }
+
+    /// This rotor with one more effect switched on (validated like a file's `[[effect]]`).
+    pub fn with_effect(&self, effect: EffectSpec) -> Result<Rotor, RotorError> {
+        let mut spec = self.spec.clone();
+        spec.effects.push(effect);
+        RotorBuilder::from_spec(spec).build()
+    }
+
+    /// This rotor with its bearings' nominal stiffnesses replaced (N/m, in parameter order).
+    pub fn with_stiffnesses(&self, stiffnesses: &[f64]) -> Result<Rotor, RotorError> {
+        self.parameters.check(stiffnesses).map_err(RotorError::Parameter)?;
+        let mut spec = self.spec.clone();
+        for (b, &k) in spec.bearings.iter_mut().zip(stiffnesses) {
+            b.stiffness = k;
+        }
+        RotorBuilder::from_spec(spec).build()
+    }
+
     /// Node positions along the shaft (m), strictly increasing.
     pub fn nodes(&self) -> &[f64] {
         &self.nodes
@@ -175,6 +218,15 @@ impl Rotor {
     }
 }
 
+fn add_sparse(a: &mut DMatrix<f64>, s: &SparseSymmetric, factor: f64) {
+    for &(i, j, v) in s.entries() {
+        a[(i, j)] += factor * v;
+        if i != j {
+            a[(j, i)] += factor * v;
+        }
+    }
+}
+
 /// Adds a 4×4 element matrix for element `e` (global DOFs 2e … 2e + 3).
 fn add_element(global: &mut DMatrix<f64>, e: usize, local: &Matrix4<f64>) {
     let mut block = global.view_mut((2 * e, 2 * e), (4, 4));
@@ -212,6 +264,10 @@ impl StructuralModel for Rotor {
         d.stiffness.add(j, j, 1.0);
         debug_assert!(d.mass == SparseSymmetric::zeros(self.dofs()));
         Ok(d)
+    }
+
+    fn candidates(&self) -> Vec<eigenfit_core::discovery::Candidate> {
+        effects::candidates(self)
     }
 }
 

@@ -1,0 +1,109 @@
+//! Missing-effect discovery on data in which an effect is hidden (issue: discovery).
+
+use eigenfit::discovery::{discover, Augmented, DiscoveryOptions, DiscoveryReport};
+use eigenfit::rotor::{presets, EffectSpec, Rotor};
+use eigenfit::{DenseSolver, EigenSolver, MeasuredMode, Measurement, StructuralModel};
+
+/// SplitMix64 + Box–Muller: reproducible noise without an RNG crate.
+struct Noise(u64);
+
+impl Noise {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn normal(&mut self) -> f64 {
+        let u = self.uniform().max(f64::MIN_POSITIVE);
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
+    }
+}
+
+/// `modes` measured frequencies of `truth` at `stiffness`, with relative noise `rel`.
+fn measure(truth: &Rotor, stiffness: &[f64], modes: usize, rel: f64, seed: u64) -> Measurement {
+    let f = DenseSolver.lowest(&truth.system_at(stiffness).unwrap(), modes).unwrap().frequencies_hz();
+    let mut noise = Noise(seed);
+    Measurement::new(
+        f.iter()
+            .enumerate()
+            .map(|(k, &f)| MeasuredMode::new(k, f * (1.0 + rel * noise.normal())).with_std(rel * f))
+            .collect(),
+    )
+    .unwrap()
+}
+
+fn run(hidden: Option<EffectSpec>, seed: u64) -> DiscoveryReport {
+    let base = presets::paper_rotor();
+    let truth = match hidden {
+        Some(e) => base.with_effect(e).unwrap(),
+        None => base.clone(),
+    };
+    let k = [2e5, 5e4];
+    let measured = measure(&truth, &k, 8, 5e-4, seed);
+    discover(&base, &DenseSolver, &measured, &base.candidates(), &[1e5, 1e5], &DiscoveryOptions::default())
+        .unwrap()
+}
+
+fn assert_names(report: &DiscoveryReport, kind: &str, location: Option<usize>, value: f64) {
+    let sel = report.selected.as_ref().unwrap_or_else(|| panic!("nothing named; fits: {:#?}", report.fits));
+    assert!(report.disagreement_significant);
+    assert_eq!((sel.kind.as_str(), sel.location), (kind, location), "fits: {:#?}", report.fits);
+    let iv = sel.interval.unwrap();
+    assert!(iv[0] <= value && value <= iv[1], "true value {value} outside the interval {iv:?}");
+    assert!(
+        report.rms_after_hz < 0.5 * report.rms_before_hz,
+        "{} → {}",
+        report.rms_before_hz,
+        report.rms_after_hz
+    );
+}
+
+#[test]
+fn names_a_hidden_disk_inertia() {
+    let r = run(Some(EffectSpec::new("disk-rotary-inertia", Some(0), 4e-3)), 1);
+    assert_names(&r, "disk-rotary-inertia", Some(0), 4e-3);
+}
+
+#[test]
+fn names_a_hidden_point_mass() {
+    let r = run(Some(EffectSpec::new("point-mass", Some(5), 0.3)), 2);
+    assert_names(&r, "point-mass", Some(5), 0.3);
+}
+
+#[test]
+fn names_a_cracked_element() {
+    let r = run(Some(EffectSpec::new("shaft-stiffness-loss", Some(4), 0.3)), 3);
+    assert_names(&r, "shaft-stiffness-loss", Some(4), 0.3);
+}
+
+#[test]
+fn adds_nothing_when_the_model_already_fits() {
+    let r = run(None, 4);
+    assert!(!r.disagreement_significant, "p = {}", r.p_value);
+    assert!(r.selected.is_none());
+    assert_eq!(r.rms_after_hz, r.rms_before_hz);
+}
+
+#[test]
+fn a_candidate_at_a_value_is_the_same_model_as_the_effect_in_a_file() {
+    let base = presets::paper_rotor();
+    for c in base.candidates() {
+        let value = c.parameter.as_ref().map_or(1.0, |p| 0.5 * c.plausible.1.min(p.upper));
+        let aug = Augmented::new(&base, &c).unwrap();
+        let mut p = base.nominal_stiffnesses();
+        if c.parameter.is_some() {
+            p.push(value);
+        }
+        let a = aug.assemble(&p).unwrap();
+        let b = base
+            .with_effect(EffectSpec::new(c.kind.clone(), c.location, value))
+            .unwrap()
+            .nominal_system()
+            .unwrap();
+        let scale = b.stiffness().amax();
+        assert!((a.stiffness() - b.stiffness()).amax() <= 1e-12 * scale, "{}", c.label());
+        assert!((a.mass() - b.mass()).amax() <= 1e-12, "{}", c.label());
+    }
+}
