@@ -6,7 +6,9 @@
 mod commands;
 mod error;
 mod measured;
+mod output;
 mod source;
+mod svg;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -26,14 +28,18 @@ enum Command {
     Estimate(commands::estimate::EstimateArgs),
     /// Compare update strategies over targets and a grid of initial guesses.
     Compare(commands::compare::CompareArgs),
+    /// Find where model and measurement disagree, name the missing effect and add it.
+    Discover(commands::discover::DiscoverArgs),
 }
 
 fn main() -> ExitCode {
+    quiet_panics();
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Simulate(a) => commands::simulate::run(a).map(|()| error::EXIT_OK),
         Command::Estimate(a) => commands::estimate::run(a),
         Command::Compare(a) => commands::compare::run(a).map(|()| error::EXIT_OK),
+        Command::Discover(a) => commands::discover::run(a).map(|()| error::EXIT_OK),
     };
     match result {
         Ok(code) => ExitCode::from(code),
@@ -42,4 +48,22 @@ fn main() -> ExitCode {
             ExitCode::from(e.exit_code())
         }
     }
+}
+
+/// No Rust panic text or backtrace ever reaches the user: a closed pipe (`eigenfit … | head`)
+/// ends the program quietly, anything else is reported as an internal error with exit code 1.
+fn quiet_panics() {
+    std::panic::set_hook(Box::new(|info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("unknown");
+        if msg.contains("Broken pipe") {
+            std::process::exit(0);
+        }
+        eprintln!("eigenfit: internal error: {msg} (please report this with the input that caused it)");
+        std::process::exit(i32::from(error::EXIT_FAILURE));
+    }));
 }

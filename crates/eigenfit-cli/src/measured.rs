@@ -8,9 +8,16 @@ use std::path::Path;
 /// the line.
 pub fn read(path: &Path) -> Result<Measurement, CliError> {
     let bytes = std::fs::read(path).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
-    let text =
-        String::from_utf8(bytes).map_err(|_| input(format!("{}: not a UTF-8 text file", path.display())))?;
-    parse(&text).map_err(|e| input(format!("{}:{e}", path.display())))
+    let text = String::from_utf8(bytes).map_err(|e| {
+        // Say where the first bad byte is: a binary file, or text saved in another encoding.
+        let valid = std::str::from_utf8(&e.as_bytes()[..e.utf8_error().valid_up_to()]).unwrap_or_default();
+        let line = valid.matches('\n').count() + 1;
+        let column = valid.rsplit('\n').next().unwrap_or_default().chars().count() + 1;
+        input(format!("{}:{line}: not a UTF-8 text file (invalid byte at column {column})", path.display()))
+    })?;
+    // Spreadsheets often save CSV as "UTF-8 with BOM"; the BOM is not part of the first column's name.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    parse(text).map_err(|e| input(format!("{}:{e}", path.display())))
 }
 
 /// Parses the CSV text; errors start with `LINE: `.
@@ -31,7 +38,8 @@ pub fn parse(text: &str) -> Result<Measurement, String> {
             "std_hz" => 2,
             other => {
                 return Err(format!(
-                    "{hline}: unknown column `{other}`; the header must be `mode,frequency_hz[,std_hz]`"
+                    "{hline}: unknown column `{}`; the header must be `mode,frequency_hz[,std_hz]`",
+                    other.escape_debug()
                 ))
             }
         };
@@ -55,7 +63,12 @@ pub fn parse(text: &str) -> Result<Measurement, String> {
         let field = |slot: usize| col[slot].map(|i| fields[i]);
         let number = |slot: usize, name: &str| -> Result<Option<f64>, String> {
             field(slot)
-                .map(|s| s.parse::<f64>().map_err(|_| format!("{line}: {name} `{s}` is not a number")))
+                .map(|s| match s {
+                    "" => Err(format!("{line}: {name} is empty")),
+                    _ => s
+                        .parse::<f64>()
+                        .map_err(|_| format!("{line}: {name} `{}` is not a number", s.escape_debug())),
+                })
                 .transpose()
         };
         let mode_text = field(0).unwrap_or_default();

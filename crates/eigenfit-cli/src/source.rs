@@ -3,7 +3,7 @@
 use crate::error::{input, CliError};
 use clap::Args;
 use eigenfit_core::{DenseSolver, EigenSolver, StructuralModel};
-use eigenfit_rotor::{presets, Rotor};
+use eigenfit_rotor::{presets, Rotor, RotorError};
 use std::path::PathBuf;
 
 /// Model selection shared by every command.
@@ -24,7 +24,14 @@ impl ModelArgs {
     /// Loads the model and a label for reports.
     pub fn load(&self) -> Result<(Rotor, String), CliError> {
         if let Some(path) = &self.model {
-            let rotor = Rotor::from_toml_file(path).map_err(|e| input(e.to_string()))?;
+            let rotor = Rotor::from_toml_file(path).map_err(|e| match e {
+                // These already name the file (and the line where the parser could place it).
+                RotorError::Io { .. } | RotorError::Parse { .. } | RotorError::ParseUnplaced { .. } => {
+                    input(e.to_string())
+                }
+                // Validation errors name the entry (`disk 1`, `bearing 0 \`drive_end\``) but not the file.
+                other => input(format!("{}: {other}", path.display())),
+            })?;
             return Ok((rotor, path.display().to_string()));
         }
         let name = self.preset.as_deref().unwrap_or_default();

@@ -122,3 +122,29 @@ fn compare_prints_one_run_per_cell() {
         }
     }
 }
+
+#[test]
+fn discover_names_the_hidden_effect_of_the_example_data() {
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_hidden_effect.csv");
+    let (code, v) = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data, "--json"]);
+    assert_eq!(code, 0);
+    assert_eq!(v["disagreement_significant"], true);
+    // The data were made with disk-rotary-inertia@0 = 1e-3 kg·m² (docs/discovery.md).
+    assert_eq!(v["missing_effect"]["kind"], "disk-rotary-inertia");
+    assert_eq!(v["missing_effect"]["location"], 0);
+    let value = v["missing_effect"]["value"].as_f64().unwrap();
+    assert!((value / 1e-3 - 1.0).abs() < 0.02, "{value}");
+    let (before, after) =
+        (v["rms_residual_before_hz"].as_f64().unwrap(), v["rms_residual_after_hz"].as_f64().unwrap());
+    assert!(after < before / 100.0, "{before} → {after}");
+}
+
+#[test]
+fn discover_adds_nothing_to_a_model_that_fits() {
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_no_effect.csv");
+    let (code, v) = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data, "--json"]);
+    assert_eq!(code, 0);
+    assert_eq!(v["disagreement_significant"], false);
+    assert!(v["missing_effect"].is_null());
+    assert_eq!(v["rms_residual_before_hz"], v["rms_residual_after_hz"]);
+}

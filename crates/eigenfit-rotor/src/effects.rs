@@ -237,8 +237,10 @@ pub fn candidates(rotor: &Rotor) -> Vec<Candidate> {
             });
         }
     };
+    // Values start at 0 (no effect); restart seeds cover three decades below the plausible limit.
     let value = |name: String, unit: &str, lo: f64, hi: f64| {
-        Some(Parameter::new(name, unit, 0.0).with_bounds(lo, hi))
+        let p = Parameter::new(name, unit, 0.0).with_bounds(lo, hi);
+        Some(if lo == 0.0 { p.with_search_range(hi * 1e-4, hi * 0.1) } else { p })
     };
     for (d, disk) in rotor.disks().iter().enumerate() {
         // A disk of radius r has Id ≈ m r²/4; r up to 0.25 m is plausible on a rig like this.

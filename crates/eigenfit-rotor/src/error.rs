@@ -43,7 +43,7 @@ pub enum RotorError {
     #[error("cannot write the rotor as TOML: {0}")]
     Serialize(String),
     /// A number is NaN, infinite, or outside the range where it makes physical sense.
-    #[error("{location}: {quantity} = {value} is invalid: it must be {requirement}")]
+    #[error("{location}: {quantity} = {} is invalid: it must be {requirement}", Num(*.value))]
     InvalidValue {
         /// Where, e.g. `disk 1` or `material \`steel\``.
         location: String,
@@ -81,7 +81,7 @@ pub enum RotorError {
     /// Node positions do not strictly increase (a zero-length or negative-length element).
     #[error(
         "shaft nodes must strictly increase: node {node} at {position} m is not beyond node {} at {previous} m \
-         (element {} would have length {} m)", .node - 1, .node - 1, .position - .previous
+         (element {} would have length {} m)", .node - 1, .node - 1, Num(round12(.position - .previous))
     )]
     NodesNotIncreasing {
         /// The node that is not beyond its predecessor.
@@ -192,4 +192,25 @@ pub enum RotorError {
     /// The bearing parameters could not be formed (should be prevented by the checks above).
     #[error(transparent)]
     Parameter(#[from] eigenfit_core::ParameterError),
+}
+
+/// A number as people write it: plain for moderate magnitudes (`-0.4`, `7850`), with an exponent
+/// otherwise (`1e20`, not `100000000000000000000`; `1e-9`, not `0.000000001`).
+struct Num(f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-4..1e7).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
+}
+
+/// `v` rounded to 12 significant digits: a difference of two positions without its round-off
+/// (`-0.1`, not `-0.09999999999999998`).
+fn round12(v: f64) -> f64 {
+    format!("{v:.11e}").parse().unwrap_or(v)
 }

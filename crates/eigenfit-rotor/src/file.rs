@@ -225,9 +225,16 @@ impl Rotor {
     /// Reads and validates a rotor from a TOML file; parse errors name the file.
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<Self, RotorError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| RotorError::Io { path: path.to_path_buf(), message: e.to_string() })?;
-        parse(&text, Some(path))?.build()
+        let io = |message: String| RotorError::Io { path: path.to_path_buf(), message };
+        let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            // Say where the first bad byte is: a binary file, or text saved in another encoding.
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let (line, column) = line_column(std::str::from_utf8(valid).unwrap_or_default(), valid.len());
+            io(format!("not a UTF-8 text file (invalid byte at line {line}, column {column})"))
+        })?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        parse(text, Some(path))?.build()
     }
 
     /// Writes the rotor as TOML: the description it was built from, with bearing names filled in.

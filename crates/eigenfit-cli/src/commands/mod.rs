@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
 pub mod compare;
+pub mod discover;
 pub mod estimate;
 pub mod simulate;

@@ -4,6 +4,7 @@ use crate::error::{input, CliError};
 use crate::source::{parameter_vector, parse_list, ModelArgs};
 use clap::Args;
 use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_rotor::EffectSpec;
 use serde_json::json;
 
 /// Arguments of `simulate`.
@@ -17,6 +18,11 @@ pub struct SimulateArgs {
     /// Override one parameter, NAME=VALUE (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub sets: Vec<String>,
+    /// Switch an effect on for a what-if study, KIND[@LOCATION]=VALUE (repeatable); kinds:
+    /// disk-rotary-inertia, bearing-rotational-stiffness, support-mass, point-mass,
+    /// shaft-stiffness-loss, modulus-error, shear-deformation.
+    #[arg(long = "effect", value_name = "KIND[@LOCATION]=VALUE")]
+    pub effects: Vec<String>,
     /// Number of modes.
     #[arg(long, default_value_t = 4)]
     pub modes: usize,
@@ -30,7 +36,11 @@ pub struct SimulateArgs {
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
-    let (rotor, label) = args.model.load()?;
+    let (mut rotor, label) = args.model.load()?;
+    for text in &args.effects {
+        let effect = EffectSpec::parse(text).map_err(|e| input(format!("--effect {e}")))?;
+        rotor = rotor.with_effect(effect).map_err(|e| input(format!("--effect `{text}`: {e}")))?;
+    }
     let solver = args.model.solver()?;
     if args.modes == 0 || args.modes > rotor.dofs() {
         return Err(input(format!(

@@ -47,11 +47,20 @@ pub struct DiscoveryOptions {
     pub min_aicc_gain: f64,
     /// Relative frequency std assumed for modes without one (default 1e-3).
     pub assumed_relative_std: f64,
+    /// An effect is named only if, with it, the misfit is one noise can explain: P(χ² ≥ observed)
+    /// at least this (default 1e-3). A better but still inconsistent fit is reported, not named.
+    pub min_after_p_value: f64,
 }
 
 impl Default for DiscoveryOptions {
     fn default() -> Self {
-        Self { significance: 0.05, refits: 8, min_aicc_gain: 4.0, assumed_relative_std: 1e-3 }
+        Self {
+            significance: 0.05,
+            refits: 8,
+            min_aicc_gain: 4.0,
+            assumed_relative_std: 1e-3,
+            min_after_p_value: 1e-3,
+        }
     }
 }
 
@@ -220,7 +229,9 @@ where
     // (d) select by AICc among plausible fits
     let mut plausible = report.fits.iter().filter(|f| f.plausible);
     if let Some(best) = plausible.next() {
-        if aicc_before - best.aicc >= options.min_aicc_gain {
+        let k = best.parameters.len();
+        let consistent = n > k && chi2_upper_tail(best.chi2, n - k) >= options.min_after_p_value;
+        if aicc_before - best.aicc >= options.min_aicc_gain && consistent {
             report.selected = Some(best.clone());
             report.runner_up = plausible.next().cloned();
         }

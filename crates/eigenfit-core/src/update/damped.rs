@@ -149,8 +149,14 @@ pub(crate) fn ranked_seeds(problem: &dyn Evaluate, around: &[f64], fixed: &[bool
                 return vec![around[i]];
             }
             let (lo, hi) = p.search_range();
-            let (a, b) = (p.to_scaled(lo), p.to_scaled(hi));
-            (0..per_axis).map(|k| p.from_scaled(a + (b - a) * (k as f64 + 0.5) / per_axis as f64)).collect()
+            let t = |k: usize| (k as f64 + 0.5) / per_axis as f64;
+            if lo > 0.0 && hi / lo > 100.0 {
+                // A positive range spanning decades is searched in log spacing, whatever the scale.
+                (0..per_axis).map(|k| (lo.ln() + (hi / lo).ln() * t(k)).exp()).collect()
+            } else {
+                let (a, b) = (p.to_scaled(lo), p.to_scaled(hi));
+                (0..per_axis).map(|k| p.from_scaled(a + (b - a) * t(k))).collect()
+            }
         })
         .collect();
     let mut points: Vec<Vec<f64>> = vec![Vec::new()];
