@@ -20,6 +20,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod banded;
 pub mod compare;
 pub mod dense;
 pub mod discovery;
@@ -33,9 +34,11 @@ pub mod sensitivity;
 pub mod solver;
 pub mod sparse;
 pub mod statistics;
+pub mod subspace;
 pub mod system;
 pub mod update;
 
+pub use banded::{BandCholesky, BandedSymmetric};
 pub use dense::DenseSolver;
 pub use measurement::{MeasuredMode, Measurement, MeasurementError};
 pub use model::{finite_difference_derivative, ModelError, StructuralModel};
@@ -46,6 +49,7 @@ pub use sensitivity::{Sensitivities, SensitivityError};
 pub use solver::{EigenSolver, SolveError};
 pub use sparse::SparseSymmetric;
 pub use statistics::{alternative_solutions, uncertainty, Identifiability, Uncertainty};
+pub use subspace::BandedSolver;
 pub use system::{System, SystemDerivative, SystemError};
 pub use update::{
     Damped, Driver, Estimate, IterationRecordSink, Newton, PStep, StrategyKind, Termination, UpdateError,

@@ -76,8 +76,7 @@ pub fn check_distinct(modes: &Modes, k: usize, tolerance: f64, floor: f64) -> Re
 
 /// Round-off level of computed eigenvalues of `system`: 1e-10 · max|Kᵢⱼ| / max|Mᵢⱼ|.
 pub fn noise_floor(system: &System) -> f64 {
-    let kmax = system.stiffness().amax();
-    let mmax = system.mass().amax();
+    let (kmax, mmax) = system.amax();
     if mmax > 0.0 {
         1e-10 * kmax / mmax
     } else {

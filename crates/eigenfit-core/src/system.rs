@@ -1,7 +1,9 @@
 //! Assembled matrices K, M of a structure at one parameter vector, and their parameter derivatives.
 
+use crate::banded::BandedSymmetric;
 use crate::sparse::SparseSymmetric;
 use nalgebra::DMatrix;
+use std::sync::OnceLock;
 use thiserror::Error;
 
 /// Why a pair (K, M) is not a valid symmetric eigenproblem.
@@ -23,10 +25,41 @@ pub enum SystemError {
 }
 
 /// Stiffness K and mass M of a structure (n×n, symmetric; M positive definite for a solve).
-#[derive(Debug, Clone, PartialEq)]
+///
+/// Stored densely ([`System::new`]) or by band ([`System::banded`], for large beam-like models
+/// whose dense matrices would not fit: 10⁴ DOFs are 800 MB per dense matrix, 320 kB per band).
+/// [`stiffness`](Self::stiffness) and [`mass`](Self::mass) always answer with dense matrices —
+/// for a banded system they are built on first use and kept, at O(n²) memory — so dense solvers
+/// work on either; band-aware code asks [`band`](Self::band) first.
+#[derive(Debug, Clone)]
 pub struct System {
-    stiffness: DMatrix<f64>,
-    mass: DMatrix<f64>,
+    storage: Storage,
+}
+
+#[derive(Debug, Clone)]
+enum Storage {
+    Dense {
+        stiffness: DMatrix<f64>,
+        mass: DMatrix<f64>,
+    },
+    Banded {
+        stiffness: BandedSymmetric,
+        mass: BandedSymmetric,
+        dense: OnceLock<(DMatrix<f64>, DMatrix<f64>)>,
+    },
+}
+
+impl PartialEq for System {
+    /// Equal matrices, whatever the storage.
+    fn eq(&self, other: &Self) -> bool {
+        match (&self.storage, &other.storage) {
+            (
+                Storage::Banded { stiffness: k1, mass: m1, .. },
+                Storage::Banded { stiffness: k2, mass: m2, .. },
+            ) if k1.bandwidth() == k2.bandwidth() && m1.bandwidth() == m2.bandwidth() => k1 == k2 && m1 == m2,
+            _ => self.stiffness() == other.stiffness() && self.mass() == other.mass(),
+        }
+    }
 }
 
 impl System {
@@ -46,27 +79,78 @@ impl System {
         }
         check_matrix("K", &stiffness)?;
         check_matrix("M", &mass)?;
-        Ok(Self { stiffness, mass })
+        Ok(Self { storage: Storage::Dense { stiffness, mass } })
+    }
+
+    /// A system stored by band (symmetric by construction): checks size and finiteness, O(n·b).
+    pub fn banded(stiffness: BandedSymmetric, mass: BandedSymmetric) -> Result<Self, SystemError> {
+        let n = stiffness.dim();
+        if mass.dim() != n {
+            return Err(SystemError::Shape { k_rows: n, k_cols: n, m_rows: mass.dim(), m_cols: mass.dim() });
+        }
+        if n == 0 {
+            return Err(SystemError::Empty);
+        }
+        for (name, a) in [("K", &stiffness), ("M", &mass)] {
+            if let Some((row, col, value)) = a.first_non_finite() {
+                return Err(SystemError::NonFinite { matrix: name, row, col, value });
+            }
+        }
+        Ok(Self { storage: Storage::Banded { stiffness, mass, dense: OnceLock::new() } })
     }
 
     /// Number of degrees of freedom n.
     pub fn dofs(&self) -> usize {
-        self.stiffness.nrows()
+        match &self.storage {
+            Storage::Dense { stiffness, .. } => stiffness.nrows(),
+            Storage::Banded { stiffness, .. } => stiffness.dim(),
+        }
     }
 
-    /// Stiffness matrix K.
+    /// (K, M) by band when the system is stored so.
+    pub fn band(&self) -> Option<(&BandedSymmetric, &BandedSymmetric)> {
+        match &self.storage {
+            Storage::Dense { .. } => None,
+            Storage::Banded { stiffness, mass, .. } => Some((stiffness, mass)),
+        }
+    }
+
+    fn dense_pair(&self) -> (&DMatrix<f64>, &DMatrix<f64>) {
+        match &self.storage {
+            Storage::Dense { stiffness, mass } => (stiffness, mass),
+            Storage::Banded { stiffness, mass, dense } => {
+                let (k, m) = dense.get_or_init(|| (stiffness.to_dense(), mass.to_dense()));
+                (k, m)
+            }
+        }
+    }
+
+    /// Stiffness matrix K (dense; built and kept on first use for a banded system).
     pub fn stiffness(&self) -> &DMatrix<f64> {
-        &self.stiffness
+        self.dense_pair().0
     }
 
-    /// Mass matrix M.
+    /// Mass matrix M (dense; built and kept on first use for a banded system).
     pub fn mass(&self) -> &DMatrix<f64> {
-        &self.mass
+        self.dense_pair().1
     }
 
-    /// Consumes the system, returning (K, M).
+    /// Largest |Kᵢⱼ| and largest |Mᵢⱼ|, without densifying a banded system.
+    pub fn amax(&self) -> (f64, f64) {
+        match &self.storage {
+            Storage::Dense { stiffness, mass } => (stiffness.amax(), mass.amax()),
+            Storage::Banded { stiffness, mass, .. } => (stiffness.amax(), mass.amax()),
+        }
+    }
+
+    /// Consumes the system, returning (K, M) dense.
     pub fn into_parts(self) -> (DMatrix<f64>, DMatrix<f64>) {
-        (self.stiffness, self.mass)
+        match self.storage {
+            Storage::Dense { stiffness, mass } => (stiffness, mass),
+            Storage::Banded { stiffness, mass, dense } => {
+                dense.into_inner().unwrap_or_else(|| (stiffness.to_dense(), mass.to_dense()))
+            }
+        }
     }
 }
 
@@ -134,5 +218,26 @@ mod tests {
         ));
         assert!(matches!(System::new(DMatrix::identity(3, 3), m), Err(SystemError::Shape { .. })));
         assert_eq!(System::new(DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)), Err(SystemError::Empty));
+    }
+
+    #[test]
+    fn banded_storage_answers_like_dense() {
+        let k = DMatrix::from_row_slice(3, 3, &[2.0, -1.0, 0.0, -1.0, 2.0, -1.0, 0.0, -1.0, 1.0]);
+        let m = DMatrix::from_diagonal_element(3, 3, 0.5);
+        let dense = System::new(k.clone(), m.clone()).unwrap();
+        let banded =
+            System::banded(BandedSymmetric::from_dense(&k), BandedSymmetric::from_dense(&m)).unwrap();
+        assert_eq!(banded.dofs(), 3);
+        assert_eq!(banded.band().unwrap().0.bandwidth(), 1);
+        assert_eq!(banded.amax(), (2.0, 0.5));
+        assert_eq!(banded.stiffness(), &k);
+        assert_eq!(banded, dense);
+        assert_eq!(banded.clone().into_parts(), (k, m));
+        let mut bad = BandedSymmetric::zeros(3, 1);
+        bad.add(2, 1, f64::INFINITY);
+        assert!(matches!(
+            System::banded(bad, BandedSymmetric::zeros(3, 0)),
+            Err(SystemError::NonFinite { matrix: "K", row: 2, col: 1, .. })
+        ));
     }
 }

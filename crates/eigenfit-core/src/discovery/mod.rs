@@ -17,6 +17,7 @@ pub use candidate::{Augmented, Candidate};
 pub use chi2::chi2_upper_tail;
 
 use crate::measurement::{MeasuredMode, Measurement};
+use crate::multi::Stacked;
 use crate::residual::{Linearisation, Problem};
 use crate::statistics::uncertainty;
 use crate::update::{Damped, Driver, Evaluate};
@@ -67,6 +68,8 @@ impl Default for DiscoveryOptions {
 /// One mode before and after adding the selected effect.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeComparison {
+    /// Test configuration (0 when there is one).
+    pub configuration: usize,
     /// 0-based mode number.
     pub mode: usize,
     /// Measured frequency, Hz.
@@ -168,16 +171,44 @@ where
     M: StructuralModel,
     S: EigenSolver,
 {
-    let measured = with_std(measured, options.assumed_relative_std)?;
-    let n = measured.len();
+    discover_configurations(&[(model, measured)], solver, candidates, initial, options)
+}
+
+/// Runs the workflow on several test configurations of one structure at once (e.g. a building
+/// measured bare and with known test masses): each configuration is a model sharing the same
+/// parameters and the same candidate contributions, with its own measured modes. Mode numbers
+/// in the report run over the configurations in order.
+pub fn discover_configurations<M, S>(
+    configurations: &[(&M, &Measurement)],
+    solver: &S,
+    candidates: &[Candidate],
+    initial: &[f64],
+    options: &DiscoveryOptions,
+) -> Result<DiscoveryReport, DiscoveryError>
+where
+    M: StructuralModel,
+    S: EigenSolver,
+{
+    let Some(&(model, _)) = configurations.first() else {
+        return Err(DiscoveryError::Data("no test configuration given".into()));
+    };
+    let measured: Vec<Measurement> = configurations
+        .iter()
+        .map(|(_, m)| with_std(m, options.assumed_relative_std))
+        .collect::<Result<_, _>>()?;
+    let models: Vec<&M> = configurations.iter().map(|&(m, _)| m).collect();
+    let n: usize = measured.iter().map(Measurement::len).sum();
     let nb = model.parameters().len();
     if n <= nb {
         return Err(DiscoveryError::Data(format!(
             "{n} measured modes for {nb} parameters: detecting a missing effect needs more modes than parameters"
         )));
     }
+    let problems: Vec<Problem<&M, &S>> =
+        models.iter().zip(&measured).map(|(&m, d)| Problem::new(m, solver, d.clone())).collect();
+    let base = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect())
+        .ok_or_else(|| DiscoveryError::Data("the configurations' parameters differ".into()))?;
     // (a) calibrate
-    let base = Problem::new(model, solver, measured.clone());
     let est = Driver::default()
         .run(&base, &mut Damped::default(), initial, &mut [])
         .map_err(|e| DiscoveryError::Calibration(e.to_string()))?;
@@ -211,7 +242,7 @@ where
         .iter()
         .enumerate()
         .filter(|(_, c)| c.parameter.is_some())
-        .filter_map(|(i, c)| screen(model, solver, &measured, c, &base_lin, &projector).map(|s| (i, s)))
+        .filter_map(|(i, c)| screen(&models, solver, &measured, c, &base_lin, &projector).map(|s| (i, s)))
         .collect();
     scored.sort_by(|a, b| b.1.total_cmp(&a.1));
     report.screening = scored.iter().map(|&(i, s)| (candidates[i].label(), s)).collect();
@@ -221,7 +252,7 @@ where
         .map(|&(i, _)| i)
         .chain(candidates.iter().enumerate().filter(|(_, c)| c.parameter.is_none()).map(|(i, _)| i));
     for i in to_refit {
-        if let Some(fit) = refit(model, solver, &measured, &candidates[i], &base_lin.parameters) {
+        if let Some(fit) = refit(&models, solver, &measured, &candidates[i], &base_lin.parameters) {
             report.fits.push(fit);
         }
     }
@@ -258,15 +289,17 @@ fn with_std(measured: &Measurement, relative: f64) -> Result<Measurement, Discov
 }
 
 fn compare_modes(
-    measured: &Measurement,
+    measured: &[Measurement],
     before: &Linearisation,
     after: &Linearisation,
 ) -> Vec<ModeComparison> {
     measured
-        .modes()
         .iter()
         .enumerate()
-        .map(|(k, m)| ModeComparison {
+        .flat_map(|(c, m)| m.modes().iter().map(move |mode| (c, mode)))
+        .enumerate()
+        .map(|(k, (configuration, m))| ModeComparison {
+            configuration,
             mode: m.mode,
             measured_hz: m.frequency_hz,
             std_hz: m.std_hz.unwrap_or(f64::NAN),
@@ -308,21 +341,40 @@ impl Projector {
     }
 }
 
+/// The candidate added to every configuration, stacked into one problem, evaluated by `f`.
+fn with_augmented<M, S, T>(
+    models: &[&M],
+    solver: &S,
+    measured: &[Measurement],
+    candidate: &Candidate,
+    f: impl FnOnce(&dyn Evaluate) -> Option<T>,
+) -> Option<T>
+where
+    M: StructuralModel,
+    S: EigenSolver,
+{
+    let augmented: Vec<Augmented<'_, M>> =
+        models.iter().map(|&m| Augmented::new(m, candidate)).collect::<Result<_, _>>().ok()?;
+    let problems: Vec<Problem<&Augmented<'_, M>, &S>> =
+        augmented.iter().zip(measured).map(|(a, d)| Problem::new(a, solver, d.clone())).collect();
+    let stacked = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect())?;
+    f(&stacked)
+}
+
 /// Predicted χ² reduction of fitting the candidate's value alone, after the base parameters
 /// have absorbed what they can; 0 when the fit would need a value outside the bounds' sign.
 fn screen<M: StructuralModel, S: EigenSolver>(
-    model: &M,
+    models: &[&M],
     solver: &S,
-    measured: &Measurement,
+    measured: &[Measurement],
     candidate: &Candidate,
     base: &Linearisation,
     projector: &Projector,
 ) -> Option<f64> {
     let par = candidate.parameter.as_ref()?;
-    let aug = Augmented::new(model, candidate).ok()?;
     let mut p = base.parameters.clone();
     p.push(par.nominal);
-    let lin = Problem::new(&aug, solver, measured.clone()).linearise(&p).ok()?;
+    let lin = with_augmented(models, solver, measured, candidate, |problem| problem.linearise(&p).ok())?;
     let j = projector.apply(&lin.jacobian.column(lin.jacobian.ncols() - 1).into_owned());
     let r = projector.apply(&lin.residual);
     let jj = j.norm_squared();
@@ -337,39 +389,39 @@ fn screen<M: StructuralModel, S: EigenSolver>(
 
 /// Refits the base parameters with the candidate added.
 fn refit<M: StructuralModel, S: EigenSolver>(
-    model: &M,
+    models: &[&M],
     solver: &S,
-    measured: &Measurement,
+    measured: &[Measurement],
     candidate: &Candidate,
     base_parameters: &[f64],
 ) -> Option<Fit> {
-    let aug = Augmented::new(model, candidate).ok()?;
-    let problem = Problem::new(&aug, solver, measured.clone());
     let mut start = base_parameters.to_vec();
     start.extend(candidate.parameter.as_ref().map(|p| p.nominal));
-    let est = Driver::default().run(&problem, &mut Damped::default(), &start, &mut []).ok()?;
-    let n = measured.len();
-    let k = aug.parameters().len();
-    let chi2 = 2.0 * est.last.cost();
-    let value = candidate.parameter.as_ref().map(|_| est.parameters[k - 1]);
-    let interval = value.and_then(|_| uncertainty(&problem, &est.last, true)).map(|u| u.intervals[k - 1]);
-    let (lo, hi) = candidate.plausible;
-    let plausible = match (value, interval) {
-        (Some(v), Some(iv)) => v >= lo && v <= hi && (iv[0] > 0.0 || iv[1] < 0.0),
-        (Some(v), None) => v >= lo && v <= hi,
-        (None, _) => true,
-    };
-    Some(Fit {
-        label: candidate.label(),
-        kind: candidate.kind.clone(),
-        location: candidate.location,
-        value,
-        unit: candidate.unit().to_string(),
-        interval,
-        chi2,
-        aicc: aicc(chi2, n, k),
-        plausible,
-        frequencies_hz: est.last.frequencies_hz.clone(),
-        parameters: est.parameters,
+    let n: usize = measured.iter().map(Measurement::len).sum();
+    with_augmented(models, solver, measured, candidate, |problem| {
+        let est = Driver::default().run(problem, &mut Damped::default(), &start, &mut []).ok()?;
+        let k = problem.parameters().len();
+        let chi2 = 2.0 * est.last.cost();
+        let value = candidate.parameter.as_ref().map(|_| est.parameters[k - 1]);
+        let interval = value.and_then(|_| uncertainty(problem, &est.last, true)).map(|u| u.intervals[k - 1]);
+        let (lo, hi) = candidate.plausible;
+        let plausible = match (value, interval) {
+            (Some(v), Some(iv)) => v >= lo && v <= hi && (iv[0] > 0.0 || iv[1] < 0.0),
+            (Some(v), None) => v >= lo && v <= hi,
+            (None, _) => true,
+        };
+        Some(Fit {
+            label: candidate.label(),
+            kind: candidate.kind.clone(),
+            location: candidate.location,
+            value,
+            unit: candidate.unit().to_string(),
+            interval,
+            chi2,
+            aicc: aicc(chi2, n, k),
+            plausible,
+            frequencies_hz: est.last.frequencies_hz.clone(),
+            parameters: est.parameters,
+        })
     })
 }
