@@ -17,18 +17,7 @@ use eigenfit::{
     Problem, Scale, StructuralModel, System,
 };
 
-/// The paper's Table 1: support stiffnesses K1, K2 (N/m) and the first two frequencies (Hz).
-const TABLE_1: [([f64; 2], [f64; 2]); 9] = [
-    ([1e2, 1e2], [1.408, 2.827]),
-    ([1e3, 1e3], [4.442, 8.936]),
-    ([1e4, 1e4], [13.738, 28.118]),
-    ([1e5, 1e5], [36.069, 84.517]),
-    ([1e6, 1e6], [55.012, 172.618]),
-    ([1e7, 1e7], [58.791, 196.907]),
-    ([1e8, 1e8], [59.206, 199.536]),
-    ([1e9, 1e9], [59.248, 199.800]),
-    ([1e5, 1e3], [4.921, 71.888]),
-];
+use presets::PAPER_TABLE_1 as TABLE_1;
 
 /// The paper rotor at fixed support stiffnesses; parameters: heavy-disk position, light-disk
 /// position (m), Young's modulus (Pa), density (kg/m³).

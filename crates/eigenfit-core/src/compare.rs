@@ -6,6 +6,7 @@ use crate::residual::Problem;
 use crate::statistics::{alternative_solutions, uncertainty, Identifiability};
 use crate::update::{Driver, StrategyKind};
 use crate::{EigenSolver, StructuralModel};
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Local fits tried when looking for other solutions of a damped run.
@@ -142,9 +143,54 @@ where
     }
 }
 
-/// Every combination of targets × initial guesses × strategies, in that nesting order;
-/// `on_run` sees each finished run (progress, streaming output).
+/// Every combination of targets × initial guesses × strategies, in that nesting order, run in
+/// parallel (rayon); `on_run` sees each finished run on the calling thread, in the order the runs
+/// finish (progress, streaming output). The result is identical to [`run_grid_serial`]'s but for
+/// the wall-clock `seconds` of each run.
 pub fn run_grid<M, S>(
+    model: &M,
+    solver: &S,
+    targets: &[Vec<f64>],
+    initials: &[Vec<f64>],
+    strategies: &[StrategyKind],
+    settings: &CompareSettings,
+    mut on_run: impl FnMut(&CompareRun),
+) -> Result<Vec<CompareRun>, String>
+where
+    M: StructuralModel + Sync,
+    S: EigenSolver + Sync,
+{
+    let problems = targets
+        .iter()
+        .map(|target| {
+            Ok(Problem::new(model, solver, reference_measurement(model, solver, target, settings)?))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let cases: Vec<(usize, &Vec<f64>, StrategyKind)> = (0..targets.len())
+        .flat_map(|t| initials.iter().flat_map(move |i| strategies.iter().map(move |&s| (t, i, s))))
+        .collect();
+    let (sender, receiver) = std::sync::mpsc::channel::<CompareRun>();
+    std::thread::scope(|scope| {
+        let worker = scope.spawn(move || {
+            cases
+                .par_iter()
+                .map_with(sender, |sender, &(t, initial, strategy)| {
+                    let run = run_case(&problems[t], &targets[t], initial, strategy, settings);
+                    // The receiver lives until every run is sent; a failed send only loses progress.
+                    let _ = sender.send(run.clone());
+                    run
+                })
+                .collect::<Vec<_>>()
+        });
+        for run in receiver {
+            on_run(&run);
+        }
+        worker.join().map_err(|_| "a comparison run panicked".to_string())
+    })
+}
+
+/// [`run_grid`] on the calling thread only, one run after another.
+pub fn run_grid_serial<M, S>(
     model: &M,
     solver: &S,
     targets: &[Vec<f64>],
@@ -201,4 +247,54 @@ pub fn tensor_grid(axis: &[f64], dims: usize) -> Vec<Vec<f64>> {
 
 fn relative_error(estimate: &[f64], target: &[f64]) -> f64 {
     estimate.iter().zip(target).map(|(e, t)| (e / t - 1.0).abs()).fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{DenseSolver, ModelError, Parameter, ParameterSet, Scale, System};
+    use nalgebra::{DMatrix, DVector};
+
+    /// ground –k₁– m₁ –k₂– m₂ –k₃– m₃, the three stiffnesses the parameters.
+    struct Chain(ParameterSet);
+
+    impl StructuralModel for Chain {
+        fn parameters(&self) -> &ParameterSet {
+            &self.0
+        }
+        fn dofs(&self) -> usize {
+            3
+        }
+        fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+            self.0.check(p)?;
+            let k = DMatrix::from_row_slice(
+                3,
+                3,
+                &[p[0] + p[1], -p[1], 0.0, -p[1], p[1] + p[2], -p[2], 0.0, -p[2], p[2]],
+            );
+            Ok(System::new(k, DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 1.5])))?)
+        }
+    }
+
+    #[test]
+    fn parallel_grid_equals_serial_in_content_and_order() {
+        let k = |n: &str| Parameter::new(n, "N/m", 1e4).with_bounds(1e-3, 1e9).with_scale(Scale::Log);
+        let chain = Chain(ParameterSet::new(vec![k("k1"), k("k2"), k("k3")]).unwrap());
+        let targets = vec![vec![3e4, 1e4, 2e4], vec![1e3, 5e4, 1e4]];
+        let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
+        let strategies = StrategyKind::ALL;
+        let settings =
+            CompareSettings { modes: 3, decimals: Some(3), std_hz: Some(0.01), max_iterations: 100 };
+        let mut seen = 0;
+        let par = run_grid(&chain, &DenseSolver, &targets, &initials, &strategies, &settings, |_| seen += 1)
+            .unwrap();
+        let ser = run_grid_serial(&chain, &DenseSolver, &targets, &initials, &strategies, &settings, |_| {})
+            .unwrap();
+        assert_eq!(seen, par.len());
+        assert_eq!(par.len(), 2 * 27 * strategies.len());
+        let strip = |runs: Vec<CompareRun>| -> Vec<CompareRun> {
+            runs.into_iter().map(|r| CompareRun { seconds: 0.0, ..r }).collect()
+        };
+        assert_eq!(strip(par), strip(ser));
+    }
 }

@@ -26,7 +26,10 @@ pub enum SolveError {
 ///
 /// Implementations return λ ascending and Φ mass-normalised (ΦᵀMΦ = I) with
 /// [`apply_sign_rule`](crate::apply_sign_rule) applied, so backends are interchangeable.
-pub trait EigenSolver {
+///
+/// Solvers are `Send + Sync` so batches ([`compare::run_grid`](crate::compare::run_grid)) can
+/// share one across threads.
+pub trait EigenSolver: Send + Sync {
     /// Short backend name for reports, e.g. `dense` or `lapack`.
     fn name(&self) -> &'static str;
 

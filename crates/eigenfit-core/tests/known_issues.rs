@@ -1,6 +1,6 @@
 //! Regression tests for defects found in `eigenfit-core/src` while writing the property tests.
 //!
-//! Each asserts the CORRECT behaviour. Open issues are `#[ignore]`d until the fix lands (run them
+//! Each asserts the CORRECT behaviour; both issues found are fixed and stay as regression tests. (Open issues would be `#[ignore]`d until their fix lands — run them
 //! with `cargo test -p eigenfit-core --test known_issues -- --ignored`; remove the `ignore`
 //! together with the fix); fixed ones stay as plain regression tests.
 
@@ -74,7 +74,6 @@ fn compute_with_more_modes_than_dofs_is_an_error_not_a_panic() {
 /// floor used for repeated eigenvalues (`noise_floor(system)`) counts as zero →
 /// `ZeroFrequency` for every n and s below.
 #[test]
-#[ignore = "BUG: rigid-body mode answered or refused depending on round-off sign"]
 fn rigid_body_mode_frequency_sensitivity_is_refused_consistently() {
     let mut answered = Vec::new();
     for n in 2..10 {
@@ -126,7 +125,6 @@ impl StructuralModel for LinearDiag {
 /// that only matters near λ = 0 (e.g. relative to λ₁ or to the first elastic eigenvalue, or a
 /// per-solver round-off estimate) would keep the rigid-body protection.
 #[test]
-#[ignore = "DESIGN ISSUE: noise floor scaled by λmax refuses well-separated low modes"]
 fn noise_floor_does_not_refuse_well_separated_low_modes() {
     let k = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 1.001, 1e8]));
     let sys = System::new(k, DMatrix::identity(3, 3)).unwrap();

@@ -1,17 +1,44 @@
-//! Built-in rotors: the paper's rotor and the ROSS cross-check rotor.
+//! Built-in rotors: the paper's rotor, the ROSS cross-check rotor and a uniform rotor of any mesh
+//! size for scale studies.
 
 use crate::{BearingSpec, Disk, Material, Rotor, RotorError};
 
 /// Names accepted by [`by_name`].
-pub const NAMES: [&str; 2] = ["paper-rotor", "ross-example"];
+pub const NAMES: [&str; 3] = ["paper-rotor", "ross-example", "uniform-rotor"];
 
-/// A preset by name.
+/// A preset by name (`uniform-rotor` with [`UNIFORM_ROTOR_ELEMENTS`] elements).
 pub fn by_name(name: &str) -> Option<Rotor> {
     match name {
         "paper-rotor" => Some(paper_rotor()),
         "ross-example" => Some(ross_example()),
+        "uniform-rotor" => uniform_rotor(UNIFORM_ROTOR_ELEMENTS).ok(),
         _ => None,
     }
+}
+
+/// Default mesh of the `uniform-rotor` preset.
+pub const UNIFORM_ROTOR_ELEMENTS: usize = 100;
+
+/// A uniform rotor for scale studies: a 1.2 m × Ø50 mm steel shaft in `elements` equal elements
+/// (2·(elements + 1) DOFs), disks of 8 kg, 12 kg and 8 kg (diametral inertia 0.02, 0.03 and
+/// 0.02 kg·m²) at the nodes nearest a quarter, half and three quarters of the length, and
+/// bearings `k_A` (node 0) and `k_B` (last node) of 1e7 N/m. Needs `elements` ≥ 4 so the disks
+/// sit on distinct inner nodes, and at most [`MAX_ELEMENTS`](crate::MAX_ELEMENTS).
+pub fn uniform_rotor(elements: usize) -> Result<Rotor, RotorError> {
+    if elements < 4 {
+        return Err(RotorError::ShaftLayout("the uniform rotor needs at least 4 elements"));
+    }
+    let at = |f: f64| ((elements as f64 * f).round() as usize).clamp(1, elements - 1);
+    Rotor::builder()
+        .material(Material::steel())
+        .uniform(1.2, elements)
+        .diameter(0.05)
+        .disk(Disk::new(at(0.25), 8.0).with_diametral_inertia(0.02))
+        .disk(Disk::new(at(0.5), 12.0).with_diametral_inertia(0.03))
+        .disk(Disk::new(at(0.75), 8.0).with_diametral_inertia(0.02))
+        .bearing(BearingSpec::new(0, 1e7).named("A"))
+        .bearing(BearingSpec::new(elements, 1e7).named("B"))
+        .build()
 }
 
 /// The ROSS cross-check rotor: 10 equal elements, Ø14 mm × 500 mm steel shaft, point disks of
@@ -29,6 +56,20 @@ pub fn ross_example() -> Rotor {
         .build()
         .expect("the ROSS example is valid") // proof: fixed data, checked by the test below
 }
+
+/// The paper's Table 1: support stiffnesses [K1, K2] (N/m) and the first two natural
+/// frequencies (Hz) the paper reports for them.
+pub const PAPER_TABLE_1: [([f64; 2], [f64; 2]); 9] = [
+    ([1e2, 1e2], [1.408, 2.827]),
+    ([1e3, 1e3], [4.442, 8.936]),
+    ([1e4, 1e4], [13.738, 28.118]),
+    ([1e5, 1e5], [36.069, 84.517]),
+    ([1e6, 1e6], [55.012, 172.618]),
+    ([1e7, 1e7], [58.791, 196.907]),
+    ([1e8, 1e8], [59.206, 199.536]),
+    ([1e9, 1e9], [59.248, 199.800]),
+    ([1e5, 1e3], [4.921, 71.888]),
+];
 
 /// Heavy (1.35 kg) disk position of the paper rotor, m from the K2 end (calibrated, Table 1).
 pub const PAPER_X_HEAVY_DISK: f64 = 0.120;
@@ -91,25 +132,29 @@ mod tests {
         assert!(super::by_name("nope").is_none());
     }
 
-    /// The paper's Table 1 (K1, K2 in N/m; first and second natural frequency in Hz).
-    const TABLE_1: [([f64; 2], [f64; 2]); 9] = [
-        ([1e2, 1e2], [1.408, 2.827]),
-        ([1e3, 1e3], [4.442, 8.936]),
-        ([1e4, 1e4], [13.738, 28.118]),
-        ([1e5, 1e5], [36.069, 84.517]),
-        ([1e6, 1e6], [55.012, 172.618]),
-        ([1e7, 1e7], [58.791, 196.907]),
-        ([1e8, 1e8], [59.206, 199.536]),
-        ([1e9, 1e9], [59.248, 199.800]),
-        ([1e5, 1e3], [4.921, 71.888]),
-    ];
+    #[test]
+    fn uniform_rotor_scales_and_keeps_its_low_modes() {
+        use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
+        assert!(super::uniform_rotor(3).is_err());
+        assert!(super::uniform_rotor(crate::MAX_ELEMENTS + 1).is_err());
+        let coarse = super::uniform_rotor(40).unwrap();
+        let fine = super::uniform_rotor(400).unwrap();
+        assert_eq!(fine.dofs(), 802);
+        let p = [1e7, 1e7];
+        let a = DenseSolver.lowest(&coarse.system_at(&p).unwrap(), 3).unwrap().frequencies_hz();
+        let b = BandedSolver::default().lowest(&fine.system_at(&p).unwrap(), 3).unwrap().frequencies_hz();
+        for m in 0..3 {
+            // Mesh convergence: 40 elements already resolve the lowest modes.
+            assert!((a[m] / b[m] - 1.0).abs() < 1e-4, "mode {m}: {} vs {}", a[m], b[m]);
+        }
+    }
 
     #[test]
     fn paper_rotor_reproduces_every_value_of_table_1_within_3_percent() {
         use eigenfit_core::{DenseSolver, EigenSolver};
         let rotor = super::paper_rotor();
         let mut worst: f64 = 0.0;
-        for (k, f) in TABLE_1 {
+        for (k, f) in super::PAPER_TABLE_1 {
             let model = DenseSolver.lowest(&rotor.system_at(&k).unwrap(), 2).unwrap().frequencies_hz();
             for m in 0..2 {
                 let diff = (model[m] / f[m] - 1.0).abs();
