@@ -144,24 +144,8 @@ pub const NOISE: f64 = 2e-3;
 /// is detected (χ² above its 95% threshold) in 98% (tests/custom_structure.rs checks the rates).
 pub const SEED: u64 = 2;
 
-/// SplitMix64 with Box–Muller: reproducible normal noise without an RNG crate.
-pub struct Noise(pub u64);
-
-impl Noise {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// A standard normal sample.
-    pub fn normal(&mut self) -> f64 {
-        let u = self.uniform().max(f64::MIN_POSITIVE);
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
-    }
-}
+/// Reproducible normal noise (SplitMix64 with Box–Muller), from eigenfit.
+pub use eigenfit::synthetic::Gaussian as Noise;
 
 /// The model as the engineer knows it: design stiffnesses, drawing masses.
 pub fn building() -> ShearBuilding {

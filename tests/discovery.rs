@@ -2,36 +2,12 @@
 
 use eigenfit::discovery::{discover, Augmented, DiscoveryOptions, DiscoveryReport};
 use eigenfit::rotor::{presets, EffectSpec, Rotor};
-use eigenfit::{DenseSolver, EigenSolver, MeasuredMode, Measurement, StructuralModel};
-
-/// SplitMix64 + Box–Muller: reproducible noise without an RNG crate.
-struct Noise(u64);
-
-impl Noise {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let u = self.uniform().max(f64::MIN_POSITIVE);
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
-    }
-}
+use eigenfit::synthetic::{synthesise, Gaussian};
+use eigenfit::{DenseSolver, Measurement, StructuralModel};
 
 /// `modes` measured frequencies of `truth` at `stiffness`, with relative noise `rel`.
 fn measure(truth: &Rotor, stiffness: &[f64], modes: usize, rel: f64, seed: u64) -> Measurement {
-    let f = DenseSolver.lowest(&truth.system_at(stiffness).unwrap(), modes).unwrap().frequencies_hz();
-    let mut noise = Noise(seed);
-    Measurement::new(
-        f.iter()
-            .enumerate()
-            .map(|(k, &f)| MeasuredMode::new(k, f * (1.0 + rel * noise.normal())).with_std(rel * f))
-            .collect(),
-    )
-    .unwrap()
+    synthesise(truth, &DenseSolver, stiffness, modes, rel, Some(&mut Gaussian(seed))).unwrap()
 }
 
 fn run(hidden: Option<EffectSpec>, seed: u64) -> DiscoveryReport {

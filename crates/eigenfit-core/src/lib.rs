@@ -35,6 +35,7 @@ pub mod solver;
 pub mod sparse;
 pub mod statistics;
 pub mod subspace;
+pub mod synthetic;
 pub mod system;
 pub mod update;
 
