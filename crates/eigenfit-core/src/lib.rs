@@ -53,8 +53,8 @@ pub use statistics::{alternative_solutions, uncertainty, Identifiability, Uncert
 pub use subspace::BandedSolver;
 pub use system::{System, SystemDerivative, SystemError};
 pub use update::{
-    Damped, Driver, Estimate, IterationRecordSink, Newton, PStep, StrategyKind, Termination, UpdateError,
-    UpdateStrategy,
+    Damped, Driver, Estimate, Evaluate, IterationRecord, IterationRecordSink, Newton, Observer, PStep, Step,
+    StepStatus, StrategyKind, Termination, UpdateError, UpdateStrategy,
 };
 
 /// Converts an eigenvalue λ = ω² (rad/s)² to a frequency in Hz.

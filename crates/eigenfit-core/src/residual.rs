@@ -82,6 +82,21 @@ impl Linearisation {
         0.5 * self.residual.norm_squared()
     }
 
+    /// χ² = ‖r‖² (meaningful when the residual is weighted by standard deviations).
+    pub fn chi2(&self) -> f64 {
+        self.residual.norm_squared()
+    }
+
+    /// Degrees of freedom of a fit of all parameters: measured modes − parameters (0 if fewer).
+    pub fn dof(&self) -> usize {
+        self.residual.len().saturating_sub(self.parameters.len())
+    }
+
+    /// Jacobian with respect to the parameters' update scales (log for stiffnesses): J·diag(dp/ds).
+    pub fn scaled_jacobian(&self, params: &ParameterSet) -> DMatrix<f64> {
+        crate::update::damped::scaled_jacobian(params, self)
+    }
+
     /// Largest |f_model − f_measured| in Hz (the paper's stopping test).
     pub fn max_abs_diff_hz(&self) -> f64 {
         self.frequencies_hz.iter().zip(&self.measured_hz).fold(0.0, |m, (a, b)| f64::max(m, (a - b).abs()))
