@@ -148,3 +148,27 @@ fn discover_adds_nothing_to_a_model_that_fits() {
     assert!(v["missing_effect"].is_null());
     assert_eq!(v["rms_residual_before_hz"], v["rms_residual_after_hz"]);
 }
+
+#[cfg(feature = "lapack")]
+#[test]
+fn lapack_and_dense_backends_agree_on_the_paper_rotor() {
+    let run = |solver: &str| -> Vec<f64> {
+        let (code, v) = eigenfit(&[
+            "simulate",
+            "--preset",
+            "paper-rotor",
+            "--stiffness",
+            "1e5,1e3",
+            "--modes",
+            "6",
+            "--solver",
+            solver,
+            "--json",
+        ]);
+        assert_eq!(code, 0);
+        v["frequencies_hz"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    for (d, l) in run("dense").iter().zip(run("lapack")) {
+        assert!((d / l - 1.0).abs() < 1e-9, "dense {d} vs lapack {l}");
+    }
+}
