@@ -1,0 +1,41 @@
+//! Fuzz target `measured_file`: the CLI's measured-data CSV parser on arbitrary text.
+//!
+//! The parser lives in the binary crate, so its source is included here with `#[path]`.
+//! Properties: `parse` returns `Ok` or an error that starts with the 1-based line it is about
+//! (`LINE: …`, a line of the text); an accepted measurement is non-empty, sorted by strictly
+//! increasing mode number, with positive finite frequencies and std all-or-none, positive and
+//! finite.
+
+#![no_main]
+
+#[allow(dead_code)]
+#[path = "../../crates/eigenfit-cli/src/error.rs"]
+mod error;
+#[allow(dead_code)]
+#[path = "../../crates/eigenfit-cli/src/measured.rs"]
+mod measured;
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    // `measured::read` rejects non-UTF-8 files before parsing (tested in the CLI corpus).
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    match measured::parse(text) {
+        Err(message) => {
+            let (line, _) = message.split_once(": ").unwrap_or_else(|| panic!("no `LINE: ` in {message:?}"));
+            let line: usize = line.parse().unwrap_or_else(|_| panic!("no line number in {message:?}"));
+            assert!(
+                line >= 1 && line <= text.lines().count().max(1),
+                "line {line} out of range: {message:?}"
+            );
+        }
+        Ok(m) => {
+            assert!(!m.is_empty());
+            let modes = m.modes();
+            assert!(modes.windows(2).all(|w| w[0].mode < w[1].mode));
+            assert!(modes.iter().all(|x| x.frequency_hz.is_finite() && x.frequency_hz > 0.0));
+            assert!(modes.iter().all(|x| x.std_hz.is_none_or(|s| s.is_finite() && s > 0.0)));
+            assert!(m.has_std() || modes.iter().all(|x| x.std_hz.is_none()));
+        }
+    }
+});
