@@ -159,7 +159,14 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             Pairing::Order => needed,
             Pairing::Mac { .. } => (2 * needed + 2).min(dofs),
         };
-        let sens = Sensitivities::compute(&self.model, &self.solver, p, count)?;
+        let sens = match self.pairing {
+            // Only the measured modes must be distinct and elastic (free–free structures).
+            Pairing::Order => {
+                let wanted: Vec<usize> = self.measured.modes().iter().map(|m| m.mode).collect();
+                Sensitivities::compute_for(&self.model, &self.solver, p, count, &wanted)?
+            }
+            Pairing::Mac { .. } => Sensitivities::compute(&self.model, &self.solver, p, count)?,
+        };
         let paired = self.pair(&sens)?;
         let m = paired.len();
         let np = self.model.parameters().len();

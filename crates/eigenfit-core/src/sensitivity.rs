@@ -118,12 +118,33 @@ impl Sensitivities {
         M: StructuralModel + ?Sized,
         S: EigenSolver + ?Sized,
     {
+        let all: Vec<usize> = (0..count).collect();
+        Self::compute_for(model, solver, p, count, &all)
+    }
+
+    /// Like [`compute`](Self::compute), but only the modes in `wanted` (each < `count`) must be
+    /// distinct and elastic: rows of the other modes are NaN. For data that measure elastic modes
+    /// of a free–free structure, whose rigid-body modes are repeated zeros.
+    pub fn compute_for<M, S>(
+        model: &M,
+        solver: &S,
+        p: &[f64],
+        count: usize,
+        wanted: &[usize],
+    ) -> Result<Self, SensitivityError>
+    where
+        M: StructuralModel + ?Sized,
+        S: EigenSolver + ?Sized,
+    {
         let system = model.assemble(p)?;
         crate::solver::check_count(&system, count)?;
+        if let Some(&k) = wanted.iter().find(|&&k| k >= count) {
+            return Err(SensitivityError::ModeIndex { mode: k, count });
+        }
         let extra = (count + 1).min(system.dofs());
         let mut modes = solver.lowest(&system, extra)?;
         let floor = noise_floor(&system);
-        for k in 0..count.min(modes.count()) {
+        for &k in wanted {
             check_distinct(&modes, k, DEFAULT_REPEATED_TOLERANCE, floor)?;
         }
         if modes.count() > count {
@@ -133,20 +154,22 @@ impl Sensitivities {
             };
         }
         let np = model.parameters().len();
-        let mut dl = DMatrix::zeros(count, np);
-        for i in 0..np {
-            let d = model.derivative(p, i)?;
-            for k in 0..count {
-                dl[(k, i)] = eigenvalue_derivative(&modes, k, &d);
-            }
-        }
-        let mut df = DMatrix::zeros(count, np);
-        for k in 0..count {
+        let mut dl = DMatrix::from_element(count, np, f64::NAN);
+        let mut df = DMatrix::from_element(count, np, f64::NAN);
+        for &k in wanted {
             let lambda = modes.eigenvalues[k];
             if lambda <= floor {
                 return Err(SensitivityError::ZeroFrequency { mode: k, lambda });
             }
-            let f = crate::eigenvalue_to_hz(lambda);
+        }
+        for i in 0..np {
+            let d = model.derivative(p, i)?;
+            for &k in wanted {
+                dl[(k, i)] = eigenvalue_derivative(&modes, k, &d);
+            }
+        }
+        for &k in wanted {
+            let f = crate::eigenvalue_to_hz(modes.eigenvalues[k]);
             let factor = 1.0 / (8.0 * std::f64::consts::PI.powi(2) * f);
             df.row_mut(k).copy_from(&(dl.row(k) * factor));
         }

@@ -134,11 +134,6 @@ proptest! {
         };
         // The initial guess: random (possibly out of bounds, possibly the wrong length) or nominal.
         let np = rotor.parameters().len();
-        // Known core bug, pinned by `zero_parameters_newton_does_not_panic` below: the paper's
-        // Newton step (used by newton and p-step) panics inside nalgebra with no parameter.
-        if np == 0 && strategy != StrategyKind::Damped {
-            return Ok(());
-        }
         let initial = if start.len() == np { start } else { rotor.nominal_stiffnesses() };
         let problem = Problem::new(&rotor, DenseSolver, measurement);
         let mut strategy = strategy.build();
@@ -161,10 +156,8 @@ proptest! {
 /// Found by the property above (4000 cases): a rotor without bearings has no parameter, and the
 /// Newton step then LU-solves a 0×0 system, which overflows inside nalgebra
 /// (`solve_lower_triangular_with_diag_mut`: attempt to subtract with overflow) instead of
-/// returning a typed error. The fix belongs in `eigenfit_core::update::newton_point` (or the
-/// driver: refuse a problem without parameters). Un-ignore once fixed.
+/// returning a typed error. Fixed: the driver refuses a problem without parameters.
 #[test]
-#[ignore = "core bug: newton_point panics on a model with no parameter"]
 fn zero_parameters_newton_does_not_panic() {
     let rotor = RotorBuilder::new()
         .material(Material::new("wire", 280983041803.2432, 1000.0))

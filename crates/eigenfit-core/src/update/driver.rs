@@ -120,6 +120,9 @@ impl Driver {
         initial: &[f64],
         observers: &mut [&mut dyn Observer],
     ) -> Result<Estimate, UpdateError> {
+        if problem.parameters().is_empty() {
+            return Err(UpdateError::Setup("the model has no parameter: nothing to estimate".into()));
+        }
         problem.parameters().check(initial).map_err(|e| UpdateError::Setup(e.to_string()))?;
         let mut current = problem.linearise(initial)?;
         strategy.start(problem, &current)?;

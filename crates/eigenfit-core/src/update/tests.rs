@@ -106,3 +106,42 @@ fn strategy_names_round_trip() {
     }
     assert_eq!(StrategyKind::from_name("gauss"), None);
 }
+
+/// Two masses (1, 2 kg) joined by one spring k and nothing else: a free–free structure.
+struct FreeFree(ParameterSet);
+
+impl StructuralModel for FreeFree {
+    fn parameters(&self) -> &ParameterSet {
+        &self.0
+    }
+    fn dofs(&self) -> usize {
+        2
+    }
+    fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+        self.0.check(p)?;
+        let k = DMatrix::from_row_slice(2, 2, &[p[0], -p[0], -p[0], p[0]]);
+        Ok(System::new(k, DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 2.0])))?)
+    }
+}
+
+#[test]
+fn a_free_free_structure_is_updated_from_its_elastic_mode() {
+    let params =
+        ParameterSet::new(vec![Parameter::new("k", "N/m", 1e3).with_bounds(1.0, 1e9).with_scale(Scale::Log)])
+            .unwrap();
+    // λ = k (1/m₁ + 1/m₂) = 1.5 k for the elastic mode; the rigid-body mode (mode 0) is not measured.
+    let truth: f64 = 4e4;
+    let f = (1.5 * truth).sqrt() / (2.0 * std::f64::consts::PI);
+    let p =
+        Problem::new(FreeFree(params), DenseSolver, Measurement::new(vec![MeasuredMode::new(1, f)]).unwrap());
+    let est = Driver::default().run(&p, &mut Damped::default(), &[1e3], &mut []).unwrap();
+    assert!(est.termination.is_converged(), "{}", est.termination);
+    assert!((est.parameters[0] / truth - 1.0).abs() < 1e-8, "{:?}", est.parameters);
+    // Asking for the rigid-body mode itself is refused, never answered with a number.
+    let rigid = Problem::new(
+        FreeFree(ParameterSet::new(vec![Parameter::new("k", "N/m", 1e3)]).unwrap()),
+        DenseSolver,
+        Measurement::new(vec![MeasuredMode::new(0, 1.0), MeasuredMode::new(1, f)]).unwrap(),
+    );
+    assert!(rigid.linearise(&[1e3]).is_err());
+}
