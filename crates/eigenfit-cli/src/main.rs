@@ -7,8 +7,9 @@ mod commands;
 mod error;
 mod measured;
 mod output;
+mod plot;
+mod progress;
 mod source;
-mod svg;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -30,6 +31,9 @@ enum Command {
     Compare(commands::compare::CompareArgs),
     /// Find where model and measurement disagree, name the missing effect and add it.
     Discover(commands::discover::DiscoverArgs),
+    /// The paper rotor end to end: Table 1, Table 3 case 1 with every strategy, a convergence map
+    /// and a discovery, with every plot written to a folder.
+    Demo(commands::demo::DemoArgs),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +44,7 @@ fn main() -> ExitCode {
         Command::Estimate(a) => commands::estimate::run(a),
         Command::Compare(a) => commands::compare::run(a).map(|()| error::EXIT_OK),
         Command::Discover(a) => commands::discover::run(a).map(|()| error::EXIT_OK),
+        Command::Demo(a) => commands::demo::run(a).map(|()| error::EXIT_OK),
     };
     match result {
         Ok(code) => ExitCode::from(code),

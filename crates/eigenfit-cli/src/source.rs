@@ -2,9 +2,18 @@
 
 use crate::error::{input, CliError};
 use clap::Args;
-use eigenfit_core::{DenseSolver, EigenSolver, StructuralModel};
+use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
 use eigenfit_rotor::{presets, Rotor, RotorError};
+use std::cell::Cell;
 use std::path::PathBuf;
+
+/// Largest model (DOFs) that `--solver auto` gives to the dense solver; larger ones go to the
+/// banded solver.
+pub const AUTO_DENSE_MAX_DOFS: usize = 400;
+
+/// Largest model (DOFs) a dense backend (`dense`, `lapack`) accepts: its two n×n matrices take
+/// 16n² bytes (256 MB here) and its solve O(n³) time.
+pub const DENSE_MAX_DOFS: usize = 4002;
 
 /// Model selection shared by every command.
 #[derive(Debug, Args)]
@@ -12,17 +21,47 @@ pub struct ModelArgs {
     /// Rotor model file (TOML, see docs/rotor-model.md).
     #[arg(long, value_name = "FILE.toml", conflicts_with = "preset", required_unless_present = "preset")]
     pub model: Option<PathBuf>,
-    /// Built-in model: paper-rotor, ross-example.
+    /// Built-in model: paper-rotor, ross-example, uniform-rotor.
     #[arg(long, value_name = "NAME")]
     pub preset: Option<String>,
-    /// Eigen-solver backend: dense (default) or lapack (when built with the `lapack` feature).
-    #[arg(long, default_value = "dense", value_name = "NAME")]
+    /// Shaft elements of the uniform-rotor preset (4 … 100000; default 100).
+    #[arg(long, value_name = "N", requires = "preset")]
+    pub elements: Option<usize>,
+    /// Eigen-solver backend: auto (default: dense up to 400 DOFs, banded beyond), dense, banded
+    /// (shift-invert subspace iteration by band, for large models) or lapack (when built with the
+    /// `lapack` feature).
+    #[arg(long, default_value = "auto", value_name = "NAME")]
     pub solver: String,
+    /// DOFs of the model last loaded, for `--solver auto`.
+    #[arg(skip)]
+    loaded_dofs: Cell<Option<usize>>,
 }
 
 impl ModelArgs {
     /// Loads the model and a label for reports.
     pub fn load(&self) -> Result<(Rotor, String), CliError> {
+        let (rotor, label) = self.load_model()?;
+        self.loaded_dofs.set(Some(rotor.dofs()));
+        let dense = matches!(self.solver.as_str(), "dense" | "lapack");
+        if dense && rotor.dofs() > DENSE_MAX_DOFS {
+            return Err(input(format!(
+                "--solver {}: the model has {} DOFs, more than the {DENSE_MAX_DOFS} a dense solver accepts; \
+                 use --solver banded",
+                self.solver,
+                rotor.dofs()
+            )));
+        }
+        Ok((rotor, label))
+    }
+
+    fn load_model(&self) -> Result<(Rotor, String), CliError> {
+        if let (Some(_), Some(name)) = (self.elements, self.preset.as_deref()) {
+            if name != "uniform-rotor" {
+                return Err(input(format!(
+                    "--elements applies to the uniform-rotor preset only, not `{name}`"
+                )));
+            }
+        }
         if let Some(path) = &self.model {
             let rotor = Rotor::from_toml_file(path).map_err(|e| match e {
                 // These already name the file (and the line where the parser could place it).
@@ -35,23 +74,33 @@ impl ModelArgs {
             return Ok((rotor, path.display().to_string()));
         }
         let name = self.preset.as_deref().unwrap_or_default();
+        if let (Some(elements), "uniform-rotor") = (self.elements, name) {
+            let rotor =
+                presets::uniform_rotor(elements).map_err(|e| input(format!("--elements {elements}: {e}")))?;
+            return Ok((rotor, name.to_string()));
+        }
         let rotor = presets::by_name(name).ok_or_else(|| {
             input(format!("unknown preset `{name}`; available: {}", presets::NAMES.join(", ")))
         })?;
         Ok((rotor, name.to_string()))
     }
 
-    /// The chosen eigen-solver.
+    /// The chosen eigen-solver (`auto` decides by the size of the model last [`load`](Self::load)ed).
     pub fn solver(&self) -> Result<Box<dyn EigenSolver>, CliError> {
         match self.solver.as_str() {
+            "auto" => match self.loaded_dofs.get() {
+                Some(n) if n > AUTO_DENSE_MAX_DOFS => Ok(Box::new(BandedSolver::default())),
+                _ => Ok(Box::new(DenseSolver)),
+            },
             "dense" => Ok(Box::new(DenseSolver)),
+            "banded" => Ok(Box::new(BandedSolver::default())),
             #[cfg(feature = "lapack")]
             "lapack" => Ok(Box::new(eigenfit_lapack::LapackSolver::default())),
             #[cfg(not(feature = "lapack"))]
             "lapack" => Err(input(
                 "this eigenfit was built without the `lapack` feature; rebuild with --features lapack",
             )),
-            other => Err(input(format!("unknown solver `{other}`; available: dense, lapack"))),
+            other => Err(input(format!("unknown solver `{other}`; available: auto, dense, banded, lapack"))),
         }
     }
 }

@@ -1,11 +1,14 @@
 //! `eigenfit compare`: strategies × targets × a grid of initial guesses on reference data.
 
 use crate::error::{input, CliError};
+use crate::plot::compare_map::{CompareMaps, MapKind};
 use crate::source::{parse_list, ModelArgs};
+use crate::{plot, progress};
 use clap::Args;
 use eigenfit_core::compare::{log_space, run_grid, tensor_grid, CompareRun, CompareSettings};
 use eigenfit_core::{Identifiability, StrategyKind, StructuralModel};
 use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
 
 /// Arguments of `compare`.
 #[derive(Debug, Args)]
@@ -44,6 +47,13 @@ pub struct CompareArgs {
     /// Also print a convergence map per target and strategy (grid runs with two parameters).
     #[arg(long)]
     pub maps: bool,
+    /// Write the convergence and iteration maps (compare-convergence.svg/.png,
+    /// compare-iterations.svg/.png) into this folder (two parameters, a grid of initial guesses).
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
     /// Print one JSON object (`runs` array and `summary`) instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -89,17 +99,26 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         std_hz: args.std_hz,
         max_iterations: args.max_iterations,
     };
-    let runs = run_grid(&rotor, &solver.as_ref(), &targets, &initials, &strategies, &settings, |_| {})
-        .map_err(|e| input(format!("reference data: {e}")))?;
+    let total = (targets.len() * initials.len() * strategies.len()) as u64;
+    let pb = progress::bar(total, "compare runs", args.quiet);
+    let runs = run_grid(&rotor, &solver.as_ref(), &targets, &initials, &strategies, &settings, |_| pb.inc(1));
+    pb.finish_and_clear();
+    let runs = runs.map_err(|e| input(format!("reference data: {e}")))?;
     let summary = summarise(&runs, &targets, &strategies);
+    let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
+    let plots = match &args.plot {
+        Some(dir) => write_maps(dir, &label, &names, &runs, &targets, &strategies)?,
+        None => Vec::new(),
+    };
     if args.json {
         let runs_json: Vec<Value> = runs.iter().map(run_json).collect();
         let summary_json: Vec<Value> = summary.iter().map(Summary::to_json).collect();
-        println!(
-            "{}",
-            json!({"model": label, "solver": solver.name(), "modes": settings.modes, "decimals": args.decimals,
-                   "std_hz": args.std_hz, "runs": runs_json, "summary": summary_json})
-        );
+        let mut out = json!({"model": label, "solver": solver.name(), "modes": settings.modes,
+                   "decimals": args.decimals, "std_hz": args.std_hz, "runs": runs_json, "summary": summary_json});
+        if args.plot.is_some() {
+            out["plots"] = json!(plot::names(&plots));
+        }
+        println!("{out}");
     } else {
         println!(
             "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",
@@ -110,13 +129,13 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             settings.modes
         );
         println!(
-            "{:<16}{:<9}{:>11}{:>12}{:>8}{:>8}{:>15}{:>11}",
+            "{:<16}{:<9}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",
             "target [N/m]",
             "strategy",
             "converged",
             "err ≤ 1e-6",
-            "median",
-            "max",
+            "it. med",
+            "it. max",
             "max rel err",
             "ambiguous"
         );
@@ -124,7 +143,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             let target: Vec<String> = s.target.iter().map(|v| format!("{v:.0e}")).collect();
             let fmt = |v: Option<usize>| v.map_or("-".to_string(), |v| v.to_string());
             println!(
-                "{:<16}{:<9}{:>11}{:>12}{:>8}{:>8}{:>15.2e}{:>11}",
+                "{:<16}{:<9}{:>11}{:>12}{:>9}{:>9}{:>15.2e}{:>11}",
                 target.join(":"),
                 s.strategy.name(),
                 format!("{}/{}", s.converged, s.runs),
@@ -135,12 +154,45 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
                 s.ambiguous
             );
         }
-        println!("(median/max: iterations of the converged runs; ambiguous: converged runs whose data also fit another solution)");
+        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged runs whose data also fit another solution)");
         if args.maps && np == 2 {
             print_maps(&runs, &targets, &strategies);
         }
+        plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
     Ok(())
+}
+
+/// Writes the convergence and iteration maps; a note on stderr (and nothing written) unless the
+/// model has two parameters and the initial guesses form a grid.
+pub fn write_maps(
+    dir: &Path,
+    label: &str,
+    names: &[String],
+    runs: &[CompareRun],
+    targets: &[Vec<f64>],
+    strategies: &[StrategyKind],
+) -> Result<Vec<PathBuf>, CliError> {
+    if names.len() != 2 {
+        eprintln!("eigenfit: --plot: compare maps need a model with two parameters; none written");
+        return Ok(Vec::new());
+    }
+    let names = [names[0].clone(), names[1].clone()];
+    let mut written = Vec::new();
+    for (kind, stem) in
+        [(MapKind::Convergence, "compare-convergence"), (MapKind::Iterations, "compare-iterations")]
+    {
+        match CompareMaps::from_runs(label, names.clone(), runs, targets, strategies, kind) {
+            Some(maps) => written.extend(plot::write(&maps, dir, stem)?),
+            None => {
+                eprintln!(
+                    "eigenfit: --plot: compare maps need a grid of initial guesses (--grid N); none written"
+                );
+                return Ok(written);
+            }
+        }
+    }
+    Ok(written)
 }
 
 fn points(flag: &str, text: &str, np: usize) -> Result<Vec<Vec<f64>>, CliError> {

@@ -2,8 +2,9 @@
 
 use crate::error::{input, CliError};
 use crate::output::write_atomically;
+use crate::plot::discovery::DiscoveryPlot;
 use crate::source::ModelArgs;
-use crate::{measured, svg};
+use crate::{measured, plot, progress};
 use clap::Args;
 use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit};
 use eigenfit_core::StructuralModel;
@@ -25,9 +26,12 @@ pub struct DiscoverArgs {
     /// Write the augmented model (calibrated stiffnesses + the named effect) to this TOML file.
     #[arg(long, value_name = "FILE.toml")]
     pub write_model: Option<PathBuf>,
-    /// Write the before/after residual plot (discovery.svg) into this folder.
+    /// Write the before/after residual plot (discovery.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// No progress indicator.
+    #[arg(long)]
+    pub quiet: bool,
     /// Print one JSON object instead of a report.
     #[arg(long)]
     pub json: bool,
@@ -43,9 +47,11 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
     }
     let options = DiscoveryOptions { assumed_relative_std: args.assumed_std, ..Default::default() };
     let candidates = rotor.candidates();
+    let pb = progress::spinner("discovering: calibrate, detect, screen and refit candidates", args.quiet);
     let report =
-        discover(&rotor, &solver.as_ref(), &data, &candidates, &rotor.nominal_stiffnesses(), &options)
-            .map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
+        discover(&rotor, &solver.as_ref(), &data, &candidates, &rotor.nominal_stiffnesses(), &options);
+    pb.finish_and_clear();
+    let report = report.map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
     let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
     let mut written = Vec::new();
     if let Some(path) = &args.write_model {
@@ -61,15 +67,14 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
         written.push(path.display().to_string());
     }
     if let Some(dir) = &args.plot {
-        let path = dir.join("discovery.svg");
-        std::fs::create_dir_all(dir).map_err(|e| input(format!("{}: cannot create: {e}", dir.display())))?;
-        write_atomically(&path, svg::discovery(&report, &label).as_bytes())?;
-        written.push(path.display().to_string());
+        let figure = DiscoveryPlot::from_report(&label, &report);
+        written.extend(plot::names(&plot::write(&figure, dir, "discovery")?));
     }
     if args.json {
         println!("{}", report_json(&report, &names, &label, &written));
     } else {
-        print_report(&report, &names, &label);
+        let units: Vec<String> = rotor.parameters().iter().map(|p| p.unit.clone()).collect();
+        print_report(&report, &names, &units, &label);
         for w in written {
             println!("wrote {w}");
         }
@@ -107,10 +112,10 @@ fn report_json(r: &DiscoveryReport, names: &[String], label: &str, written: &[St
     })
 }
 
-fn print_report(r: &DiscoveryReport, names: &[String], label: &str) {
+fn print_report(r: &DiscoveryReport, names: &[String], units: &[String], label: &str) {
     println!("{label}: calibrated the nominal parameters:");
-    for (n, v) in names.iter().zip(&r.base_parameters) {
-        println!("  {n} = {v:.6e}");
+    for ((n, v), u) in names.iter().zip(&r.base_parameters).zip(units) {
+        println!("  {n} = {v:.6e} {u}");
     }
     println!(
         "misfit: χ² = {:.2} on {} degrees of freedom, p = {:.3e} → {}",

@@ -1,8 +1,9 @@
 //! `eigenfit estimate`: update the bearing stiffnesses to match measured frequencies.
 
 use crate::error::{input, CliError, EXIT_NOT_CONVERGED};
-use crate::measured;
+use crate::plot::convergence::{Convergence, Run};
 use crate::source::{parameter_vector, ModelArgs};
+use crate::{measured, plot, progress};
 use clap::Args;
 use eigenfit_core::statistics::uncertainty;
 use eigenfit_core::{Driver, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel};
@@ -29,6 +30,12 @@ pub struct EstimateArgs {
     /// Iteration limit.
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: usize,
+    /// Write the convergence history (convergence.svg/.png) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+    /// No progress indicator.
+    #[arg(long)]
+    pub quiet: bool,
     /// Print one JSON object instead of a report.
     #[arg(long)]
     pub json: bool,
@@ -70,9 +77,12 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let has_std = measurement.has_std();
     let problem = Problem::new(&rotor, solver.as_ref(), measurement).with_kind(kind);
     let mut strategy = strategy_kind.build();
+    let pb = progress::spinner(&format!("estimating ({})", strategy_kind.name()), args.quiet);
     let estimate = Driver { max_iterations: args.max_iterations }
         .run(&problem, strategy.as_mut(), &initial, &mut [])
-        .map_err(|e| input(e.to_string()))?;
+        .map_err(|e| input(e.to_string()));
+    pb.finish_and_clear();
+    let estimate = estimate?;
     let unc = if estimate.termination.is_converged() {
         uncertainty(&problem, &estimate.last, has_std)
     } else {
@@ -80,6 +90,20 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     };
     let names: Vec<&str> = rotor.parameters().iter().map(|p| p.name.as_str()).collect();
     let converged = estimate.termination.is_converged();
+    let plots = match &args.plot {
+        Some(dir) => {
+            let figure = Convergence {
+                title: format!("{label}: convergence of the {} strategy", estimate.strategy),
+                parameter_names: names.iter().map(|n| n.to_string()).collect(),
+                unit: rotor.parameters().iter().next().map_or(String::new(), |p| p.unit.clone()),
+                runs: vec![Run::from_estimate(&estimate)],
+                target: None,
+                tolerance_hz: Some(0.01),
+            };
+            plot::write(&figure, dir, "convergence")?
+        }
+        None => Vec::new(),
+    };
     if args.json {
         let obj = |values: Vec<Value>| -> Map<String, Value> {
             names.iter().map(|n| n.to_string()).zip(values).collect()
@@ -110,6 +134,9 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             out["condition_number"] = json!(u.condition_number);
             out["standard_deviations"] =
                 Value::Object(obj((0..np).map(|i| json!(u.covariance[(i, i)].sqrt())).collect()));
+        }
+        if args.plot.is_some() {
+            out["plots"] = json!(plot::names(&plots));
         }
         println!("{out}");
     } else {
@@ -149,6 +176,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 u.singular_values, u.condition_number
             );
         }
+        plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
     Ok(if converged { 0 } else { EXIT_NOT_CONVERGED })
 }

@@ -1,6 +1,7 @@
 //! One module per subcommand.
 
 pub mod compare;
+pub mod demo;
 pub mod discover;
 pub mod estimate;
 pub mod simulate;

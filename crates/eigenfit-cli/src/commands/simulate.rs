@@ -1,11 +1,20 @@
 //! `eigenfit simulate`: natural frequencies of a model, at one point or over a stiffness sweep.
 
 use crate::error::{input, CliError};
+use crate::plot::critical_speed::CriticalSpeedMap;
+use crate::plot::mode_shapes::ModeShapes;
 use crate::source::{parameter_vector, parse_list, ModelArgs};
+use crate::{plot, progress};
 use clap::Args;
 use eigenfit_core::{EigenSolver, StructuralModel};
-use eigenfit_rotor::EffectSpec;
+use eigenfit_rotor::{presets, EffectSpec, Rotor};
 use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// Stiffnesses drawn on the critical speed map (log-spaced).
+const MAP_POINTS: usize = 61;
+/// Modes drawn on the critical speed map and the mode-shape plot.
+const PLOT_MODES: usize = 4;
 
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]
@@ -29,6 +38,13 @@ pub struct SimulateArgs {
     /// Critical speed map: every bearing at the same stiffness, log-spaced FROM:TO:COUNT (N/m).
     #[arg(long, value_name = "FROM:TO:COUNT")]
     pub sweep: Option<String>,
+    /// Write the critical speed map (critical-speed-map.svg/.png, over the --sweep range or
+    /// 1e2–1e9 N/m) and the mode shapes (mode-shapes.svg/.png) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -52,15 +68,34 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
     if let Some(sweep) = &args.sweep {
         let points = sweep_points(sweep)?;
+        let range = (points[0], points[points.len() - 1]);
+        let plots = match &args.plot {
+            Some(dir) => {
+                // Mode shapes at the model's (or the given) stiffnesses.
+                let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
+                {
+                    let options = MapOptions { range, plain: args.effects.is_empty(), quiet: args.quiet };
+                    write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
+                }
+            }
+            None => Vec::new(),
+        };
+        let pb = progress::bar(points.len() as u64, "sweep", args.quiet);
         let mut rows = Vec::with_capacity(points.len());
         for k in points {
             let p = vec![k; names.len()];
             rows.push((k, frequencies(&rotor, solver.as_ref(), &p, args.modes)?));
+            pb.inc(1);
         }
+        pb.finish_and_clear();
         if args.json {
             let sweep: Vec<_> =
                 rows.iter().map(|(k, f)| json!({"stiffness": k, "frequencies_hz": f})).collect();
-            println!("{}", json!({"model": label, "solver": solver.name(), "sweep": sweep}));
+            let mut out = json!({"model": label, "solver": solver.name(), "sweep": sweep});
+            if args.plot.is_some() {
+                out["plots"] = json!(plot::names(&plots));
+            }
+            println!("{out}");
         } else {
             println!("{label}: natural frequencies against support stiffness (all bearings equal)");
             print!("{:>14}", "k [N/m]");
@@ -71,17 +106,27 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 f.iter().for_each(|v| print!("{v:>14.4}"));
                 println!();
             }
+            plots.iter().for_each(|w| println!("wrote {}", w.display()));
         }
         return Ok(());
     }
     let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
     let f = frequencies(&rotor, solver.as_ref(), &p, args.modes)?;
+    let plots = match &args.plot {
+        Some(dir) => {
+            let options = MapOptions { range: (1e2, 1e9), plain: args.effects.is_empty(), quiet: args.quiet };
+            write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
+        }
+        None => Vec::new(),
+    };
     if args.json {
         let params: serde_json::Map<_, _> = names.iter().cloned().zip(p.iter().map(|&v| json!(v))).collect();
-        println!(
-            "{}",
-            json!({"model": label, "solver": solver.name(), "parameters": params, "frequencies_hz": f})
-        );
+        let mut out =
+            json!({"model": label, "solver": solver.name(), "parameters": params, "frequencies_hz": f});
+        if args.plot.is_some() {
+            out["plots"] = json!(plot::names(&plots));
+        }
+        println!("{out}");
     } else {
         println!("{label} ({} DOF, {} solver)", rotor.dofs(), solver.name());
         for (n, v) in names.iter().zip(&p) {
@@ -91,8 +136,50 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         for (i, v) in f.iter().enumerate() {
             println!("{:>6}{v:>18.6}", i + 1);
         }
+        plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
     Ok(())
+}
+
+/// Whether `rotor` is the paper's rotor (whatever its current support stiffnesses).
+pub fn is_paper_rotor(rotor: &Rotor) -> bool {
+    let paper = presets::paper_rotor();
+    rotor.with_stiffnesses(&paper.nominal_stiffnesses()).is_ok_and(|r| r == paper)
+}
+
+/// How the critical speed map is drawn.
+#[derive(Debug, Clone, Copy)]
+pub struct MapOptions {
+    /// Stiffness range (N/m).
+    pub range: (f64, f64),
+    /// No what-if effects switched on: the paper's Table 1 may be overlaid on the paper rotor.
+    pub plain: bool,
+    /// No progress bar.
+    pub quiet: bool,
+}
+
+/// Writes the critical speed map and the mode shapes at `p`; the paper's Table 1 is overlaid
+/// when the model is the paper rotor without what-if effects.
+pub fn write_plots(
+    dir: &Path,
+    label: &str,
+    rotor: &Rotor,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    MapOptions { range, plain, quiet }: MapOptions,
+) -> Result<Vec<PathBuf>, CliError> {
+    let modes = PLOT_MODES.min(rotor.dofs());
+    let pb = progress::bar(MAP_POINTS as u64, "critical speed map", quiet);
+    let map = CriticalSpeedMap::sweep(label, rotor, solver, range, MAP_POINTS, modes, || pb.inc(1));
+    pb.finish_and_clear();
+    let mut map = map?;
+    if plain && is_paper_rotor(rotor) {
+        map = map.with_paper_table_1();
+    }
+    let mut written = plot::write(&map, dir, "critical-speed-map")?;
+    let shapes = ModeShapes::of_rotor(label, rotor, solver, p, modes)?;
+    written.extend(plot::write(&shapes, dir, "mode-shapes")?);
+    Ok(written)
 }
 
 fn frequencies(

@@ -1,0 +1,179 @@
+//! (c) Convergence history of estimates: parameters (log) and the largest frequency difference
+//! per iteration, one colour per strategy.
+
+use super::style::{self, log_bounds, log_tick, strategy_colour, Swatch, INK};
+use super::{err, DrawResult, Figure};
+use eigenfit_core::Estimate;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Smallest |Δf| drawn on the log axis (exact convergence would be −∞).
+const FLOOR_HZ: f64 = 1e-9;
+
+/// One run's history.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Run {
+    /// Strategy name.
+    pub strategy: String,
+    /// How it ended, e.g. `converged after 4 iterations`.
+    pub outcome: String,
+    /// (iteration, parameters, largest |f − f_measured| in Hz).
+    pub history: Vec<(usize, Vec<f64>, f64)>,
+}
+
+impl Run {
+    /// From a finished estimate.
+    pub fn from_estimate(e: &Estimate) -> Self {
+        Self {
+            strategy: e.strategy.to_string(),
+            outcome: format!("{}, {} it.", e.termination.label(), e.iterations),
+            history: e
+                .history
+                .iter()
+                .map(|r| (r.iteration, r.parameters.clone(), r.max_abs_diff_hz))
+                .collect(),
+        }
+    }
+}
+
+/// The data of a convergence plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Convergence {
+    /// Title.
+    pub title: String,
+    /// Parameter names (with the unit given in the axis title).
+    pub parameter_names: Vec<String>,
+    /// Unit of the parameters, e.g. `N/m`.
+    pub unit: String,
+    /// The runs, drawn in order.
+    pub runs: Vec<Run>,
+    /// True parameters, when known (drawn as dotted lines).
+    pub target: Option<Vec<f64>>,
+    /// Frequency tolerance to mark on the residual panel (Hz), e.g. the paper's 0.01 Hz.
+    pub tolerance_hz: Option<f64>,
+}
+
+/// Width of the legend column on the right (px).
+const LEGEND_W: u32 = 300;
+
+impl Figure for Convergence {
+    fn size(&self) -> (u32, u32) {
+        (1250, 900)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let max_it = self.runs.iter().filter_map(|r| r.history.last().map(|h| h.0)).max().unwrap_or(1).max(1);
+        let body = style::title(root, &self.title, 60)?;
+        let (plots, legend) = body.split_horizontally(body.dim_in_pixel().0 - LEGEND_W);
+        let split = (plots.dim_in_pixel().1 as f64 * 0.56) as u32;
+        let (top, bottom) = plots.split_vertically(split);
+        let x_end = max_it as f64 + 0.3;
+        let x_fmt = |v: &f64| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() };
+
+        // Top: the parameters.
+        let p_range = log_bounds(
+            self.runs
+                .iter()
+                .flat_map(|r| r.history.iter().flat_map(|h| h.1.iter().copied()))
+                .chain(self.target.iter().flatten().copied()),
+            2.0,
+        );
+        let mut chart = ChartBuilder::on(&top)
+            .margin(15)
+            .margin_left(20)
+            .x_label_area_size(45)
+            .y_label_area_size(90)
+            .build_cartesian_2d(0.0..x_end, p_range.log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("iteration")
+            .y_desc(format!("parameter [{}]", self.unit))
+            .axis_desc_style(style::font(style::AXIS))
+            .label_style(style::font(style::TICK))
+            .x_label_formatter(&x_fmt)
+            .y_label_formatter(&log_tick)
+            .light_line_style(style::LIGHT.mix(0.4))
+            .bold_line_style(style::LIGHT)
+            .draw()
+            .map_err(err)?;
+        let mut entries = Vec::new();
+        if let Some(t) = &self.target {
+            for &v in t {
+                chart
+                    .draw_series(DashedLineSeries::new([(0.0, v), (x_end, v)], 4, 5, INK.stroke_width(1)))
+                    .map_err(err)?;
+            }
+            entries.push((Swatch::Guide, "target".to_string()));
+        }
+        for run in &self.runs {
+            let c = strategy_colour(&run.strategy);
+            for (j, name) in self.parameter_names.iter().enumerate() {
+                let points: Vec<(f64, f64)> = run.history.iter().map(|h| (h.0 as f64, h.1[j])).collect();
+                if j == 0 {
+                    chart.draw_series(LineSeries::new(points.clone(), c.stroke_width(3))).map_err(err)?;
+                    chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(err)?;
+                    entries.push((Swatch::Line(c), format!("{} · {name}", run.strategy)));
+                } else {
+                    chart
+                        .draw_series(DashedLineSeries::new(points.clone(), 8, 5, c.stroke_width(3)))
+                        .map_err(err)?;
+                    chart
+                        .draw_series(points.iter().map(|&p| TriangleMarker::new(p, 5, c.filled())))
+                        .map_err(err)?;
+                    entries.push((Swatch::Dashed(c), format!("{} · {name}", run.strategy)));
+                }
+            }
+        }
+        style::legend_column(&legend, (0, 30), &entries)?;
+
+        // Bottom: the largest frequency difference.
+        let clamped = self.runs.iter().any(|r| r.history.iter().any(|h| h.2 < FLOOR_HZ));
+        let d_range = log_bounds(
+            self.runs
+                .iter()
+                .flat_map(|r| r.history.iter().map(|h| h.2.max(FLOOR_HZ)))
+                .chain(self.tolerance_hz),
+            3.0,
+        );
+        let mut chart = ChartBuilder::on(&bottom)
+            .margin(15)
+            .margin_left(20)
+            .x_label_area_size(50)
+            .y_label_area_size(90)
+            .build_cartesian_2d(0.0..x_end, d_range.log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("iteration")
+            .y_desc("max |f − f_measured| [Hz]")
+            .axis_desc_style(style::font(style::AXIS))
+            .label_style(style::font(style::TICK))
+            .x_label_formatter(&x_fmt)
+            .y_label_formatter(&log_tick)
+            .light_line_style(style::LIGHT.mix(0.4))
+            .bold_line_style(style::LIGHT)
+            .draw()
+            .map_err(err)?;
+        let mut entries = Vec::new();
+        if let Some(tol) = self.tolerance_hz {
+            chart
+                .draw_series(DashedLineSeries::new([(0.0, tol), (x_end, tol)], 4, 5, INK.stroke_width(1)))
+                .map_err(err)?;
+            entries.push((Swatch::Guide, format!("paper's tolerance, {tol} Hz")));
+        }
+        for run in &self.runs {
+            let c = strategy_colour(&run.strategy);
+            let points: Vec<(f64, f64)> =
+                run.history.iter().map(|h| (h.0 as f64, h.2.max(FLOOR_HZ))).collect();
+            chart.draw_series(LineSeries::new(points.clone(), c.stroke_width(3))).map_err(err)?;
+            chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(err)?;
+            entries.push((Swatch::Line(c), format!("{} ({})", run.strategy, run.outcome)));
+        }
+        if clamped {
+            entries.push((Swatch::None, format!("(below {} Hz: drawn at {0})", log_tick(&FLOOR_HZ))));
+        }
+        style::legend_column(&legend, (0, split as i32 + 30), &entries)?;
+        Ok(())
+    }
+}

@@ -1,0 +1,215 @@
+//! (b) Mode shapes of the lowest modes along the shaft, disks and bearings marked.
+
+use super::style::{self, mode_colour, short_sci, INK};
+use super::{err, DrawResult, Figure};
+use crate::error::CliError;
+use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_rotor::Rotor;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+/// One mode: its frequency and its displacement along the shaft.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shape {
+    /// Natural frequency (Hz).
+    pub frequency_hz: f64,
+    /// (x in m, displacement normalised to a largest |value| of 1).
+    pub curve: Vec<(f64, f64)>,
+}
+
+/// A marked place on the shaft.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Marker {
+    /// Position (m).
+    pub x: f64,
+    /// Label, e.g. `1.35 kg` or `K1 1e5 N/m`.
+    pub label: String,
+}
+
+/// The data of a mode-shape plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeShapes {
+    /// Title (model and support stiffnesses).
+    pub title: String,
+    /// Node positions (m).
+    pub nodes: Vec<f64>,
+    /// The modes, lowest first.
+    pub shapes: Vec<Shape>,
+    /// Disks and point masses.
+    pub masses: Vec<Marker>,
+    /// Bearings.
+    pub bearings: Vec<Marker>,
+}
+
+/// Samples drawn per element (cubic Hermite interpolation between the nodes).
+const SAMPLES: usize = 6;
+
+impl ModeShapes {
+    /// The lowest `modes` modes of `rotor` at the stiffnesses `p` (N/m).
+    pub fn of_rotor(
+        label: &str,
+        rotor: &Rotor,
+        solver: &dyn EigenSolver,
+        p: &[f64],
+        modes: usize,
+    ) -> Result<Self, CliError> {
+        let system = rotor.assemble(p).map_err(|e| CliError::Failure(e.to_string()))?;
+        let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
+        let nodes = rotor.nodes().to_vec();
+        let shapes = (0..m.count())
+            .map(|k| Shape { frequency_hz: m.frequencies_hz()[k], curve: interpolate(&nodes, m.shape(k)) })
+            .collect();
+        let masses = rotor
+            .disks()
+            .iter()
+            .map(|d| Marker { x: nodes[d.node], label: format!("disk {} kg", style::trim(d.mass, 3)) })
+            .chain(rotor.point_masses().iter().map(|pm| Marker {
+                x: nodes[pm.node],
+                label: format!("mass {} kg", style::trim(pm.mass, 3)),
+            }))
+            .collect();
+        let bearings = rotor
+            .bearings()
+            .iter()
+            .zip(p)
+            .map(|(b, k)| Marker { x: nodes[b.node], label: format!("{} = {} N/m", b.name, short_sci(*k)) })
+            .collect();
+        let ks: Vec<String> =
+            rotor.bearings().iter().zip(p).map(|(b, &k)| format!("{} = {}", b.name, short_sci(k))).collect();
+        Ok(Self {
+            title: format!("{label}: mode shapes at {} N/m", ks.join(", ")),
+            nodes,
+            shapes,
+            masses,
+            bearings,
+        })
+    }
+}
+
+/// The displacement along the shaft from the nodal [v, θ] (θ = dv/dx), by the element's cubic
+/// Hermite shape functions, normalised so that the largest |v| is 1 and positive.
+fn interpolate(nodes: &[f64], shape: &[f64]) -> Vec<(f64, f64)> {
+    let mut curve = Vec::with_capacity((nodes.len() - 1) * SAMPLES + 1);
+    for e in 0..nodes.len().saturating_sub(1) {
+        let (xa, l) = (nodes[e], nodes[e + 1] - nodes[e]);
+        let (v1, t1, v2, t2) = (shape[2 * e], shape[2 * e + 1], shape[2 * e + 2], shape[2 * e + 3]);
+        let last = if e + 2 == nodes.len() { SAMPLES } else { SAMPLES - 1 };
+        for i in 0..=last {
+            let s = i as f64 / SAMPLES as f64;
+            let (s2, s3) = (s * s, s * s * s);
+            let v = (1.0 - 3.0 * s2 + 2.0 * s3) * v1
+                + l * (s - 2.0 * s2 + s3) * t1
+                + (3.0 * s2 - 2.0 * s3) * v2
+                + l * (s3 - s2) * t2;
+            curve.push((xa + s * l, v));
+        }
+    }
+    let peak = curve.iter().map(|p| p.1).fold(0.0_f64, |m, v| if v.abs() > m.abs() { v } else { m });
+    if peak != 0.0 {
+        curve.iter_mut().for_each(|p| p.1 /= peak);
+    }
+    curve
+}
+
+impl Figure for ModeShapes {
+    fn size(&self) -> (u32, u32) {
+        (1000, 720)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let (x0, x1) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
+        let pad = (x1 - x0) * 0.04;
+        let body = style::title(root, &self.title, 50)?;
+        let mut chart = ChartBuilder::on(&body)
+            .margin(20)
+            .margin_top(5)
+            .x_label_area_size(60)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0 - pad..x1 + pad, -1.75..2.15)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("position along the shaft x [m]")
+            .y_desc("displacement (normalised to the largest) [–]")
+            .axis_desc_style(style::font(style::AXIS))
+            .label_style(style::font(style::TICK))
+            .y_labels(17)
+            .y_label_formatter(&|v: &f64| {
+                if v.abs() > 1.01 || (v * 2.0 - (v * 2.0).round()).abs() > 1e-9 {
+                    String::new()
+                } else {
+                    style::trim(*v, 1)
+                }
+            })
+            .light_line_style(style::LIGHT.mix(0.4))
+            .bold_line_style(style::LIGHT)
+            .draw()
+            .map_err(err)?;
+        // The shaft axis and the nodes.
+        chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], INK.stroke_width(2))).map_err(err)?;
+        chart.draw_series(self.nodes.iter().map(|&x| Circle::new((x, 0.0), 3, INK.filled()))).map_err(err)?;
+        // Disks: a tall bar across the shaft and the mass above.
+        for d in &self.masses {
+            chart
+                .draw_series(LineSeries::new([(d.x, -1.15), (d.x, 1.15)], style::GUIDE.stroke_width(1)))
+                .map_err(err)?;
+            chart
+                .draw_series([Rectangle::new(
+                    [(d.x - pad * 0.18, -0.16), (d.x + pad * 0.18, 0.16)],
+                    INK.filled(),
+                )])
+                .map_err(err)?;
+            chart
+                .draw_series([Text::new(
+                    d.label.clone(),
+                    (d.x, 1.27),
+                    style::text(style::LEGEND, INK).pos(Pos::new(HPos::Center, VPos::Center)),
+                )])
+                .map_err(err)?;
+        }
+        // Bearings: a triangle under the shaft and the name with its stiffness below.
+        for b in &self.bearings {
+            chart.draw_series([TriangleMarker::new((b.x, -1.28), 11, INK.filled())]).map_err(err)?;
+            chart
+                .draw_series([Text::new(
+                    b.label.clone(),
+                    (b.x, -1.5),
+                    style::text(style::LEGEND, INK).pos(Pos::new(
+                        if b.x < (x0 + x1) / 2.0 { HPos::Left } else { HPos::Right },
+                        VPos::Center,
+                    )),
+                )])
+                .map_err(err)?;
+        }
+        for (k, s) in self.shapes.iter().enumerate() {
+            let c = mode_colour(k);
+            chart
+                .draw_series(LineSeries::new(s.curve.iter().copied(), c.stroke_width(3)))
+                .map_err(err)?
+                .label(format!("mode {}: {} Hz", k + 1, format_hz(s.frequency_hz)))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperMiddle)
+            .label_font(style::font(style::LEGEND))
+            .background_style(WHITE.mix(0.9))
+            .border_style(style::GUIDE)
+            .margin(12)
+            .draw()
+            .map_err(err)?;
+        Ok(())
+    }
+}
+
+/// A frequency with four significant digits or more.
+pub fn format_hz(f: f64) -> String {
+    if f >= 1000.0 {
+        format!("{f:.1}")
+    } else if f >= 10.0 {
+        format!("{f:.3}")
+    } else {
+        format!("{f:.4}")
+    }
+}

@@ -1,0 +1,313 @@
+//! The shared look: the bundled font, sizes, colours, number formats and a symmetric-log axis.
+
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::{FontStyle, RGBColor};
+use std::ops::Range;
+use std::sync::Once;
+
+/// DejaVu Sans, bundled: plots look the same on every machine.
+static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+
+/// The font family every plot uses (registered to the bundled font).
+pub const FAMILY: &str = "sans-serif";
+
+/// Registers the bundled font as `sans-serif` (once per process).
+pub fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The font is a fixed, valid TrueType file; if plotters ever rejected it the text would
+        // be missing from the PNG, never a crash.
+        let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, DEJAVU_SANS);
+        let _ = plotters::style::register_font(FAMILY, FontStyle::Bold, DEJAVU_SANS);
+    });
+}
+
+/// Figure title size (px).
+pub const TITLE: u32 = 24;
+/// Panel caption size (px).
+pub const CAPTION: u32 = 19;
+/// Axis title size (px).
+pub const AXIS: u32 = 18;
+/// Tick label size (px).
+pub const TICK: u32 = 15;
+/// Legend and annotation size (px).
+pub const LEGEND: u32 = 15;
+
+/// The font at `size` px.
+pub fn font(size: u32) -> FontDesc<'static> {
+    (FAMILY, size).into_font()
+}
+
+/// The font at `size` px in `colour`.
+pub fn text(size: u32, colour: RGBColor) -> TextStyle<'static> {
+    font(size).color(&colour)
+}
+
+/// Near-black for text and axes.
+pub const INK: RGBColor = RGBColor(30, 30, 30);
+/// Mid grey for guides.
+pub const GUIDE: RGBColor = RGBColor(120, 120, 120);
+/// Light grey for grids and failed cells.
+pub const LIGHT: RGBColor = RGBColor(225, 225, 225);
+
+/// Colours of the modes (1, 2, 3, …), colour-blind-safe (Okabe–Ito).
+pub const MODES: [RGBColor; 6] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+];
+
+/// Colour of mode `k` (0-based).
+pub fn mode_colour(k: usize) -> RGBColor {
+    MODES[k % MODES.len()]
+}
+
+/// Colour of a strategy, the same in every plot.
+pub fn strategy_colour(name: &str) -> RGBColor {
+    match name {
+        "newton" => RGBColor(213, 94, 0),
+        "p-step" => RGBColor(204, 121, 167),
+        "damped" => RGBColor(0, 114, 178),
+        _ => RGBColor(0, 158, 115),
+    }
+}
+
+const SUPERSCRIPT: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+
+/// `10⁵`, `10⁻³`.
+pub fn power_of_ten(exponent: i32) -> String {
+    let digits: String =
+        exponent.unsigned_abs().to_string().chars().map(|c| SUPERSCRIPT[c as usize - 48]).collect();
+    format!("10{}{digits}", if exponent < 0 { "⁻" } else { "" })
+}
+
+/// Tick label of a log axis: `10⁵` on powers of ten, `2·10⁵` between.
+pub fn log_tick(v: &f64) -> String {
+    if !(v.is_finite() && *v > 0.0) {
+        return String::new();
+    }
+    let e = v.log10().floor();
+    let mantissa = v / 10f64.powf(e);
+    let (mantissa, e) = if mantissa > 9.9995 { (1.0, e + 1.0) } else { (mantissa, e) };
+    if (mantissa - 1.0).abs() < 1e-3 {
+        power_of_ten(e as i32)
+    } else {
+        format!("{}·{}", trim(mantissa, 1), power_of_ten(e as i32))
+    }
+}
+
+/// A compact number: `1e5` style for stiffnesses in captions.
+pub fn short_sci(v: f64) -> String {
+    let e = v.log10().floor();
+    let m = v / 10f64.powf(e);
+    if (m - 1.0).abs() < 1e-6 {
+        format!("1e{}", e as i32)
+    } else {
+        format!("{}e{}", trim(m, 2), e as i32)
+    }
+}
+
+/// `v` with at most `decimals` decimals and no trailing zeros.
+pub fn trim(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// A logarithmic range padded by `pad` (a factor) around the finite positive values given.
+pub fn log_bounds(values: impl IntoIterator<Item = f64>, pad: f64) -> Range<f64> {
+    let (lo, hi) = values
+        .into_iter()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    if !(lo.is_finite() && hi > 0.0) {
+        return 1.0..10.0;
+    }
+    let (lo, hi) = (lo / pad, hi * pad);
+    // At least one decade, so that the axis carries a labelled power of ten.
+    if hi / lo < 10.0 {
+        let mid = (lo * hi).sqrt();
+        return mid / 10f64.sqrt()..mid * 10f64.sqrt();
+    }
+    lo..hi
+}
+
+/// A symmetric logarithmic axis, y ↦ sign(y)·log₁₀(1 + |y|): linear near 0 (the ±2σ band stays
+/// visible), logarithmic far out (a 1000σ residual still fits).
+#[derive(Debug, Clone)]
+pub struct SymLog {
+    /// Lower end (data units).
+    pub lo: f64,
+    /// Upper end (data units).
+    pub hi: f64,
+}
+
+impl SymLog {
+    /// The transform.
+    pub fn t(v: f64) -> f64 {
+        v.signum() * (1.0 + v.abs()).log10()
+    }
+
+    /// A range covering `[lo, hi]` and at least ±3, with a little room.
+    pub fn covering(lo: f64, hi: f64) -> Self {
+        let room = |v: f64| 10f64.powf(Self::t(v.max(3.0)) * 1.08) - 1.0;
+        Self { lo: -room(-lo), hi: room(hi) }
+    }
+}
+
+impl Ranged for SymLog {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        let (a, b) = (Self::t(self.lo), Self::t(self.hi));
+        let r = (Self::t(*value) - a) / (b - a);
+        limit.0 + (r * f64::from(limit.1 - limit.0)).round() as i32
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        let mut magnitudes = vec![1.0, 2.0];
+        let mut decade = 10.0;
+        while decade <= self.hi.abs().max(self.lo.abs()) {
+            magnitudes.push(decade);
+            decade *= 10.0;
+        }
+        let mut points = vec![0.0];
+        for m in magnitudes {
+            points.extend([-m, m]);
+        }
+        points.retain(|v| (self.lo..=self.hi).contains(v));
+        // ±1 crowds ±2 once the axis reaches beyond ±10.
+        if self.hi.abs().max(self.lo.abs()) > 10.0 || points.len() > hint.max_num_points().max(5) {
+            points.retain(|v| v.abs() != 1.0);
+        }
+        points.sort_by(f64::total_cmp);
+        points
+    }
+
+    fn range(&self) -> Range<f64> {
+        self.lo..self.hi
+    }
+}
+
+/// Tick label of the symmetric-log residual axis: `0`, `±2σ`, `+1000σ`.
+pub fn sigma_tick(v: &f64) -> String {
+    if *v == 0.0 {
+        "0".to_string()
+    } else {
+        let magnitude = trim(v.abs(), 0);
+        format!("{}{magnitude}σ", if *v < 0.0 { "−" } else { "+" })
+    }
+}
+
+/// A legend entry's symbol.
+pub enum Swatch {
+    /// A filled box.
+    Box(RGBColor),
+    /// A solid line.
+    Line(RGBColor),
+    /// A dashed line.
+    Dashed(RGBColor),
+    /// A thin dashed guide line.
+    Guide,
+    /// The target marker (a cross).
+    Target,
+    /// Text only.
+    None,
+}
+
+/// Draws one swatch at `(x, y)` (top-left of a 20 px high row); returns its width.
+fn swatch<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    (x, y): (i32, i32),
+    swatch: &Swatch,
+) -> Result<i32, String> {
+    let e = super::err;
+    let mid = y + 10;
+    match swatch {
+        Swatch::Box(c) => {
+            area.draw(&Rectangle::new([(x, y + 3), (x + 16, y + 17)], c.filled())).map_err(e)?;
+            area.draw(&Rectangle::new([(x, y + 3), (x + 16, y + 17)], GUIDE.stroke_width(1))).map_err(e)?;
+            Ok(24)
+        }
+        Swatch::Line(c) => {
+            area.draw(&PathElement::new(vec![(x, mid), (x + 26, mid)], c.stroke_width(3))).map_err(e)?;
+            Ok(34)
+        }
+        Swatch::Dashed(c) => {
+            for (a, b) in [(0, 8), (13, 26)] {
+                area.draw(&PathElement::new(vec![(x + a, mid), (x + b, mid)], c.stroke_width(3)))
+                    .map_err(e)?;
+            }
+            Ok(34)
+        }
+        Swatch::Guide => {
+            for (a, b) in [(0, 4), (9, 13), (18, 22)] {
+                area.draw(&PathElement::new(vec![(x + a, mid), (x + b, mid)], INK.stroke_width(1)))
+                    .map_err(e)?;
+            }
+            Ok(34)
+        }
+        Swatch::Target => {
+            area.draw(&Cross::new((x + 8, mid), 6, INK.stroke_width(3))).map_err(e)?;
+            Ok(24)
+        }
+        Swatch::None => Ok(0),
+    }
+}
+
+/// Draws `entries` in one row starting at `(x, y)` (top-left); returns the x after the last.
+pub fn legend_row<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    (mut x, y): (i32, i32),
+    entries: &[(Swatch, String)],
+) -> Result<i32, String> {
+    let style = text(LEGEND, INK);
+    for (sw, label) in entries {
+        x += swatch(area, (x, y), sw)?;
+        area.draw(&Text::new(label.clone(), (x, y + 2), style.clone())).map_err(super::err)?;
+        let (w, _) = area.estimate_text_size(label, &style).map_err(super::err)?;
+        x += w as i32 + 26;
+    }
+    Ok(x)
+}
+
+/// Draws `entries` one per line starting at `(x, y)` (top-left); returns the y after the last.
+pub fn legend_column<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    (x, mut y): (i32, i32),
+    entries: &[(Swatch, String)],
+) -> Result<i32, String> {
+    let style = text(LEGEND, INK);
+    for (sw, label) in entries {
+        let w = swatch(area, (x, y), sw)?;
+        area.draw(&Text::new(label.clone(), (x + w, y + 2), style.clone())).map_err(super::err)?;
+        y += 26;
+    }
+    Ok(y)
+}
+
+/// The figure title, centred in the top `height` pixels of `area`; returns the rest.
+pub fn title<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    height: u32,
+) -> Result<DrawingArea<DB, plotters::coord::Shift>, String> {
+    let (head, rest) = area.split_vertically(height);
+    let (w, _) = head.dim_in_pixel();
+    head.draw(&Text::new(
+        title.to_string(),
+        (w as i32 / 2, 30),
+        text(TITLE, INK).pos(Pos::new(HPos::Center, VPos::Center)),
+    ))
+    .map_err(super::err)?;
+    Ok(rest)
+}

@@ -1,0 +1,296 @@
+//! Plots (issue: the product face): every `--plot` writes its SVG and PNG, the SVG carries the
+//! expected titles, axes and legend entries, the PNG is a real image; `eigenfit demo` writes every
+//! plot kind; progress bars stay off stderr when it is not a terminal.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn eigenfit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs")
+}
+
+fn json(out: &Output) -> Value {
+    let stdout = String::from_utf8(out.stdout.clone()).expect("utf-8");
+    serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}: {stdout}"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("eigenfit-plots-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn example(name: &str) -> String {
+    format!("{}/../../examples/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Checks `DIR/STEM.svg` (well-formed enough, with every `expected` text) and `DIR/STEM.png`
+/// (PNG signature, an IHDR of a sensible size, more than a blank image's bytes).
+fn check_plot(dir: &Path, stem: &str, expected: &[&str]) {
+    let svg_path = dir.join(format!("{stem}.svg"));
+    let svg = std::fs::read_to_string(&svg_path).unwrap_or_else(|e| panic!("{}: {e}", svg_path.display()));
+    assert!(
+        svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+        "{stem}.svg is not an SVG document"
+    );
+    assert_eq!(svg.matches("<text").count(), svg.matches("</text>").count(), "{stem}.svg: unbalanced <text>");
+    assert!(svg.matches('<').count() > 50, "{stem}.svg has almost nothing drawn");
+    for text in expected {
+        assert!(svg.contains(text), "{stem}.svg lacks `{text}`");
+    }
+    let png_path = dir.join(format!("{stem}.png"));
+    let png = std::fs::read(&png_path).unwrap_or_else(|e| panic!("{}: {e}", png_path.display()));
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{stem}.png: not a PNG");
+    assert_eq!(&png[12..16], b"IHDR");
+    let width = u32::from_be_bytes(png[16..20].try_into().unwrap());
+    let height = u32::from_be_bytes(png[20..24].try_into().unwrap());
+    assert!(
+        (600..=3000).contains(&width) && (400..=3000).contains(&height),
+        "{stem}.png is {width}×{height}"
+    );
+    assert!(png.len() > 20_000, "{stem}.png is only {} bytes: no text or lines drawn?", png.len());
+    // No temporary file is left behind by the atomic writes.
+    let leftovers: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}
+
+#[test]
+fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
+    let dir = temp_dir("simulate");
+    let out = eigenfit(&[
+        "simulate",
+        "--preset",
+        "paper-rotor",
+        "--stiffness",
+        "1e5,1e5",
+        "--modes",
+        "3",
+        "--plot",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v = json(&out);
+    assert_eq!(v["frequencies_hz"].as_array().unwrap().len(), 3, "the JSON contract is unchanged");
+    assert_eq!(v["plots"].as_array().unwrap().len(), 4);
+    check_plot(
+        &dir,
+        "critical-speed-map",
+        &[
+            "paper-rotor: critical speed map",
+            "support stiffness k [N/m]",
+            "natural frequency f [Hz]",
+            "model, mode 1",
+            "model, mode 4",
+            "paper, Table 1 (modes 1–2)",
+        ],
+    );
+    check_plot(
+        &dir,
+        "mode-shapes",
+        &[
+            "position along the shaft x [m]",
+            "displacement (normalised to the largest) [–]",
+            "mode 1: 36.107 Hz",
+            "mode 4:",
+            "disk 1.35 kg",
+            "disk 0.4 kg",
+            "K1 = 1e5 N/m",
+            "K2 = 1e5 N/m",
+        ],
+    );
+}
+
+#[test]
+fn a_model_file_gets_no_table_1_overlay() {
+    let dir = temp_dir("simulate-file");
+    let out = eigenfit(&[
+        "simulate",
+        "--model",
+        &example("rotor.toml"),
+        "--sweep",
+        "1e3:1e8:6",
+        "--plot",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("f1 [Hz]") && stdout.contains("wrote "), "{stdout}");
+    check_plot(&dir, "critical-speed-map", &["support stiffness k [N/m]", "model, mode 1"]);
+    let svg = std::fs::read_to_string(dir.join("critical-speed-map.svg")).unwrap();
+    assert!(!svg.contains("Table 1"));
+}
+
+#[test]
+fn estimate_plots_its_convergence_history() {
+    let dir = temp_dir("estimate");
+    let csv = dir.join("m.csv");
+    std::fs::write(&csv, "mode,frequency_hz\n1,36.107\n2,84.066\n").unwrap();
+    let out = eigenfit(&[
+        "estimate",
+        "--preset",
+        "paper-rotor",
+        "--measured",
+        csv.to_str().unwrap(),
+        "--strategy",
+        "newton",
+        "--initial",
+        "1e2,1e2",
+        "--plot",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v = json(&out);
+    assert_eq!(v["converged"], true);
+    assert_eq!(v["plots"].as_array().unwrap().len(), 2);
+    check_plot(
+        &dir,
+        "convergence",
+        &[
+            "convergence of the newton strategy",
+            "iteration",
+            "parameter [N/m]",
+            "max |f − f_measured| [Hz]",
+            "newton · k_K1",
+            "newton · k_K2",
+            "newton (converged,",
+            "tolerance, 0.01 Hz",
+        ],
+    );
+}
+
+#[test]
+fn compare_plots_convergence_and_iteration_maps() {
+    let dir = temp_dir("compare");
+    let out = eigenfit(&[
+        "compare",
+        "--preset",
+        "paper-rotor",
+        "--targets",
+        "1e5:1e5",
+        "--grid",
+        "4",
+        "--strategies",
+        "newton,damped",
+        "--plot",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    // Not a terminal: no progress bar on stderr.
+    assert!(out.stderr.is_empty(), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("target [N/m]") && stdout.contains("it. med"), "{stdout}");
+    for stem in ["compare-convergence", "compare-iterations"] {
+        check_plot(
+            &dir,
+            stem,
+            &[
+                "initial k_K1 [N/m]",
+                "initial k_K2 [N/m]",
+                "newton · target 1e5, 1e5 N/m",
+                "damped · target 1e5, 1e5 N/m",
+            ],
+        );
+    }
+    let svg = std::fs::read_to_string(dir.join("compare-convergence.svg")).unwrap();
+    for legend in
+        ["converged to the target (within 10 %)", "converged elsewhere", "no convergence", "the target"]
+    {
+        assert!(svg.contains(legend), "{legend}");
+    }
+    let svg = std::fs::read_to_string(dir.join("compare-iterations.svg")).unwrap();
+    assert!(svg.contains("iterations from each initial guess") && svg.contains(">\niterations\n<"));
+}
+
+#[test]
+fn discover_plots_the_residual_before_and_after_with_the_noise_band() {
+    let dir = temp_dir("discover");
+    let out = eigenfit(&[
+        "discover",
+        "--preset",
+        "paper-rotor",
+        "--measured",
+        &example("measured_hidden_effect.csv"),
+        "--plot",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v = json(&out);
+    let written: Vec<&str> = v["written"].as_array().unwrap().iter().map(|w| w.as_str().unwrap()).collect();
+    assert!(
+        written.iter().any(|w| w.ends_with("discovery.svg"))
+            && written.iter().any(|w| w.ends_with("discovery.png"))
+    );
+    check_plot(
+        &dir,
+        "discovery",
+        &[
+            "residual per mode before and after discovery",
+            "(model − measured) / σ",
+            "mode",
+            "±2σ noise band",
+            "before: stiffnesses calibrated, nominal model",
+            "after: with disk-rotary-inertia@0",
+            "+2σ",
+            "−2σ",
+        ],
+    );
+}
+
+#[test]
+fn demo_writes_every_plot_kind_and_reports() {
+    let dir = temp_dir("demo");
+    let out_dir = dir.join("report");
+    let out = eigenfit(&["demo", "--out", out_dir.to_str().unwrap(), "--grid", "4"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.stderr.is_empty(), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    for part in
+        ["1. Table 1", "paper [Hz]", "model [Hz]", "diff [%]", "2. Table 3 case 1", "damped", "4. Discovery"]
+    {
+        assert!(stdout.contains(part), "report lacks `{part}`:\n{stdout}");
+    }
+    assert!(stdout.contains("missing effect: disk-rotary-inertia@0"), "{stdout}");
+    assert!(stdout.contains(&format!("written to {}", std::fs::canonicalize(&out_dir).unwrap().display())));
+    let kinds = [
+        "critical-speed-map",
+        "mode-shapes",
+        "convergence",
+        "compare-convergence",
+        "compare-iterations",
+        "discovery",
+    ];
+    for stem in kinds {
+        check_plot(&out_dir, stem, &["paper-rotor"]);
+    }
+    let svg = std::fs::read_to_string(out_dir.join("convergence.svg")).unwrap();
+    for strategy in ["newton · k_K1", "p-step · k_K1", "damped · k_K1", "target"] {
+        assert!(svg.contains(strategy), "convergence.svg lacks {strategy}");
+    }
+}
+
+#[test]
+fn demo_json_lists_the_results_and_the_plots() {
+    let dir = temp_dir("demo-json");
+    let out = eigenfit(&["demo", "--out", dir.to_str().unwrap(), "--grid", "3", "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v = json(&out);
+    assert_eq!(v["table_1"].as_array().unwrap().len(), 18);
+    let estimates = v["table_3_case_1"]["estimates"].as_array().unwrap();
+    assert_eq!(estimates.len(), 3);
+    for e in estimates {
+        assert_eq!(e["converged"], true, "{e}");
+        let k1 = e["parameters"][0].as_f64().unwrap();
+        assert!((k1 / 1e5 - 1.0).abs() < 1e-3, "{e}");
+    }
+    assert_eq!(v["discovery"]["kind"], "disk-rotary-inertia");
+    assert_eq!(v["plots"].as_array().unwrap().len(), 12);
+}
