@@ -32,7 +32,9 @@ pub struct BandedSolver {
 
 impl Default for BandedSolver {
     fn default() -> Self {
-        Self { tolerance: 1e-10, max_iterations: 500 }
+        // 1e-8 on the shapes (1e-16 on the eigenvalues) is at the round-off floor of fine beam
+        // meshes already; asking for less only spends iterations until the stall rule stops them.
+        Self { tolerance: 1e-8, max_iterations: 500 }
     }
 }
 
@@ -124,7 +126,7 @@ impl BandedSolver {
         let mut kr = DMatrix::zeros(p, p);
         let mut mr = DMatrix::zeros(p, p);
         let mut nu: Option<DVector<f64>> = None;
-        let (mut best, mut stalled) = (f64::INFINITY, 0);
+        let (mut best, mut stalled, mut refills) = (f64::INFINITY, 0, 0);
         m.mul_columns(&x, &mut y);
         for _ in 0..self.max_iterations {
             z.copy_from(&y);
@@ -149,6 +151,10 @@ impl BandedSolver {
             mr.gemm_tr(1.0, &z, &mz, 0.0);
             let (values, q) = projected(&kr, &mr)?;
             x.gemm(1.0, &z, &q, 0.0);
+            for j in (0..p).filter(|&j| !values[j].is_finite()) {
+                refills += 1;
+                x.column_mut(j).copy_from(&start_vectors(n, 1 + refills).column(refills));
+            }
             m.mul_columns(&x, &mut y);
             nu = Some(values);
         }
@@ -158,6 +164,9 @@ impl BandedSolver {
 
 /// max over the wanted modes of ‖νᵢ zᵢ − xᵢ‖∞ / ‖xᵢ‖∞.
 fn inverse_residual(x: &DMatrix<f64>, z: &DMatrix<f64>, nu: &DVector<f64>, count: usize) -> f64 {
+    if nu.iter().take(count).any(|v| !v.is_finite()) {
+        return f64::INFINITY;
+    }
     (0..count)
         .map(|i| {
             let (xc, zc) = (x.column(i), z.column(i));
@@ -191,11 +200,25 @@ fn projected(kr: &DMatrix<f64>, mr: &DMatrix<f64>) -> Result<(DVector<f64>, DMat
     let mut order: Vec<usize> = (0..p).collect();
     order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
     let mu_max = eig.eigenvalues[order[0]];
-    if !(mu_max > 0.0) || order.iter().any(|&i| !(eig.eigenvalues[i] > 1e-300 * mu_max)) {
+    if mu_max.is_nan() || mu_max <= 0.0 {
         return Err(backend("the iteration subspace collapsed"));
     }
-    let values = DVector::from_iterator(p, order.iter().map(|&i| 1.0 / eig.eigenvalues[i]));
-    let w = DMatrix::from_fn(p, p, |r, j| eig.eigenvectors[(r, order[j])] / eig.eigenvalues[order[j]].sqrt());
+    // Directions lost to round-off (the columns of Z nearly dependent, as after the first step
+    // from random vectors when λ₂/λ₁ is huge) come back as ν = ∞ with a zero column in Q; the
+    // caller refills them.
+    let good = |i: usize| eig.eigenvalues[i] > 1e-14 * mu_max;
+    let values = DVector::from_iterator(
+        p,
+        order.iter().map(|&i| if good(i) { 1.0 / eig.eigenvalues[i] } else { f64::INFINITY }),
+    );
+    let w = DMatrix::from_fn(p, p, |r, j| {
+        let i = order[j];
+        if good(i) {
+            eig.eigenvectors[(r, i)] / eig.eigenvalues[i].sqrt()
+        } else {
+            0.0
+        }
+    });
     let mut q =
         l.transpose().solve_upper_triangular(&w).ok_or_else(|| backend("zero pivot in projected factor"))?;
     for (i, mut row) in q.row_iter_mut().enumerate() {

@@ -67,8 +67,8 @@ pub enum RotorError {
     /// The shaft has no element.
     #[error("the shaft has no element: give at least two node positions, or `elements` ≥ 1")]
     NoElements,
-    /// More elements than the dense matrices are meant for.
-    #[error("the shaft has {elements} elements; at most {max} are supported (K and M are stored densely)")]
+    /// More elements than a rotor may have.
+    #[error("the shaft has {elements} elements; at most {max} are supported")]
     TooManyElements {
         /// Elements asked for.
         elements: usize,

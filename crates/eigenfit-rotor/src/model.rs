@@ -5,8 +5,10 @@ use crate::element;
 use crate::error::RotorError;
 use crate::file::{Disk, Material, PointMass, RotorSpec};
 use crate::RotorBuilder;
-use eigenfit_core::{ModelError, ParameterSet, SparseSymmetric, StructuralModel, System, SystemDerivative};
-use nalgebra::{DMatrix, Matrix4};
+use eigenfit_core::{
+    BandedSymmetric, ModelError, ParameterSet, SparseSymmetric, StructuralModel, System, SystemDerivative,
+};
+use nalgebra::Matrix4;
 
 /// Lower bound of every bearing-stiffness parameter (N/m): positive, as the log scale needs.
 pub const STIFFNESS_LOWER: f64 = 1e-6;
@@ -14,9 +16,15 @@ pub const STIFFNESS_LOWER: f64 = 1e-6;
 /// well inside what a double-precision eigen-solve resolves next to a shaft.
 pub const STIFFNESS_UPPER: f64 = 1e15;
 
-/// Most shaft elements a rotor may have: K and M are stored densely (n = 2·(elements + 1) DOFs,
-/// 2000 elements ≈ 128 MB per matrix).
-pub const MAX_ELEMENTS: usize = 2000;
+/// Most shaft elements a rotor may have. K and M are kept by band (half-bandwidth 3: 32 bytes
+/// per DOF and matrix), so memory is no limit; 10⁵ elements (200,002 DOFs) is far beyond any
+/// sensible mesh. Above [`DENSE_ASSEMBLY_MAX_DOFS`] a dense solver would need 8n² bytes per
+/// matrix: solve such rotors with [`BandedSolver`](eigenfit_core::BandedSolver).
+pub const MAX_ELEMENTS: usize = 100_000;
+
+/// Largest rotor (in DOFs) whose [`assemble`](StructuralModel::assemble) returns a dense
+/// [`System`]; larger rotors return a banded one.
+pub const DENSE_ASSEMBLY_MAX_DOFS: usize = 200;
 
 /// One resolved shaft element between nodes `index` and `index + 1`.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,8 +62,9 @@ pub struct Bearing {
 /// [[`STIFFNESS_LOWER`], [`STIFFNESS_UPPER`]].
 ///
 /// The parameter-independent part of K and M (shaft, disks, point masses, rotational bearing
-/// springs) is assembled once at construction; [`assemble`](StructuralModel::assemble) copies it
-/// and adds the bearing stiffnesses on the diagonal.
+/// springs) is assembled once at construction, by band; [`assemble`](StructuralModel::assemble)
+/// copies it, adds the bearing stiffnesses on the diagonal and returns a dense [`System`] for
+/// rotors up to [`DENSE_ASSEMBLY_MAX_DOFS`] DOFs, a banded one beyond.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rotor {
     pub(crate) spec: RotorSpec,
@@ -63,8 +72,8 @@ pub struct Rotor {
     elements: Vec<ShaftElement>,
     bearings: Vec<Bearing>,
     parameters: ParameterSet,
-    base_stiffness: DMatrix<f64>,
-    base_mass: DMatrix<f64>,
+    base_stiffness: BandedSymmetric,
+    base_mass: BandedSymmetric,
 }
 
 impl Rotor {
@@ -77,8 +86,8 @@ impl Rotor {
         parameters: ParameterSet,
     ) -> Self {
         let n = 2 * nodes.len();
-        let mut k = DMatrix::zeros(n, n);
-        let mut m = DMatrix::zeros(n, n);
+        let mut k = BandedSymmetric::zeros(n, 3);
+        let mut m = BandedSymmetric::zeros(n, 3);
         for (e, el) in elements.iter().enumerate() {
             let mat = &spec.materials[el.material];
             let ei =
@@ -88,14 +97,14 @@ impl Rotor {
             add_element(&mut m, e, &element::consistent_mass(rho_a, el.length));
         }
         for d in &spec.disks {
-            m[(2 * d.node, 2 * d.node)] += d.mass;
-            m[(2 * d.node + 1, 2 * d.node + 1)] += d.diametral_inertia;
+            m.add(2 * d.node, 2 * d.node, d.mass);
+            m.add(2 * d.node + 1, 2 * d.node + 1, d.diametral_inertia);
         }
         for pm in &spec.point_masses {
-            m[(2 * pm.node, 2 * pm.node)] += pm.mass;
+            m.add(2 * pm.node, 2 * pm.node, pm.mass);
         }
         for b in &bearings {
-            k[(2 * b.node + 1, 2 * b.node + 1)] += b.rotational_stiffness;
+            k.add(2 * b.node + 1, 2 * b.node + 1, b.rotational_stiffness);
         }
         Self { spec, nodes, elements, bearings, parameters, base_stiffness: k, base_mass: m }
     }
@@ -218,19 +227,23 @@ impl Rotor {
     }
 }
 
-fn add_sparse(a: &mut DMatrix<f64>, s: &SparseSymmetric, factor: f64) {
+fn add_sparse(a: &mut BandedSymmetric, s: &SparseSymmetric, factor: f64) {
+    let reach = s.entries().iter().map(|&(i, j, _)| j - i).max().unwrap_or(0);
+    if reach > a.bandwidth() {
+        *a = a.widened(reach);
+    }
     for &(i, j, v) in s.entries() {
-        a[(i, j)] += factor * v;
-        if i != j {
-            a[(j, i)] += factor * v;
-        }
+        a.add(i, j, factor * v);
     }
 }
 
-/// Adds a 4×4 element matrix for element `e` (global DOFs 2e … 2e + 3).
-fn add_element(global: &mut DMatrix<f64>, e: usize, local: &Matrix4<f64>) {
-    let mut block = global.view_mut((2 * e, 2 * e), (4, 4));
-    block += local;
+/// Adds a 4×4 element matrix for element `e` (global DOFs 2e … 2e + 3), lower triangle.
+fn add_element(global: &mut BandedSymmetric, e: usize, local: &Matrix4<f64>) {
+    for c in 0..4 {
+        for r in c..4 {
+            global.add(2 * e + r, 2 * e + c, local[(r, c)]);
+        }
+    }
 }
 
 impl StructuralModel for Rotor {
@@ -247,9 +260,13 @@ impl StructuralModel for Rotor {
         let mut k = self.base_stiffness.clone();
         for (b, &kb) in self.bearings.iter().zip(p) {
             let j = Self::displacement_dof(b.node);
-            k[(j, j)] += kb;
+            k.add(j, j, kb);
         }
-        Ok(System::new(k, self.base_mass.clone())?)
+        if self.dofs() <= DENSE_ASSEMBLY_MAX_DOFS {
+            Ok(System::new(k.to_dense(), self.base_mass.to_dense())?)
+        } else {
+            Ok(System::banded(k, self.base_mass.clone())?)
+        }
     }
 
     /// Exact: ∂K/∂kᵢ has the single entry 1 at the bearing's displacement DOF; ∂M/∂kᵢ = 0.

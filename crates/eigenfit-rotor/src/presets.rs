@@ -133,6 +133,27 @@ mod tests {
     }
 
     #[test]
+    fn banded_solver_agrees_with_dense_on_modes_and_sensitivities() {
+        use eigenfit_core::{BandedSolver, DenseSolver, Sensitivities};
+        let rotor = super::uniform_rotor(150).unwrap();
+        for p in [[1e7, 1e7], [1e3, 1e9], [1e2, 1e4]] {
+            let a = Sensitivities::compute(&rotor, &BandedSolver::default(), &p, 6)
+                .unwrap_or_else(|e| panic!("{p:?}: {e}"));
+            let b = Sensitivities::compute(&rotor, &DenseSolver, &p, 6).unwrap();
+            for k in 0..6 {
+                let (la, lb) = (a.modes.eigenvalues[k], b.modes.eigenvalues[k]);
+                assert!((la / lb - 1.0).abs() < 1e-9, "{p:?} mode {k}: {la} vs {lb}");
+                let (x, y) = (a.modes.shapes.column(k), b.modes.shapes.column(k));
+                assert!((x - y).amax().min((x + y).amax()) < 1e-6 * y.amax(), "{p:?} shape {k}");
+                for i in 0..2 {
+                    let (sa, sb) = (a.eigenvalues[(k, i)], b.eigenvalues[(k, i)]);
+                    assert!((sa - sb).abs() <= 1e-6 * sb.abs() + 1e-12, "{p:?} dλ{k}/dp{i}: {sa} vs {sb}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn uniform_rotor_scales_and_keeps_its_low_modes() {
         use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
         assert!(super::uniform_rotor(3).is_err());

@@ -1,0 +1,169 @@
+//! Criterion benchmarks: eigen-solves by backend and size, sensitivities, one paper estimation per
+//! strategy, a comparison grid, a discovery run. `cargo bench` (add `--features lapack` for the
+//! LAPACK backend); figures and ratios are in docs/performance.md.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use eigenfit::compare::{log_space, run_grid, run_grid_serial, tensor_grid, CompareSettings};
+use eigenfit::discovery::{discover, DiscoveryOptions};
+use eigenfit::rotor::presets::{paper_rotor, uniform_rotor};
+use eigenfit::rotor::Rotor;
+use eigenfit::{
+    BandedSolver, BandedSymmetric, DenseSolver, Driver, EigenSolver, MeasuredMode, Measurement, Problem,
+    Sensitivities, StrategyKind, StructuralModel, System,
+};
+use std::hint::black_box;
+use std::time::Duration;
+
+/// The rotor of `dofs` DOFs: the paper rotor for 22, else the uniform rotor.
+fn rotor(dofs: usize) -> Rotor {
+    if dofs == 22 {
+        paper_rotor()
+    } else {
+        uniform_rotor(dofs / 2 - 1).expect("valid size")
+    }
+}
+
+/// The same K, M stored densely and by band.
+fn systems(rotor: &Rotor) -> (System, System) {
+    let sys = rotor.assemble(&rotor.nominal_stiffnesses()).expect("assembles");
+    let (k, m) = match sys.band() {
+        Some((k, m)) => (k.clone(), m.clone()),
+        None => (BandedSymmetric::from_dense(sys.stiffness()), BandedSymmetric::from_dense(sys.mass())),
+    };
+    let dense = System::new(k.to_dense(), m.to_dense()).expect("valid");
+    (dense, System::banded(k, m).expect("valid"))
+}
+
+fn eigen_solve(c: &mut Criterion) {
+    let mut g = c.benchmark_group("eigen_solve_lowest_3");
+    g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
+    for n in [22, 100, 400, 1000] {
+        let (dense, banded) = systems(&rotor(n));
+        g.bench_with_input(BenchmarkId::new("dense", n), &dense, |b, s| {
+            b.iter(|| DenseSolver.lowest(black_box(s), 3).unwrap())
+        });
+        #[cfg(feature = "lapack")]
+        g.bench_with_input(BenchmarkId::new("lapack", n), &dense, |b, s| {
+            b.iter(|| eigenfit::lapack::LapackSolver::default().lowest(black_box(s), 3).unwrap())
+        });
+        g.bench_with_input(BenchmarkId::new("banded", n), &banded, |b, s| {
+            b.iter(|| BandedSolver::default().lowest(black_box(s), 3).unwrap())
+        });
+    }
+    g.finish();
+    // The large-model cost curve: lowest 10 modes (+1 checked neighbour) by band.
+    let mut g = c.benchmark_group("banded_lowest_11");
+    g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
+    for n in [1002, 3002, 10002, 30002] {
+        let (_, banded) = systems(&rotor(n));
+        g.bench_with_input(BenchmarkId::from_parameter(n), &banded, |b, s| {
+            b.iter(|| BandedSolver::default().lowest(black_box(s), 11).unwrap())
+        });
+    }
+    g.finish();
+}
+
+fn sensitivities(c: &mut Criterion) {
+    let mut g = c.benchmark_group("sensitivities");
+    g.sample_size(20).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
+    let paper = paper_rotor();
+    g.bench_function("paper_rotor_2_modes_dense", |b| {
+        b.iter(|| Sensitivities::compute(&paper, &DenseSolver, black_box(&[1e5, 1e5]), 2).unwrap())
+    });
+    g.bench_function("paper_rotor_assemble", |b| b.iter(|| paper.assemble(black_box(&[1e5, 1e5])).unwrap()));
+    g.sample_size(10);
+    // The large-model target: 10 modes and their sensitivities, 10,002 DOFs.
+    let large = uniform_rotor(5000).expect("valid");
+    let solver = BandedSolver::default();
+    g.bench_function("uniform_rotor_10002_dofs_10_modes_banded", |b| {
+        b.iter(|| Sensitivities::compute(&large, &solver, black_box(&[1e7, 1e7]), 10).unwrap())
+    });
+    g.finish();
+}
+
+/// Table 3 case 1: exact reference data at K1 = K2 = 1e5 N/m, start at 1e2 N/m.
+fn paper_problem() -> Problem<Rotor, DenseSolver> {
+    let rotor = paper_rotor();
+    let f = DenseSolver.lowest(&rotor.assemble(&[1e5, 1e5]).unwrap(), 2).unwrap().frequencies_hz();
+    Problem::new(rotor, DenseSolver, Measurement::from_frequencies(&f).unwrap())
+}
+
+fn estimation(c: &mut Criterion) {
+    let mut g = c.benchmark_group("estimate_table3_case1");
+    g.sample_size(20).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
+    let problem = paper_problem();
+    for kind in StrategyKind::ALL {
+        g.bench_function(kind.name(), |b| {
+            b.iter(|| {
+                let mut s = kind.build();
+                Driver::default().run(&problem, s.as_mut(), black_box(&[1e2, 1e2]), &mut []).unwrap()
+            })
+        });
+    }
+    g.bench_function("linearise", |b| b.iter(|| problem.linearise(black_box(&[1e3, 2e4])).unwrap()));
+    g.finish();
+}
+
+fn compare_grid(c: &mut Criterion) {
+    let mut g = c.benchmark_group("compare_grid");
+    g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(3));
+    let rotor = paper_rotor();
+    let targets = vec![vec![1e5, 1e5]];
+    let initials = tensor_grid(&log_space(1e1, 1e9, 5), 2);
+    let strategies = StrategyKind::ALL;
+    let settings = CompareSettings { modes: 2, decimals: None, std_hz: None, max_iterations: 1000 };
+    let runs = targets.len() * initials.len() * strategies.len();
+    g.bench_function(format!("{runs}_runs_parallel"), |b| {
+        b.iter(|| {
+            run_grid(&rotor, &DenseSolver, &targets, &initials, &strategies, &settings, |_| {}).unwrap()
+        })
+    });
+    g.bench_function(format!("{runs}_runs_serial"), |b| {
+        b.iter(|| {
+            run_grid_serial(&rotor, &DenseSolver, &targets, &initials, &strategies, &settings, |_| {})
+                .unwrap()
+        })
+    });
+    g.finish();
+}
+
+/// `examples/measured_hidden_effect.csv` (mode,frequency_hz,std_hz; modes counted from 1).
+fn hidden_effect_data() -> Measurement {
+    let text = include_str!("../examples/measured_hidden_effect.csv");
+    let modes = text
+        .lines()
+        .skip(1)
+        .filter(|l| !l.trim().is_empty())
+        .map(|line| {
+            let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().expect("number")).collect();
+            MeasuredMode { mode: v[0] as usize - 1, frequency_hz: v[1], std_hz: Some(v[2]), shape: None }
+        })
+        .collect();
+    Measurement::new(modes).expect("valid data")
+}
+
+fn discovery(c: &mut Criterion) {
+    let mut g = c.benchmark_group("discovery");
+    g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(3));
+    let rotor = paper_rotor();
+    let data = hidden_effect_data();
+    let candidates = rotor.candidates();
+    let options = DiscoveryOptions::default();
+    g.bench_function("paper_rotor_hidden_effect", |b| {
+        b.iter(|| {
+            discover(
+                &rotor,
+                &DenseSolver,
+                black_box(&data),
+                &candidates,
+                &rotor.nominal_stiffnesses(),
+                &options,
+            )
+            .unwrap()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, eigen_solve, sensitivities, estimation, compare_grid, discovery);
+criterion_main!(benches);
