@@ -172,3 +172,30 @@ fn lapack_and_dense_backends_agree_on_the_paper_rotor() {
         assert!((d / l - 1.0).abs() < 1e-9, "dense {d} vs lapack {l}");
     }
 }
+
+#[test]
+fn simulate_reports_sensitivities_that_match_finite_differences() {
+    let freqs = |k1: f64| -> (Vec<f64>, Value) {
+        let (code, v) = eigenfit(&[
+            "simulate",
+            "--preset",
+            "paper-rotor",
+            "--stiffness",
+            &format!("{k1},1e5"),
+            "--modes",
+            "3",
+            "--json",
+        ]);
+        assert_eq!(code, 0);
+        (v["frequencies_hz"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect(), v)
+    };
+    let (_, v) = freqs(1e5);
+    let analytic: Vec<f64> =
+        v["sensitivities_hz"]["k_K1"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    let h = 1e-4 * 1e5;
+    let (up, down) = (freqs(1e5 + h).0, freqs(1e5 - h).0);
+    for k in 0..3 {
+        let fd = (up[k] - down[k]) / (2.0 * h);
+        assert!((analytic[k] / fd - 1.0).abs() < 1e-5, "mode {k}: {} vs {fd}", analytic[k]);
+    }
+}

@@ -6,7 +6,7 @@ use crate::plot::mode_shapes::ModeShapes;
 use crate::source::{parameter_vector, parse_list, ModelArgs};
 use crate::{plot, progress};
 use clap::Args;
-use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_core::{EigenSolver, Sensitivities, StructuralModel};
 use eigenfit_rotor::{presets, EffectSpec, Rotor};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -111,7 +111,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         return Ok(());
     }
     let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
-    let f = frequencies(&rotor, solver.as_ref(), &p, args.modes)?;
+    // Frequencies and their sensitivities from one solve; a model whose modes have none
+    // (repeated or rigid-body modes) still gets its frequencies, and says why.
+    let (f, sens) = match Sensitivities::compute(&rotor, solver.as_ref(), &p, args.modes) {
+        Ok(s) => (s.modes.frequencies_hz(), Ok(s.frequencies_hz)),
+        Err(e) => (frequencies(&rotor, solver.as_ref(), &p, args.modes)?, Err(e.to_string())),
+    };
     let plots = match &args.plot {
         Some(dir) => {
             let options = MapOptions { range: (1e2, 1e9), plain: args.effects.is_empty(), quiet: args.quiet };
@@ -123,6 +128,18 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         let params: serde_json::Map<_, _> = names.iter().cloned().zip(p.iter().map(|&v| json!(v))).collect();
         let mut out =
             json!({"model": label, "solver": solver.name(), "parameters": params, "frequencies_hz": f});
+        match &sens {
+            // df_k/dp_i in Hz per parameter unit, one array (over modes) per parameter.
+            Ok(df) => {
+                let by_param: serde_json::Map<_, _> = names
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| (n.clone(), json!(df.column(i).iter().copied().collect::<Vec<f64>>())))
+                    .collect();
+                out["sensitivities_hz"] = json!(by_param);
+            }
+            Err(why) => out["sensitivities_unavailable"] = json!(why),
+        }
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
