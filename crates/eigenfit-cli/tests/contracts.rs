@@ -199,3 +199,59 @@ fn simulate_reports_sensitivities_that_match_finite_differences() {
         assert!((analytic[k] / fd - 1.0).abs() < 1e-5, "mode {k}: {} vs {fd}", analytic[k]);
     }
 }
+
+fn stdout_of(args: &[&str]) -> Vec<u8> {
+    Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs").stdout
+}
+
+#[test]
+fn the_same_input_gives_byte_for_byte_the_same_output() {
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_hidden_effect.csv");
+    let runs: [&[&str]; 3] = [
+        &[
+            "compare",
+            "--preset",
+            "paper-rotor",
+            "--targets",
+            "1e5:1e5,1e8:1e8",
+            "--grid",
+            "4",
+            "--json",
+            "--quiet",
+        ],
+        &["estimate", "--preset", "paper-rotor", "--measured", data, "--initial", "1e3,1e3", "--json"],
+        &["discover", "--preset", "paper-rotor", "--measured", data, "--json", "--quiet"],
+    ];
+    for args in runs {
+        let first = stdout_of(args);
+        assert!(!first.is_empty(), "{args:?}");
+        assert_eq!(first, stdout_of(args), "{args:?} differs between two runs");
+    }
+}
+
+#[test]
+fn compare_streams_every_finished_run() {
+    let path = temp_file("runs.jsonl", "");
+    let (code, v) = eigenfit(&[
+        "compare",
+        "--preset",
+        "paper-rotor",
+        "--targets",
+        "1e5:1e5",
+        "--grid",
+        "3",
+        "--json",
+        "--quiet",
+        "--stream",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0);
+    let streamed: Vec<Value> =
+        std::fs::read_to_string(&path).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let runs = v["runs"].as_array().unwrap();
+    assert_eq!(streamed.len(), runs.len());
+    // Streamed in the order runs finish; the same set as the final report.
+    for r in runs {
+        assert!(streamed.contains(r), "{r} was not streamed");
+    }
+}

@@ -54,6 +54,14 @@ pub struct CompareArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Also append each finished run to this file as one JSON line, flushed at once, so that a
+    /// long batch loses nothing already computed if it is interrupted.
+    #[arg(long, value_name = "FILE.jsonl")]
+    pub stream: Option<PathBuf>,
+    /// Include each run's wall-clock time (`seconds`) in the JSON; off by default so that the
+    /// same input gives byte-for-byte the same output.
+    #[arg(long)]
+    pub timing: bool,
     /// Print one JSON object (`runs` array and `summary`) instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -101,8 +109,27 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     };
     let total = (targets.len() * initials.len() * strategies.len()) as u64;
     let pb = progress::bar(total, "compare runs", args.quiet);
-    let runs = run_grid(&rotor, &solver.as_ref(), &targets, &initials, &strategies, &settings, |_| pb.inc(1));
+    let mut stream = match &args.stream {
+        Some(path) => Some(std::io::BufWriter::new(
+            std::fs::File::create(path)
+                .map_err(|e| input(format!("{}: cannot create: {e}", path.display())))?,
+        )),
+        None => None,
+    };
+    let mut stream_error = None;
+    let runs = run_grid(&rotor, &solver.as_ref(), &targets, &initials, &strategies, &settings, |r| {
+        pb.inc(1);
+        if let (Some(w), None) = (stream.as_mut(), &stream_error) {
+            use std::io::Write;
+            if let Err(e) = writeln!(w, "{}", run_json(r, args.timing)).and_then(|()| w.flush()) {
+                stream_error = Some(e);
+            }
+        }
+    });
     pb.finish_and_clear();
+    if let (Some(e), Some(path)) = (stream_error, &args.stream) {
+        eprintln!("eigenfit: warning: {}: streaming stopped: {e}", path.display());
+    }
     let runs = runs.map_err(|e| input(format!("reference data: {e}")))?;
     let summary = summarise(&runs, &targets, &strategies);
     let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
@@ -111,7 +138,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     if args.json {
-        let runs_json: Vec<Value> = runs.iter().map(run_json).collect();
+        let runs_json: Vec<Value> = runs.iter().map(|r| run_json(r, args.timing)).collect();
         let summary_json: Vec<Value> = summary.iter().map(Summary::to_json).collect();
         let mut out = json!({"model": label, "solver": solver.name(), "modes": settings.modes,
                    "decimals": args.decimals, "std_hz": args.std_hz, "runs": runs_json, "summary": summary_json});
@@ -209,7 +236,7 @@ fn points(flag: &str, text: &str, np: usize) -> Result<Vec<Vec<f64>>, CliError> 
         .collect()
 }
 
-fn run_json(r: &CompareRun) -> Value {
+fn run_json(r: &CompareRun, timing: bool) -> Value {
     let mut v = json!({
         "strategy": r.strategy.name(),
         "target": r.target,
@@ -220,8 +247,10 @@ fn run_json(r: &CompareRun) -> Value {
         "evaluations": r.evaluations,
         "estimate": r.estimate,
         "relative_error": r.relative_error,
-        "seconds": r.seconds,
     });
+    if timing {
+        v["seconds"] = json!(r.seconds);
+    }
     if r.strategy == StrategyKind::Damped && r.converged {
         v["alternative_solutions"] = json!(r.alternatives);
     }

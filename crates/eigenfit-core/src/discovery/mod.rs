@@ -324,7 +324,7 @@ impl Projector {
         let js = crate::update::damped::scaled_jacobian(base.parameters(), lin);
         // Orthonormal basis of the column space (thin SVD, dropping null directions).
         let svd = js.svd(true, false);
-        let u = svd.u.expect("requested");
+        let u = svd.u.expect("requested"); // proof: svd(true, _) always computes U
         let smax = svd.singular_values.iter().cloned().fold(0.0, f64::max);
         let keep: Vec<usize> =
             (0..svd.singular_values.len()).filter(|&i| svd.singular_values[i] > 1e-12 * smax).collect();
