@@ -8,18 +8,8 @@ use eigenfit_core::{EigenSolver, StructuralModel};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-/// The paper's Table 1: (K1, K2) in N/m and the first two natural frequencies in Hz.
-pub const PAPER_TABLE_1: [([f64; 2], [f64; 2]); 9] = [
-    ([1e2, 1e2], [1.408, 2.827]),
-    ([1e3, 1e3], [4.442, 8.936]),
-    ([1e4, 1e4], [13.738, 28.118]),
-    ([1e5, 1e5], [36.069, 84.517]),
-    ([1e6, 1e6], [55.012, 172.618]),
-    ([1e7, 1e7], [58.791, 196.907]),
-    ([1e8, 1e8], [59.206, 199.536]),
-    ([1e9, 1e9], [59.248, 199.800]),
-    ([1e5, 1e3], [4.921, 71.888]),
-];
+/// The paper's Table 1, defined once in the rotor crate.
+pub use eigenfit_rotor::presets::PAPER_TABLE_1;
 
 /// A measured or published point on the map.
 #[derive(Debug, Clone, PartialEq)]
