@@ -64,11 +64,12 @@ impl ModelArgs {
         }
         if let Some(path) = &self.model {
             let rotor = Rotor::from_toml_file(path).map_err(|e| match e {
-                // These already name the file (and the line where the parser could place it).
-                RotorError::Io { .. } | RotorError::Parse { .. } | RotorError::ParseUnplaced { .. } => {
-                    input(e.to_string())
-                }
-                // Validation errors name the entry (`disk 1`, `bearing 0 \`drive_end\``) but not the file.
+                // These already name the file (and the line where it could be placed).
+                RotorError::Io { .. }
+                | RotorError::Parse { .. }
+                | RotorError::ParseUnplaced { .. }
+                | RotorError::Located { .. } => input(e.to_string()),
+                // A validation error that could not be placed names the entry (`disk 1`) but not the file.
                 other => input(format!("{}: {other}", path.display())),
             })?;
             return Ok((rotor, path.display().to_string()));

@@ -4,7 +4,7 @@
 //! `eigenfit simulate --model FILE`) or bad measured data (`measured/*.csv`, run through
 //! `eigenfit estimate --preset paper-rotor --measured FILE`). Each must end with exit code 2 (bad
 //! input), print exactly `eigenfit: MESSAGE` on stderr — the message names the file and, where
-//! it applies, the line — print nothing on stdout, and never a panic or a backtrace. The table
+//! it applies (every syntax and validation error of a model file), the line — print nothing on stdout, and never a panic or a backtrace. The table
 //! below holds the expected message of every file; a file without an entry fails the test, so
 //! the corpus and the table stay in step. A missing file and a directory are checked too.
 
@@ -35,41 +35,41 @@ const fn measured(file: &'static str, message: &'static str) -> Case {
 /// Every corpus file and its exact message (after `eigenfit: `). Paths are relative to
 /// `tests/bad_input/`, where the binary runs.
 const CASES: &[Case] = &[
-    model("model/bearing_missing_node.toml", "model/bearing_missing_node.toml: bearing 1 is at node 11, but the shaft has nodes 0–10"),
-    model("model/binary_garbage.toml", "cannot read `model/binary_garbage.toml`: not a UTF-8 text file (invalid byte at line 1, column 1)"),
-    model("model/bore_not_below_outer.toml", "model/bore_not_below_outer.toml: element 0: inner diameter 0.014 m must be smaller than the outer diameter 0.014 m"),
-    model("model/both_layouts.toml", "model/both_layouts.toml: shaft: give either `nodes` or `length` with `elements`, not both"),
+    model("model/bearing_missing_node.toml", "model/bearing_missing_node.toml: line 18: bearing 1 is at node 11, but the shaft has nodes 0–10"),
+    model("model/binary_garbage.toml", "model/binary_garbage.toml: cannot read: not a UTF-8 text file (invalid byte at line 1, column 1)"),
+    model("model/bore_not_below_outer.toml", "model/bore_not_below_outer.toml: line 10: element 0: inner diameter 0.014 m must be smaller than the outer diameter 0.014 m"),
+    model("model/both_layouts.toml", "model/both_layouts.toml: line 6: shaft: give either `nodes` or `length` with `elements`, not both"),
     model("model/comments_only.toml", "model/comments_only.toml: line 1, column 1: missing field `shaft`"),
     model("model/control_chars.toml", "model/control_chars.toml: line 1, column 1: invalid key"),
-    model("model/decreasing_nodes.toml", "model/decreasing_nodes.toml: shaft nodes must strictly increase: node 2 at 0.2 m is not beyond node 1 at 0.3 m (element 1 would have length -0.1 m)"),
-    model("model/disk_missing_node.toml", "model/disk_missing_node.toml: disk 0 is at node 42, but the shaft has nodes 0–10"),
-    model("model/duplicate_bearing.toml", "model/duplicate_bearing.toml: bearings 0 and 1 are both named `drive_end`"),
+    model("model/decreasing_nodes.toml", "model/decreasing_nodes.toml: line 7: shaft nodes must strictly increase: node 2 at 0.2 m is not beyond node 1 at 0.3 m (element 1 would have length -0.1 m)"),
+    model("model/disk_missing_node.toml", "model/disk_missing_node.toml: line 12: disk 0 is at node 42, but the shaft has nodes 0–10"),
+    model("model/duplicate_bearing.toml", "model/duplicate_bearing.toml: line 17: bearings 0 and 1 are both named `drive_end`"),
     model("model/empty.toml", "model/empty.toml: line 1, column 1: missing field `shaft`"),
-    model("model/empty_model.toml", "model/empty_model.toml: shaft: give the node positions `nodes`, or `length` with `elements`"),
-    model("model/huge_stiffness.toml", "model/huge_stiffness.toml: bearing 0 `drive_end`: stiffness = 1e20 is invalid: it must be finite and within [1e-6, 1e15] N/m"),
-    model("model/inf_modulus.toml", "model/inf_modulus.toml: material `steel`: youngs_modulus = inf is invalid: it must be finite and > 0"),
-    model("model/latin1.toml", "cannot read `model/latin1.toml`: not a UTF-8 text file (invalid byte at line 2, column 11)"),
+    model("model/empty_model.toml", "model/empty_model.toml: line 2: shaft: give the node positions `nodes`, or `length` with `elements`"),
+    model("model/huge_stiffness.toml", "model/huge_stiffness.toml: line 14: bearing 0 `drive_end`: stiffness = 1e20 is invalid: it must be finite and within [1e-6, 1e15] N/m"),
+    model("model/inf_modulus.toml", "model/inf_modulus.toml: line 3: material `steel`: youngs_modulus = inf is invalid: it must be finite and > 0"),
+    model("model/latin1.toml", "model/latin1.toml: cannot read: not a UTF-8 text file (invalid byte at line 2, column 11)"),
     model("model/missing_field.toml", "model/missing_field.toml: line 16, column 1: missing field `node`"),
     model("model/missing_shaft.toml", "model/missing_shaft.toml: line 1, column 1: missing field `shaft`"),
-    model("model/nan_density.toml", "model/nan_density.toml: material `steel`: density = NaN is invalid: it must be finite and > 0"),
-    model("model/nan_node.toml", "model/nan_node.toml: shaft node 1: position = NaN is invalid: it must be finite"),
-    model("model/nan_stiffness.toml", "model/nan_stiffness.toml: bearing 0 `drive_end`: stiffness = NaN is invalid: it must be finite and within [1e-6, 1e15] N/m"),
-    model("model/negative_density.toml", "model/negative_density.toml: material `steel`: density = -7850 is invalid: it must be finite and > 0"),
-    model("model/negative_disk_mass.toml", "model/negative_disk_mass.toml: disk 0: mass = -0.4 is invalid: it must be finite and > 0"),
+    model("model/nan_density.toml", "model/nan_density.toml: line 4: material `steel`: density = NaN is invalid: it must be finite and > 0"),
+    model("model/nan_node.toml", "model/nan_node.toml: line 7: shaft node 1: position = NaN is invalid: it must be finite"),
+    model("model/nan_stiffness.toml", "model/nan_stiffness.toml: line 14: bearing 0 `drive_end`: stiffness = NaN is invalid: it must be finite and within [1e-6, 1e15] N/m"),
+    model("model/negative_density.toml", "model/negative_density.toml: line 4: material `steel`: density = -7850 is invalid: it must be finite and > 0"),
+    model("model/negative_disk_mass.toml", "model/negative_disk_mass.toml: line 13: disk 0: mass = -0.4 is invalid: it must be finite and > 0"),
     model("model/negative_elements.toml", "model/negative_elements.toml: line 8, column 12: invalid value: integer `-10`, expected usize"),
-    model("model/no_elements.toml", "model/no_elements.toml: the shaft has no element: give at least two node positions, or `elements` ≥ 1"),
-    model("model/overlapping_sections.toml", "model/overlapping_sections.toml: shaft sections 0 and 1 both cover element 5"),
-    model("model/section_out_of_range.toml", "model/section_out_of_range.toml: shaft section 0: elements [8, 10] are invalid: the shaft has elements 0–9"),
+    model("model/no_elements.toml", "model/no_elements.toml: line 8: the shaft has no element: give at least two node positions, or `elements` ≥ 1"),
+    model("model/overlapping_sections.toml", "model/overlapping_sections.toml: line 16: shaft sections 0 and 1 both cover element 5"),
+    model("model/section_out_of_range.toml", "model/section_out_of_range.toml: line 12: shaft section 0: elements [8, 10] are invalid: the shaft has elements 0–9"),
     model("model/syntax_error.toml", "model/syntax_error.toml: line 15, column 13: invalid string\nexpected `\"`, `'`"),
     model("model/unclosed_table.toml", "model/unclosed_table.toml: line 1, column 11: invalid table header\nexpected `.`, `]]`"),
     model("model/unknown_key.toml", "model/unknown_key.toml: line 9, column 1: unknown field `diamter`, expected one of `nodes`, `length`, `elements`, `diameter`, `inner_diameter`, `material`, `section`"),
-    model("model/unknown_material.toml", "model/unknown_material.toml: shaft: unknown material `stainless` (defined: `steel`)"),
+    model("model/unknown_material.toml", "model/unknown_material.toml: line 10: shaft: unknown material `stainless` (defined: `steel`)"),
     model("model/unknown_table.toml", "model/unknown_table.toml: line 21, column 3: unknown field `bearings`, expected one of `material`, `shaft`, `disk`, `bearing`, `point_mass`, `effect`"),
     model("model/wrong_type.toml", "model/wrong_type.toml: line 8, column 12: invalid type: string \"ten\", expected usize"),
-    model("model/zero_diameter.toml", "model/zero_diameter.toml: shaft: diameter = 0 is invalid: it must be finite and > 0"),
-    model("model/zero_length.toml", "model/zero_length.toml: shaft: length = 0 is invalid: it must be finite and > 0"),
-    model("model/zero_length_element.toml", "model/zero_length_element.toml: shaft nodes must strictly increase: node 2 at 0.1 m is not beyond node 1 at 0.1 m (element 1 would have length 0 m)"),
-    model("model/zero_stiffness.toml", "model/zero_stiffness.toml: bearing 0 `drive_end`: stiffness = 0 is invalid: it must be finite and within [1e-6, 1e15] N/m"),
+    model("model/zero_diameter.toml", "model/zero_diameter.toml: line 9: shaft: diameter = 0 is invalid: it must be finite and > 0"),
+    model("model/zero_length.toml", "model/zero_length.toml: line 7: shaft: length = 0 is invalid: it must be finite and > 0"),
+    model("model/zero_length_element.toml", "model/zero_length_element.toml: line 7: shaft nodes must strictly increase: node 2 at 0.1 m is not beyond node 1 at 0.1 m (element 1 would have length 0 m)"),
+    model("model/zero_stiffness.toml", "model/zero_stiffness.toml: line 14: bearing 0 `drive_end`: stiffness = 0 is invalid: it must be finite and within [1e-6, 1e15] N/m"),
     measured("measured/binary_garbage.csv", "measured/binary_garbage.csv:1: not a UTF-8 text file (invalid byte at column 1)"),
     measured("measured/comments_only.csv", "measured/comments_only.csv:1: empty file: expected the header `mode,frequency_hz[,std_hz]`"),
     measured("measured/control_chars.csv", "measured/control_chars.csv:1: unknown column `\\0\\u{1}\\u{2}`; the header must be `mode,frequency_hz[,std_hz]`"),
@@ -172,6 +172,16 @@ fn every_corpus_file_has_an_expected_message() {
         assert!(corpus().join(c.file).is_file(), "{}: listed in CASES but missing", c.file);
         // Every message names its file.
         assert!(c.message.contains(c.file), "{}: message does not name the file: {}", c.file, c.message);
+        // And a model file's syntax and validation errors the line (an unreadable file has none).
+        if c.kind == Kind::Model && !c.message.contains(": cannot read: ") {
+            let line = format!("{}: line ", c.file);
+            assert!(
+                c.message.starts_with(&line),
+                "{}: message does not name the line: {}",
+                c.file,
+                c.message
+            );
+        }
     }
 }
 
@@ -181,9 +191,9 @@ fn missing_files_and_directories_are_bad_input() {
         (
             Kind::Model,
             "model/no_such_file.toml",
-            "cannot read `model/no_such_file.toml`: No such file or directory (os error 2)",
+            "model/no_such_file.toml: cannot read: No such file or directory (os error 2)",
         ),
-        (Kind::Model, "model", "cannot read `model`: Is a directory (os error 21)"),
+        (Kind::Model, "model", "model: cannot read: Is a directory (os error 21)"),
         (
             Kind::Measured,
             "measured/no_such_file.csv",
@@ -209,8 +219,8 @@ fn missing_files_and_directories_are_bad_input() {
 #[test]
 fn every_command_reports_a_bad_model_the_same_way() {
     let file = "model/nan_density.toml";
-    let message =
-        "model/nan_density.toml: material `steel`: density = NaN is invalid: it must be finite and > 0";
+    let message = "model/nan_density.toml: line 4: material `steel`: density = NaN is invalid: it must be \
+                   finite and > 0";
     let runs = [
         eigenfit(&["estimate", "--model", file, "--measured", "measured/empty.csv"]),
         eigenfit(&["compare", "--model", file, "--targets", "1e5:1e5", "--grid", "2"]),

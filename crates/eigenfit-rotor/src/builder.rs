@@ -6,6 +6,70 @@ use crate::file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section};
 use crate::model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
 use eigenfit_core::{Parameter, ParameterSet, Scale};
 
+/// The entry of a description an error is about, in file order (0-based).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Entry {
+    /// A `[[material]]`.
+    Material(usize),
+    /// The `[shaft]` table.
+    Shaft,
+    /// A `[[shaft.section]]`.
+    Section(usize),
+    /// A `[[disk]]`.
+    Disk(usize),
+    /// A `[[bearing]]`.
+    Bearing(usize),
+    /// A `[[point_mass]]`.
+    PointMass(usize),
+    /// An `[[effect]]`.
+    Effect(usize),
+}
+
+/// Where in the description an error lies: an entry, and within it the key (and, for an array
+/// such as `nodes`, the item) at fault where one is. A file reader turns it into a line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Site {
+    pub entry: Entry,
+    pub key: Option<&'static str>,
+    pub item: Option<usize>,
+}
+
+/// A validation error and where it lies (`None` only for errors the checks should prevent).
+#[derive(Debug)]
+pub(crate) struct SitedError {
+    pub error: RotorError,
+    pub site: Option<Site>,
+}
+
+/// Attaches `entry` (and `key`) to an error.
+fn at(entry: Entry, key: Option<&'static str>) -> impl FnOnce(RotorError) -> SitedError {
+    move |error| SitedError { error, site: Some(Site { entry, key, item: None }) }
+}
+
+/// Attaches item `item` of the shaft's `nodes` to an error.
+fn at_node(item: usize) -> impl FnOnce(RotorError) -> SitedError {
+    move |error| SitedError {
+        error,
+        site: Some(Site { entry: Entry::Shaft, key: Some("nodes"), item: Some(item) }),
+    }
+}
+
+/// The `[[effect]]` entry and key an error from [`Rotor::apply_effects`] is about.
+fn effect_site(error: &RotorError) -> Option<Site> {
+    let (entry, key) = match error {
+        RotorError::Effect { entry, why, .. } => {
+            (*entry, if why.contains("location") { "location" } else { "kind" })
+        }
+        // `effects::check_value` names the entry as "effect {entry} `{kind}`".
+        RotorError::InvalidValue { location, .. } => {
+            let index = location.strip_prefix("effect ")?.split(' ').next()?;
+            (index.parse().ok()?, "value")
+        }
+        _ => return None,
+    };
+    Some(Site { entry: Entry::Effect(entry), key: Some(key), item: None })
+}
+
 /// Collects a rotor description; nothing is checked until [`build`](Self::build).
 ///
 /// ```
@@ -129,6 +193,11 @@ impl RotorBuilder {
     /// sections, every element's cross-section, disks, bearings, point masses. The first
     /// problem found is returned, naming the entry (0-based) and the offending value.
     pub fn build(self) -> Result<Rotor, RotorError> {
+        self.build_sited().map_err(|e| e.error)
+    }
+
+    /// [`build`](Self::build), saying which entry (and key) of the description an error is about.
+    pub(crate) fn build_sited(self) -> Result<Rotor, SitedError> {
         let mut spec = self.spec;
         check_materials(&spec.materials)?;
         let nodes = node_positions(&spec)?;
@@ -142,31 +211,37 @@ impl RotorBuilder {
             }
         };
         for (i, d) in spec.disks.iter().enumerate() {
-            node_check("disk", i, d.node)?;
-            let at = || format!("disk {i}");
-            positive(at, "mass", d.mass)?;
-            non_negative(at, "diametral_inertia", d.diametral_inertia)?;
+            let entry = Entry::Disk(i);
+            node_check("disk", i, d.node).map_err(at(entry, Some("node")))?;
+            let here = || format!("disk {i}");
+            positive(here, "mass", d.mass).map_err(at(entry, Some("mass")))?;
+            non_negative(here, "diametral_inertia", d.diametral_inertia)
+                .map_err(at(entry, Some("diametral_inertia")))?;
         }
         let mut bearings: Vec<Bearing> = Vec::with_capacity(spec.bearings.len());
         for (i, b) in spec.bearings.iter_mut().enumerate() {
-            node_check("bearing", i, b.node)?;
+            let entry = Entry::Bearing(i);
+            node_check("bearing", i, b.node).map_err(at(entry, Some("node")))?;
             let name = b.name.get_or_insert_with(|| format!("bearing_{i}")).clone();
-            let at = || format!("bearing {i} `{name}`");
+            let here = || format!("bearing {i} `{name}`");
             if name.trim().is_empty() {
-                return Err(RotorError::EmptyName { location: format!("bearing {i}") });
+                return Err(at(entry, Some("name"))(RotorError::EmptyName {
+                    location: format!("bearing {i}"),
+                }));
             }
             if let Some(first) = bearings.iter().position(|q| q.name == name) {
-                return Err(RotorError::DuplicateBearing { name, first, second: i });
+                return Err(at(entry, Some("name"))(RotorError::DuplicateBearing { name, first, second: i }));
             }
             if !(b.stiffness.is_finite() && (STIFFNESS_LOWER..=STIFFNESS_UPPER).contains(&b.stiffness)) {
-                return Err(RotorError::InvalidValue {
-                    location: at(),
+                return Err(at(entry, Some("stiffness"))(RotorError::InvalidValue {
+                    location: here(),
                     quantity: "stiffness",
                     value: b.stiffness,
                     requirement: "finite and within [1e-6, 1e15] N/m",
-                });
+                }));
             }
-            non_negative(at, "rotational_stiffness", b.rotational_stiffness)?;
+            non_negative(here, "rotational_stiffness", b.rotational_stiffness)
+                .map_err(at(entry, Some("rotational_stiffness")))?;
             bearings.push(Bearing {
                 name,
                 node: b.node,
@@ -175,8 +250,9 @@ impl RotorBuilder {
             });
         }
         for (i, pm) in spec.point_masses.iter().enumerate() {
-            node_check("point_mass", i, pm.node)?;
-            positive(|| format!("point_mass {i}"), "mass", pm.mass)?;
+            let entry = Entry::PointMass(i);
+            node_check("point_mass", i, pm.node).map_err(at(entry, Some("node")))?;
+            positive(|| format!("point_mass {i}"), "mass", pm.mass).map_err(at(entry, Some("mass")))?;
         }
         let parameters = ParameterSet::new(
             bearings
@@ -188,8 +264,11 @@ impl RotorBuilder {
                 })
                 .collect(),
         )
-        .map_err(RotorError::Parameter)?;
-        Rotor::from_checked_parts(spec, nodes, elements, bearings, parameters).apply_effects()
+        // The checks above make the parameters valid; no entry to blame if they are not.
+        .map_err(|e| SitedError { error: RotorError::Parameter(e), site: None })?;
+        Rotor::from_checked_parts(spec, nodes, elements, bearings, parameters)
+            .apply_effects()
+            .map_err(|error| SitedError { site: effect_site(&error), error })
     }
 }
 
@@ -209,69 +288,76 @@ fn non_negative(at: impl FnOnce() -> String, quantity: &'static str, v: f64) -> 
     }
 }
 
-fn check_materials(materials: &[Material]) -> Result<(), RotorError> {
+fn check_materials(materials: &[Material]) -> Result<(), SitedError> {
     for (i, m) in materials.iter().enumerate() {
+        let entry = Entry::Material(i);
         if m.name.trim().is_empty() {
-            return Err(RotorError::EmptyName { location: format!("material {i}") });
+            return Err(at(entry, Some("name"))(RotorError::EmptyName { location: format!("material {i}") }));
         }
         if let Some(first) = materials[..i].iter().position(|q| q.name == m.name) {
-            return Err(RotorError::DuplicateMaterial { name: m.name.clone(), first, second: i });
+            let error = RotorError::DuplicateMaterial { name: m.name.clone(), first, second: i };
+            return Err(at(entry, Some("name"))(error));
         }
-        let at = || format!("material `{}`", m.name);
-        positive(at, "youngs_modulus", m.youngs_modulus)?;
-        positive(at, "density", m.density)?;
+        let here = || format!("material `{}`", m.name);
+        positive(here, "youngs_modulus", m.youngs_modulus).map_err(at(entry, Some("youngs_modulus")))?;
+        positive(here, "density", m.density).map_err(at(entry, Some("density")))?;
     }
     Ok(())
 }
 
 /// The node positions from either `nodes` or `length` + `elements`; at least two, increasing.
-fn node_positions(spec: &RotorSpec) -> Result<Vec<f64>, RotorError> {
+fn node_positions(spec: &RotorSpec) -> Result<Vec<f64>, SitedError> {
     let shaft = &spec.shaft;
+    let layout = |why| at(Entry::Shaft, None)(RotorError::ShaftLayout(why));
     let nodes = match (&shaft.nodes, shaft.length, shaft.elements) {
         (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
-            return Err(RotorError::ShaftLayout("give either `nodes` or `length` with `elements`, not both"))
+            return Err(layout("give either `nodes` or `length` with `elements`, not both"))
         }
         (Some(nodes), None, None) => {
             for (i, &x) in nodes.iter().enumerate() {
                 if !x.is_finite() {
-                    return Err(RotorError::InvalidValue {
+                    return Err(at_node(i)(RotorError::InvalidValue {
                         location: format!("shaft node {i}"),
                         quantity: "position",
                         value: x,
                         requirement: "finite",
-                    });
+                    }));
                 }
             }
             nodes.clone()
         }
         (None, Some(length), Some(elements)) => {
-            positive(|| "shaft".into(), "length", length)?;
+            positive(|| "shaft".into(), "length", length).map_err(at(Entry::Shaft, Some("length")))?;
             if elements == 0 {
-                return Err(RotorError::NoElements);
+                return Err(at(Entry::Shaft, Some("elements"))(RotorError::NoElements));
             }
             if elements > MAX_ELEMENTS {
-                return Err(RotorError::TooManyElements { elements, max: MAX_ELEMENTS });
+                let error = RotorError::TooManyElements { elements, max: MAX_ELEMENTS };
+                return Err(at(Entry::Shaft, Some("elements"))(error));
             }
             (0..=elements).map(|i| length * i as f64 / elements as f64).collect()
         }
         (None, Some(_), None) | (None, None, Some(_)) => {
-            return Err(RotorError::ShaftLayout("`length` and `elements` must be given together"))
+            return Err(layout("`length` and `elements` must be given together"))
         }
         (None, None, None) => {
-            return Err(RotorError::ShaftLayout(
-                "give the node positions `nodes`, or `length` with `elements`",
-            ))
+            return Err(layout("give the node positions `nodes`, or `length` with `elements`"))
         }
     };
     if nodes.len() < 2 {
-        return Err(RotorError::NoElements);
+        return Err(at(Entry::Shaft, Some("nodes"))(RotorError::NoElements));
     }
     if nodes.len() - 1 > MAX_ELEMENTS {
-        return Err(RotorError::TooManyElements { elements: nodes.len() - 1, max: MAX_ELEMENTS });
+        let error = RotorError::TooManyElements { elements: nodes.len() - 1, max: MAX_ELEMENTS };
+        return Err(at(Entry::Shaft, Some("nodes"))(error));
     }
     for (i, w) in nodes.windows(2).enumerate() {
         if w[1] <= w[0] {
-            return Err(RotorError::NodesNotIncreasing { node: i + 1, position: w[1], previous: w[0] });
+            return Err(at_node(i + 1)(RotorError::NodesNotIncreasing {
+                node: i + 1,
+                position: w[1],
+                previous: w[0],
+            }));
         }
     }
     Ok(nodes)
@@ -290,17 +376,20 @@ fn material_index(spec: &RotorSpec, location: String, name: &str) -> Result<usiz
 }
 
 /// Resolves every element's diameters and material from the shaft defaults and the sections.
-fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>, RotorError> {
+fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>, SitedError> {
     let shaft = &spec.shaft;
     let count = nodes.len() - 1;
     if let Some(d) = shaft.diameter {
-        positive(|| "shaft".into(), "diameter", d)?;
+        positive(|| "shaft".into(), "diameter", d).map_err(at(Entry::Shaft, Some("diameter")))?;
     }
     if let Some(d) = shaft.inner_diameter {
-        non_negative(|| "shaft".into(), "inner_diameter", d)?;
+        non_negative(|| "shaft".into(), "inner_diameter", d)
+            .map_err(at(Entry::Shaft, Some("inner_diameter")))?;
     }
     let default_material = match &shaft.material {
-        Some(name) => Some(material_index(spec, "shaft".into(), name)?),
+        Some(name) => {
+            Some(material_index(spec, "shaft".into(), name).map_err(at(Entry::Shaft, Some("material")))?)
+        }
         None if spec.materials.len() == 1 => Some(0),
         None => None,
     };
@@ -308,43 +397,54 @@ fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>
     let mut owner: Vec<Option<usize>> = vec![None; count];
     let mut section_material = Vec::with_capacity(shaft.sections.len());
     for (s, sec) in shaft.sections.iter().enumerate() {
+        let entry = Entry::Section(s);
         let [first, last] = sec.elements;
         if first > last || last >= count {
-            return Err(RotorError::SectionRange { section: s, first, last, elements: count });
+            let error = RotorError::SectionRange { section: s, first, last, elements: count };
+            return Err(at(entry, Some("elements"))(error));
         }
         for (e, slot) in owner.iter_mut().enumerate().take(last + 1).skip(first) {
             if let Some(prev) = *slot {
-                return Err(RotorError::SectionOverlap { first: prev, second: s, element: e });
+                let error = RotorError::SectionOverlap { first: prev, second: s, element: e };
+                return Err(at(entry, Some("elements"))(error));
             }
             *slot = Some(s);
         }
-        let at = || format!("shaft section {s}");
+        let here = || format!("shaft section {s}");
         if let Some(d) = sec.diameter {
-            positive(at, "diameter", d)?;
+            positive(here, "diameter", d).map_err(at(entry, Some("diameter")))?;
         }
         if let Some(d) = sec.inner_diameter {
-            non_negative(at, "inner_diameter", d)?;
+            non_negative(here, "inner_diameter", d).map_err(at(entry, Some("inner_diameter")))?;
         }
         section_material.push(match &sec.material {
-            Some(name) => Some(material_index(spec, at(), name)?),
+            Some(name) => Some(material_index(spec, here(), name).map_err(at(entry, Some("material")))?),
             None => None,
         });
     }
     let mut elements = Vec::with_capacity(count);
     for (e, sec) in owner.iter().enumerate() {
         let section = sec.map(|s| &shaft.sections[s]);
+        // An element-wide problem lies with the section covering the element, else the shaft.
+        let entry = sec.map_or(Entry::Shaft, Entry::Section);
         let outer = section
             .and_then(|s| s.diameter)
             .or(shaft.diameter)
-            .ok_or(RotorError::MissingDiameter { element: e })?;
+            .ok_or_else(|| at(entry, None)(RotorError::MissingDiameter { element: e }))?;
         let inner = section.and_then(|s| s.inner_diameter).or(shaft.inner_diameter).unwrap_or(0.0);
         if inner >= outer {
-            return Err(RotorError::InnerNotBelowOuter { element: e, inner, outer });
+            // Blame the section's bore or outer diameter where it sets one, else the shaft's bore.
+            let (entry, key) = match section {
+                Some(s) if s.inner_diameter.is_some() => (entry, "inner_diameter"),
+                Some(s) if s.diameter.is_some() => (entry, "diameter"),
+                _ => (Entry::Shaft, "inner_diameter"),
+            };
+            return Err(at(entry, Some(key))(RotorError::InnerNotBelowOuter { element: e, inner, outer }));
         }
         let material = sec
             .and_then(|s| section_material[s])
             .or(default_material)
-            .ok_or(RotorError::MissingMaterial { element: e })?;
+            .ok_or_else(|| at(entry, None)(RotorError::MissingMaterial { element: e }))?;
         elements.push(ShaftElement {
             length: nodes[e + 1] - nodes[e],
             outer_diameter: outer,

@@ -11,7 +11,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum RotorError {
     /// The file could not be read.
-    #[error("cannot read `{path}`: {message}")]
+    #[error("{}: cannot read: {message}", .path.display())]
     Io {
         /// The file.
         path: PathBuf,
@@ -38,6 +38,18 @@ pub enum RotorError {
         path: Option<PathBuf>,
         /// The parser's description.
         message: String,
+    },
+    /// A validation error (any of the variants below) in TOML text or a file, with the 1-based
+    /// line of the entry or key at fault. The builder API has no file and no lines, so its
+    /// errors are never wrapped; [`unlocated`](Self::unlocated) gives the wrapped error.
+    #[error("{}line {line}: {error}", .path.as_ref().map(|p| format!("{}: ", p.display())).unwrap_or_default())]
+    Located {
+        /// The file, when read from one.
+        path: Option<PathBuf>,
+        /// 1-based line.
+        line: usize,
+        /// The validation error.
+        error: Box<RotorError>,
     },
     /// The rotor could not be written as TOML.
     #[error("cannot write the rotor as TOML: {0}")]
@@ -192,6 +204,25 @@ pub enum RotorError {
     /// The bearing parameters could not be formed (should be prevented by the checks above).
     #[error(transparent)]
     Parameter(#[from] eigenfit_core::ParameterError),
+}
+
+impl RotorError {
+    /// The error without its place in the file: the wrapped error of a
+    /// [`Located`](Self::Located), else `self`.
+    pub fn unlocated(&self) -> &RotorError {
+        match self {
+            Self::Located { error, .. } => error,
+            other => other,
+        }
+    }
+
+    /// The 1-based line in the TOML text the error lies on, where known.
+    pub fn line(&self) -> Option<usize> {
+        match self {
+            Self::Parse { line, .. } | Self::Located { line, .. } => Some(*line),
+            _ => None,
+        }
+    }
 }
 
 /// A number as people write it: plain for moderate magnitudes (`-0.4`, `7850`), with an exponent

@@ -4,10 +4,11 @@
 //! rejected. Nothing is validated here: [`RotorBuilder::build`](crate::RotorBuilder::build)
 //! does that once.
 
-use crate::builder::RotorBuilder;
+use crate::builder::{Entry, RotorBuilder, SitedError};
 use crate::error::RotorError;
 use crate::model::Rotor;
-use serde::{Deserialize, Serialize};
+use serde::de::{MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize};
 use std::path::Path;
 
 /// A complete, unchecked rotor description: what a TOML file holds.
@@ -217,12 +218,14 @@ impl Rotor {
     ///
     /// Syntax errors, unknown keys, missing keys and wrong types come back as
     /// [`RotorError::Parse`] with the 1-based line and column; physically invalid values as the
-    /// other [`RotorError`] variants.
+    /// other [`RotorError`] variants wrapped in [`RotorError::Located`] with the line of the entry
+    /// or key at fault.
     pub fn from_toml_str(text: &str) -> Result<Self, RotorError> {
-        parse(text, None)?.build()
+        build(text, None)
     }
 
-    /// Reads and validates a rotor from a TOML file; parse errors name the file.
+    /// Reads and validates a rotor from a TOML file; every error names the file, and parse and
+    /// validation errors the line.
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<Self, RotorError> {
         let path = path.as_ref();
         let io = |message: String| RotorError::Io { path: path.to_path_buf(), message };
@@ -234,7 +237,7 @@ impl Rotor {
             io(format!("not a UTF-8 text file (invalid byte at line {line}, column {column})"))
         })?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-        parse(text, Some(path))?.build()
+        build(text, Some(path))
     }
 
     /// Writes the rotor as TOML: the description it was built from, with bearing names filled in.
@@ -248,6 +251,217 @@ impl RotorSpec {
     /// Parses TOML text into an unchecked description (no physical validation).
     pub fn from_toml_str(text: &str) -> Result<Self, RotorError> {
         parse(text, None).map(|b| b.spec().clone())
+    }
+}
+
+/// Parses and validates `text`; a validation error gets the line of the entry or key at fault.
+fn build(text: &str, path: Option<&Path>) -> Result<Rotor, RotorError> {
+    parse(text, path)?.build_sited().map_err(|SitedError { error, site }| {
+        let line = site.and_then(|site| {
+            // The text parsed as a `RotorSpec`, so it parses as a tree too; if not, no line.
+            let root = toml::from_str::<Node>(text).ok()?;
+            let table = match site.entry {
+                Entry::Material(i) => root.get("material")?.item(i)?,
+                Entry::Shaft => root.get("shaft")?,
+                Entry::Section(i) => root.get("shaft")?.get("section")?.item(i)?,
+                Entry::Disk(i) => root.get("disk")?.item(i)?,
+                Entry::Bearing(i) => root.get("bearing")?.item(i)?,
+                Entry::PointMass(i) => root.get("point_mass")?.item(i)?,
+                Entry::Effect(i) => root.get("effect")?.item(i)?,
+            };
+            // The item of an array value, the key, or the entry itself (when the key is left at
+            // its default, such as a bearing's name): the first of these the file places.
+            let (key, value) =
+                site.key.and_then(|k| table.entry(k)).map_or((None, None), |(k, v)| (Some(k), Some(v)));
+            let item = value.zip(site.item).and_then(|(v, i)| v.item(i));
+            let offset = item.and_then(|n| n.start).or(key.and_then(|k| k.start)).or(table.start);
+            // An implicit table (`shaft.length = …`) has no start: its first key has.
+            let first_key = || match &table.tree {
+                Tree::Table(entries) => entries.first().and_then(|(k, _)| k.start),
+                _ => None,
+            };
+            let offset = offset.or_else(first_key)?;
+            Some(line_column(text, offset).0)
+        });
+        match line {
+            Some(line) => {
+                RotorError::Located { path: path.map(Path::to_path_buf), line, error: Box::new(error) }
+            }
+            None => error,
+        }
+    })
+}
+
+/// A TOML value and the byte offset it starts at, where the parser knows it: an implicit table
+/// (made by a dotted key `shaft.length = …` or a header `[a.b]` without `[a]`) has none. Read
+/// only to place a validation error.
+struct Node {
+    start: Option<usize>,
+    tree: Tree,
+}
+
+/// A key and the byte offset it starts at.
+struct Key {
+    name: String,
+    start: Option<usize>,
+}
+
+/// The shape of a TOML value.
+enum Tree {
+    /// A string, number, boolean or date.
+    Leaf,
+    /// An array (of values or of tables).
+    Array(Vec<Node>),
+    /// A table, keys in file order.
+    Table(Vec<(Key, Node)>),
+}
+
+impl Node {
+    /// The key `key` and its value, if this is a table that has it.
+    fn entry(&self, key: &str) -> Option<(&Key, &Node)> {
+        match &self.tree {
+            Tree::Table(entries) => entries.iter().find(|(k, _)| k.name == key).map(|(k, v)| (k, v)),
+            _ => None,
+        }
+    }
+
+    /// The value of `key`, if this is a table that has it.
+    fn get(&self, key: &str) -> Option<&Node> {
+        self.entry(key).map(|(_, v)| v)
+    }
+
+    /// Item `i`, if this is an array that long.
+    fn item(&self, i: usize) -> Option<&Node> {
+        match &self.tree {
+            Tree::Array(items) => items.get(i),
+            _ => None,
+        }
+    }
+}
+
+// `toml` hands out spans through `toml::Spanned`'s serde protocol: a value deserialized as the
+// struct named `SPANNED` with these fields comes as a map of them, if the parser knows its span,
+// and as the plain value otherwise. `Spanned` itself fails on the latter; `Node` and `Key` accept
+// both.
+const SPANNED: &str = "$__serde_spanned_private_Spanned";
+const START: &str = "$__serde_spanned_private_start";
+const END: &str = "$__serde_spanned_private_end";
+const VALUE: &str = "$__serde_spanned_private_value";
+const FIELDS: &[&str] = &[START, END, VALUE];
+
+/// Reads the rest of a span map whose first key, `START`, has been read: (start, value).
+fn spanned<'de, A: MapAccess<'de>, T: Deserialize<'de>>(mut map: A) -> Result<(usize, T), A::Error> {
+    let start: usize = map.next_value()?;
+    let (mut value, mut end_seen) = (None, false);
+    while let Some(key) = map.next_key::<String>()? {
+        match key.as_str() {
+            END if !end_seen => {
+                map.next_value::<usize>()?;
+                end_seen = true;
+            }
+            VALUE if value.is_none() => value = Some(map.next_value()?),
+            _ => return Err(serde::de::Error::custom("unexpected key in a span")),
+        }
+    }
+    let value = value.ok_or_else(|| serde::de::Error::missing_field(VALUE))?;
+    Ok((start, value))
+}
+
+impl<'de> Deserialize<'de> for Key {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct KeyVisitor;
+
+        impl<'de> Visitor<'de> for KeyVisitor {
+            type Value = Key;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a TOML key")
+            }
+
+            fn visit_str<E>(self, name: &str) -> Result<Key, E> {
+                Ok(Key { name: name.to_string(), start: None })
+            }
+
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Key, A::Error> {
+                match map.next_key::<String>()?.as_deref() {
+                    Some(START) => spanned(map).map(|(start, name)| Key { name, start: Some(start) }),
+                    _ => Err(serde::de::Error::custom("a key that is a table")),
+                }
+            }
+        }
+
+        deserializer.deserialize_struct(SPANNED, FIELDS, KeyVisitor)
+    }
+}
+
+/// Visits a value: with its span (a map of `START`, `END`, `VALUE`) when `spans`, else plain.
+struct NodeVisitor {
+    spans: bool,
+}
+
+impl<'de> Visitor<'de> for NodeVisitor {
+    type Value = Node;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a TOML value")
+    }
+
+    fn visit_bool<E>(self, _: bool) -> Result<Node, E> {
+        Ok(Node { start: None, tree: Tree::Leaf })
+    }
+
+    fn visit_i64<E>(self, _: i64) -> Result<Node, E> {
+        Ok(Node { start: None, tree: Tree::Leaf })
+    }
+
+    fn visit_u64<E>(self, _: u64) -> Result<Node, E> {
+        Ok(Node { start: None, tree: Tree::Leaf })
+    }
+
+    fn visit_f64<E>(self, _: f64) -> Result<Node, E> {
+        Ok(Node { start: None, tree: Tree::Leaf })
+    }
+
+    fn visit_str<E>(self, _: &str) -> Result<Node, E> {
+        Ok(Node { start: None, tree: Tree::Leaf })
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Node, A::Error> {
+        let mut items = Vec::new();
+        while let Some(item) = seq.next_element()? {
+            items.push(item);
+        }
+        Ok(Node { start: None, tree: Tree::Array(items) })
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Node, A::Error> {
+        let Some(first) = map.next_key::<Key>()? else {
+            return Ok(Node { start: None, tree: Tree::Table(Vec::new()) });
+        };
+        if self.spans && first.start.is_none() && first.name == START {
+            let (start, Plain(node)) = spanned(map)?;
+            return Ok(Node { start: Some(start), tree: node.tree });
+        }
+        let mut entries = vec![(first, map.next_value()?)];
+        while let Some(key) = map.next_key()? {
+            entries.push((key, map.next_value()?));
+        }
+        Ok(Node { start: None, tree: Tree::Table(entries) })
+    }
+}
+
+impl<'de> Deserialize<'de> for Node {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_struct(SPANNED, FIELDS, NodeVisitor { spans: true })
+    }
+}
+
+/// The value inside a span map (asking for its span again would recurse).
+struct Plain(Node);
+
+impl<'de> Deserialize<'de> for Plain {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(NodeVisitor { spans: false }).map(Plain)
     }
 }
 

@@ -91,15 +91,15 @@ fn file_errors_name_the_file() {
     let missing = dir.join("missing.toml");
     let err = Rotor::from_toml_file(&missing).unwrap_err();
     assert!(matches!(err, RotorError::Io { .. }), "{err:?}");
-    assert!(err.to_string().starts_with(&format!("cannot read `{}`: ", missing.display())));
+    assert!(err.to_string().starts_with(&format!("{}: cannot read: ", missing.display())));
 }
 
 #[test]
 fn validation_errors_come_through_the_file() {
     let text = VALID.replace("node = 2", "node = 11");
-    assert_eq!(error(&text), "disk 0 is at node 11, but the shaft has nodes 0–10");
+    assert_eq!(error(&text), "line 13: disk 0 is at node 11, but the shaft has nodes 0–10");
     let text = VALID.replace("density = 7850.0", "density = nan");
-    assert_eq!(error(&text), "material `steel`: density = NaN is invalid: it must be finite and > 0");
+    assert_eq!(error(&text), "line 5: material `steel`: density = NaN is invalid: it must be finite and > 0");
 }
 
 #[test]
