@@ -101,6 +101,8 @@ fn estimation(c: &mut Criterion) {
         });
     }
     g.bench_function("linearise", |b| b.iter(|| problem.linearise(black_box(&[1e3, 2e4])).unwrap()));
+    // Residual only (eigenvalues, no shapes or sensitivities): what `damped` ranks its seeds by.
+    g.bench_function("cost", |b| b.iter(|| problem.cost(black_box(&[1e3, 2e4])).unwrap()));
     g.finish();
 }
 

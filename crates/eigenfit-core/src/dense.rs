@@ -48,6 +48,54 @@ impl EigenSolver for DenseSolver {
             _ => Ok(first),
         }
     }
+
+    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
+        self.eigenvalues_only(system, count)
+    }
+}
+
+impl DenseSolver {
+    /// [`EigenSolver::lowest_eigenvalues`]: the same arithmetic as `lowest` on its common path
+    /// (K positive definite, at most half the modes), without accumulating eigenvectors.
+    fn eigenvalues_only(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
+        check_count(system, count)?;
+        let (k, m) = (system.stiffness(), system.mass());
+        if Cholesky::new(m.clone()).is_none() {
+            return Err(SolveError::MassNotPositiveDefinite { detail: None });
+        }
+        if 2 * count <= system.dofs() {
+            if let Some(chol) = Cholesky::new(k.clone()).filter(well_conditioned) {
+                let b = reduced_inverted(&chol, m)?;
+                let mut mu = b.symmetric_eigenvalues().as_slice().to_vec();
+                mu.sort_by(|a, b| b.total_cmp(a));
+                mu.truncate(count);
+                if mu.iter().any(|&v| v <= 0.0) {
+                    return Err(SolveError::Backend {
+                        backend: "dense",
+                        detail: "a reduced eigenvalue is not positive".into(),
+                    });
+                }
+                let eigenvalues = DVector::from_iterator(count, mu.iter().map(|&v| 1.0 / v));
+                if eigenvalues.iter().any(|v| !v.is_finite()) {
+                    return Err(SolveError::Backend { backend: "dense", detail: "non-finite result".into() });
+                }
+                return Ok(eigenvalues);
+            }
+        }
+        // Rigid-body modes or most of the spectrum: the full solve.
+        self.lowest(system, count).map(|modes| modes.eigenvalues)
+    }
+}
+
+/// B = L⁻¹ M L⁻ᵀ, symmetrised, for K + σM = LLᵀ.
+fn reduced_inverted(
+    chol: &Cholesky<f64, nalgebra::Dyn>,
+    m: &DMatrix<f64>,
+) -> Result<DMatrix<f64>, SolveError> {
+    let l = chol.l();
+    let x = l.solve_lower_triangular(m).ok_or_else(|| not_pd("zero pivot in L"))?;
+    let b = l.solve_lower_triangular(&x.transpose()).ok_or_else(|| not_pd("zero pivot in L"))?;
+    Ok((&b + b.transpose()) * 0.5)
 }
 
 /// A Cholesky factor whose pivots do not reveal a (numerically) singular matrix.
@@ -73,9 +121,7 @@ fn inverted_solve(
     count: usize,
 ) -> Result<Modes, SolveError> {
     let l = chol.l();
-    let x = l.solve_lower_triangular(m).ok_or_else(|| not_pd("zero pivot in L"))?;
-    let b = l.solve_lower_triangular(&x.transpose()).ok_or_else(|| not_pd("zero pivot in L"))?;
-    let b = (&b + b.transpose()) * 0.5;
+    let b = reduced_inverted(chol, m)?;
     let eig = SymmetricEigen::try_new(b, f64::EPSILON, 0).ok_or(SolveError::Backend {
         backend: "dense",
         detail: "symmetric QR iteration did not converge".into(),
@@ -160,6 +206,29 @@ mod tests {
         let sys = System::new(DMatrix::identity(2, 2), DMatrix::identity(2, 2)).unwrap();
         assert_eq!(DenseSolver.lowest(&sys, 3), Err(SolveError::TooManyModes { requested: 3, available: 2 }));
         assert_eq!(DenseSolver.lowest(&sys, 0), Err(SolveError::NoModes));
+    }
+
+    #[test]
+    fn eigenvalues_only_match_the_full_solve() {
+        let n = 30;
+        let k = DMatrix::from_fn(n, n, |i, j| match i.abs_diff(j) {
+            0 => 2.0 + 1e-6 * (i == 0) as u8 as f64,
+            1 => -1.0,
+            _ => 0.0,
+        });
+        let m = DMatrix::from_fn(n, n, |i, j| if i == j { 1.0 + 0.1 * (i % 3) as f64 } else { 0.0 });
+        let sys = System::new(k.clone(), m).unwrap();
+        for count in [1, 3, 15, 20] {
+            let full = DenseSolver.lowest(&sys, count).unwrap().eigenvalues;
+            let only = DenseSolver.lowest_eigenvalues(&sys, count).unwrap();
+            assert!((&full - &only).amax() <= 1e-15 * full.amax(), "{full} vs {only}");
+        }
+        let softer = System::new(k.map(|v| if v == 2.0 + 1e-6 { 1.0 } else { v }), DMatrix::identity(n, n));
+        let softer = softer.unwrap();
+        assert_eq!(
+            DenseSolver.lowest_eigenvalues(&softer, 2),
+            DenseSolver.lowest(&softer, 2).map(|m| m.eigenvalues)
+        );
     }
 
     #[test]

@@ -1,9 +1,12 @@
 //! The update problem: a model, a solver and measured modes; its residual and Jacobian at a point.
 
-use crate::measurement::Measurement;
+use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
+use crate::modes::Modes;
 use crate::parameters::ParameterSet;
-use crate::sensitivity::{Sensitivities, SensitivityError};
+use crate::sensitivity::{
+    check_distinct, noise_floor, Sensitivities, SensitivityError, DEFAULT_REPEATED_TOLERANCE,
+};
 use crate::solver::EigenSolver;
 use crate::{eigenvalue_to_hz, hz_to_eigenvalue};
 use nalgebra::{DMatrix, DVector};
@@ -191,24 +194,67 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             lin.frequencies_hz[row] = f;
             lin.measured_hz[row] = fm;
             lin.eigenvalue_jacobian.row_mut(row).copy_from(&sens.eigenvalues.row(k));
-            // Residual value, Jacobian row and weight in the chosen quantity.
-            let (r, scale, sigma) = match self.kind {
-                ResidualKind::Eigenvalue => (
-                    lin.measured_eigenvalues[row] - lambda,
-                    1.0,
-                    meas.std_hz.map_or(1.0, |s| 8.0 * PI * PI * fm * s),
-                ),
-                ResidualKind::FrequencyHz => (fm - f, 1.0 / (8.0 * PI * PI * f), meas.std_hz.unwrap_or(1.0)),
-                // ln(f_m/f): the relative difference to first order, and linear in ln k where
-                // the supports dominate (f ∝ √k), which makes log-stiffness steps nearly exact.
-                ResidualKind::Relative => {
-                    ((fm / f).ln(), 1.0 / (2.0 * lambda), meas.std_hz.map_or(1.0, |s| s / fm))
-                }
-            };
+            let (r, scale, sigma) = self.residual_terms(meas, lambda);
             lin.residual[row] = r / sigma;
             lin.jacobian.row_mut(row).copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));
         }
         Ok(lin)
+    }
+
+    /// Residual value, Jacobian scale and weight of one measured mode against model eigenvalue λ.
+    fn residual_terms(&self, meas: &MeasuredMode, lambda: f64) -> (f64, f64, f64) {
+        let f = eigenvalue_to_hz(lambda);
+        let fm = meas.frequency_hz;
+        match self.kind {
+            ResidualKind::Eigenvalue => {
+                (hz_to_eigenvalue(fm) - lambda, 1.0, meas.std_hz.map_or(1.0, |s| 8.0 * PI * PI * fm * s))
+            }
+            ResidualKind::FrequencyHz => (fm - f, 1.0 / (8.0 * PI * PI * f), meas.std_hz.unwrap_or(1.0)),
+            // ln(f_m/f): the relative difference to first order, and linear in ln k where
+            // the supports dominate (f ∝ √k), which makes log-stiffness steps nearly exact.
+            ResidualKind::Relative => {
+                ((fm / f).ln(), 1.0 / (2.0 * lambda), meas.std_hz.map_or(1.0, |s| s / fm))
+            }
+        }
+    }
+
+    /// ½‖r‖² at `p` without the Jacobian: equal to `linearise(p)?.cost()`, and failing where it
+    /// fails on the model's assembly, the solve and the mode checks, but skipping the parameter
+    /// derivatives (for ranking many candidate points). MAC pairing needs the full linearisation.
+    pub fn cost(&self, p: &[f64]) -> Result<f64, ResidualError> {
+        if !matches!(self.pairing, Pairing::Order) {
+            return self.linearise(p).map(|l| l.cost());
+        }
+        let needed = self.measured.modes_needed();
+        let dofs = self.model.dofs();
+        if needed > dofs {
+            return Err(ResidualError::TooFewModelModes { needed, available: dofs });
+        }
+        // The checks of `Sensitivities::compute_for`, in the same order.
+        let system = self.model.assemble(p).map_err(SensitivityError::from)?;
+        crate::solver::check_count(&system, needed).map_err(SensitivityError::from)?;
+        let count = (needed + 1).min(system.dofs());
+        let eigenvalues = self.solver.lowest_eigenvalues(&system, count).map_err(SensitivityError::from)?;
+        // The distinctness checks read the eigenvalues only.
+        let modes = Modes { eigenvalues, shapes: DMatrix::zeros(0, count) };
+        let floor = noise_floor(&system);
+        for meas in self.measured.modes() {
+            check_distinct(&modes, meas.mode, DEFAULT_REPEATED_TOLERANCE, floor)?;
+        }
+        for meas in self.measured.modes() {
+            let lambda = modes.eigenvalues[meas.mode];
+            if lambda <= floor {
+                return Err(SensitivityError::ZeroFrequency { mode: meas.mode, lambda }.into());
+            }
+        }
+        let residual = DVector::from_iterator(
+            self.measured.len(),
+            self.measured.modes().iter().map(|meas| {
+                let (r, _, sigma) = self.residual_terms(meas, modes.eigenvalues[meas.mode]);
+                r / sigma
+            }),
+        );
+        Ok(0.5 * residual.norm_squared())
     }
 
     fn pair(&self, sens: &Sensitivities) -> Result<Vec<usize>, ResidualError> {
@@ -263,5 +309,48 @@ pub fn mac(a: &[f64], b: &[f64]) -> f64 {
         dot(a, b).powi(2) / den
     } else {
         0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{DenseSolver, EigenSolver, ModelError, Parameter, Scale, System};
+
+    /// ground –k₁– m₁ –k₂– m₂ –k₃– m₃.
+    struct Chain(ParameterSet);
+
+    impl StructuralModel for Chain {
+        fn parameters(&self) -> &ParameterSet {
+            &self.0
+        }
+        fn dofs(&self) -> usize {
+            3
+        }
+        fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+            self.0.check(p)?;
+            let k = DMatrix::from_row_slice(
+                3,
+                3,
+                &[p[0] + p[1], -p[1], 0.0, -p[1], p[1] + p[2], -p[2], 0.0, -p[2], p[2]],
+            );
+            Ok(System::new(k, DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 1.5, 0.8])))?)
+        }
+    }
+
+    #[test]
+    fn cost_equals_the_linearisation_cost() {
+        let k = |name: &str| Parameter::new(name, "N/m", 1e4).with_bounds(1e-3, 1e9).with_scale(Scale::Log);
+        let model = Chain(ParameterSet::new(vec![k("k1"), k("k2"), k("k3")]).unwrap());
+        let f = DenseSolver.lowest(&model.assemble(&[2e3, 5e3, 1e4]).unwrap(), 3).unwrap().frequencies_hz();
+        for kind in [ResidualKind::Eigenvalue, ResidualKind::FrequencyHz, ResidualKind::Relative] {
+            let problem = Problem::new(&model, DenseSolver, Measurement::from_frequencies(&f[..2]).unwrap())
+                .with_kind(kind);
+            for p in [[1e3, 1e3, 1e3], [2e3, 5e3, 1e4], [1e5, 1e2, 3e3]] {
+                let lin = problem.linearise(&p).unwrap().cost();
+                let cost = problem.cost(&p).unwrap();
+                assert!((lin - cost).abs() <= 1e-14 * lin.max(1e-300), "{kind:?} {p:?}: {lin} vs {cost}");
+            }
+        }
     }
 }

@@ -2,6 +2,7 @@
 
 use crate::modes::Modes;
 use crate::system::System;
+use nalgebra::DVector;
 use thiserror::Error;
 
 /// Why an eigen-solve failed.
@@ -35,6 +36,12 @@ pub trait EigenSolver: Send + Sync {
 
     /// The lowest `count` modes.
     fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError>;
+
+    /// The lowest `count` eigenvalues only, as [`lowest`](Self::lowest) computes them; backends
+    /// may skip the shapes (used to rank many candidate points by cost).
+    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
+        self.lowest(system, count).map(|m| m.eigenvalues)
+    }
 }
 
 impl<T: EigenSolver + ?Sized> EigenSolver for &T {
@@ -43,6 +50,9 @@ impl<T: EigenSolver + ?Sized> EigenSolver for &T {
     }
     fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
         (**self).lowest(system, count)
+    }
+    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
+        (**self).lowest_eigenvalues(system, count)
     }
 }
 

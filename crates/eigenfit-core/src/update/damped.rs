@@ -175,7 +175,7 @@ pub(crate) fn ranked_seeds(problem: &dyn Evaluate, around: &[f64], fixed: &[bool
     }
     let mut ranked: Vec<(f64, Vec<f64>)> = points
         .into_iter()
-        .filter_map(|p| problem.linearise(&p).ok().map(|l| (l.cost(), p)))
+        .filter_map(|p| problem.cost(&p).map(|c| (c, p)))
         .filter(|(c, _)| c.is_finite())
         .collect();
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -27,6 +27,11 @@ pub trait Evaluate {
     fn parameters(&self) -> &ParameterSet;
     /// Residual and Jacobian at `p`.
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError>;
+    /// ½‖r‖² at `p`, `None` where the residual cannot be evaluated: equal to
+    /// `linearise(p)`'s cost; implementations may skip the Jacobian (used to rank many points).
+    fn cost(&self, p: &[f64]) -> Option<f64> {
+        self.linearise(p).ok().map(|l| l.cost())
+    }
 }
 
 impl<M: StructuralModel, S: EigenSolver> Evaluate for Problem<M, S> {
@@ -35,6 +40,9 @@ impl<M: StructuralModel, S: EigenSolver> Evaluate for Problem<M, S> {
     }
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
         Problem::linearise(self, p)
+    }
+    fn cost(&self, p: &[f64]) -> Option<f64> {
+        Problem::cost(self, p).ok()
     }
 }
 
