@@ -252,34 +252,12 @@ fn relative_error(estimate: &[f64], target: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{DenseSolver, ModelError, Parameter, ParameterSet, Scale, System};
-    use nalgebra::{DMatrix, DVector};
-
-    /// ground –k₁– m₁ –k₂– m₂ –k₃– m₃, the three stiffnesses the parameters.
-    struct Chain(ParameterSet);
-
-    impl StructuralModel for Chain {
-        fn parameters(&self) -> &ParameterSet {
-            &self.0
-        }
-        fn dofs(&self) -> usize {
-            3
-        }
-        fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
-            self.0.check(p)?;
-            let k = DMatrix::from_row_slice(
-                3,
-                3,
-                &[p[0] + p[1], -p[1], 0.0, -p[1], p[1] + p[2], -p[2], 0.0, -p[2], p[2]],
-            );
-            Ok(System::new(k, DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 1.5])))?)
-        }
-    }
+    use crate::test_chain::Chain;
+    use crate::DenseSolver;
 
     #[test]
     fn parallel_grid_equals_serial_in_content_and_order() {
-        let k = |n: &str| Parameter::new(n, "N/m", 1e4).with_bounds(1e-3, 1e9).with_scale(Scale::Log);
-        let chain = Chain(ParameterSet::new(vec![k("k1"), k("k2"), k("k3")]).unwrap());
+        let chain = Chain::new(&[1.0, 2.0, 1.5]);
         let targets = vec![vec![3e4, 1e4, 2e4], vec![1e3, 5e4, 1e4]];
         let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
         let strategies = StrategyKind::ALL;

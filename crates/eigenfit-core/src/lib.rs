@@ -37,6 +37,8 @@ pub mod statistics;
 pub mod subspace;
 pub mod synthetic;
 pub mod system;
+#[cfg(test)]
+mod test_chain;
 pub mod update;
 
 pub use banded::{BandCholesky, BandedSymmetric};

@@ -315,33 +315,12 @@ pub fn mac(a: &[f64], b: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{DenseSolver, EigenSolver, ModelError, Parameter, Scale, System};
-
-    /// ground –k₁– m₁ –k₂– m₂ –k₃– m₃.
-    struct Chain(ParameterSet);
-
-    impl StructuralModel for Chain {
-        fn parameters(&self) -> &ParameterSet {
-            &self.0
-        }
-        fn dofs(&self) -> usize {
-            3
-        }
-        fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
-            self.0.check(p)?;
-            let k = DMatrix::from_row_slice(
-                3,
-                3,
-                &[p[0] + p[1], -p[1], 0.0, -p[1], p[1] + p[2], -p[2], 0.0, -p[2], p[2]],
-            );
-            Ok(System::new(k, DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 1.5, 0.8])))?)
-        }
-    }
+    use crate::test_chain::Chain;
+    use crate::{DenseSolver, EigenSolver};
 
     #[test]
     fn cost_equals_the_linearisation_cost() {
-        let k = |name: &str| Parameter::new(name, "N/m", 1e4).with_bounds(1e-3, 1e9).with_scale(Scale::Log);
-        let model = Chain(ParameterSet::new(vec![k("k1"), k("k2"), k("k3")]).unwrap());
+        let model = Chain::new(&[1.0, 1.5, 0.8]);
         let f = DenseSolver.lowest(&model.assemble(&[2e3, 5e3, 1e4]).unwrap(), 3).unwrap().frequencies_hz();
         for kind in [ResidualKind::Eigenvalue, ResidualKind::FrequencyHz, ResidualKind::Relative] {
             let problem = Problem::new(&model, DenseSolver, Measurement::from_frequencies(&f[..2]).unwrap())

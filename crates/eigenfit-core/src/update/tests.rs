@@ -1,6 +1,7 @@
 //! Strategy and driver tests on a two-mass chain whose answer is known exactly.
 
 use super::*;
+use crate::test_chain::Chain;
 use crate::{
     DenseSolver, EigenSolver, IterationRecordSink, MeasuredMode, Measurement, ModelError, Parameter,
     ParameterSet, Problem, Scale, System,
@@ -8,31 +9,12 @@ use crate::{
 use nalgebra::DMatrix;
 
 /// ground –k₁– m₁ –k₂– m₂, m = (1, 2) kg; stiffnesses around 1e4 N/m give modes of 10–30 Hz.
-struct Chain(ParameterSet);
-
-impl Chain {
-    fn new() -> Self {
-        let k = |name: &str| Parameter::new(name, "N/m", 1e4).with_bounds(1e-3, 1e9).with_scale(Scale::Log);
-        Self(ParameterSet::new(vec![k("k1"), k("k2")]).unwrap())
-    }
-}
-
-impl StructuralModel for Chain {
-    fn parameters(&self) -> &ParameterSet {
-        &self.0
-    }
-    fn dofs(&self) -> usize {
-        2
-    }
-    fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
-        self.0.check(p)?;
-        let k = DMatrix::from_row_slice(2, 2, &[p[0] + p[1], -p[1], -p[1], p[1]]);
-        Ok(System::new(k, DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 2.0])))?)
-    }
+fn chain() -> Chain {
+    Chain::new(&[1.0, 2.0])
 }
 
 fn problem(truth: &[f64]) -> Problem<Chain, DenseSolver> {
-    let chain = Chain::new();
+    let chain = chain();
     let f = DenseSolver.lowest(&chain.assemble(truth).unwrap(), 2).unwrap().frequencies_hz();
     Problem::new(chain, DenseSolver, Measurement::from_frequencies(&f).unwrap())
 }
@@ -55,7 +37,7 @@ fn every_strategy_recovers_the_chain_from_a_nearby_start() {
 fn newton_leaving_the_physical_range_is_reported_as_diverged_with_history() {
     // Two nearly equal frequencies no positive pair of springs can produce: the chain's
     // eigenvalue ratio is bounded away from 1, so the linear steps drive a stiffness negative.
-    let p = Problem::new(Chain::new(), DenseSolver, Measurement::from_frequencies(&[10.0, 10.5]).unwrap());
+    let p = Problem::new(chain(), DenseSolver, Measurement::from_frequencies(&[10.0, 10.5]).unwrap());
     let est = Driver::default().run(&p, &mut Newton::default(), &[1e4, 1e4], &mut []).unwrap();
     assert!(matches!(est.termination, Termination::Diverged(_)), "{}", est.termination);
     assert!(!est.history.is_empty());
@@ -82,7 +64,7 @@ fn iteration_limit_keeps_the_last_iterate() {
 
 #[test]
 fn strategies_refuse_too_few_modes() {
-    let chain = Chain::new();
+    let chain = chain();
     let one = Measurement::new(vec![MeasuredMode::new(0, 10.0)]).unwrap();
     let p = Problem::new(chain, DenseSolver, one);
     for kind in StrategyKind::ALL {
