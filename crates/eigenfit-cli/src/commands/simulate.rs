@@ -27,7 +27,7 @@ pub struct SimulateArgs {
     /// Override one parameter, NAME=VALUE (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub sets: Vec<String>,
-    /// Switch an effect on for a what-if study, KIND[@LOCATION]=VALUE (repeatable); kinds:
+    /// Switch an effect on for a what-if study, `KIND[@LOCATION]=VALUE` (repeatable); kinds:
     /// disk-rotary-inertia, bearing-rotational-stiffness, support-mass, point-mass,
     /// shaft-stiffness-loss, modulus-error, shear-deformation.
     #[arg(long = "effect", value_name = "KIND[@LOCATION]=VALUE")]

@@ -2,7 +2,7 @@
 //! system libraries).
 //!
 //! One module per plot kind; each has a data struct that a command fills and that implements
-//! [`Figure`]. [`write`] renders a figure twice — to an SVG string and to a PNG — and writes both
+//! [`Figure`]. [`write()`] renders a figure twice — to an SVG string and to a PNG — and writes both
 //! atomically into a folder.
 
 pub mod compare_map;
