@@ -3,7 +3,7 @@
 //!
 //! Run: `cargo run --release --example paper_tables`
 
-use eigenfit::compare::{reference_measurement, run_case, CompareRun, CompareSettings};
+use eigenfit::compare::{reference_measurement, run_case, CompareRun, CompareSettings, SharedData};
 use eigenfit::rotor::presets;
 use eigenfit::{DenseSolver, Problem, StrategyKind};
 
@@ -89,6 +89,7 @@ fn main() {
             println!("| case | initial [N/m] | paper | newton | p-step | damped |");
             println!("|---|---|---|---|---|---|");
             let problem = Problem::new(&rotor, DenseSolver, measured);
+            let shared = SharedData::new(&problem);
             for (i, case) in cases.iter().enumerate() {
                 let paper = match case.paper {
                     Some((k, loops)) => format!("{:.4e} / {:.4e} ({loops} it.)", k[0], k[1]),
@@ -96,7 +97,7 @@ fn main() {
                 };
                 let cells: Vec<String> = StrategyKind::ALL
                     .iter()
-                    .map(|&s| cell(&run_case(&problem, target, &[case.initial; 2], s, &settings)))
+                    .map(|&s| cell(&run_case(&problem, &shared, target, &[case.initial; 2], s, &settings)))
                     .collect();
                 println!("| {} | {:.1e} | {paper} | {} |", i + 1, case.initial, cells.join(" | "));
             }

@@ -15,7 +15,8 @@ or, for Markdown the command prints itself (tables):
     <!-- end regen -->
 
 Commands run with bash from the repository root, with target/release (the `eigenfit` binary)
-first on PATH. Usage: cargo build --release -p eigenfit-cli && scripts/regenerate-docs.py docs/*.md
+first on PATH. Usage:
+    cargo build --release -p eigenfit-cli && cargo build --release --examples && scripts/regenerate-docs.py docs/*.md
 """
 import os
 import re

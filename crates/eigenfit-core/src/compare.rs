@@ -2,11 +2,14 @@
 //! from the model itself (the paper's Tables 2–5 and convergence maps).
 
 use crate::measurement::{MeasuredMode, Measurement};
+use crate::residual::Linearisation;
 use crate::residual::Problem;
-use crate::statistics::{alternative_solutions, uncertainty, Identifiability};
+use crate::statistics::{alternatives_among, local_solutions, uncertainty, Identifiability};
+use crate::update::{Damped, Evaluate, UpdateStrategy};
 use crate::update::{Driver, StrategyKind};
 use crate::{EigenSolver, StructuralModel};
 use rayon::prelude::*;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Local fits tried when looking for other solutions of a damped run.
@@ -82,9 +85,31 @@ where
     Measurement::new(measured).map_err(|e| e.to_string())
 }
 
-/// Runs one strategy from one initial guess against reference data made at `target`.
+/// What every damped run on the same reference data shares, computed once: the coarse grid of
+/// restart seeds ranked by residual, and the local solutions of the data (for the check for
+/// alternative solutions). Both depend on the data only, not on the initial guess.
+pub struct SharedData {
+    seeds: Arc<Vec<Vec<f64>>>,
+    solutions: Vec<Linearisation>,
+}
+
+impl SharedData {
+    /// Ranks the seeds and finds the local solutions of `problem`'s data.
+    pub fn new(problem: &dyn Evaluate) -> Self {
+        Self { seeds: Damped::rank_seeds(problem), solutions: local_solutions(problem, ALTERNATIVE_STARTS) }
+    }
+
+    /// Nothing shared (for grids without a damped run).
+    pub fn none() -> Self {
+        Self { seeds: Arc::new(Vec::new()), solutions: Vec::new() }
+    }
+}
+
+/// Runs one strategy from one initial guess against reference data made at `target`. A damped
+/// run uses `shared`'s seeds, so its `evaluations` leave out the one-off ranking of the grid.
 pub fn run_case<M, S>(
     problem: &Problem<M, S>,
+    shared: &SharedData,
     target: &[f64],
     initial: &[f64],
     strategy: StrategyKind,
@@ -95,7 +120,12 @@ where
     S: EigenSolver,
 {
     let start = Instant::now();
-    let mut s = strategy.build();
+    let mut s: Box<dyn UpdateStrategy> = match strategy {
+        StrategyKind::Damped if !shared.seeds.is_empty() => {
+            Box::new(Damped::default().with_seeds(shared.seeds.clone()))
+        }
+        _ => strategy.build(),
+    };
     let outcome =
         Driver { max_iterations: settings.max_iterations }.run(problem, s.as_mut(), initial, &mut []);
     let seconds = start.elapsed().as_secs_f64();
@@ -107,7 +137,7 @@ where
                 .flatten()
                 .map(|u| u.identifiability);
             let alternatives = if converged && strategy == StrategyKind::Damped {
-                alternative_solutions(problem, &est.last, ALTERNATIVE_STARTS)
+                alternatives_among(problem, &est.last, &shared.solutions)
             } else {
                 Vec::new()
             };
@@ -166,6 +196,17 @@ where
             Ok(Problem::new(model, solver, reference_measurement(model, solver, target, settings)?))
         })
         .collect::<Result<Vec<_>, String>>()?;
+    let shared: Vec<SharedData> =
+        problems
+            .iter()
+            .map(|p| {
+                if strategies.contains(&StrategyKind::Damped) {
+                    SharedData::new(p)
+                } else {
+                    SharedData::none()
+                }
+            })
+            .collect();
     let cases: Vec<(usize, &Vec<f64>, StrategyKind)> = (0..targets.len())
         .flat_map(|t| initials.iter().flat_map(move |i| strategies.iter().map(move |&s| (t, i, s))))
         .collect();
@@ -175,7 +216,7 @@ where
             cases
                 .par_iter()
                 .map_with(sender, |sender, &(t, initial, strategy)| {
-                    let run = run_case(&problems[t], &targets[t], initial, strategy, settings);
+                    let run = run_case(&problems[t], &shared[t], &targets[t], initial, strategy, settings);
                     // The receiver lives until every run is sent; a failed send only loses progress.
                     let _ = sender.send(run.clone());
                     run
@@ -207,9 +248,14 @@ where
     for target in targets {
         let measured = reference_measurement(model, solver, target, settings)?;
         let problem = Problem::new(model, solver, measured);
+        let shared = if strategies.contains(&StrategyKind::Damped) {
+            SharedData::new(&problem)
+        } else {
+            SharedData::none()
+        };
         for initial in initials {
             for &strategy in strategies {
-                let run = run_case(&problem, target, initial, strategy, settings);
+                let run = run_case(&problem, &shared, target, initial, strategy, settings);
                 on_run(&run);
                 runs.push(run);
             }

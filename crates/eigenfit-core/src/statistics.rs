@@ -158,29 +158,47 @@ fn profile_bound(problem: &dyn Evaluate, at: &Linearisation, i: usize, dir: f64)
 /// alone cannot choose. Local fits from the best points of the coarse restart grid that reach
 /// an acceptable fit more than 1% (scaled) away from `at` are returned, distinct, best first.
 pub fn alternative_solutions(problem: &dyn Evaluate, at: &Linearisation, starts: usize) -> Vec<Vec<f64>> {
+    alternatives_among(problem, at, &local_solutions(problem, starts))
+}
+
+/// The converged local fits (no restarts) from the `starts` best points of the coarse grid: a
+/// property of the data alone, computed once when several estimates share the data.
+pub fn local_solutions(problem: &dyn Evaluate, starts: usize) -> Vec<Linearisation> {
+    crate::update::damped::ranked_seeds(problem, &problem.parameters().nominal_values(), &[])
+        .into_iter()
+        .take(starts)
+        .filter_map(|seed| {
+            let mut local = Damped::default().with_max_restarts(0);
+            let est = (Driver { max_iterations: 100 }).run(problem, &mut local, &seed, &mut []).ok()?;
+            est.termination.is_converged().then_some(est.last)
+        })
+        .collect()
+}
+
+/// Those of `solutions` that fit as well as `at` (an exact fit, or within the 95% χ² threshold)
+/// more than 1% (scaled) away from it and from each other.
+pub fn alternatives_among(
+    problem: &dyn Evaluate,
+    at: &Linearisation,
+    solutions: &[Linearisation],
+) -> Vec<Vec<f64>> {
     let params = problem.parameters();
     let scaled = |p: &[f64]| -> Vec<f64> { params.iter().zip(p).map(|(q, &v)| q.to_scaled(v)).collect() };
     let distance = |a: &[f64], b: &[f64]| -> f64 {
         scaled(a).iter().zip(scaled(b)).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
     };
-    // "As good a fit": within the estimate's own χ² by the 95% threshold, or an exact fit.
     let good = |lin: &Linearisation| {
         let tol = Damped::default().residual_tolerance;
         lin.max_rel_diff() <= tol.max(at.max_rel_diff() * 10.0)
             || (lin.has_std && 2.0 * (lin.cost() - at.cost()) <= CHI2_95_1DOF)
     };
     let mut found: Vec<Vec<f64>> = Vec::new();
-    for seed in crate::update::damped::ranked_seeds(problem, &at.parameters, &[]).into_iter().take(starts) {
-        let mut local = Damped::default().with_max_restarts(0);
-        let Ok(est) = (Driver { max_iterations: 100 }).run(problem, &mut local, &seed, &mut []) else {
-            continue;
-        };
-        if est.termination.is_converged()
-            && good(&est.last)
-            && distance(&est.parameters, &at.parameters) > 0.01
-            && found.iter().all(|f| distance(f, &est.parameters) > 0.01)
+    for sol in solutions {
+        if good(sol)
+            && distance(&sol.parameters, &at.parameters) > 0.01
+            && found.iter().all(|f| distance(f, &sol.parameters) > 0.01)
         {
-            found.push(est.parameters);
+            found.push(sol.parameters.clone());
         }
     }
     found

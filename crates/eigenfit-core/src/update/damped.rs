@@ -4,6 +4,7 @@ use super::{Evaluate, Step, StepStatus, UpdateError, UpdateStrategy};
 use crate::parameters::ParameterSet;
 use crate::residual::Linearisation;
 use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 
 /// Levenberg–Marquardt on the weighted residual, in each parameter's scale (log for
 /// stiffnesses), with Marquardt's diagonal scaling, a gain-ratio test that accepts or rejects
@@ -32,6 +33,8 @@ pub struct Damped {
     mu: f64,
     nu: f64,
     seeds: Option<Vec<Vec<f64>>>,
+    shared_seeds: Option<Arc<Vec<Vec<f64>>>>,
+    far_checked: bool,
     best: Option<Linearisation>,
     restarts: usize,
     stuck_for: usize,
@@ -50,6 +53,8 @@ impl Default for Damped {
             mu: 1e-3,
             nu: 2.0,
             seeds: None,
+            shared_seeds: None,
+            far_checked: false,
             best: None,
             restarts: 0,
             stuck_for: 0,
@@ -88,6 +93,36 @@ impl Damped {
         self
     }
 
+    /// Uses restart seeds ranked once for several runs on the same data ([`Damped::rank_seeds`]),
+    /// instead of ranking the coarse grid again in every run.
+    pub fn with_seeds(mut self, seeds: Arc<Vec<Vec<f64>>>) -> Self {
+        self.shared_seeds = Some(seeds);
+        self
+    }
+
+    /// The coarse log grid of restart seeds for `problem`, ranked by residual (lowest first).
+    pub fn rank_seeds(problem: &dyn Evaluate) -> Arc<Vec<Vec<f64>>> {
+        let around = problem.parameters().nominal_values();
+        Arc::new(ranked_seeds(problem, &around, &[]))
+    }
+
+    /// This run's seeds (ranked on first use, or copied from shared ones) and the evaluations spent.
+    fn seeds(&mut self, problem: &dyn Evaluate, around: &[f64]) -> (&mut Vec<Vec<f64>>, usize) {
+        let mut spent = 0;
+        if self.seeds.is_none() {
+            let fixed = self.fixed.iter().any(|&f| f);
+            self.seeds = Some(match (&self.shared_seeds, fixed) {
+                (Some(shared), false) => shared.as_ref().clone(),
+                _ => {
+                    let ranked = ranked_seeds(problem, around, &self.fixed);
+                    spent = ranked.len();
+                    ranked
+                }
+            });
+        }
+        (self.seeds.as_mut().expect("set above"), spent) // proof: assigned just above when None
+    }
+
     /// Restarts taken in the last run.
     pub fn restarts(&self) -> usize {
         self.restarts
@@ -117,10 +152,11 @@ impl Damped {
     /// point found.
     fn restart(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError> {
         self.remember(current);
-        let seeds = self.seeds.get_or_insert_with(|| ranked_seeds(problem, &current.parameters, &self.fixed));
-        let mut evaluations = 0;
-        while self.restarts < self.max_restarts && !seeds.is_empty() {
-            let p = seeds.remove(0);
+        let (_, mut evaluations) = self.seeds(problem, &current.parameters);
+        while self.restarts < self.max_restarts {
+            let Some(p) = self.seeds.as_mut().and_then(|s| (!s.is_empty()).then(|| s.remove(0))) else {
+                break;
+            };
             evaluations += 1;
             if let Ok(next) = problem.linearise(&p) {
                 self.restarts += 1;
@@ -207,6 +243,7 @@ impl UpdateStrategy for Damped {
         self.mu = 1e-3;
         self.nu = 2.0;
         self.seeds = None;
+        self.far_checked = false;
         self.best = None;
         self.restarts = 0;
         self.stuck_for = 0;
@@ -222,15 +259,11 @@ impl UpdateStrategy for Damped {
         let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
         // Far from the data at the start (a frequency off by more than FAR_START): begin from
         // the best point of the coarse grid instead, when it fits better.
-        if self.seeds.is_none() && self.max_restarts > 0 && current.max_rel_diff() > FAR_START {
-            let seeds = ranked_seeds(problem, &current.parameters, &self.fixed);
-            let evaluations = seeds.len();
-            self.seeds = Some(seeds);
-            if let Some(Ok(next)) = self
-                .seeds
-                .as_mut()
-                .and_then(|s| (!s.is_empty()).then(|| s.remove(0)))
-                .map(|p| problem.linearise(&p))
+        if !self.far_checked && self.max_restarts > 0 && current.max_rel_diff() > FAR_START {
+            self.far_checked = true;
+            let (seeds, evaluations) = self.seeds(problem, &current.parameters);
+            if let Some(Ok(next)) =
+                (!seeds.is_empty()).then(|| seeds.remove(0)).map(|p| problem.linearise(&p))
             {
                 if next.cost() < current.cost() {
                     self.remember(current);
