@@ -15,7 +15,7 @@
 //! the intervals. The same program on data without it recovers every storey stiffness within
 //! its interval.
 
-use eigenfit::discovery::discover_configurations;
+use eigenfit::discovery::{discover_configurations, DiscoveryReport};
 use eigenfit::multi::Stacked;
 use eigenfit::statistics::uncertainty;
 use eigenfit::update::Evaluate;
@@ -269,6 +269,16 @@ fn report(title: &str, data: &[Measurement], runs: &[Run]) -> bool {
     all
 }
 
+/// Discovery over every test of `data`, with the building's own candidates (extra storey mass).
+pub fn discover_storey_mass(data: &[Measurement]) -> DiscoveryReport {
+    let base = building();
+    let models: Vec<ShearBuilding> =
+        TESTS.iter().map(|&(_, floor, mass)| base.clone().with_added_mass(floor, mass)).collect();
+    let configurations: Vec<(&ShearBuilding, &Measurement)> = models.iter().zip(data).collect();
+    discover_configurations(&configurations, &DenseSolver, &base.candidates(), &DESIGN, &Default::default())
+        .expect("discovery runs")
+}
+
 fn main() {
     for (hidden, title) in [
         (true, "measured WITH a hidden +30% mass on storey 3 (not in the model)"),
@@ -290,20 +300,8 @@ fn main() {
     }
 
     // --- discovery: the building's own candidates (extra mass on storey j), all three tests.
-    let base = building();
     for (hidden, title) in [(true, "WITH the hidden mass"), (false, "WITHOUT it")] {
-        let data = measurements(hidden, Some(&mut Noise(SEED)));
-        let models: Vec<ShearBuilding> =
-            TESTS.iter().map(|&(_, floor, mass)| base.clone().with_added_mass(floor, mass)).collect();
-        let configurations: Vec<(&ShearBuilding, &Measurement)> = models.iter().zip(&data).collect();
-        let report = discover_configurations(
-            &configurations,
-            &DenseSolver,
-            &base.candidates(),
-            &DESIGN,
-            &Default::default(),
-        )
-        .expect("discovery runs");
+        let report = discover_storey_mass(&measurements(hidden, Some(&mut Noise(SEED))));
         print!(
             "\n== discovery on the data {title}: χ² = {:.1} on {} dof, p = {:.1e}: ",
             report.chi2_before, report.dof_before, report.p_value

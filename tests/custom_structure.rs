@@ -8,11 +8,10 @@
 mod example;
 
 use eigenfit::{finite_difference_derivative, ModelError, StrategyKind, StructuralModel};
-use eigenfit::{DenseSolver, Measurement};
 use example::model::ShearBuilding;
 use example::{
-    building, chi2_95, measurements, problems, update_all, Noise, Run, DESIGN, HIDDEN_MASS, MASSES, SEED,
-    TESTS, TRUTH,
+    building, chi2_95, discover_storey_mass, measurements, problems, update_all, Noise, Run, DESIGN,
+    HIDDEN_MASS, MASSES, SEED, TRUTH,
 };
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
@@ -152,20 +151,7 @@ proptest! {
 
 #[test]
 fn discovery_names_the_hidden_storey_mass() {
-    use eigenfit::discovery::discover_configurations;
-    let base = building();
-    let data = measurements(true, Some(&mut Noise(SEED)));
-    let models: Vec<ShearBuilding> =
-        TESTS.iter().map(|&(_, floor, mass)| base.clone().with_added_mass(floor, mass)).collect();
-    let configurations: Vec<(&ShearBuilding, &Measurement)> = models.iter().zip(&data).collect();
-    let report = discover_configurations(
-        &configurations,
-        &DenseSolver,
-        &base.candidates(),
-        &DESIGN,
-        &Default::default(),
-    )
-    .unwrap();
+    let report = discover_storey_mass(&measurements(true, Some(&mut Noise(SEED))));
     assert!(report.disagreement_significant);
     let fit = report.selected.expect("an effect is named");
     // Storey 3 (floor index 2), +30% of its mass.
@@ -174,15 +160,6 @@ fn discovery_names_the_hidden_storey_mass() {
     let truth = HIDDEN_MASS.1 / MASSES[HIDDEN_MASS.0];
     assert!(lo <= truth && truth <= hi, "{truth} outside [{lo}, {hi}]");
     // Without the hidden mass nothing is added.
-    let clean = measurements(false, Some(&mut Noise(SEED)));
-    let configurations: Vec<(&ShearBuilding, &Measurement)> = models.iter().zip(&clean).collect();
-    let report = discover_configurations(
-        &configurations,
-        &DenseSolver,
-        &base.candidates(),
-        &DESIGN,
-        &Default::default(),
-    )
-    .unwrap();
+    let report = discover_storey_mass(&measurements(false, Some(&mut Noise(SEED))));
     assert!(report.selected.is_none());
 }

@@ -222,6 +222,5 @@ fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
     if !(a > 0.0 && b > a && count >= 2) {
         return Err(bad());
     }
-    let (la, lb) = (a.log10(), b.log10());
-    Ok((0..count).map(|i| 10f64.powf(la + (lb - la) * i as f64 / (count - 1) as f64)).collect())
+    Ok(eigenfit_core::compare::log_space(a, b, count))
 }

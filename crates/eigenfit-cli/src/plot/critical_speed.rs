@@ -49,12 +49,10 @@ impl CriticalSpeedMap {
         on_point: impl Fn(),
     ) -> Result<Self, CliError> {
         let np = model.parameters().len();
-        let (a, b) = (range.0.log10(), range.1.log10());
         let count = count.max(2);
         let mut stiffness = Vec::with_capacity(count);
         let mut frequencies = Vec::with_capacity(count);
-        for i in 0..count {
-            let k = 10f64.powf(a + (b - a) * i as f64 / (count - 1) as f64);
+        for k in eigenfit_core::compare::log_space(range.0, range.1, count) {
             let system = model.assemble(&vec![k; np]).map_err(|e| CliError::Failure(e.to_string()))?;
             let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
             stiffness.push(k);
