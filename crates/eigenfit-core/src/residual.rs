@@ -4,9 +4,7 @@ use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::modes::Modes;
 use crate::parameters::ParameterSet;
-use crate::sensitivity::{
-    check_distinct, noise_floor, Sensitivities, SensitivityError, DEFAULT_REPEATED_TOLERANCE,
-};
+use crate::sensitivity::{check_wanted_distinct, noise_floor, Sensitivities, SensitivityError};
 use crate::solver::EigenSolver;
 use crate::{eigenvalue_to_hz, hz_to_eigenvalue};
 use nalgebra::{DMatrix, DVector};
@@ -233,14 +231,13 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
         // The checks of `Sensitivities::compute_for`, in the same order.
         let system = self.model.assemble(p).map_err(SensitivityError::from)?;
         crate::solver::check_count(&system, needed).map_err(SensitivityError::from)?;
-        let count = (needed + 1).min(system.dofs());
-        let eigenvalues = self.solver.lowest_eigenvalues(&system, count).map_err(SensitivityError::from)?;
-        // The distinctness checks read the eigenvalues only.
-        let modes = Modes { eigenvalues, shapes: DMatrix::zeros(0, count) };
+        let (eigenvalues, next) =
+            self.solver.lowest_eigenvalues_with_next(&system, needed).map_err(SensitivityError::from)?;
         let floor = noise_floor(&system);
         for meas in self.measured.modes() {
-            check_distinct(&modes, meas.mode, DEFAULT_REPEATED_TOLERANCE, floor)?;
+            check_wanted_distinct(eigenvalues.as_slice(), next, &[meas.mode], floor)?;
         }
+        let modes = Modes { eigenvalues, shapes: DMatrix::zeros(0, needed) };
         for meas in self.measured.modes() {
             let lambda = modes.eigenvalues[meas.mode];
             if lambda <= floor {

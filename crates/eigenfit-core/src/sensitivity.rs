@@ -53,23 +53,26 @@ pub enum SensitivityError {
 /// low eigenvalues accurate relative to themselves, so closely spaced low modes are told apart
 /// however large the highest eigenvalue is.
 pub fn check_distinct(modes: &Modes, k: usize, tolerance: f64, floor: f64) -> Result<(), SensitivityError> {
-    let lam = &modes.eigenvalues;
+    distinct(modes.eigenvalues.as_slice(), f64::INFINITY, k, tolerance, floor)
+}
+
+/// [`check_distinct`] of mode `k` among the eigenvalues `lam` and the next eigenvalue beyond
+/// them, or a lower bound on it, `next` (∞: none; see [`EigenSolver::lowest_with_next`]).
+fn distinct(lam: &[f64], next: f64, k: usize, tolerance: f64, floor: f64) -> Result<(), SensitivityError> {
     if k >= lam.len() {
         return Err(SensitivityError::ModeIndex { mode: k, count: lam.len() });
     }
-    for l in 0..lam.len() {
-        if l == k {
-            continue;
-        }
-        let gap = (lam[k] - lam[l]).abs();
-        let size = lam[k].abs().max(lam[l].abs());
+    let others = lam.iter().copied().chain(next.is_finite().then_some(next)).enumerate();
+    for (l, other) in others.filter(|&(l, _)| l != k) {
+        let gap = (lam[k] - other).abs();
+        let size = lam[k].abs().max(other.abs());
         // Relative test, except for two (rigid-body) eigenvalues that are both zero to round-off.
         if gap <= tolerance * size || size <= floor {
             return Err(SensitivityError::RepeatedEigenvalue {
                 mode: k,
                 other: l,
                 lambda_mode: lam[k],
-                lambda_other: lam[l],
+                lambda_other: other,
                 relative_gap: if size > 0.0 { gap / size } else { 0.0 },
             });
         }
@@ -141,18 +144,9 @@ impl Sensitivities {
         if let Some(&k) = wanted.iter().find(|&&k| k >= count) {
             return Err(SensitivityError::ModeIndex { mode: k, count });
         }
-        let extra = (count + 1).min(system.dofs());
-        let mut modes = solver.lowest(&system, extra)?;
+        let (modes, next) = solver.lowest_with_next(&system, count)?;
         let floor = noise_floor(&system);
-        for &k in wanted {
-            check_distinct(&modes, k, DEFAULT_REPEATED_TOLERANCE, floor)?;
-        }
-        if modes.count() > count {
-            modes = Modes {
-                eigenvalues: modes.eigenvalues.rows(0, count).into_owned(),
-                shapes: modes.shapes.columns(0, count).into_owned(),
-            };
-        }
+        check_wanted_distinct(modes.eigenvalues.as_slice(), next, wanted, floor)?;
         let np = model.parameters().len();
         let mut dl = DMatrix::from_element(count, np, f64::NAN);
         let mut df = DMatrix::from_element(count, np, f64::NAN);
@@ -175,6 +169,17 @@ impl Sensitivities {
         }
         Ok(Self { modes, eigenvalues: dl, frequencies_hz: df })
     }
+}
+
+/// Checks every wanted mode against the others and against the next eigenvalue (or its lower
+/// bound) `next`, which the solver computed beyond the modes returned.
+pub(crate) fn check_wanted_distinct(
+    lowest: &[f64],
+    next: f64,
+    wanted: &[usize],
+    floor: f64,
+) -> Result<(), SensitivityError> {
+    wanted.iter().try_for_each(|&k| distinct(lowest, next, k, DEFAULT_REPEATED_TOLERANCE, floor))
 }
 
 /// dφₖ/dpᵢ by modal expansion over the supplied modes (the paper's eq. 4 with eq. 22):

@@ -42,6 +42,36 @@ pub trait EigenSolver: Send + Sync {
     fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
         self.lowest(system, count).map(|m| m.eigenvalues)
     }
+
+    /// The lowest `count` modes and a lower bound on the next eigenvalue λ_count (∞ when the
+    /// system has no further mode), to check that the highest mode returned is separated from
+    /// its neighbour. The default solves one mode more and returns that eigenvalue itself; a
+    /// backend with a cheaper certificate (the banded solver's Sturm count) returns a bound.
+    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
+        if count >= system.dofs() {
+            return self.lowest(system, count).map(|m| (m, f64::INFINITY));
+        }
+        let modes = self.lowest(system, count + 1)?;
+        let next = modes.eigenvalues[count];
+        let modes = Modes {
+            eigenvalues: modes.eigenvalues.rows(0, count).into_owned(),
+            shapes: modes.shapes.columns(0, count).into_owned(),
+        };
+        Ok((modes, next))
+    }
+
+    /// [`lowest_with_next`](Self::lowest_with_next) without the shapes (backends may skip them).
+    fn lowest_eigenvalues_with_next(
+        &self,
+        system: &System,
+        count: usize,
+    ) -> Result<(DVector<f64>, f64), SolveError> {
+        if count >= system.dofs() {
+            return self.lowest_eigenvalues(system, count).map(|e| (e, f64::INFINITY));
+        }
+        let all = self.lowest_eigenvalues(system, count + 1)?;
+        Ok((all.rows(0, count).into_owned(), all[count]))
+    }
 }
 
 impl<T: EigenSolver + ?Sized> EigenSolver for &T {
@@ -53,6 +83,16 @@ impl<T: EigenSolver + ?Sized> EigenSolver for &T {
     }
     fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
         (**self).lowest_eigenvalues(system, count)
+    }
+    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
+        (**self).lowest_with_next(system, count)
+    }
+    fn lowest_eigenvalues_with_next(
+        &self,
+        system: &System,
+        count: usize,
+    ) -> Result<(DVector<f64>, f64), SolveError> {
+        (**self).lowest_eigenvalues_with_next(system, count)
     }
 }
 

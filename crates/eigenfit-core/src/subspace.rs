@@ -1,27 +1,38 @@
-//! The large-model eigen-solver: shift-invert subspace iteration on a banded Cholesky factor.
+//! The banded eigen-solver: shift-invert subspace iteration on a band Cholesky factor, for beam
+//! models of every size — 22 DOFs in a few microseconds, 10⁵ DOFs in a fraction of a second.
 
 use crate::banded::{BandCholesky, BandedSymmetric};
 use crate::dense::DenseSolver;
+use crate::lanczos::{self, LanczosWork};
 use crate::modes::{apply_sign_rule, Modes};
+use crate::small_eigen::symmetric_eigen;
 use crate::solver::{check_count, EigenSolver, SolveError};
 use crate::system::System;
-use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use nalgebra::{DMatrix, DVector};
+use std::cell::RefCell;
 
-/// Lowest modes of large banded systems (beam meshes of 10³–10⁵ DOFs) in O(n·m²) per iteration.
+/// Lowest modes of banded systems (beam meshes) in O(n·b·p) per iteration, without allocating
+/// beyond the returned modes.
 ///
 /// Subspace iteration (Bathe) with the inverted operator: K + σM = LLᵀ is factored once by band
-/// (O(n·b²), b = 3 for beam models), then a block of p = max(2m, m + 8) M-orthonormal vectors X
-/// is driven towards the lowest modes by Z = (K + σM)⁻¹MX followed by a Rayleigh–Ritz step on
-/// span(Z). The projected p×p problem is solved in the same inverted form as [`DenseSolver`]
-/// (eigenvalues μ = 1/(λ + σ) of the pencil (ZᵀMZ, ZᵀK_σZ)), so a low mode keeps round-off
-/// relative to its own eigenvalue rather than to λ_max. The shift follows the dense solver: σ = 0
-/// when K is positive definite, otherwise a tiny σ₀ and then the lowest elastic eigenvalue.
+/// (O(n·b²), b = 3 for beam models), then a block of p M-orthonormal vectors X (p = m + 2 for a
+/// few modes, up to 2m for many) is driven towards the lowest modes by Z = (K + σM)⁻¹MX followed
+/// by a Rayleigh–Ritz step on span(Z). The projected p×p problem is solved in the same inverted
+/// form as [`DenseSolver`] (eigenvalues μ = 1/(λ + σ) of the pencil (ZᵀMZ, ZᵀK_σZ), by Jacobi
+/// with a relative stopping test), so a low mode keeps round-off relative to its own eigenvalue
+/// rather than to λ_max. The shift follows the dense solver: σ = 0 when K is positive definite,
+/// otherwise a tiny σ₀ and then the lowest elastic eigenvalue.
 ///
 /// A mode counts as converged when its inverse residual ‖ν zᵢ − xᵢ‖∞ / ‖xᵢ‖∞ (ν = λ + σ) falls
 /// below [`tolerance`](Self::tolerance): that is the relative error of the mode shape; the
-/// eigenvalue's is about its square. Systems too small for the iteration to pay (n < 3p) are
-/// handed to [`DenseSolver`]. A dense [`System`] is converted to band storage first (O(n²));
-/// a banded one ([`System::banded`]) is used as it is.
+/// eigenvalue's is about its square. A Sturm count (the negative pivots of K − σ′M = LDLᵀ just
+/// above the highest mode found) then proves no lower mode was missed; if one was, or when more
+/// than half the modes are requested, the solve goes to [`DenseSolver`].
+///
+/// Blocks are stored by rows, so the p columns sit in the innermost, vectorisable loops, and all
+/// work arrays live in a per-thread workspace reused from call to call: repeated solves of the
+/// same size (an update loop) allocate only the returned [`Modes`]. A dense [`System`] is
+/// converted to band storage first (O(n²)); a banded one ([`System::banded`]) is used as it is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BandedSolver {
     /// Relative inverse-residual below which a mode is converged.
@@ -34,13 +45,58 @@ impl Default for BandedSolver {
     fn default() -> Self {
         // 1e-8 on the shapes (1e-16 on the eigenvalues) is at the round-off floor of fine beam
         // meshes already; asking for less only spends iterations until the stall rule stops them.
-        Self { tolerance: 1e-8, max_iterations: 500 }
+        Self { tolerance: 1e-10, max_iterations: 500 }
     }
 }
 
-/// Subspace size for `count` wanted modes of an n-DOF system.
+/// Subspace size for `count` wanted modes of an n-DOF system: two guard vectors for a few modes
+/// (cheap iterations, the spectrum of a beam spreads fast), up to 2m for many (fewer iterations).
 pub fn subspace_size(dofs: usize, count: usize) -> usize {
-    (2 * count).max(count + 8).min(dofs)
+    (count + 2).max((2 * count).min(count + 8)).min(dofs)
+}
+
+/// Reusable work arrays of one thread's solves.
+#[derive(Default)]
+struct Workspace {
+    factor: BandCholesky,
+    /// The last mass matrix proven positive definite: an update loop solves one M many times.
+    checked_mass: Option<BandedSymmetric>,
+    lanczos: LanczosWork,
+    scratch: Vec<f64>,
+    /// n×p blocks, row-major.
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    mz: Vec<f64>,
+    /// p×p projected matrices and Ritz data, row-major.
+    kr: Vec<f64>,
+    mr: Vec<f64>,
+    q: Vec<f64>,
+    w: Vec<f64>,
+    nu: Vec<f64>,
+    scale: Vec<f64>,
+    order: Vec<usize>,
+}
+
+impl Workspace {
+    fn resize(&mut self, n: usize, p: usize) {
+        for v in [&mut self.x, &mut self.y, &mut self.z, &mut self.mz] {
+            v.clear();
+            v.resize(n * p, 0.0);
+        }
+        for v in [&mut self.kr, &mut self.mr, &mut self.q, &mut self.w] {
+            v.clear();
+            v.resize(p * p, 0.0);
+        }
+        self.nu.clear();
+        self.nu.resize(p, f64::INFINITY);
+        self.scale.clear();
+        self.scale.resize(p, 0.0);
+    }
+}
+
+thread_local! {
+    static WORKSPACE: RefCell<Workspace> = RefCell::new(Workspace::default());
 }
 
 impl EigenSolver for BandedSolver {
@@ -49,11 +105,39 @@ impl EigenSolver for BandedSolver {
     }
 
     fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
+        match self.banded(system, count)? {
+            Some((modes, _)) => Ok(modes),
+            None => DenseSolver.lowest(system, count),
+        }
+    }
+
+    /// The next eigenvalue's bound is the Sturm check's shift: no eigenvalue beyond the modes
+    /// returned lies below it, at no extra cost.
+    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
+        match self.banded(system, count)? {
+            Some(found) => Ok(found),
+            None => DenseSolver.lowest_with_next(system, count),
+        }
+    }
+
+    fn lowest_eigenvalues_with_next(
+        &self,
+        system: &System,
+        count: usize,
+    ) -> Result<(DVector<f64>, f64), SolveError> {
+        self.lowest_with_next(system, count).map(|(modes, next)| (modes.eigenvalues, next))
+    }
+}
+
+impl BandedSolver {
+    /// The lowest `count` modes with a lower bound on the next eigenvalue, or `None` for the
+    /// dense solver: more than half the spectrum wanted, or a mode missed (see the type's
+    /// documentation) in a system small enough for it.
+    fn banded(&self, system: &System, count: usize) -> Result<Option<(Modes, f64)>, SolveError> {
         check_count(system, count)?;
         let n = system.dofs();
-        let p = subspace_size(n, count);
-        if 3 * p > n {
-            return DenseSolver.lowest(system, count);
+        if 2 * count > n {
+            return Ok(None);
         }
         let converted;
         let (k, m) = match system.band() {
@@ -66,23 +150,22 @@ impl EigenSolver for BandedSolver {
                 (&converted.0, &converted.1)
             }
         };
-        if m.cholesky().is_none() {
-            return Err(SolveError::MassNotPositiveDefinite { detail: None });
-        }
-        if let Some(chol) = k.cholesky().filter(well_conditioned) {
-            return self.iterate(&chol, m, 0.0, count, p);
-        }
-        // Rigid-body modes: as in the dense solver, locate the lowest elastic mode with a tiny
-        // shift, then shift to it for accuracy.
-        let scale = k.diagonal_max() / m.diagonal_max();
-        let sigma0 = 1e-8 * scale.max(f64::MIN_POSITIVE);
-        let first = self.shifted(k, m, sigma0, count, p)?;
-        match first.eigenvalues.iter().find(|&&l| l > 1e-3 * sigma0) {
-            Some(&sigma1) if sigma1 > 10.0 * sigma0 => self.shifted(k, m, sigma1, count, p),
-            _ => Ok(first),
+        let found = WORKSPACE.with(|ws| {
+            let ws = &mut *ws.try_borrow_mut().map_err(|_| backend("workspace in use (re-entrant solve)"))?;
+            self.solve(k, m, count, ws)
+        })?;
+        match found {
+            Some(found) => Ok(Some(found)),
+            // The Sturm count found a mode below the highest one returned: the start vectors
+            // missed it (or two eigenvalues coincide to 1e-6). The dense solver cannot miss modes.
+            None if n <= MAX_DENSE_FALLBACK => Ok(None),
+            None => Err(backend("a mode was missed by the subspace iteration (Sturm count)")),
         }
     }
 }
+
+/// Largest system the banded solver hands to the dense one when its Sturm check fails.
+const MAX_DENSE_FALLBACK: usize = 4000;
 
 fn well_conditioned(c: &BandCholesky) -> bool {
     let (dmin, dmax) = c.pivot_range();
@@ -94,6 +177,38 @@ fn backend(detail: impl Into<String>) -> SolveError {
 }
 
 impl BandedSolver {
+    /// The lowest `count` modes and a lower bound on the next eigenvalue, or `None` when the
+    /// Sturm check shows a missed mode.
+    fn solve(
+        &self,
+        k: &BandedSymmetric,
+        m: &BandedSymmetric,
+        count: usize,
+        ws: &mut Workspace,
+    ) -> Result<Option<(Modes, f64)>, SolveError> {
+        if ws.checked_mass.as_ref() != Some(m) {
+            if !ws.factor.factor_shifted(m, 0.0, m) {
+                return Err(SolveError::MassNotPositiveDefinite { detail: None });
+            }
+            ws.checked_mass = Some(m.clone());
+        }
+        let p = subspace_size(m.dim(), count);
+        let modes = if ws.factor.factor_shifted(k, 0.0, m) && well_conditioned(&ws.factor) {
+            self.iterate(m, 0.0, count, p, ws)?
+        } else {
+            // Rigid-body modes: as in the dense solver, locate the lowest elastic mode with a tiny
+            // shift, then shift to it for accuracy.
+            let scale = k.diagonal_max() / m.diagonal_max();
+            let sigma0 = 1e-8 * scale.max(f64::MIN_POSITIVE);
+            let first = self.shifted(k, m, sigma0, count, p, ws)?;
+            match first.eigenvalues.iter().find(|&&l| l > 1e-3 * sigma0) {
+                Some(&sigma1) if sigma1 > 10.0 * sigma0 => self.shifted(k, m, sigma1, count, p, ws)?,
+                _ => first,
+            }
+        };
+        Ok(sturm_bound(k, m, &modes, &mut ws.scratch).map(|next| (modes, next)))
+    }
+
     fn shifted(
         &self,
         k: &BandedSymmetric,
@@ -101,42 +216,56 @@ impl BandedSolver {
         sigma: f64,
         count: usize,
         p: usize,
+        ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
-        let chol = k
-            .add_scaled(sigma, m)
-            .cholesky()
-            .ok_or_else(|| backend("K + σM is not positive definite: K has negative stiffness"))?;
-        self.iterate(&chol, m, sigma, count, p)
+        if !ws.factor.factor_shifted(k, sigma, m) {
+            return Err(backend("K + σM is not positive definite: K has negative stiffness"));
+        }
+        self.iterate(m, sigma, count, p, ws)
     }
 
-    /// Subspace iteration with the factor of K + σM; returns the lowest `count` modes.
+    /// The lowest modes from the factor of K + σM held in the workspace: Lanczos first, block
+    /// subspace iteration when Lanczos does not converge in its step limit or misses a mode.
     fn iterate(
         &self,
-        chol: &BandCholesky,
         m: &BandedSymmetric,
         sigma: f64,
         count: usize,
         p: usize,
+        ws: &mut Workspace,
+    ) -> Result<Modes, SolveError> {
+        if let Some(ritz) = lanczos::largest(&ws.factor, m, count, self.tolerance, &mut ws.lanczos) {
+            let n = m.dim();
+            let eigenvalues = DVector::from_iterator(count, ritz.mu.iter().map(|&mu| 1.0 / mu - sigma));
+            let shapes = DMatrix::from_column_slice(n, count, ritz.vectors);
+            return finish(eigenvalues, shapes);
+        }
+        self.subspace_iteration(m, sigma, count, p, ws)
+    }
+
+    /// Block subspace iteration with the factor of K + σM held in the workspace.
+    fn subspace_iteration(
+        &self,
+        m: &BandedSymmetric,
+        sigma: f64,
+        count: usize,
+        p: usize,
+        ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
         let n = m.dim();
-        let mut x = start_vectors(n, p);
-        let mut y = DMatrix::zeros(n, p);
-        let mut z = DMatrix::zeros(n, p);
-        let mut mz = DMatrix::zeros(n, p);
-        let mut kr = DMatrix::zeros(p, p);
-        let mut mr = DMatrix::zeros(p, p);
-        let mut nu: Option<DVector<f64>> = None;
-        let (mut best, mut stalled, mut refills) = (f64::INFINITY, 0, 0);
-        m.mul_columns(&x, &mut y);
+        ws.resize(n, p);
+        start_vectors(&mut ws.x, 0);
+        m.mul_block(&ws.x, &mut ws.y, p);
+        let (mut best, mut stalled, mut refills, mut first) = (f64::INFINITY, 0, 0, true);
         for _ in 0..self.max_iterations {
-            z.copy_from(&y);
-            chol.solve_columns(&mut z);
-            if let Some(nu) = &nu {
-                let res = inverse_residual(&x, &z, nu, count);
+            ws.z.copy_from_slice(&ws.y);
+            ws.factor.solve_block(&mut ws.z, p);
+            if !first {
+                let res = inverse_residual(&ws.x, &ws.z, &ws.nu, p, count);
                 // Converged, or at the round-off floor: no more progress on a small residual.
                 if res <= self.tolerance || (stalled >= 4 && best <= 1e-6) {
-                    let eigenvalues = DVector::from_iterator(count, nu.iter().take(count).map(|v| v - sigma));
-                    let shapes = x.columns(0, count).into_owned();
+                    let eigenvalues = DVector::from_iterator(count, ws.nu[..count].iter().map(|v| v - sigma));
+                    let shapes = DMatrix::from_fn(n, count, |r, c| ws.x[r * p + c]);
                     return finish(eigenvalues, shapes);
                 }
                 if res < 0.5 * best {
@@ -146,100 +275,209 @@ impl BandedSolver {
                     stalled += 1;
                 }
             }
-            kr.gemm_tr(1.0, &z, &y, 0.0);
-            m.mul_columns(&z, &mut mz);
-            mr.gemm_tr(1.0, &z, &mz, 0.0);
-            let (values, q) = projected(&kr, &mr)?;
-            x.gemm(1.0, &z, &q, 0.0);
-            for j in (0..p).filter(|&j| !values[j].is_finite()) {
-                refills += 1;
-                x.column_mut(j).copy_from(&start_vectors(n, 1 + refills).column(refills));
+            first = false;
+            gram(&ws.z, &ws.y, &mut ws.kr, p);
+            m.mul_block(&ws.z, &mut ws.mz, p);
+            gram(&ws.z, &ws.mz, &mut ws.mr, p);
+            projected(ws, p)?;
+            // X = ZQ and, since M is linear, MX = (MZ)Q without another band product.
+            combine(&ws.z, &ws.q, &mut ws.x, p);
+            combine(&ws.mz, &ws.q, &mut ws.y, p);
+            let lost: Vec<usize> = (0..p).filter(|&j| !ws.nu[j].is_finite()).collect();
+            if !lost.is_empty() {
+                for j in lost {
+                    refills += 1;
+                    refill_column(&mut ws.x, p, j, refills);
+                }
+                m.mul_block(&ws.x, &mut ws.y, p);
             }
-            m.mul_columns(&x, &mut y);
-            nu = Some(values);
         }
         Err(backend(format!("subspace iteration did not converge in {} iterations", self.max_iterations)))
     }
 }
 
-/// max over the wanted modes of ‖νᵢ zᵢ − xᵢ‖∞ / ‖xᵢ‖∞.
-fn inverse_residual(x: &DMatrix<f64>, z: &DMatrix<f64>, nu: &DVector<f64>, count: usize) -> f64 {
-    if nu.iter().take(count).any(|v| !v.is_finite()) {
-        return f64::INFINITY;
-    }
-    (0..count)
-        .map(|i| {
-            let (xc, zc) = (x.column(i), z.column(i));
-            let scale = xc.amax();
-            let diff = xc.iter().zip(zc.iter()).fold(0.0_f64, |a, (xv, zv)| a.max((nu[i] * zv - xv).abs()));
-            if scale > 0.0 {
-                diff / scale
-            } else {
-                f64::INFINITY
-            }
-        })
-        .fold(0.0, f64::max)
+/// Sturm check: exactly `count` eigenvalues lie below a point σ′ just above the highest one
+/// found. Returns σ′ — a lower bound on the next eigenvalue — or `None` when a mode was missed.
+fn sturm_bound(
+    k: &BandedSymmetric,
+    m: &BandedSymmetric,
+    modes: &Modes,
+    scratch: &mut Vec<f64>,
+) -> Option<f64> {
+    let count = modes.count();
+    let top = modes.eigenvalues[count - 1];
+    // Above round-off of a rigid-body zero, and 1e-6 relative above an elastic eigenvalue.
+    let floor = 1e-11 * k.diagonal_max() / m.diagonal_max();
+    let sigma = top + (1e-6 * top.abs()).max(floor);
+    (k.count_below(m, sigma, scratch) == Some(count)).then_some(sigma)
 }
 
-/// Rayleigh–Ritz on the pencil Kr q = ν Mr q (both p×p, positive definite), in inverted form:
-/// ν ascending and Q with QᵀMrQ = I.
-fn projected(kr: &DMatrix<f64>, mr: &DMatrix<f64>) -> Result<(DVector<f64>, DMatrix<f64>), SolveError> {
-    let p = kr.nrows();
+/// max over the wanted modes of ‖νᵢ zᵢ − xᵢ‖∞ / ‖xᵢ‖∞ (blocks row-major, p columns).
+fn inverse_residual(x: &[f64], z: &[f64], nu: &[f64], p: usize, count: usize) -> f64 {
+    if nu[..count].iter().any(|v| !v.is_finite()) {
+        return f64::INFINITY;
+    }
+    let mut worst = 0.0_f64;
+    for i in 0..count {
+        let (mut scale, mut diff) = (0.0_f64, 0.0_f64);
+        for (xr, zr) in x.chunks_exact(p).zip(z.chunks_exact(p)) {
+            scale = scale.max(xr[i].abs());
+            diff = diff.max((nu[i] * zr[i] - xr[i]).abs());
+        }
+        worst = worst.max(if scale > 0.0 { diff / scale } else { f64::INFINITY });
+    }
+    worst
+}
+
+/// out = AᵀB for row-major n×p blocks A, B (p×p, row-major).
+fn gram(a: &[f64], b: &[f64], out: &mut [f64], p: usize) {
+    out.fill(0.0);
+    for (ar, br) in a.chunks_exact(p).zip(b.chunks_exact(p)) {
+        for (i, &ai) in ar.iter().enumerate() {
+            for (o, &bj) in out[i * p..(i + 1) * p].iter_mut().zip(br) {
+                *o += ai * bj;
+            }
+        }
+    }
+}
+
+/// out = A Q for a row-major n×p block A and p×p Q.
+fn combine(a: &[f64], q: &[f64], out: &mut [f64], p: usize) {
+    for (ar, or) in a.chunks_exact(p).zip(out.chunks_exact_mut(p)) {
+        or.fill(0.0);
+        for (i, &ai) in ar.iter().enumerate() {
+            for (o, &qj) in or.iter_mut().zip(&q[i * p..(i + 1) * p]) {
+                *o += ai * qj;
+            }
+        }
+    }
+}
+
+/// Rayleigh–Ritz on the pencil Kr q = ν Mr q (p×p in the workspace, both positive definite), in
+/// inverted form: ν ascending into `ws.nu` and Q (QᵀMrQ = I) into `ws.q`. A direction lost to
+/// round-off (the columns of Z nearly dependent, as after the first step from random vectors when
+/// λ₂/λ₁ is huge) comes back as ν = ∞ with a zero column in Q, for the caller to refill.
+fn projected(ws: &mut Workspace, p: usize) -> Result<(), SolveError> {
+    let Workspace { kr, mr, q, w, nu, scale, order, .. } = ws;
     // Jacobi scaling: the columns of Z differ in size by λ_p/λ_1.
-    let d = DVector::from_iterator(p, (0..p).map(|i| 1.0 / mr[(i, i)].max(f64::MIN_POSITIVE).sqrt()));
-    let scale = |a: &DMatrix<f64>| DMatrix::from_fn(p, p, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]) * d[i] * d[j]);
-    let (ks, ms) = (scale(kr), scale(mr));
-    let c = ks.cholesky().ok_or_else(|| backend("projected stiffness is not positive definite"))?;
-    let l = c.l();
-    let t = l.solve_lower_triangular(&ms).ok_or_else(|| backend("zero pivot in projected factor"))?;
-    let a =
-        l.solve_lower_triangular(&t.transpose()).ok_or_else(|| backend("zero pivot in projected factor"))?;
-    let a = (&a + a.transpose()) * 0.5;
-    let eig = SymmetricEigen::try_new(a, f64::EPSILON, 0)
-        .ok_or_else(|| backend("projected symmetric QR iteration did not converge"))?;
-    let mut order: Vec<usize> = (0..p).collect();
-    order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
-    let mu_max = eig.eigenvalues[order[0]];
+    for i in 0..p {
+        scale[i] = 1.0 / mr[i * p + i].max(f64::MIN_POSITIVE).sqrt();
+    }
+    for i in 0..p {
+        for j in 0..=i {
+            let s = scale[i] * scale[j];
+            let (kv, mv) =
+                (0.5 * (kr[i * p + j] + kr[j * p + i]) * s, 0.5 * (mr[i * p + j] + mr[j * p + i]) * s);
+            kr[i * p + j] = kv;
+            kr[j * p + i] = kv;
+            mr[i * p + j] = mv;
+            mr[j * p + i] = mv;
+        }
+    }
+    // Kr = LLᵀ in place (lower triangle).
+    for j in 0..p {
+        let mut d = kr[j * p + j];
+        for k in 0..j {
+            d -= kr[j * p + k] * kr[j * p + k];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return Err(backend("projected stiffness is not positive definite"));
+        }
+        let d = d.sqrt();
+        kr[j * p + j] = d;
+        for i in j + 1..p {
+            let mut s = kr[i * p + j];
+            for k in 0..j {
+                s -= kr[i * p + k] * kr[j * p + k];
+            }
+            kr[i * p + j] = s / d;
+        }
+    }
+    // A = L⁻¹ Mr L⁻ᵀ: rows of L⁻¹Mr by forward substitution, then the same on its transpose.
+    for _ in 0..2 {
+        for c in 0..p {
+            for i in 0..p {
+                let mut s = mr[i * p + c];
+                for k in 0..i {
+                    s -= kr[i * p + k] * mr[k * p + c];
+                }
+                mr[i * p + c] = s / kr[i * p + i];
+            }
+        }
+        transpose_in_place(mr, p);
+    }
+    for i in 0..p {
+        for j in 0..i {
+            let v = 0.5 * (mr[i * p + j] + mr[j * p + i]);
+            mr[i * p + j] = v;
+            mr[j * p + i] = v;
+        }
+    }
+    if !symmetric_eigen(mr, w, p) {
+        return Err(backend("projected Jacobi iteration did not converge"));
+    }
+    order.clear();
+    order.extend(0..p);
+    order.sort_by(|&i, &j| mr[j * p + j].total_cmp(&mr[i * p + i]));
+    let mu_max = mr[order[0] * p + order[0]];
     if mu_max.is_nan() || mu_max <= 0.0 {
         return Err(backend("the iteration subspace collapsed"));
     }
-    // Directions lost to round-off (the columns of Z nearly dependent, as after the first step
-    // from random vectors when λ₂/λ₁ is huge) come back as ν = ∞ with a zero column in Q; the
-    // caller refills them.
-    let good = |i: usize| eig.eigenvalues[i] > 1e-14 * mu_max;
-    let values = DVector::from_iterator(
-        p,
-        order.iter().map(|&i| if good(i) { 1.0 / eig.eigenvalues[i] } else { f64::INFINITY }),
-    );
-    let w = DMatrix::from_fn(p, p, |r, j| {
-        let i = order[j];
-        if good(i) {
-            eig.eigenvectors[(r, i)] / eig.eigenvalues[i].sqrt()
-        } else {
-            0.0
+    // Q = D L⁻ᵀ W Λ^(-1/2), columns in ascending ν.
+    for (col, &i) in order.iter().enumerate() {
+        let mu = mr[i * p + i];
+        let good = mu > 1e-14 * mu_max;
+        nu[col] = if good { 1.0 / mu } else { f64::INFINITY };
+        let f = if good { 1.0 / mu.sqrt() } else { 0.0 };
+        for r in (0..p).rev() {
+            let mut s = w[r * p + i] * f;
+            for k in r + 1..p {
+                s -= kr[k * p + r] * q[k * p + col];
+            }
+            q[r * p + col] = s / kr[r * p + r];
         }
-    });
-    let mut q =
-        l.transpose().solve_upper_triangular(&w).ok_or_else(|| backend("zero pivot in projected factor"))?;
-    for (i, mut row) in q.row_iter_mut().enumerate() {
-        row *= d[i];
     }
-    Ok((values, q))
+    for r in 0..p {
+        for v in &mut q[r * p..(r + 1) * p] {
+            *v *= scale[r];
+        }
+    }
+    Ok(())
 }
 
-/// Deterministic pseudo-random start block (splitmix64), so solves are reproducible.
-fn start_vectors(n: usize, p: usize) -> DMatrix<f64> {
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-    DMatrix::from_fn(n, p, |_, _| {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    })
+fn transpose_in_place(a: &mut [f64], p: usize) {
+    for i in 0..p {
+        for j in 0..i {
+            a.swap(i * p + j, j * p + i);
+        }
+    }
 }
 
+/// splitmix64 at position `k` of a fixed sequence, mapped to [−½, ½): reproducible start vectors.
+pub(crate) fn pseudo_random(k: u64) -> f64 {
+    let mut z = 0x9E37_79B9_7F4A_7C15_u64.wrapping_mul(k + 1);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+}
+
+/// Deterministic pseudo-random start block, so solves are reproducible.
+fn start_vectors(x: &mut [f64], offset: u64) {
+    for (k, v) in x.iter_mut().enumerate() {
+        *v = pseudo_random(offset + k as u64);
+    }
+}
+
+/// A fresh pseudo-random column j (the `refill`-th) in place of a lost direction.
+fn refill_column(x: &mut [f64], p: usize, j: usize, refill: usize) {
+    let n = x.len() / p;
+    for (r, row) in x.chunks_exact_mut(p).enumerate() {
+        row[j] = pseudo_random(((refill * n + r) as u64) << 20);
+    }
+}
+
+/// Rejects non-finite results and applies the sign rule.
 fn finish(eigenvalues: DVector<f64>, mut shapes: DMatrix<f64>) -> Result<Modes, SolveError> {
     if eigenvalues.iter().chain(shapes.iter()).any(|v| !v.is_finite()) {
         return Err(backend("non-finite result"));
@@ -308,7 +546,13 @@ mod tests {
     #[test]
     fn small_and_dense_systems_and_bad_input() {
         let small = chain(10, 1.0);
-        assert_eq!(BandedSolver::default().lowest(&small, 2), DenseSolver.lowest(&small, 2));
+        assert_agrees(
+            &BandedSolver::default().lowest(&small, 2).unwrap(),
+            &DenseSolver.lowest(&small, 2).unwrap(),
+            1e-12,
+        );
+        // More than half the spectrum: the dense solver's job.
+        assert_eq!(BandedSolver::default().lowest(&small, 6), DenseSolver.lowest(&small, 6));
         let dense = System::new(chain(90, 5.0).stiffness().clone(), chain(90, 5.0).mass().clone()).unwrap();
         let a = BandedSolver::default().lowest(&dense, 3).unwrap();
         assert_agrees(&a, &DenseSolver.lowest(&dense, 3).unwrap(), 1e-9);
@@ -319,5 +563,25 @@ mod tests {
             Err(SolveError::MassNotPositiveDefinite { .. })
         ));
         assert_eq!(BandedSolver::default().lowest(&dense, 0), Err(SolveError::NoModes));
+    }
+
+    #[test]
+    fn sturm_count_catches_a_missed_mode() {
+        let sys = chain(60, 3.0);
+        let (k, m) = sys.band().unwrap();
+        let all = DenseSolver.lowest(&sys, 4).unwrap();
+        let mut scratch = Vec::new();
+        assert!(sturm_bound(k, m, &all, &mut scratch)
+            .is_some_and(|b| b < DenseSolver.lowest(&sys, 5).unwrap().eigenvalues[4]));
+        // Modes 0, 1, 3 without 2: a subspace iteration that missed a mode would return this.
+        let keep = [0, 1, 3];
+        let missed = Modes {
+            eigenvalues: DVector::from_iterator(3, keep.iter().map(|&i| all.eigenvalues[i])),
+            shapes: DMatrix::from_columns(&keep.map(|i| all.shapes.column(i))),
+        };
+        assert_eq!(sturm_bound(k, m, &missed, &mut scratch), None);
+        for (sigma, below) in [(0.0, 0), (0.5 * (all.eigenvalues[1] + all.eigenvalues[2]), 2)] {
+            assert_eq!(k.count_below(m, sigma, &mut scratch), Some(below));
+        }
     }
 }

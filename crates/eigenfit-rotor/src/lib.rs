@@ -63,6 +63,4 @@ pub use builder::RotorBuilder;
 pub use effects::EffectSpec;
 pub use error::RotorError;
 pub use file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section, ShaftSpec};
-pub use model::{
-    Bearing, Rotor, ShaftElement, DENSE_ASSEMBLY_MAX_DOFS, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER,
-};
+pub use model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};

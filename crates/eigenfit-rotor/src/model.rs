@@ -18,13 +18,9 @@ pub const STIFFNESS_UPPER: f64 = 1e15;
 
 /// Most shaft elements a rotor may have. K and M are kept by band (half-bandwidth 3: 32 bytes
 /// per DOF and matrix), so memory is no limit; 10⁵ elements (200,002 DOFs) is far beyond any
-/// sensible mesh. Above [`DENSE_ASSEMBLY_MAX_DOFS`] a dense solver would need 8n² bytes per
-/// matrix: solve such rotors with [`BandedSolver`](eigenfit_core::BandedSolver).
+/// sensible mesh. A dense solver would need 8n² bytes per matrix: solve large rotors with
+/// [`BandedSolver`](eigenfit_core::BandedSolver).
 pub const MAX_ELEMENTS: usize = 100_000;
-
-/// Largest rotor (in DOFs) whose [`assemble`](StructuralModel::assemble) returns a dense
-/// [`System`]; larger rotors return a banded one.
-pub const DENSE_ASSEMBLY_MAX_DOFS: usize = 200;
 
 /// One resolved shaft element between nodes `index` and `index + 1`.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,8 +59,8 @@ pub struct Bearing {
 ///
 /// The parameter-independent part of K and M (shaft, disks, point masses, rotational bearing
 /// springs) is assembled once at construction, by band; [`assemble`](StructuralModel::assemble)
-/// copies it, adds the bearing stiffnesses on the diagonal and returns a dense [`System`] for
-/// rotors up to [`DENSE_ASSEMBLY_MAX_DOFS`] DOFs, a banded one beyond.
+/// copies it, adds the bearing stiffnesses on the diagonal and returns a banded [`System`] (dense
+/// solvers densify it on first use).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rotor {
     pub(crate) spec: RotorSpec,
@@ -262,11 +258,7 @@ impl StructuralModel for Rotor {
             let j = Self::displacement_dof(b.node);
             k.add(j, j, kb);
         }
-        if self.dofs() <= DENSE_ASSEMBLY_MAX_DOFS {
-            Ok(System::new(k.to_dense(), self.base_mass.to_dense())?)
-        } else {
-            Ok(System::banded(k, self.base_mass.clone())?)
-        }
+        Ok(System::banded(k, self.base_mass.clone())?)
     }
 
     /// Exact: ∂K/∂kᵢ has the single entry 1 at the bearing's displacement DOF; ∂M/∂kᵢ = 0.

@@ -1,0 +1,226 @@
+//! Shift-invert Lanczos with full reorthogonalisation: the fast path of
+//! [`BandedSolver`](crate::BandedSolver).
+//!
+//! On the inverted operator (K + σM)⁻¹M the lowest modes are the largest, best separated
+//! eigenvalues μ = 1/(λ + σ), and a Krylov space finds them in a few steps more than the modes
+//! wanted: each step costs one band solve, one band product and the reorthogonalisation, O(n·j).
+//! Subspace iteration needs several block iterations of the same cost per vector for the same
+//! accuracy. A single start vector cannot see a repeated eigenvalue twice; the caller's Sturm
+//! check catches that and falls back to block subspace iteration.
+
+use crate::banded::{BandCholesky, BandedSymmetric};
+use crate::small_eigen::tridiagonal_eigen;
+use crate::subspace::pseudo_random;
+
+/// Reusable work arrays of Lanczos runs (grown on demand, never shrunk).
+#[derive(Debug, Default)]
+pub(crate) struct LanczosWork {
+    /// Basis vectors q₀ … q_j, each contiguous (n per vector).
+    q: Vec<f64>,
+    /// M qᵢ, same layout: the M inner product (x, qᵢ)_M = xᵀ(M qᵢ) without band products.
+    mq: Vec<f64>,
+    w: Vec<f64>,
+    mw: Vec<f64>,
+    alpha: Vec<f64>,
+    beta: Vec<f64>,
+    d: Vec<f64>,
+    e: Vec<f64>,
+    z: Vec<f64>,
+    order: Vec<usize>,
+    coefficients: Vec<f64>,
+}
+
+/// Converged Lanczos modes, in the solver's workspace until copied out.
+pub(crate) struct Ritz<'a> {
+    /// μ = 1/(λ + σ), descending (lowest λ first).
+    pub mu: &'a [f64],
+    /// Ritz vectors, mode k at `vectors[k·n..(k + 1)·n]`, M-orthonormal.
+    pub vectors: &'a [f64],
+}
+
+const PASSES: usize = 1;
+/// Steps beyond `count` before the first convergence check: each check is a QL decomposition of
+/// T, dearer than a step on small models, and fewer steps never suffice for the tolerance.
+const FIRST_CHECK: usize = 5;
+/// Steps allowed before giving up on `count` modes of an n-DOF system.
+fn step_limit(n: usize, count: usize) -> usize {
+    n.min(4 * count + 40)
+}
+
+/// The `count` largest eigenpairs of (K + σM)⁻¹M (factor given) with relative inverse residual
+/// ‖ν·Op y − y‖_M ≤ `tolerance` (ν = 1/μ), or `None` when the step limit is reached first.
+pub(crate) fn largest<'a>(
+    factor: &BandCholesky,
+    m: &BandedSymmetric,
+    count: usize,
+    tolerance: f64,
+    work: &'a mut LanczosWork,
+) -> Option<Ritz<'a>> {
+    let n = m.dim();
+    let cap = step_limit(n, count);
+    let LanczosWork { q, mq, w, mw, alpha, beta, d, e, z, order, coefficients } = work;
+    // Every entry is written before it is read: grow, never clear.
+    for v in [&mut *q, &mut *mq] {
+        if v.len() < n * (cap + 1) {
+            v.resize(n * (cap + 1), 0.0);
+        }
+    }
+    for v in [&mut *w, &mut *mw] {
+        v.clear();
+        v.resize(n, 0.0);
+    }
+    alpha.clear();
+    beta.clear();
+    for (i, v) in w.iter_mut().enumerate() {
+        *v = pseudo_random(i as u64);
+    }
+    let mut restarts = 0;
+    let norm = m_norm(m, w, mw);
+    if !scale_into(w, mw, norm, &mut q[..n], &mut mq[..n]) {
+        return None;
+    }
+    let mut steps = 0;
+    while steps < cap {
+        let j = steps;
+        // w = (K + σM)⁻¹ M qⱼ.
+        w.copy_from_slice(&mq[j * n..(j + 1) * n]);
+        factor.solve_in_place(w);
+        // Full reorthogonalisation, classical Gram–Schmidt twice ("twice is enough"); the
+        // coefficient on qⱼ is αⱼ, those on q_{j−1} … q₀ are β_{j−1} and round-off.
+        let mut a = 0.0;
+        for _ in 0..PASSES {
+            a += orthogonalise(w, &q[..(j + 1) * n], &mq[..(j + 1) * n], coefficients);
+        }
+        alpha.push(a);
+        let mut b = m_norm(m, w, mw);
+        beta.push(b);
+        steps += 1;
+        if steps >= (count + FIRST_CHECK).min(n) && converged(alpha, beta, count, tolerance, d, e, z, order) {
+            break;
+        }
+        if steps == cap {
+            return None;
+        }
+        // An invariant subspace (β ≈ 0): continue from a fresh direction M-orthogonal to the
+        // basis, with a zero coupling in T.
+        if b <= 1e-12 * a.abs() {
+            restarts += 1;
+            for (i, v) in w.iter_mut().enumerate() {
+                *v = pseudo_random((restarts * n + i) as u64 + (1 << 40));
+            }
+            for _ in 0..2 {
+                orthogonalise(w, &q[..steps * n], &mq[..steps * n], coefficients);
+            }
+            beta[j] = 0.0;
+            b = m_norm(m, w, mw);
+        }
+        let (qs, mqs) = (&mut q[steps * n..(steps + 1) * n], &mut mq[steps * n..(steps + 1) * n]);
+        if !scale_into(w, mw, b, qs, mqs) {
+            return None;
+        }
+    }
+    // d, z, order hold the eigen-decomposition of the converged T.
+    let j = steps;
+    // Ritz vectors y_k = Σᵢ qᵢ s_{i,k} into w (count·n), μ into alpha.
+    w.clear();
+    w.resize(count * n, 0.0);
+    alpha.clear();
+    for (k, &col) in order.iter().take(count).enumerate() {
+        let y = &mut w[k * n..(k + 1) * n];
+        for i in 0..j {
+            axpy(z[col * j + i], &q[i * n..(i + 1) * n], y);
+        }
+        // T's eigenvalues carry round-off of size ε·μ₁, large against a small μ_k (a high mode
+        // next to a soft rigid-body-like one). The inverted Rayleigh quotient
+        // μ_k = (My)ᵀ(K + σM)⁻¹(My) / yᵀMy of the converged vector is accurate to μ_k itself.
+        mw.fill(0.0);
+        m.mul_add(1.0, y, mw);
+        e.clear();
+        e.extend_from_slice(mw);
+        factor.solve_in_place(e);
+        alpha.push(dot(mw, e) / dot(y, mw));
+    }
+    Some(Ritz { mu: alpha, vectors: w })
+}
+
+/// Whether the `count` largest Ritz values of T (α, β) have relative inverse residuals
+/// β_last·|s_last,k| / θ_k ≤ `tolerance` (Paige's estimate). Leaves T's eigenvalues in `d`, its
+/// eigenvectors in `z` (column-major) and the eigenvalues' descending order in `order`.
+#[allow(clippy::too_many_arguments)]
+fn converged(
+    alpha: &[f64],
+    beta: &[f64],
+    count: usize,
+    tolerance: f64,
+    d: &mut Vec<f64>,
+    e: &mut Vec<f64>,
+    z: &mut Vec<f64>,
+    order: &mut Vec<usize>,
+) -> bool {
+    let j = alpha.len();
+    d.clear();
+    d.extend_from_slice(alpha);
+    e.clear();
+    e.extend_from_slice(beta);
+    z.clear();
+    z.resize(j * j, 0.0);
+    if !tridiagonal_eigen(d, e, z) {
+        return false;
+    }
+    order.clear();
+    order.extend(0..j);
+    order.sort_by(|&a, &b| d[b].total_cmp(&d[a]));
+    let b = beta[j - 1];
+    order.iter().take(count).all(|&k| d[k] > 0.0 && b * z[k * j + j - 1].abs() <= tolerance * d[k])
+}
+
+/// One classical Gram–Schmidt pass in the M inner product: w −= Σᵢ (wᵀMqᵢ) qᵢ over the basis
+/// `q` (with `mq` = M q). The coefficients are computed first, independently of each other,
+/// then applied; returns the last one (αⱼ on the newest vector).
+fn orthogonalise(w: &mut [f64], q: &[f64], mq: &[f64], coefficients: &mut Vec<f64>) -> f64 {
+    let n = w.len();
+    coefficients.clear();
+    coefficients.extend(mq.chunks_exact(n).map(|v| dot(w, v)));
+    for (&c, v) in coefficients.iter().zip(q.chunks_exact(n)) {
+        axpy(-c, v, w);
+    }
+    coefficients.last().copied().unwrap_or(0.0)
+}
+
+/// ‖w‖_M, leaving M w in `mw`.
+fn m_norm(m: &BandedSymmetric, w: &[f64], mw: &mut [f64]) -> f64 {
+    mw.fill(0.0);
+    m.mul_add(1.0, w, mw);
+    dot(w, mw).max(0.0).sqrt()
+}
+
+/// q = w/norm and Mq = Mw/norm; false for a zero or non-finite norm.
+fn scale_into(w: &[f64], mw: &[f64], norm: f64, q: &mut [f64], mq: &mut [f64]) -> bool {
+    if !(norm > 0.0 && norm.is_finite()) {
+        return false;
+    }
+    for (((qv, mqv), &wv), &mwv) in q.iter_mut().zip(mq.iter_mut()).zip(w).zip(mw) {
+        *qv = wv / norm;
+        *mqv = mwv / norm;
+    }
+    true
+}
+
+/// aᵀb with four partial sums: a single running sum is a chain of dependent additions.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (ac, bc) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ac.remainder().iter().zip(bc.remainder()).map(|(x, y)| x * y).sum();
+    for (x, y) in ac.zip(bc) {
+        for k in 0..4 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
+fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (yv, &xv) in y.iter_mut().zip(x) {
+        *yv += alpha * xv;
+    }
+}
