@@ -4,12 +4,7 @@ use crate::error::{input, CliError};
 use clap::Args;
 use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
 use eigenfit_rotor::{presets, Rotor, RotorError};
-use std::cell::Cell;
 use std::path::PathBuf;
-
-/// Largest model (DOFs) that `--solver auto` gives to the dense solver; larger ones go to the
-/// banded solver.
-pub const AUTO_DENSE_MAX_DOFS: usize = 400;
 
 /// Largest model (DOFs) a dense backend (`dense`, `lapack`) accepts: its two n×n matrices take
 /// 16n² bytes (256 MB here) and its solve O(n³) time.
@@ -27,21 +22,17 @@ pub struct ModelArgs {
     /// Shaft elements of the uniform-rotor preset (4 … 100000; default 100).
     #[arg(long, value_name = "N", requires = "preset")]
     pub elements: Option<usize>,
-    /// Eigen-solver backend: auto (default: dense up to 400 DOFs, banded beyond), dense, banded
-    /// (shift-invert subspace iteration by band, for large models) or lapack (when built with the
+    /// Eigen-solver backend: auto (default: banded), banded (shift-invert Lanczos on a band
+    /// factor, the fastest at every size), dense (the reference) or lapack (when built with the
     /// `lapack` feature).
     #[arg(long, default_value = "auto", value_name = "NAME")]
     pub solver: String,
-    /// DOFs of the model last loaded, for `--solver auto`.
-    #[arg(skip)]
-    loaded_dofs: Cell<Option<usize>>,
 }
 
 impl ModelArgs {
     /// Loads the model and a label for reports.
     pub fn load(&self) -> Result<(Rotor, String), CliError> {
         let (rotor, label) = self.load_model()?;
-        self.loaded_dofs.set(Some(rotor.dofs()));
         let dense = matches!(self.solver.as_str(), "dense" | "lapack");
         if dense && rotor.dofs() > DENSE_MAX_DOFS {
             return Err(input(format!(
@@ -86,15 +77,11 @@ impl ModelArgs {
         Ok((rotor, name.to_string()))
     }
 
-    /// The chosen eigen-solver (`auto` decides by the size of the model last [`load`](Self::load)ed).
+    /// The chosen eigen-solver.
     pub fn solver(&self) -> Result<Box<dyn EigenSolver>, CliError> {
         match self.solver.as_str() {
-            "auto" => match self.loaded_dofs.get() {
-                Some(n) if n > AUTO_DENSE_MAX_DOFS => Ok(Box::new(BandedSolver::default())),
-                _ => Ok(Box::new(DenseSolver)),
-            },
+            "auto" | "banded" => Ok(Box::new(BandedSolver::default())),
             "dense" => Ok(Box::new(DenseSolver)),
-            "banded" => Ok(Box::new(BandedSolver::default())),
             #[cfg(feature = "lapack")]
             "lapack" => Ok(Box::new(eigenfit_lapack::LapackSolver::default())),
             #[cfg(not(feature = "lapack"))]

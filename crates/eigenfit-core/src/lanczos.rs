@@ -38,10 +38,13 @@ pub(crate) struct Ritz<'a> {
     pub vectors: &'a [f64],
 }
 
-const PASSES: usize = 1;
+const SINGLE_PASS_STEPS: usize = 8;
 /// Steps beyond `count` before the first convergence check: each check is a QL decomposition of
-/// T, dearer than a step on small models, and fewer steps never suffice for the tolerance.
-const FIRST_CHECK: usize = 5;
+/// T, dearer than a step on small models, and on beam models each step gains about two decades,
+/// so fewer steps rarely reach the tolerance.
+fn first_check(count: usize, tolerance: f64) -> usize {
+    count + ((-tolerance.log10() / 2.0).ceil() as usize).clamp(2, 6)
+}
 /// Steps allowed before giving up on `count` modes of an n-DOF system.
 fn step_limit(n: usize, count: usize) -> usize {
     n.min(4 * count + 40)
@@ -88,14 +91,19 @@ pub(crate) fn largest<'a>(
         // Full reorthogonalisation, classical Gram–Schmidt twice ("twice is enough"); the
         // coefficient on qⱼ is αⱼ, those on q_{j−1} … q₀ are β_{j−1} and round-off.
         let mut a = 0.0;
-        for _ in 0..PASSES {
+        // One pass keeps the short runs of small models orthogonal to round-off; longer runs
+        // ("twice is enough", Kahan–Parlett) need the second.
+        let passes = if j < SINGLE_PASS_STEPS { 1 } else { 2 };
+        for _ in 0..passes {
             a += orthogonalise(w, &q[..(j + 1) * n], &mq[..(j + 1) * n], coefficients);
         }
         alpha.push(a);
         let mut b = m_norm(m, w, mw);
         beta.push(b);
         steps += 1;
-        if steps >= (count + FIRST_CHECK).min(n) && converged(alpha, beta, count, tolerance, d, e, z, order) {
+        if steps >= first_check(count, tolerance).min(n)
+            && converged(alpha, beta, count, tolerance, d, e, z, order)
+        {
             break;
         }
         if steps == cap {
@@ -171,7 +179,10 @@ fn converged(
     order.extend(0..j);
     order.sort_by(|&a, &b| d[b].total_cmp(&d[a]));
     let b = beta[j - 1];
-    order.iter().take(count).all(|&k| d[k] > 0.0 && b * z[k * j + j - 1].abs() <= tolerance * d[k])
+    // Round-off floor: a Ritz value far below the largest carries error ε·θ_max, which no number
+    // of steps removes (the same limit as the dense solver's inverted reduction).
+    let floor = 64.0 * f64::EPSILON * d[order[0]];
+    order.iter().take(count).all(|&k| d[k] > 0.0 && b * z[k * j + j - 1].abs() <= tolerance * d[k] + floor)
 }
 
 /// One classical Gram–Schmidt pass in the M inner product: w −= Σᵢ (wᵀMqᵢ) qᵢ over the basis

@@ -187,7 +187,7 @@ mod tests {
         for i in 0..3 {
             a[i * 3 + i] = d[i];
         }
-        let c = 1e-3 * (d[0] * d[1] as f64).sqrt();
+        let c = 1e-3 * (d[0] * d[1]).sqrt();
         a[1] = c;
         a[3] = c;
         let mut v = vec![0.0; 9];
