@@ -182,7 +182,7 @@ mod tests {
     #[test]
     fn graded_matrix_keeps_small_eigenvalues_relatively_accurate() {
         // diag(1, 1e-10, 1e-20) rotated slightly: the smallest eigenvalue to ~ε relative.
-        let d = [1.0, 1e-10, 1e-20];
+        let d: [f64; 3] = [1.0, 1e-10, 1e-20];
         let mut a = vec![0.0; 9];
         for i in 0..3 {
             a[i * 3 + i] = d[i];
