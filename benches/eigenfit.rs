@@ -8,8 +8,8 @@ use eigenfit::discovery::{discover, DiscoveryOptions};
 use eigenfit::rotor::presets::{paper_rotor, uniform_rotor};
 use eigenfit::rotor::Rotor;
 use eigenfit::{
-    BandedSolver, BandedSymmetric, DenseSolver, Driver, EigenSolver, MeasuredMode, Measurement, Problem,
-    Sensitivities, StrategyKind, StructuralModel, System,
+    BandedSolver, BandedSymmetric, Damped, DenseSolver, Driver, EigenSolver, MeasuredMode, Measurement,
+    Problem, Sensitivities, StrategyKind, StructuralModel, System,
 };
 use std::hint::black_box;
 use std::time::Duration;
@@ -67,6 +67,12 @@ fn sensitivities(c: &mut Criterion) {
     let mut g = c.benchmark_group("sensitivities");
     g.sample_size(20).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
     let paper = paper_rotor();
+    // The small-model target: the paper rotor's lowest modes and their sensitivities.
+    for (name, p) in [("1e5", [1e5, 1e5]), ("1e8", [1e8, 1e8])] {
+        g.bench_function(format!("paper_rotor_2_modes_banded_{name}"), |b| {
+            b.iter(|| Sensitivities::compute(&paper, &BandedSolver::default(), black_box(&p), 2).unwrap())
+        });
+    }
     g.bench_function("paper_rotor_2_modes_dense", |b| {
         b.iter(|| Sensitivities::compute(&paper, &DenseSolver, black_box(&[1e5, 1e5]), 2).unwrap())
     });
@@ -81,17 +87,18 @@ fn sensitivities(c: &mut Criterion) {
     g.finish();
 }
 
-/// Table 3 case 1: exact reference data at K1 = K2 = 1e5 N/m, start at 1e2 N/m.
-fn paper_problem() -> Problem<Rotor, DenseSolver> {
+/// Table 3 case 1: exact reference data at K1 = K2 = 1e5 N/m, start at 1e2 N/m, solved by
+/// `solver` (the CLI's default is banded).
+fn paper_problem<S: EigenSolver>(solver: S) -> Problem<Rotor, S> {
     let rotor = paper_rotor();
     let f = DenseSolver.lowest(&rotor.assemble(&[1e5, 1e5]).unwrap(), 2).unwrap().frequencies_hz();
-    Problem::new(rotor, DenseSolver, Measurement::from_frequencies(&f).unwrap())
+    Problem::new(rotor, solver, Measurement::from_frequencies(&f).unwrap())
 }
 
 fn estimation(c: &mut Criterion) {
     let mut g = c.benchmark_group("estimate_table3_case1");
     g.sample_size(20).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
-    let problem = paper_problem();
+    let problem = paper_problem(BandedSolver::default());
     for kind in StrategyKind::ALL {
         g.bench_function(kind.name(), |b| {
             b.iter(|| {
@@ -100,6 +107,20 @@ fn estimation(c: &mut Criterion) {
             })
         });
     }
+    // The local Levenberg–Marquardt alone, without the coarse-grid start and restarts.
+    g.bench_function("damped_local", |b| {
+        b.iter(|| {
+            let mut s = Damped::default().with_max_restarts(0);
+            Driver::default().run(&problem, &mut s, black_box(&[1e2, 1e2]), &mut []).unwrap()
+        })
+    });
+    let dense = paper_problem(DenseSolver);
+    g.bench_function("damped_dense_solver", |b| {
+        b.iter(|| {
+            let mut s = Damped::default();
+            Driver::default().run(&dense, &mut s, black_box(&[1e2, 1e2]), &mut []).unwrap()
+        })
+    });
     g.bench_function("linearise", |b| b.iter(|| problem.linearise(black_box(&[1e3, 2e4])).unwrap()));
     // Residual only (eigenvalues, no shapes or sensitivities): what `damped` ranks its seeds by.
     g.bench_function("cost", |b| b.iter(|| problem.cost(black_box(&[1e3, 2e4])).unwrap()));
@@ -114,16 +135,14 @@ fn compare_grid(c: &mut Criterion) {
     let initials = tensor_grid(&log_space(1e1, 1e9, 5), 2);
     let strategies = StrategyKind::ALL;
     let settings = CompareSettings { modes: 2, decimals: None, std_hz: None, max_iterations: 1000 };
+    let solver = BandedSolver::default();
     let runs = targets.len() * initials.len() * strategies.len();
     g.bench_function(format!("{runs}_runs_parallel"), |b| {
-        b.iter(|| {
-            run_grid(&rotor, &DenseSolver, &targets, &initials, &strategies, &settings, |_| {}).unwrap()
-        })
+        b.iter(|| run_grid(&rotor, &solver, &targets, &initials, &strategies, &settings, |_| {}).unwrap())
     });
     g.bench_function(format!("{runs}_runs_serial"), |b| {
         b.iter(|| {
-            run_grid_serial(&rotor, &DenseSolver, &targets, &initials, &strategies, &settings, |_| {})
-                .unwrap()
+            run_grid_serial(&rotor, &solver, &targets, &initials, &strategies, &settings, |_| {}).unwrap()
         })
     });
     g.finish();
@@ -155,7 +174,7 @@ fn discovery(c: &mut Criterion) {
         b.iter(|| {
             discover(
                 &rotor,
-                &DenseSolver,
+                &BandedSolver::default(),
                 black_box(&data),
                 &candidates,
                 &rotor.nominal_stiffnesses(),
