@@ -73,6 +73,11 @@ fn sensitivities(c: &mut Criterion) {
             b.iter(|| Sensitivities::compute(&paper, &BandedSolver::default(), black_box(&p), 2).unwrap())
         });
     }
+    // The speed/accuracy trade: shapes to 1e-10 instead of 1e-12 (sensitivities to ~1e-9).
+    let looser = BandedSolver { tolerance: 1e-10, ..BandedSolver::default() };
+    g.bench_function("paper_rotor_2_modes_banded_1e5_tolerance_1e-10", |b| {
+        b.iter(|| Sensitivities::compute(&paper, &looser, black_box(&[1e5, 1e5]), 2).unwrap())
+    });
     g.bench_function("paper_rotor_2_modes_dense", |b| {
         b.iter(|| Sensitivities::compute(&paper, &DenseSolver, black_box(&[1e5, 1e5]), 2).unwrap())
     });

@@ -62,12 +62,10 @@ pub(crate) fn largest<'a>(
     let n = m.dim();
     let cap = step_limit(n, count);
     let LanczosWork { q, mq, w, mw, alpha, beta, d, e, z, order, coefficients } = work;
-    // Every entry is written before it is read: grow, never clear.
-    for v in [&mut *q, &mut *mq] {
-        if v.len() < n * (cap + 1) {
-            v.resize(n * (cap + 1), 0.0);
-        }
-    }
+    // Every entry is written before it is read: the basis grows with the steps taken (not to the
+    // step limit: 10⁵ DOFs × 85 vectors would be 136 MB) and is never cleared.
+    grow(q, n);
+    grow(mq, n);
     for v in [&mut *w, &mut *mw] {
         v.clear();
         v.resize(n, 0.0);
@@ -122,6 +120,8 @@ pub(crate) fn largest<'a>(
             beta[j] = 0.0;
             b = m_norm(m, w, mw);
         }
+        grow(q, (steps + 1) * n);
+        grow(mq, (steps + 1) * n);
         let (qs, mqs) = (&mut q[steps * n..(steps + 1) * n], &mut mq[steps * n..(steps + 1) * n]);
         if !scale_into(w, mw, b, qs, mqs) {
             return None;
@@ -196,6 +196,13 @@ fn orthogonalise(w: &mut [f64], q: &[f64], mq: &[f64], coefficients: &mut Vec<f6
         axpy(-c, v, w);
     }
     coefficients.last().copied().unwrap_or(0.0)
+}
+
+/// Makes `v` at least `len` long (amortised growth; contents beyond the old length are zero).
+fn grow(v: &mut Vec<f64>, len: usize) {
+    if v.len() < len {
+        v.resize(len, 0.0);
+    }
 }
 
 /// ‖w‖_M, leaving M w in `mw`.
