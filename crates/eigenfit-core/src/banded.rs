@@ -394,12 +394,12 @@ impl BandCholesky {
         let w = b + 1;
         self.inverse_diagonal.clear();
         for col in self.data.chunks_exact_mut(w) {
-            let ljj = col[0];
+            let inv = 1.0 / col[0];
             for v in &mut col[1..] {
-                *v /= ljj;
+                *v *= inv;
             }
-            col[0] = ljj * ljj;
-            self.inverse_diagonal.push(1.0 / col[0]);
+            col[0] *= col[0];
+            self.inverse_diagonal.push(inv * inv);
         }
         true
     }

@@ -9,7 +9,7 @@
 //! check catches that and falls back to block subspace iteration.
 
 use crate::banded::{BandCholesky, BandedSymmetric};
-use crate::small_eigen::tridiagonal_eigen;
+use crate::small_eigen::{tridiagonal_eigen, tridiagonal_top};
 use crate::subspace::pseudo_random;
 
 /// Reusable work arrays of Lanczos runs (grown on demand, never shrunk).
@@ -23,11 +23,9 @@ pub(crate) struct LanczosWork {
     mw: Vec<f64>,
     alpha: Vec<f64>,
     beta: Vec<f64>,
-    d: Vec<f64>,
-    e: Vec<f64>,
-    z: Vec<f64>,
-    order: Vec<usize>,
+    ritz: RitzWork,
     coefficients: Vec<f64>,
+    start: Vec<f64>,
 }
 
 /// Converged Lanczos modes, in the solver's workspace until copied out.
@@ -39,6 +37,9 @@ pub(crate) struct Ritz<'a> {
 }
 
 const SINGLE_PASS_STEPS: usize = 8;
+/// μ₁/μ_k above which a Ritz value is recomputed as a Rayleigh quotient: below it, T's round-off
+/// (a few ε·μ₁) stays under ~1e-13 of θ_k.
+const REFINE_SPREAD: f64 = 100.0;
 /// Steps beyond `count` before the first convergence check: each check is a QL decomposition of
 /// T, dearer than a step on small models, and on beam models each step gains about two decades,
 /// so fewer steps rarely reach the tolerance.
@@ -61,20 +62,22 @@ pub(crate) fn largest<'a>(
 ) -> Option<Ritz<'a>> {
     let n = m.dim();
     let cap = step_limit(n, count);
-    let LanczosWork { q, mq, w, mw, alpha, beta, d, e, z, order, coefficients } = work;
+    let LanczosWork { q, mq, w, mw, alpha, beta, ritz, coefficients, start } = work;
     // Every entry is written before it is read: the basis grows with the steps taken (not to the
     // step limit: 10⁵ DOFs × 85 vectors would be 136 MB) and is never cleared.
     grow(q, n);
     grow(mq, n);
-    for v in [&mut *w, &mut *mw] {
-        v.clear();
-        v.resize(n, 0.0);
+    // The pseudo-random start vector, generated once per size.
+    if start.len() != n {
+        start.clear();
+        start.extend((0..n).map(|i| pseudo_random(i as u64)));
     }
+    w.clear();
+    w.extend_from_slice(start);
+    mw.clear();
+    mw.resize(n, 0.0);
     alpha.clear();
     beta.clear();
-    for (i, v) in w.iter_mut().enumerate() {
-        *v = pseudo_random(i as u64);
-    }
     let mut restarts = 0;
     let norm = m_norm(m, w, mw);
     if !scale_into(w, mw, norm, &mut q[..n], &mut mq[..n]) {
@@ -99,9 +102,7 @@ pub(crate) fn largest<'a>(
         let mut b = m_norm(m, w, mw);
         beta.push(b);
         steps += 1;
-        if steps >= first_check(count, tolerance).min(n)
-            && converged(alpha, beta, count, tolerance, d, e, z, order)
-        {
+        if steps >= first_check(count, tolerance).min(n) && converged(alpha, beta, count, tolerance, ritz) {
             break;
         }
         if steps == cap {
@@ -127,62 +128,97 @@ pub(crate) fn largest<'a>(
             return None;
         }
     }
-    // d, z, order hold the eigen-decomposition of the converged T.
+    // `ritz` holds the converged pairs of T.
     let j = steps;
     // Ritz vectors y_k = Σᵢ qᵢ s_{i,k} into w (count·n), μ into alpha.
     w.clear();
     w.resize(count * n, 0.0);
     alpha.clear();
-    for (k, &col) in order.iter().take(count).enumerate() {
+    for k in 0..count {
         let y = &mut w[k * n..(k + 1) * n];
         for i in 0..j {
-            axpy(z[col * j + i], &q[i * n..(i + 1) * n], y);
+            axpy(ritz.vectors[k * j + i], &q[i * n..(i + 1) * n], y);
         }
         // T's eigenvalues carry round-off of size ε·μ₁, large against a small μ_k (a high mode
         // next to a soft rigid-body-like one). The inverted Rayleigh quotient
-        // μ_k = (My)ᵀ(K + σM)⁻¹(My) / yᵀMy of the converged vector is accurate to μ_k itself.
+        // μ_k = (My)ᵀ(K + σM)⁻¹(My) / yᵀMy of the converged vector is accurate to μ_k itself;
+        // it costs a solve, so it is taken only where T's value could be off by more than 1e-14.
+        let theta = ritz.values[k];
+        if ritz.values[0] <= REFINE_SPREAD * theta {
+            alpha.push(theta);
+            continue;
+        }
         mw.fill(0.0);
         m.mul_add(1.0, y, mw);
-        e.clear();
-        e.extend_from_slice(mw);
-        factor.solve_in_place(e);
-        alpha.push(dot(mw, e) / dot(y, mw));
+        let z = &mut ritz.scratch;
+        z.clear();
+        z.extend_from_slice(mw);
+        factor.solve_in_place(z);
+        alpha.push(dot(mw, z) / dot(y, mw));
     }
     Some(Ritz { mu: alpha, vectors: w })
 }
 
 /// Whether the `count` largest Ritz values of T (α, β) have relative inverse residuals
-/// β_last·|s_last,k| / θ_k ≤ `tolerance` (Paige's estimate). Leaves T's eigenvalues in `d`, its
-/// eigenvectors in `z` (column-major) and the eigenvalues' descending order in `order`.
-#[allow(clippy::too_many_arguments)]
-fn converged(
-    alpha: &[f64],
-    beta: &[f64],
-    count: usize,
-    tolerance: f64,
-    d: &mut Vec<f64>,
-    e: &mut Vec<f64>,
-    z: &mut Vec<f64>,
-    order: &mut Vec<usize>,
-) -> bool {
+/// β_last·|s_last,k| / θ_k ≤ `tolerance` (Paige's estimate). Leaves the pairs in `ritz`.
+fn converged(alpha: &[f64], beta: &[f64], count: usize, tolerance: f64, ritz: &mut RitzWork) -> bool {
     let j = alpha.len();
-    d.clear();
-    d.extend_from_slice(alpha);
-    e.clear();
-    e.extend_from_slice(beta);
-    z.clear();
-    z.resize(j * j, 0.0);
-    if !tridiagonal_eigen(d, e, z) {
+    if !ritz.top_pairs(alpha, beta, count) {
         return false;
     }
-    order.clear();
-    order.extend(0..j);
-    order.sort_by(|&a, &b| d[b].total_cmp(&d[a]));
     let b = beta[j - 1];
     // Round-off floor: a Ritz value far below the largest carries error ε·θ_max, which no number
     // of steps removes (the same limit as the dense solver's inverted reduction).
-    let floor = 64.0 * f64::EPSILON * d[order[0]];
-    order.iter().take(count).all(|&k| d[k] > 0.0 && b * z[k * j + j - 1].abs() <= tolerance * d[k] + floor)
+    let floor = 64.0 * f64::EPSILON * ritz.values[0];
+    (0..count).all(|k| {
+        let theta = ritz.values[k];
+        theta > 0.0 && b * ritz.vectors[k * j + j - 1].abs() <= tolerance * theta + floor
+    })
+}
+
+/// The largest Ritz pairs of the Lanczos matrix T and the work arrays that find them.
+#[derive(Debug, Default)]
+struct RitzWork {
+    /// θ, descending.
+    values: Vec<f64>,
+    /// Unit eigenvectors of T, one per value, each contiguous.
+    vectors: Vec<f64>,
+    d: Vec<f64>,
+    e: Vec<f64>,
+    z: Vec<f64>,
+    order: Vec<usize>,
+    scratch: Vec<f64>,
+}
+
+impl RitzWork {
+    /// The `count` largest eigenpairs of T = tridiag(α, β) (β's last entry, the coupling to the
+    /// next step, is not part of T): by certified Rayleigh quotient iteration, else by QL.
+    fn top_pairs(&mut self, alpha: &[f64], beta: &[f64], count: usize) -> bool {
+        if tridiagonal_top(alpha, beta, count, &mut self.values, &mut self.vectors, &mut self.scratch) {
+            return true;
+        }
+        let j = alpha.len();
+        let RitzWork { values, vectors, d, e, z, order, .. } = self;
+        d.clear();
+        d.extend_from_slice(alpha);
+        e.clear();
+        e.extend_from_slice(beta);
+        z.clear();
+        z.resize(j * j, 0.0);
+        if !tridiagonal_eigen(d, e, z) {
+            return false;
+        }
+        order.clear();
+        order.extend(0..j);
+        order.sort_by(|&a, &b| d[b].total_cmp(&d[a]));
+        values.clear();
+        vectors.clear();
+        for &col in order.iter().take(count) {
+            values.push(d[col]);
+            vectors.extend_from_slice(&z[col * j..(col + 1) * j]);
+        }
+        true
+    }
 }
 
 /// One classical Gram–Schmidt pass in the M inner product: w −= Σᵢ (wᵀMqᵢ) qᵢ over the basis
