@@ -176,6 +176,9 @@ fn converged(alpha: &[f64], beta: &[f64], count: usize, tolerance: f64, ritz: &m
     })
 }
 
+/// Most Ritz pairs sought by Rayleigh quotient iteration before QL takes over.
+const MAX_RQI_PAIRS: usize = 4;
+
 /// The largest Ritz pairs of the Lanczos matrix T and the work arrays that find them.
 #[derive(Debug, Default)]
 struct RitzWork {
@@ -194,7 +197,11 @@ impl RitzWork {
     /// The `count` largest eigenpairs of T = tridiag(α, β) (β's last entry, the coupling to the
     /// next step, is not part of T): by certified Rayleigh quotient iteration, else by QL.
     fn top_pairs(&mut self, alpha: &[f64], beta: &[f64], count: usize) -> bool {
-        if tridiagonal_top(alpha, beta, count, &mut self.values, &mut self.vectors, &mut self.scratch) {
+        // A few pairs: RQI is cheaper than QL. For many, deflated power starts get poor (the
+        // ratios θ_{k+1}/θ_k approach 1) and QL, needed anyway, is cheaper than a failed attempt.
+        if count <= MAX_RQI_PAIRS
+            && tridiagonal_top(alpha, beta, count, &mut self.values, &mut self.vectors, &mut self.scratch)
+        {
             return true;
         }
         let j = alpha.len();
