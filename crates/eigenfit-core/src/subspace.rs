@@ -211,6 +211,15 @@ impl BandedSolver {
     }
 }
 
+/// The iteration behind a solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Method {
+    /// Lanczos, falling back to subspace iteration when it does not converge.
+    Lanczos,
+    /// Block subspace iteration.
+    Subspace,
+}
+
 /// Largest system the banded solver hands to the dense one when its Sturm check fails.
 const MAX_DENSE_FALLBACK: usize = 4000;
 
@@ -240,22 +249,43 @@ impl BandedSolver {
             ws.checked_mass = Some(m.clone());
         }
         let p = subspace_size(m.dim(), count);
-        let modes = if ws.factor.factor_shifted(k, 0.0, m) && well_conditioned(&ws.factor) {
-            self.iterate(m, 0.0, count, p, ws)?
-        } else {
-            // Rigid-body modes: as in the dense solver, locate the lowest elastic mode with a tiny
-            // shift, then shift to it for accuracy.
-            let scale = k.diagonal_max() / m.diagonal_max();
-            let sigma0 = 1e-8 * scale.max(f64::MIN_POSITIVE);
-            let first = self.shifted(k, m, sigma0, count, p, ws)?;
-            match first.eigenvalues.iter().find(|&&l| l > 1e-3 * sigma0) {
-                Some(&sigma1) if sigma1 > 10.0 * sigma0 => self.shifted(k, m, sigma1, count, p, ws)?,
-                _ => first,
-            }
+        let modes = self.modes(k, m, count, p, Method::Lanczos, ws)?;
+        if let Some(next) = sturm_bound(k, m, &modes, &mut ws.scratch) {
+            return Ok(Some((modes, next)));
+        }
+        // Lanczos missed a mode (one start vector sees a repeated eigenvalue once): a block of p
+        // vectors sees multiplicities up to p − m. Its failure, too, ends in `None`.
+        let Ok(modes) = self.modes(k, m, count, p, Method::Subspace, ws) else {
+            return Ok(None);
         };
         Ok(sturm_bound(k, m, &modes, &mut ws.scratch).map(|next| (modes, next)))
     }
 
+    /// The lowest `count` modes by `method`, with the dense solver's shift strategy.
+    fn modes(
+        &self,
+        k: &BandedSymmetric,
+        m: &BandedSymmetric,
+        count: usize,
+        p: usize,
+        method: Method,
+        ws: &mut Workspace,
+    ) -> Result<Modes, SolveError> {
+        if ws.factor.factor_shifted(k, 0.0, m) && well_conditioned(&ws.factor) {
+            return self.iterate(m, 0.0, count, p, method, ws);
+        }
+        // Rigid-body modes: as in the dense solver, locate the lowest elastic mode with a tiny
+        // shift, then shift to it for accuracy.
+        let scale = k.diagonal_max() / m.diagonal_max();
+        let sigma0 = 1e-8 * scale.max(f64::MIN_POSITIVE);
+        let first = self.shifted(k, m, sigma0, count, p, method, ws)?;
+        match first.eigenvalues.iter().find(|&&l| l > 1e-3 * sigma0) {
+            Some(&sigma1) if sigma1 > 10.0 * sigma0 => self.shifted(k, m, sigma1, count, p, method, ws),
+            _ => Ok(first),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
     fn shifted(
         &self,
         k: &BandedSymmetric,
@@ -263,25 +293,31 @@ impl BandedSolver {
         sigma: f64,
         count: usize,
         p: usize,
+        method: Method,
         ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
         if !ws.factor.factor_shifted(k, sigma, m) {
             return Err(backend("K + σM is not positive definite: K has negative stiffness"));
         }
-        self.iterate(m, sigma, count, p, ws)
+        self.iterate(m, sigma, count, p, method, ws)
     }
 
-    /// The lowest modes from the factor of K + σM held in the workspace: Lanczos first, block
-    /// subspace iteration when Lanczos does not converge in its step limit or misses a mode.
+    /// The lowest modes from the factor of K + σM held in the workspace: by Lanczos unless told
+    /// otherwise, by block subspace iteration when Lanczos does not converge in its step limit.
     fn iterate(
         &self,
         m: &BandedSymmetric,
         sigma: f64,
         count: usize,
         p: usize,
+        method: Method,
         ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
-        if let Some(ritz) = lanczos::largest(&ws.factor, m, count, self.tolerance, &mut ws.lanczos) {
+        let lanczos = match method {
+            Method::Lanczos => lanczos::largest(&ws.factor, m, count, self.tolerance, &mut ws.lanczos),
+            Method::Subspace => None,
+        };
+        if let Some(ritz) = lanczos {
             let n = m.dim();
             let eigenvalues = DVector::from_iterator(count, ritz.mu.iter().map(|&mu| 1.0 / mu - sigma));
             let shapes = DMatrix::from_column_slice(n, count, ritz.vectors);

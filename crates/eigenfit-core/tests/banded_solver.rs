@@ -84,37 +84,50 @@ proptest! {
 
 /// Two identical chains with interleaved DOFs: every eigenvalue is double. One Lanczos vector
 /// sees each eigenvalue once; the Sturm count notices, and block subspace iteration finds both.
+/// 4,100 DOFs, beyond the dense fallback (4,000), so the subspace iteration must do it; the
+/// chain's eigenvalues are known in closed form.
 #[test]
 fn repeated_eigenvalues_are_found_twice() {
-    let n = 60;
+    // Each chain: N unit masses, unit springs, the first grounded, the last free:
+    // λ_k = 4 sin²((2k − 1)π / (2(2N + 1))), k = 1 … N.
+    let chain = 2050;
+    let n = 2 * chain;
     let mut k = BandedSymmetric::zeros(n, 2);
     let mut m = BandedSymmetric::zeros(n, 0);
     for copy in 0..2 {
-        for i in (copy..n).step_by(2) {
-            m.add(i, i, 1.0 + 0.01 * (i / 2) as f64);
-            k.add(i, i, if i < 2 { 3.0 } else { 2.0 });
-            if i + 2 < n {
-                k.add(i + 2, i, -1.0);
-                k.add(i + 2, i + 2, 0.0);
+        for i in 0..chain {
+            let dof = 2 * i + copy;
+            m.add(dof, dof, 1.0);
+            k.add(dof, dof, if i + 1 < chain { 2.0 } else { 1.0 });
+            if i + 1 < chain {
+                k.add(dof + 2, dof, -1.0);
             }
         }
     }
     let system = System::banded(k, m).unwrap();
-    let dense = DenseSolver.lowest(&system, 6).unwrap();
-    let banded = BandedSolver::default().lowest(&system, 6).unwrap();
+    let (banded, next) = BandedSolver::default().lowest_with_next(&system, 6).unwrap();
+    let exact = |k: usize| {
+        let x = (2 * k - 1) as f64 * std::f64::consts::PI / (2.0 * (2 * chain + 1) as f64);
+        4.0 * x.sin().powi(2)
+    };
     for i in 0..6 {
-        let (a, b) = (banded.eigenvalues[i], dense.eigenvalues[i]);
-        assert!((a / b - 1.0).abs() < 1e-9, "λ{i}: {a} vs {b}");
+        let want = exact(i / 2 + 1);
+        assert!(
+            (banded.eigenvalues[i] / want - 1.0).abs() < 1e-9,
+            "λ{i}: {} vs {want}",
+            banded.eigenvalues[i]
+        );
     }
-    assert!((banded.eigenvalues[0] / banded.eigenvalues[1] - 1.0).abs() < 1e-12, "a double eigenvalue");
-    // Shapes of a double eigenvalue are any basis of its plane: check the identities instead.
+    assert!(next > banded.eigenvalues[5] && next <= exact(4));
+    // Shapes of a double eigenvalue are any basis of its plane: check ΦᵀMΦ = I instead (by band:
+    // a dense M of this size would take 134 MB).
     let phi = &banded.shapes;
-    let mtm = phi.transpose() * system.mass() * phi;
-    assert!((mtm - nalgebra::DMatrix::identity(6, 6)).amax() < 1e-9);
-    let ktm = phi.transpose() * system.stiffness() * phi;
-    assert!(
-        (ktm - nalgebra::DMatrix::from_diagonal(&banded.eigenvalues)).amax() < 1e-9 * banded.eigenvalues[5]
-    );
+    let mass = system.band().unwrap().1;
+    let mut m_phi = nalgebra::DMatrix::zeros(n, 6);
+    for (c, mut out) in phi.column_iter().zip(m_phi.column_iter_mut()) {
+        mass.mul_add(1.0, c.as_slice(), out.as_mut_slice());
+    }
+    assert!((phi.transpose() * m_phi - nalgebra::DMatrix::identity(6, 6)).amax() < 1e-9);
 }
 
 /// A free–free chain: K is singular (a rigid-body mode), the solver shifts as the dense one does.
