@@ -37,8 +37,9 @@ pub trait EigenSolver: Send + Sync {
     /// The lowest `count` modes.
     fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError>;
 
-    /// The lowest `count` eigenvalues only, as [`lowest`](Self::lowest) computes them; backends
-    /// may skip the shapes (used to rank many candidate points by cost).
+    /// The lowest `count` eigenvalues only, as [`lowest`](Self::lowest) computes them to round-off;
+    /// backends may skip the shapes, or iterate them less far when the eigenvalues are Rayleigh
+    /// quotients (error: the square of the shapes') — used to rank many candidate points by cost.
     fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
         self.lowest(system, count).map(|m| m.eigenvalues)
     }

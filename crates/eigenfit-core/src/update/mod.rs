@@ -28,7 +28,8 @@ pub trait Evaluate {
     /// Residual and Jacobian at `p`.
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError>;
     /// ½‖r‖² at `p`, `None` where the residual cannot be evaluated: equal to
-    /// `linearise(p)`'s cost; implementations may skip the Jacobian (used to rank many points).
+    /// `linearise(p)`'s cost to round-off; implementations may skip the Jacobian (used to rank
+    /// many points).
     fn cost(&self, p: &[f64]) -> Option<f64> {
         self.linearise(p).ok().map(|l| l.cost())
     }
