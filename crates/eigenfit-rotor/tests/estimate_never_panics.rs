@@ -1,10 +1,11 @@
 //! Property (issue 7): random — often degenerate — rotors and measured data through the whole
 //! estimate path (`Rotor` build → `Measurement` → `Problem` → `Driver` with `Damped`, and the
-//! paper's `Newton` and `PStep`) never panic: every stage returns a result or a typed error,
-//! and every result is finite and within the parameter bounds.
+//! paper's `Newton` and `PStep`, with the dense and the banded solver) never panic: every stage
+//! returns a result or a typed error, and every result is finite and within the parameter bounds.
 
 use eigenfit_core::{
-    DenseSolver, Driver, MeasuredMode, Measurement, Problem, StrategyKind, StructuralModel, Termination,
+    BandedSolver, DenseSolver, Driver, EigenSolver, MeasuredMode, Measurement, Problem, StrategyKind,
+    StructuralModel, Termination,
 };
 use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorBuilder, Section};
 use proptest::prelude::*;
@@ -116,6 +117,7 @@ proptest! {
         (modes, with_std) in data(),
         strategy in prop::sample::select(StrategyKind::ALL.to_vec()),
         start in prop::collection::vec(value(5), 0..4),
+        banded in any::<bool>(),
     ) {
         let Ok(rotor) = build(&s) else { return Ok(()) };
         let measured = modes
@@ -135,7 +137,9 @@ proptest! {
         // The initial guess: random (possibly out of bounds, possibly the wrong length) or nominal.
         let np = rotor.parameters().len();
         let initial = if start.len() == np { start } else { rotor.nominal_stiffnesses() };
-        let problem = Problem::new(&rotor, DenseSolver, measurement);
+        // Both the reference solver and the CLI's default.
+        let solver: Box<dyn EigenSolver> = if banded { Box::new(BandedSolver::default()) } else { Box::new(DenseSolver) };
+        let problem = Problem::new(&rotor, solver.as_ref(), measurement);
         let mut strategy = strategy.build();
         match (Driver { max_iterations: 40 }).run(&problem, strategy.as_mut(), &initial, &mut []) {
             Err(e) => prop_assert!(!e.to_string().is_empty()),
