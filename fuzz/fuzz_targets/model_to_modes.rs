@@ -1,5 +1,5 @@
 //! Fuzz target `model_to_modes`: a rotor description → TOML → parse → build → assemble at the
-//! nominal stiffnesses → `DenseSolver` lowest modes.
+//! nominal stiffnesses → `DenseSolver` and `BandedSolver` lowest modes.
 //!
 //! The input is structured (a random rotor whose numbers are mostly physically plausible and
 //! sometimes raw bit patterns), so that most cases get past validation and exercise the
@@ -12,7 +12,7 @@
 
 #![no_main]
 
-use eigenfit_core::{DenseSolver, EigenSolver, StructuralModel};
+use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
 use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorSpec, Section, ShaftSpec};
 use libfuzzer_sys::arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
@@ -119,16 +119,24 @@ fn run(u: &mut Unstructured) -> Result<()> {
         }
     };
     let count = 1 + count_seed % n;
-    match DenseSolver.lowest(&system, count) {
-        Err(e) => {
-            let _ = e.to_string();
-        }
-        Ok(modes) => {
-            let l = &modes.eigenvalues;
-            assert_eq!(l.len(), count);
-            assert!(l.iter().all(|v| v.is_finite()), "non-finite eigenvalue {l:?}\n{text}");
-            assert!(l.as_slice().windows(2).all(|w| w[0] <= w[1]), "eigenvalues not ascending {l:?}\n{text}");
-            assert!(modes.frequencies_hz().iter().all(|f| f.is_finite()));
+    // The reference solver and the CLI's default.
+    let solvers: [&dyn EigenSolver; 2] = [&DenseSolver, &BandedSolver::default()];
+    for solver in solvers {
+        match solver.lowest(&system, count) {
+            Err(e) => {
+                let _ = e.to_string();
+            }
+            Ok(modes) => {
+                let l = &modes.eigenvalues;
+                assert_eq!(l.len(), count);
+                assert!(l.iter().all(|v| v.is_finite()), "non-finite eigenvalue {l:?}\n{text}");
+                assert!(
+                    l.as_slice().windows(2).all(|w| w[0] <= w[1]),
+                    "{}: eigenvalues not ascending {l:?}\n{text}",
+                    solver.name()
+                );
+                assert!(modes.frequencies_hz().iter().all(|f| f.is_finite()));
+            }
         }
     }
     Ok(())
