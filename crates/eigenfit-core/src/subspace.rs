@@ -211,6 +211,9 @@ impl BandedSolver {
     }
 }
 
+/// Subspace iterations without halving the residual after which the iteration is abandoned.
+const STALL_LIMIT: usize = 60;
+
 /// The iteration behind a solve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Method {
@@ -356,6 +359,13 @@ impl BandedSolver {
                     stalled = 0;
                 } else {
                     stalled += 1;
+                }
+                // No halving of the residual in this many iterations is not slow convergence but
+                // none (an ill-conditioned mesh): fail now rather than after `max_iterations`.
+                if stalled >= STALL_LIMIT {
+                    return Err(backend(format!(
+                        "subspace iteration made no progress in {STALL_LIMIT} iterations (residual {best:.1e})"
+                    )));
                 }
             }
             first = false;
