@@ -5,6 +5,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use eigenfit::compare::{log_space, run_grid, run_grid_serial, tensor_grid, CompareSettings};
 use eigenfit::discovery::{discover, DiscoveryOptions};
+use eigenfit::monte_carlo::{self, StudySettings};
 use eigenfit::rotor::presets::{paper_rotor, uniform_rotor};
 use eigenfit::rotor::Rotor;
 use eigenfit::{
@@ -153,6 +154,29 @@ fn compare_grid(c: &mut Criterion) {
     g.finish();
 }
 
+/// A Monte Carlo study of the paper rotor's intervals: 200 noisy realisations, parallel and serial.
+fn monte_carlo_study(c: &mut Criterion) {
+    let mut g = c.benchmark_group("monte_carlo");
+    g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(3));
+    let rotor = paper_rotor();
+    let settings = StudySettings {
+        trials: 200,
+        seed: 1,
+        modes: 3,
+        relative_std: 1e-3,
+        initial: vec![1e4, 1e6],
+        max_iterations: 200,
+    };
+    let solver = BandedSolver::default();
+    g.bench_function("200_trials_parallel", |b| {
+        b.iter(|| monte_carlo::run(&rotor, &solver, &[1e5, 1e5], &settings))
+    });
+    g.bench_function("200_trials_serial", |b| {
+        b.iter(|| monte_carlo::run_serial(&rotor, &solver, &[1e5, 1e5], &settings))
+    });
+    g.finish();
+}
+
 /// `examples/measured_hidden_effect.csv` (mode,frequency_hz,std_hz; modes counted from 1).
 fn hidden_effect_data() -> Measurement {
     let text = include_str!("../examples/measured_hidden_effect.csv");
@@ -191,5 +215,5 @@ fn discovery(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, eigen_solve, sensitivities, estimation, compare_grid, discovery);
+criterion_group!(benches, eigen_solve, sensitivities, estimation, compare_grid, monte_carlo_study, discovery);
 criterion_main!(benches);

@@ -28,6 +28,7 @@ mod lanczos;
 pub mod measurement;
 pub mod model;
 pub mod modes;
+pub mod monte_carlo;
 pub mod multi;
 pub mod parameters;
 pub mod residual;
