@@ -1,7 +1,7 @@
 //! The default, pure-nalgebra eigen-solver: Cholesky reduction to a standard symmetric problem.
 
 use crate::modes::{apply_sign_rule, Modes};
-use crate::solver::{check_count, EigenSolver, SolveError};
+use crate::solver::{check_count, shifted_twice, EigenSolver, SolveError};
 use crate::system::System;
 use nalgebra::{Cholesky, DMatrix, DVector, SymmetricEigen};
 
@@ -37,16 +37,9 @@ impl EigenSolver for DenseSolver {
         if let Some(chol) = Cholesky::new(k.clone()).filter(well_conditioned) {
             return inverted_solve(&chol, m, 0.0, count);
         }
-        // Rigid-body modes: K is singular. A first pass with a tiny shift σ₀ locates the lowest
-        // elastic mode; the second shifts to it, since a mode's relative error is
-        // ε·(λ + σ)²/(σλ): smallest near σ = λ, and ε·λ/σ above it.
+        // Rigid-body modes: K is singular.
         let scale = k.diagonal().amax() / m.diagonal().amax();
-        let sigma0 = 1e-8 * scale.max(f64::MIN_POSITIVE);
-        let first = shifted(k, m, sigma0, count)?;
-        match first.eigenvalues.iter().find(|&&l| l > 1e-3 * sigma0) {
-            Some(&sigma1) if sigma1 > 10.0 * sigma0 => shifted(k, m, sigma1, count),
-            _ => Ok(first),
-        }
+        shifted_twice(scale, |sigma| shifted(k, m, sigma, count))
     }
 
     fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {

@@ -91,11 +91,14 @@ pub(crate) fn largest<'a>(
         factor.solve_in_place(w);
         // Full reorthogonalisation, classical Gram–Schmidt twice ("twice is enough"); the
         // coefficient on qⱼ is αⱼ, those on q_{j−1} … q₀ are β_{j−1} and round-off.
-        let mut a = 0.0;
-        // One pass keeps the short runs of small models orthogonal to round-off; longer runs
-        // ("twice is enough", Kahan–Parlett) need the second.
-        let passes = if j < SINGLE_PASS_STEPS { 1 } else { 2 };
-        for _ in 0..passes {
+        // One pass keeps the short runs of small models orthogonal to round-off. A second
+        // ("twice is enough", Kahan–Parlett) for longer runs, and whenever the first cancelled
+        // more than three digits of w (a DGKS test, looser than the usual 1/√2 because a
+        // converging Lanczos step always cancels much): the rest would be round-off along the
+        // basis, as in the last steps of a run through the whole space.
+        let before = dot(w, w);
+        let mut a = orthogonalise(w, &q[..(j + 1) * n], &mq[..(j + 1) * n], coefficients);
+        if j >= SINGLE_PASS_STEPS || dot(w, w) < 1e-6 * before {
             a += orthogonalise(w, &q[..(j + 1) * n], &mq[..(j + 1) * n], coefficients);
         }
         alpha.push(a);

@@ -7,7 +7,7 @@ use crate::dense::DenseSolver;
 use crate::lanczos::{self, LanczosWork};
 use crate::modes::{apply_sign_rule, Modes};
 use crate::small_eigen::symmetric_eigen;
-use crate::solver::{check_count, EigenSolver, SolveError};
+use crate::solver::{check_count, shifted_twice, EigenSolver, SolveError};
 use crate::system::System;
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
@@ -277,15 +277,9 @@ impl BandedSolver {
         if ws.factor.factor_shifted(k, 0.0, m) && well_conditioned(&ws.factor) {
             return self.iterate(m, 0.0, count, p, method, ws);
         }
-        // Rigid-body modes: as in the dense solver, locate the lowest elastic mode with a tiny
-        // shift, then shift to it for accuracy.
+        // Rigid-body modes: the dense solver's two shifts.
         let scale = k.diagonal_max() / m.diagonal_max();
-        let sigma0 = 1e-8 * scale.max(f64::MIN_POSITIVE);
-        let first = self.shifted(k, m, sigma0, count, p, method, ws)?;
-        match first.eigenvalues.iter().find(|&&l| l > 1e-3 * sigma0) {
-            Some(&sigma1) if sigma1 > 10.0 * sigma0 => self.shifted(k, m, sigma1, count, p, method, ws),
-            _ => Ok(first),
-        }
+        shifted_twice(scale, |sigma| self.shifted(k, m, sigma, count, p, method, ws))
     }
 
     #[allow(clippy::too_many_arguments)]
