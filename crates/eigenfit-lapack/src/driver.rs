@@ -6,15 +6,16 @@
 use crate::backend;
 use eigenfit_core::SolveError;
 
-/// `ITYPE = 1`: K φ = λ M φ.
+/// `ITYPE = 1`: A x = λ B x.
 const ITYPE: [i32; 1] = [1];
 const UPLO: u8 = b'U';
 
-/// All eigenpairs by `dsygvd`: (λ ascending, Φ column-major n×n with ΦᵀMΦ = I).
-pub(crate) fn sygvd(n: usize, k: &[f64], m: &[f64]) -> Result<(Vec<f64>, Vec<f64>), SolveError> {
+/// All eigenpairs of A x = λ B x (B positive definite) by `dsygvd`: (λ ascending, X column-major
+/// n×n with XᵀBX = I).
+pub(crate) fn sygvd(n: usize, a: &[f64], b: &[f64]) -> Result<(Vec<f64>, Vec<f64>), SolveError> {
     let ni = lapack_int(n, "n")?;
-    let mut a = k.to_vec();
-    let mut b = m.to_vec();
+    let mut a = a.to_vec();
+    let mut b = b.to_vec();
     let mut w = vec![0.0; n];
     let mut info = 0;
 
@@ -58,17 +59,20 @@ pub(crate) fn sygvd(n: usize, k: &[f64], m: &[f64]) -> Result<(Vec<f64>, Vec<f64
     Ok((w, a))
 }
 
-/// Eigenpairs `1..=count` by `dsygvx` (`RANGE = 'I'`): (λ ascending, Φ column-major n×count).
+/// Eigenpairs `first..first + count` (0-based, in ascending order) of A x = λ B x by `dsygvx`
+/// (`RANGE = 'I'`): (λ ascending, X column-major n×count with XᵀBX = I).
 pub(crate) fn sygvx(
     n: usize,
-    k: &[f64],
-    m: &[f64],
+    a: &[f64],
+    b: &[f64],
+    first: usize,
     count: usize,
 ) -> Result<(Vec<f64>, Vec<f64>), SolveError> {
     let ni = lapack_int(n, "n")?;
-    let iu = lapack_int(count, "count")?;
-    let mut a = k.to_vec();
-    let mut b = m.to_vec();
+    let il = lapack_int(first + 1, "first mode")?;
+    let iu = lapack_int(first + count, "count")?;
+    let mut a = a.to_vec();
+    let mut b = b.to_vec();
     let mut w = vec![0.0; n];
     let mut z = vec![0.0; n * count];
     let mut iwork = vec![0; 5 * n];
@@ -80,11 +84,11 @@ pub(crate) fn sygvx(
 
     let mut work = [0.0];
     // SAFETY: a, b are n×n (leading dimension n); w has n entries; z is n×count with leading
-    // dimension n, and RANGE = 'I' with IL = 1, IU = count yields exactly count columns;
+    // dimension n, and RANGE = 'I' with IU − IL + 1 = count yields exactly count columns;
     // iwork has 5n and ifail n entries; a query (LWORK = -1) writes only work[0].
     unsafe {
         lapack::dsygvx(
-            &ITYPE, b'V', b'I', UPLO, ni, &mut a, ni, &mut b, ni, 0.0, 0.0, 1, iu, abstol, &mut found,
+            &ITYPE, b'V', b'I', UPLO, ni, &mut a, ni, &mut b, ni, 0.0, 0.0, il, iu, abstol, &mut found,
             &mut w, &mut z, ni, &mut work, -1, &mut iwork, &mut ifail, &mut info,
         );
     }
@@ -105,7 +109,7 @@ pub(crate) fn sygvx(
             ni,
             0.0,
             0.0,
-            1,
+            il,
             iu,
             abstol,
             &mut found,
@@ -125,6 +129,26 @@ pub(crate) fn sygvx(
     }
     w.truncate(count);
     Ok((w, z))
+}
+
+/// Cholesky factorisation of the symmetric n×n `a` by `dpotrf`: the smallest and largest pivot
+/// (diagonal entry of the factor), or the order of the first leading minor that is not positive
+/// definite.
+pub(crate) fn cholesky_pivots(n: usize, a: &[f64]) -> Result<Result<(f64, f64), usize>, SolveError> {
+    let ni = lapack_int(n, "n")?;
+    let mut f = a.to_vec();
+    let mut info = 0;
+    // SAFETY: f is n×n with leading dimension n.
+    unsafe {
+        lapack::dpotrf(UPLO, ni, &mut f, ni, &mut info);
+    }
+    match usize::try_from(info) {
+        Ok(0) => Ok(Ok((0..n)
+            .map(|j| f[j * n + j])
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| (lo.min(v), hi.max(v))))),
+        Ok(order) => Ok(Err(order)),
+        Err(_) => Err(backend(format!("dpotrf: argument {} had an illegal value", -i64::from(info)))),
+    }
 }
 
 /// Maps LAPACK's `info` for `dsygvd` / `dsygvx` (with `ifail` for the latter).
