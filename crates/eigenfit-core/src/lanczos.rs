@@ -95,14 +95,16 @@ pub(crate) fn largest<'a>(
         // ("twice is enough", Kahan–Parlett) for longer runs, and whenever the first cancelled
         // more than three digits of w (a DGKS test, looser than the usual 1/√2 because a
         // converging Lanczos step always cancels much): the rest would be round-off along the
-        // basis, as in the last steps of a run through the whole space.
-        let before = dot(w, w);
+        // basis, as in the last steps of a run through the whole space. In the M norm the
+        // removed part is Σcᵢ² (the basis is M-orthonormal), so the test needs no extra product.
         let mut a = orthogonalise(w, &q[..(j + 1) * n], &mq[..(j + 1) * n], coefficients);
-        if j >= SINGLE_PASS_STEPS || dot(w, w) < 1e-6 * before {
+        let mut b = m_norm(m, w, mw);
+        let removed: f64 = coefficients.iter().map(|c| c * c).sum();
+        if j >= SINGLE_PASS_STEPS || b * b < 1e-6 * (removed + b * b) {
             a += orthogonalise(w, &q[..(j + 1) * n], &mq[..(j + 1) * n], coefficients);
+            b = m_norm(m, w, mw);
         }
         alpha.push(a);
-        let mut b = m_norm(m, w, mw);
         beta.push(b);
         steps += 1;
         if steps >= first_check(count, tolerance).min(n) && converged(alpha, beta, count, tolerance, ritz) {
