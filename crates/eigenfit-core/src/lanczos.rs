@@ -40,6 +40,8 @@ const SINGLE_PASS_STEPS: usize = 8;
 /// μ₁/μ_k above which a Ritz value is recomputed as a Rayleigh quotient: below it, T's round-off
 /// (a few ε·μ₁) stays under ~1e-13 of θ_k.
 const REFINE_SPREAD: f64 = 100.0;
+/// Largest true relative inverse residual accepted for a refined Ritz pair.
+const TRUE_RESIDUAL_LIMIT: f64 = 1e-6;
 /// Steps beyond `count` before the first convergence check: each check is a QL decomposition of
 /// T, dearer than a step on small models, and on beam models each step gains about two decades,
 /// so fewer steps rarely reach the tolerance.
@@ -159,7 +161,16 @@ pub(crate) fn largest<'a>(
         z.clear();
         z.extend_from_slice(mw);
         factor.solve_in_place(z);
-        alpha.push(dot(mw, z) / dot(y, mw));
+        let mu = dot(mw, z) / dot(y, mw);
+        // Where T's round-off matters, Paige's estimate is least trustworthy too: check the true
+        // inverse residual ‖z − μy‖∞ / (μ‖y‖∞) of this vector (z = Op y) and refuse the run when
+        // it is far from converged (the caller falls back to block iteration or the dense solver).
+        let scale = mu * y.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let residual = z.iter().zip(y.iter()).fold(0.0_f64, |a, (zv, yv)| a.max((zv - mu * yv).abs()));
+        if !(residual <= TRUE_RESIDUAL_LIMIT * scale) {
+            return None;
+        }
+        alpha.push(mu);
     }
     Some(Ritz { mu: alpha, vectors: w })
 }
