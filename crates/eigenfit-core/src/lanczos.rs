@@ -167,7 +167,7 @@ pub(crate) fn largest<'a>(
         // it is far from converged (the caller falls back to block iteration or the dense solver).
         let scale = mu * y.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         let residual = z.iter().zip(y.iter()).fold(0.0_f64, |a, (zv, yv)| a.max((zv - mu * yv).abs()));
-        if !(residual <= TRUE_RESIDUAL_LIMIT * scale) {
+        if residual.is_nan() || scale.is_nan() || residual > TRUE_RESIDUAL_LIMIT * scale {
             return None;
         }
         alpha.push(mu);
