@@ -108,12 +108,10 @@ impl BandedSymmetric {
     pub fn mul_add(&self, alpha: f64, x: &[f64], out: &mut [f64]) {
         debug_assert!(x.len() == self.dim && out.len() == self.dim);
         let w = self.bandwidth + 1;
-        // Beam models (b = 1 … 3) get the band width as a constant: unrolled inner loops.
+        // Beam models (half-bandwidth 3) get a kernel of their own.
         match w {
             4 => mul_add_band_3(&self.data, alpha, x, out),
-            2 => mul_add_band::<2>(&self.data, w, alpha, x, out),
-            3 => mul_add_band::<3>(&self.data, w, alpha, x, out),
-            _ => mul_add_band::<0>(&self.data, w, alpha, x, out),
+            _ => mul_add_band(&self.data, w, alpha, x, out),
         }
     }
 
@@ -208,10 +206,8 @@ impl BandedSymmetric {
     }
 }
 
-/// out += α·A x for the band array `a` of width w; `W` is w as a constant, or 0 for "use `w`".
-#[inline(always)]
-fn mul_add_band<const W: usize>(a: &[f64], w: usize, alpha: f64, x: &[f64], out: &mut [f64]) {
-    let w = if W > 0 { W } else { w };
+/// out += α·A x for the band array `a` of width w.
+fn mul_add_band(a: &[f64], w: usize, alpha: f64, x: &[f64], out: &mut [f64]) {
     let n = x.len();
     for j in 0..n {
         let col = &a[j * w..j * w + w.min(n - j)];
@@ -226,11 +222,8 @@ fn mul_add_band<const W: usize>(a: &[f64], w: usize, alpha: f64, x: &[f64], out:
     }
 }
 
-/// Solves L̃DL̃ᵀ x = b in place for the factor array `l` of width w (see [`mul_add_band`] for
-/// `W`): L̃ y = b, D z = y, L̃ᵀ x = z.
-#[inline(always)]
-fn solve_band<const W: usize>(l: &[f64], w: usize, inverse_diagonal: &[f64], x: &mut [f64]) {
-    let w = if W > 0 { W } else { w };
+/// Solves L̃DL̃ᵀ x = b in place for the factor array `l` of width w: L̃ y = b, D z = y, L̃ᵀ x = z.
+fn solve_band(l: &[f64], w: usize, inverse_diagonal: &[f64], x: &mut [f64]) {
     let n = x.len();
     for j in 0..n {
         let len = w.min(n - j);
@@ -427,9 +420,7 @@ impl BandCholesky {
         let (l, inv) = (&self.data, &self.inverse_diagonal);
         match self.bandwidth + 1 {
             4 if self.dim >= 4 => solve_band_3(l, inv, x),
-            2 => solve_band::<2>(l, 2, inv, x),
-            3 => solve_band::<3>(l, 3, inv, x),
-            w => solve_band::<0>(l, w, inv, x),
+            w => solve_band(l, w, inv, x),
         }
     }
 

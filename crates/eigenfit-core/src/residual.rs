@@ -2,7 +2,6 @@
 
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
-use crate::modes::Modes;
 use crate::parameters::ParameterSet;
 use crate::sensitivity::{check_wanted_distinct, noise_floor, Sensitivities, SensitivityError};
 use crate::solver::EigenSolver;
@@ -236,12 +235,10 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
         let (eigenvalues, next) =
             self.solver.lowest_eigenvalues_with_next(&system, needed).map_err(SensitivityError::from)?;
         let floor = noise_floor(&system);
+        let wanted = self.measured.modes().iter().map(|m| m.mode);
+        check_wanted_distinct(eigenvalues.as_slice(), next, wanted, floor)?;
         for meas in self.measured.modes() {
-            check_wanted_distinct(eigenvalues.as_slice(), next, &[meas.mode], floor)?;
-        }
-        let modes = Modes { eigenvalues, shapes: DMatrix::zeros(0, needed) };
-        for meas in self.measured.modes() {
-            let lambda = modes.eigenvalues[meas.mode];
+            let lambda = eigenvalues[meas.mode];
             if lambda <= floor {
                 return Err(SensitivityError::ZeroFrequency { mode: meas.mode, lambda }.into());
             }
@@ -249,7 +246,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
         let residual = DVector::from_iterator(
             self.measured.len(),
             self.measured.modes().iter().map(|meas| {
-                let (r, _, sigma) = self.residual_terms(meas, modes.eigenvalues[meas.mode]);
+                let (r, _, sigma) = self.residual_terms(meas, eigenvalues[meas.mode]);
                 r / sigma
             }),
         );

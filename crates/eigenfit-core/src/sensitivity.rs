@@ -146,7 +146,7 @@ impl Sensitivities {
         }
         let (modes, next) = solver.lowest_with_next(&system, count)?;
         let floor = noise_floor(&system);
-        check_wanted_distinct(modes.eigenvalues.as_slice(), next, wanted, floor)?;
+        check_wanted_distinct(modes.eigenvalues.as_slice(), next, wanted.iter().copied(), floor)?;
         let np = model.parameters().len();
         let mut dl = DMatrix::from_element(count, np, f64::NAN);
         let mut df = DMatrix::from_element(count, np, f64::NAN);
@@ -176,10 +176,10 @@ impl Sensitivities {
 pub(crate) fn check_wanted_distinct(
     lowest: &[f64],
     next: f64,
-    wanted: &[usize],
+    wanted: impl IntoIterator<Item = usize>,
     floor: f64,
 ) -> Result<(), SensitivityError> {
-    wanted.iter().try_for_each(|&k| distinct(lowest, next, k, DEFAULT_REPEATED_TOLERANCE, floor))
+    wanted.into_iter().try_for_each(|k| distinct(lowest, next, k, DEFAULT_REPEATED_TOLERANCE, floor))
 }
 
 /// dφₖ/dpᵢ by modal expansion over the supplied modes (the paper's eq. 4 with eq. 22):

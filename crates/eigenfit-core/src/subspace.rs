@@ -251,8 +251,7 @@ impl BandedSolver {
             }
             ws.checked_mass = Some(m.clone());
         }
-        let p = subspace_size(m.dim(), count);
-        let modes = match self.modes(k, m, count, p, Method::Lanczos, ws) {
+        let modes = match self.modes(k, m, count, Method::Lanczos, ws) {
             Ok(modes) => modes,
             // The iterations failed (an extreme stiffness contrast): the dense solver decides,
             // where it can, and reports input faults (negative stiffness) in its own words.
@@ -264,7 +263,7 @@ impl BandedSolver {
         }
         // Lanczos missed a mode (one start vector sees a repeated eigenvalue once): a block of p
         // vectors sees multiplicities up to p − m. Its failure, too, ends in `None`.
-        let Ok(modes) = self.modes(k, m, count, p, Method::Subspace, ws) else {
+        let Ok(modes) = self.modes(k, m, count, Method::Subspace, ws) else {
             return Ok(None);
         };
         Ok(sturm_bound(k, m, &modes, &mut ws.scratch).map(|next| (modes, next)))
@@ -276,33 +275,30 @@ impl BandedSolver {
         k: &BandedSymmetric,
         m: &BandedSymmetric,
         count: usize,
-        p: usize,
         method: Method,
         ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
         if ws.factor.factor_shifted(k, 0.0, m) && well_conditioned(&ws.factor) {
-            return self.iterate(m, 0.0, count, p, method, ws);
+            return self.iterate(m, 0.0, count, method, ws);
         }
         // Rigid-body modes: the dense solver's two shifts.
         let scale = k.diagonal_max() / m.diagonal_max();
-        shifted_twice(scale, |sigma| self.shifted(k, m, sigma, count, p, method, ws))
+        shifted_twice(scale, |sigma| self.shifted(k, m, sigma, count, method, ws))
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn shifted(
         &self,
         k: &BandedSymmetric,
         m: &BandedSymmetric,
         sigma: f64,
         count: usize,
-        p: usize,
         method: Method,
         ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
         if !ws.factor.factor_shifted(k, sigma, m) {
             return Err(backend("K + σM is not positive definite: K has negative stiffness"));
         }
-        self.iterate(m, sigma, count, p, method, ws)
+        self.iterate(m, sigma, count, method, ws)
     }
 
     /// The lowest modes from the factor of K + σM held in the workspace: by Lanczos unless told
@@ -312,7 +308,6 @@ impl BandedSolver {
         m: &BandedSymmetric,
         sigma: f64,
         count: usize,
-        p: usize,
         method: Method,
         ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
@@ -330,7 +325,7 @@ impl BandedSolver {
                 return finish(eigenvalues, shapes);
             }
         }
-        self.subspace_iteration(m, sigma, count, p, ws)
+        self.subspace_iteration(m, sigma, count, ws)
     }
 
     /// Block subspace iteration with the factor of K + σM held in the workspace.
@@ -339,10 +334,10 @@ impl BandedSolver {
         m: &BandedSymmetric,
         sigma: f64,
         count: usize,
-        p: usize,
         ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
         let n = m.dim();
+        let p = subspace_size(n, count);
         ws.resize(n, p);
         start_vectors(&mut ws.x, 0);
         m.mul_block(&ws.x, &mut ws.y, p);
