@@ -99,6 +99,16 @@ impl SharedData {
         Self { seeds: Damped::rank_seeds(problem), solutions: local_solutions(problem, ALTERNATIVE_STARTS) }
     }
 
+    /// What runs of `strategies` on `problem` share: the seeds and local solutions when one of
+    /// them is damped, nothing otherwise.
+    pub fn for_runs(problem: &dyn Evaluate, strategies: &[StrategyKind]) -> Self {
+        if strategies.contains(&StrategyKind::Damped) {
+            Self::new(problem)
+        } else {
+            Self::none()
+        }
+    }
+
     /// Nothing shared (for grids without a damped run).
     pub fn none() -> Self {
         Self { seeds: Arc::new(Vec::new()), solutions: Vec::new() }
@@ -196,17 +206,7 @@ where
             Ok(Problem::new(model, solver, reference_measurement(model, solver, target, settings)?))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let shared: Vec<SharedData> =
-        problems
-            .iter()
-            .map(|p| {
-                if strategies.contains(&StrategyKind::Damped) {
-                    SharedData::new(p)
-                } else {
-                    SharedData::none()
-                }
-            })
-            .collect();
+    let shared: Vec<SharedData> = problems.iter().map(|p| SharedData::for_runs(p, strategies)).collect();
     let cases: Vec<(usize, &Vec<f64>, StrategyKind)> = (0..targets.len())
         .flat_map(|t| initials.iter().flat_map(move |i| strategies.iter().map(move |&s| (t, i, s))))
         .collect();
@@ -248,11 +248,7 @@ where
     for target in targets {
         let measured = reference_measurement(model, solver, target, settings)?;
         let problem = Problem::new(model, solver, measured);
-        let shared = if strategies.contains(&StrategyKind::Damped) {
-            SharedData::new(&problem)
-        } else {
-            SharedData::none()
-        };
+        let shared = SharedData::for_runs(&problem, strategies);
         for initial in initials {
             for &strategy in strategies {
                 let run = run_case(&problem, &shared, target, initial, strategy, settings);

@@ -1,21 +1,12 @@
 //! Cross-check against ROSS (petrobras/ross) for the paper's rotor geometry, and the example file.
 
 use eigenfit_core::{DenseSolver, EigenSolver, StructuralModel};
-use eigenfit_rotor::{BearingSpec, Disk, Material, Rotor};
+use eigenfit_rotor::Rotor;
 
 /// 10 equal elements, Ø14 mm × 500 mm steel shaft, point disks 0.4 kg at node 2 and 1.35 kg at
-/// node 8, 1e5 N/m supports at nodes 0 and 10.
+/// node 8, 1e5 N/m supports at nodes 0 and 10: the `ross-example` preset.
 fn ross_rotor() -> Rotor {
-    Rotor::builder()
-        .material(Material::steel())
-        .uniform(0.5, 10)
-        .diameter(0.014)
-        .disk(Disk::new(2, 0.4))
-        .disk(Disk::new(8, 1.35))
-        .bearing(BearingSpec::new(0, 1e5))
-        .bearing(BearingSpec::new(10, 1e5))
-        .build()
-        .unwrap()
+    eigenfit_rotor::presets::ross_example()
 }
 
 /// ROSS's undamped natural frequencies (Hz) as printed, with half a unit of the last printed digit.
