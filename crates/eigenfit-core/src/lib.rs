@@ -42,6 +42,7 @@ pub mod synthetic;
 pub mod system;
 #[cfg(test)]
 mod test_chain;
+pub mod testdata;
 pub mod update;
 
 pub use banded::{BandCholesky, BandedSymmetric};

@@ -56,6 +56,7 @@ pub mod effects;
 pub mod element;
 mod error;
 mod file;
+mod layout;
 mod model;
 pub mod presets;
 
