@@ -10,6 +10,7 @@ mod output;
 mod plot;
 mod progress;
 mod source;
+mod testdata;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -3,9 +3,8 @@
 use crate::error::{input, CliError, EXIT_NOT_CONVERGED};
 use crate::plot::convergence::{Convergence, Run};
 use crate::source::{parameter_vector, ModelArgs};
-use crate::{measured, plot, progress};
+use crate::{plot, progress, testdata};
 use clap::Args;
-use eigenfit_core::statistics::uncertainty;
 use eigenfit_core::{Driver, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
@@ -15,9 +14,12 @@ use std::path::PathBuf;
 pub struct EstimateArgs {
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Measured frequencies: CSV with header `mode,frequency_hz[,std_hz]`, modes counted from 1.
-    #[arg(long, value_name = "FILE.csv")]
+    /// Measured frequencies: CSV with header `mode,frequency_hz[,std_hz]`, modes counted from 1;
+    /// or a universal file (.unv/.uff: frequencies and shapes, docs/test-data.md).
+    #[arg(long, value_name = "FILE.csv|FILE.unv")]
     pub measured: PathBuf,
+    #[command(flatten)]
+    pub test_data: testdata::TestDataArgs,
     /// Update strategy: newton, p-step or damped.
     #[arg(long, default_value = "damped")]
     pub strategy: String,
@@ -45,7 +47,8 @@ pub struct EstimateArgs {
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let (rotor, label) = args.model.load()?;
     let solver = args.model.solver()?;
-    let measurement = measured::read(&args.measured)?;
+    let data = testdata::read(&args.measured, &rotor, &args.test_data)?;
+    let measurement = data.measurement.clone();
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
         input(format!("unknown strategy `{}`; available: newton, p-step, damped", args.strategy))
     })?;
@@ -76,20 +79,22 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     }
     let has_std = measurement.has_std();
     let problem = Problem::new(&rotor, solver.as_ref(), measurement).with_kind(kind);
+    let mut fit = testdata::Fit::new(problem, &data, &args.test_data);
     let mut strategy = strategy_kind.build();
     let pb = progress::spinner(&format!("estimating ({})", strategy_kind.name()), args.quiet);
     let estimate = Driver { max_iterations: args.max_iterations }
-        .run(&problem, strategy.as_mut(), &initial, &mut [])
+        .run(&fit, strategy.as_mut(), &initial, &mut [])
         .map_err(|e| input(e.to_string()));
     pb.finish_and_clear();
     let estimate = estimate?;
-    let unc = if estimate.termination.is_converged() {
-        uncertainty(&problem, &estimate.last, has_std)
-    } else {
-        None
+    let (unc, scatter) = match estimate.termination.is_converged() {
+        true => fit.uncertainty(&estimate.last, has_std).map_or((None, None), |(u, s)| (Some(u), Some(s))),
+        false => (None, None),
     };
+    let mac = fit.mac(&estimate.parameters, args.test_data.mac_threshold);
     let names: Vec<&str> = rotor.parameters().iter().map(|p| p.name.as_str()).collect();
-    let converged = estimate.termination.is_converged();
+    // A measured mode below the MAC threshold makes the result not acceptable (exit code 3).
+    let converged = estimate.termination.is_converged() && mac.as_ref().is_none_or(|r| r.unpaired.is_empty());
     let plots = match &args.plot {
         Some(dir) => {
             let figure = Convergence {
@@ -100,7 +105,11 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 target: None,
                 tolerance_hz: Some(0.01),
             };
-            plot::write(&figure, dir, "convergence")?
+            let mut written = plot::write(&figure, dir, "convergence")?;
+            if let Some(r) = &mac {
+                written.extend(plot::write(&plot::mac_matrix::MacMatrix::new(&label, r), dir, "mac")?);
+            }
+            written
         }
         None => Vec::new(),
     };
@@ -135,6 +144,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             out["standard_deviations"] =
                 Value::Object(obj((0..np).map(|i| json!(u.covariance[(i, i)].sqrt())).collect()));
         }
+        testdata::add_json(&mut out, &fit, &data, &estimate, mac.as_ref(), scatter);
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
@@ -168,7 +178,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         }
         println!("{:>6}{:>16}{:>16}{:>14}", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]");
         for (k, (m, f)) in estimate.last.measured_hz.iter().zip(&estimate.last.frequencies_hz).enumerate() {
-            println!("{:>6}{m:>16.6}{f:>16.6}{:>14.2e}", problem.measured.modes()[k].mode + 1, f - m);
+            println!("{:>6}{m:>16.6}{f:>16.6}{:>14.2e}", fit.measured().modes()[k].mode + 1, f - m);
         }
         if let Some(u) = &unc {
             println!(
@@ -176,6 +186,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 u.singular_values, u.condition_number
             );
         }
+        testdata::print(&data, mac.as_ref(), scatter, &fit);
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
     Ok(if converged { 0 } else { EXIT_NOT_CONVERGED })

@@ -9,6 +9,7 @@ pub mod compare_map;
 pub mod convergence;
 pub mod critical_speed;
 pub mod discovery;
+pub mod mac_matrix;
 pub mod mode_shapes;
 pub mod style;
 

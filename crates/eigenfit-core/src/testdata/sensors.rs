@@ -323,3 +323,88 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<Measurement, S
     }
     Measurement::new(modes).map_err(|e| SensorError::Measurement(e.to_string()))
 }
+
+/// Adds measured shapes from CSV text to frequency data: header `mode,node,direction,value`,
+/// one row per mode, model node (0-based, as in the model file) and direction (1…6 or x, y, z,
+/// rx, ry, rz); modes counted from 1 as in the frequency file. Every mode of `measured` needs a
+/// value at every sensor (the set of (node, direction) the file names, in order of first
+/// appearance). Errors name the line.
+pub fn shapes_from_csv(
+    csv: &str,
+    layout: &dyn NodeLayout,
+    measured: &Measurement,
+) -> Result<(Measurement, SensorSet), SensorError> {
+    let bad = |line: usize, message: String| SensorError::Map { line, message };
+    let mut rows = csv
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let (hline, header) =
+        rows.next().ok_or_else(|| bad(1, "empty: expected the header `mode,node,direction,value`".into()))?;
+    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+    if cols != ["mode", "node", "direction", "value"] {
+        return Err(bad(hline, format!("header `{header}`: expected `mode,node,direction,value`")));
+    }
+    let nodes = layout.node_coordinates().len();
+    let mut set = SensorSet::default();
+    let mut values: HashMap<(usize, usize), (f64, usize)> = HashMap::new();
+    for (line, row) in rows {
+        let f: Vec<&str> = row.split(',').map(str::trim).collect();
+        if f.len() != 4 {
+            return Err(bad(line, format!("{} fields, but the header has 4", f.len())));
+        }
+        let mode: usize = f[0].parse().ok().filter(|&m| m >= 1).ok_or_else(|| {
+            bad(line, format!("mode `{}` must be a whole number ≥ 1 (modes count from 1)", f[0]))
+        })?;
+        if !measured.modes().iter().any(|m| m.mode + 1 == mode) {
+            return Err(bad(line, format!("mode {mode} has no measured frequency")));
+        }
+        let node: usize = f[1].parse().ok().filter(|&n| n < nodes).ok_or_else(|| {
+            bad(line, format!("node `{}` must be a node of the model, 0 … {}", f[1], nodes - 1))
+        })?;
+        let direction = parse_direction(f[2])
+            .ok_or_else(|| bad(line, format!("direction `{}` must be 1 … 6 or x, y, z, rx, ry, rz", f[2])))?;
+        let (dof, sign) = layout.dof(node, direction).ok_or_else(|| {
+            bad(line, format!("the model has no direction {} at node {node}", direction_name(direction)))
+        })?;
+        let value: f64 = f[3]
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| bad(line, format!("value `{}` is not a finite number", f[3])))?;
+        let index = match set.sensors.iter().position(|s| s.dof == dof) {
+            Some(i) => i,
+            None => {
+                set.sensors.push(Sensor { label: node as i64, direction, model_node: node, dof, sign });
+                set.sensors.len() - 1
+            }
+        };
+        if let Some((_, first)) = values.insert((mode, index), (value * sign, line)) {
+            return Err(bad(
+                line,
+                format!(
+                    "mode {mode}, node {node} {} is given twice (first on line {first})",
+                    direction_name(direction)
+                ),
+            ));
+        }
+    }
+    let mut modes = Vec::with_capacity(measured.len());
+    for m in measured.modes() {
+        let shape = (0..set.sensors.len())
+            .map(|i| {
+                values.get(&(m.mode + 1, i)).map(|v| v.0).ok_or_else(|| {
+                    SensorError::Measurement(format!(
+                        "shapes: mode {} has no value at {}",
+                        m.mode + 1,
+                        set.sensors[i].name()
+                    ))
+                })
+            })
+            .collect::<Result<Vec<f64>, _>>()?;
+        modes.push(MeasuredMode { shape: Some(shape), ..m.clone() });
+    }
+    let measurement = Measurement::new(modes).map_err(|e| SensorError::Measurement(e.to_string()))?;
+    Ok((measurement, set))
+}

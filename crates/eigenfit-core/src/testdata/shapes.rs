@@ -57,6 +57,31 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         Ok((shapes, lin.paired_modes))
     }
 
+    /// 95 % intervals at the estimate `at` (a linearisation of this fit). With standard
+    /// deviations in the data they come from the weights. Without, from the residual scatter:
+    /// every row is divided by σ̂ = √(‖r‖²/dof), the usual regression estimate, so the weights
+    /// only set how frequencies and shapes count against each other; `None` when there are no
+    /// more rows than parameters. Returns the intervals and σ̂ (1 with given std).
+    pub fn uncertainty(&mut self, at: &Linearisation) -> Option<(crate::Uncertainty, f64)> {
+        if self.problem.measured.has_std() {
+            return crate::statistics::uncertainty(self, at, true).map(|u| (u, 1.0));
+        }
+        let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
+        let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
+        if !(scatter > 0.0 && scatter.is_finite()) {
+            return None;
+        }
+        let old = self.scale;
+        self.scale = old * scatter;
+        let result = self
+            .linearise(&at.parameters)
+            .ok()
+            .and_then(|lin| crate::statistics::uncertainty(self, &lin, true))
+            .map(|u| (u, scatter));
+        self.scale = old;
+        result
+    }
+
     /// Modes solved: as many as MAC pairing considers.
     fn count(&self) -> usize {
         (2 * self.problem.measured.modes_needed() + 2).min(self.problem.model.dofs())

@@ -1,0 +1,126 @@
+//! Real test data on the planar rotor: UFF round trip, a pyuff-written export of an independent
+//! finite-element model, and the mirror ambiguity of a symmetric rotor resolved by shapes.
+
+use eigenfit_core::testdata::{sensors, uff, ShapeFit};
+use eigenfit_core::{
+    statistics::uncertainty, Damped, DenseSolver, Driver, EigenSolver, Measurement, Pairing, Problem,
+    StructuralModel, UpdateStrategy,
+};
+use eigenfit_rotor::Rotor;
+use serde_json::Value;
+use std::path::PathBuf;
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/uff").join(name)
+}
+
+fn symmetric() -> Rotor {
+    Rotor::from_toml_file(data("symmetric_rotor.toml")).unwrap()
+}
+
+fn fixture() -> (uff::UffFile, Value) {
+    let file = uff::parse(&std::fs::read_to_string(data("symmetric_rotor.unv")).unwrap()).unwrap();
+    let json = serde_json::from_str(&std::fs::read_to_string(data("symmetric_rotor.json")).unwrap()).unwrap();
+    (file, json)
+}
+
+const TRUTH: [f64; 2] = [2.5e5, 0.8e5];
+
+#[test]
+fn written_modes_map_back_onto_the_model_dofs() {
+    let rotor = symmetric();
+    let modes = DenseSolver.lowest(&rotor.nominal_system().unwrap(), 4).unwrap();
+    let (nodes, uff_modes) = rotor.uff_modes(&modes);
+    let file = uff::parse(&uff::write("round trip", &nodes, &uff_modes)).unwrap();
+    let set = sensors::map_by_coordinates(&file, &rotor, 1e-6).unwrap();
+    let measurement = sensors::measurement(&file, &set).unwrap();
+    assert_eq!(measurement.len(), 4);
+    // Every node's y and rx are sensors (x, z, ry, rz are zero: not measured).
+    assert_eq!(set.sensors.len(), 2 * rotor.nodes().len());
+    assert!(set.ignored.is_empty());
+    for (k, m) in measurement.modes().iter().enumerate() {
+        assert!((m.frequency_hz / modes.frequencies_hz()[k] - 1.0).abs() < 5e-6);
+        let big = modes.shape(k).iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        for (s, v) in set.sensors.iter().zip(m.shape.as_ref().unwrap()) {
+            // E13.5 keeps 6 significant digits; zero model entries come back as exact zeros.
+            assert!((v - modes.shapes[(s.dof, k)]).abs() <= 5e-6 * big, "{}: {v}", s.name());
+        }
+    }
+}
+
+#[test]
+fn the_independent_model_agrees_and_sensors_map_by_coordinates() {
+    let (file, json) = fixture();
+    let rotor = symmetric();
+    // numpy's Hermite-element model of the same rotor (generate.py) against ours.
+    let ours = DenseSolver.lowest(&rotor.system_at(&TRUTH).unwrap(), 3).unwrap().frequencies_hz();
+    for (a, b) in ours.iter().zip(json["noise_free_frequencies_hz"].as_array().unwrap()) {
+        let b = b.as_f64().unwrap();
+        assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
+    }
+    let set = sensors::map_by_coordinates(&file, &rotor, 1e-3).unwrap();
+    let names: Vec<String> = set.sensors.iter().map(|s| s.name()).collect();
+    assert_eq!(names, ["node 101 y", "node 102 y", "node 103 y", "node 104 y", "node 105 y"]);
+    assert_eq!(set.sensors.iter().map(|s| s.model_node).collect::<Vec<_>>(), [0, 2, 5, 8, 10]);
+    assert_eq!(set.ignored, ["x at node(s) 101, 102, 103, 104, 105"]);
+
+    // A node off the model names itself and its nearest model node.
+    let mut moved = file.clone();
+    moved.nodes[2].coordinates[2] += 0.01;
+    let e = sensors::map_by_coordinates(&moved, &rotor, 1e-3).unwrap_err().to_string();
+    assert!(e.contains("node 103 at (0, 0, 0.26") && e.contains("nearest model node 5"), "{e}");
+}
+
+/// Frequencies alone cannot tell the bearings apart: started nearer the mirror, a
+/// frequency-only fit settles there, as exactly as at the truth.
+#[test]
+fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
+    let (file, _) = fixture();
+    let rotor = symmetric();
+    let set = sensors::map_by_coordinates(&file, &rotor, 1e-3).unwrap();
+    let measured = sensors::measurement(&file, &set).unwrap();
+    let start = [0.9e5, 2.0e5];
+
+    let freq_only = Problem::new(
+        &rotor,
+        DenseSolver,
+        Measurement::new(
+            measured
+                .modes()
+                .iter()
+                .map(|m| {
+                    let mut m = m.clone();
+                    m.shape = None;
+                    m
+                })
+                .collect(),
+        )
+        .unwrap(),
+    );
+    let est = Driver::default().run(&freq_only, &mut Damped::default(), &start, &mut []).unwrap();
+    let p = &est.parameters;
+    assert!(p[0] < p[1], "frequency-only fit from the mirror side: {p:?}");
+    // The mirror fits the frequencies as well as the truth does (symmetry), so the data cannot
+    // exclude it: its cost equals the swapped point's.
+    let swapped = [p[1], p[0]];
+    let (c1, c2) = (freq_only.cost(p).unwrap(), freq_only.cost(&swapped).unwrap());
+    assert!((c1 - c2).abs() <= 1e-9 * c1.max(1e-20), "{c1} vs {c2}");
+
+    let fit = ShapeFit::new(
+        Problem::new(&rotor, DenseSolver, measured).with_pairing(Pairing::Mac { sensor_dofs: set.dofs() }),
+        0.05,
+    );
+    let mut damped = Damped::default();
+    let est = Driver::default().run(&fit, &mut damped as &mut dyn UpdateStrategy, &start, &mut []).unwrap();
+    assert!(est.termination.is_converged(), "{}", est.termination);
+    let u = uncertainty(&fit, &est.last, true).unwrap();
+    for (i, name) in ["drive_end", "free_end"].iter().enumerate() {
+        let [lo, hi] = u.intervals[i];
+        assert!(lo <= TRUTH[i] && TRUTH[i] <= hi, "{name}: truth {} outside [{lo}, {hi}]", TRUTH[i]);
+        let mirror = TRUTH[1 - i];
+        assert!(!(lo <= mirror && mirror <= hi), "{name}: mirror {mirror} inside [{lo}, {hi}]");
+    }
+    assert!(est.parameters[0] > est.parameters[1], "{:?}", est.parameters);
+    assert_eq!(est.last.paired_modes, [0, 1, 2]);
+    assert!(rotor.parameters().len() == 2);
+}
