@@ -47,6 +47,23 @@ pub struct TestData {
     pub notes: Vec<String>,
 }
 
+/// `simulate --uff`: the lowest `modes` modes at `p` with the rotor's node coordinates.
+pub fn write_uff(
+    path: &Path,
+    label: &str,
+    rotor: &Rotor,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    modes: usize,
+) -> Result<(), CliError> {
+    use eigenfit_core::StructuralModel;
+    let system = rotor.assemble(p).map_err(|e| input(e.to_string()))?;
+    let solved = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
+    let (nodes, uff_modes) = rotor.uff_modes(&solved);
+    let text = uff::write(&format!("eigenfit simulate: {label}"), &nodes, &uff_modes);
+    crate::output::write_atomically(path, text.as_bytes())
+}
+
 /// True for `.unv` / `.uff` (any case).
 pub fn is_universal_file(path: &Path) -> bool {
     path.extension()
@@ -238,7 +255,7 @@ pub fn add_json(
         out["interval_basis"] = json!(if s == 1.0 && fit.measured().has_std() {
             "standard deviations".to_string()
         } else {
-            format!("residual scatter (no std in the data): sigma_hat = {s:.4}")
+            format!("residual scatter (no std in the data): sigma_hat = {s:.3e}")
         });
     }
 }
@@ -275,6 +292,6 @@ pub fn print(data: &TestData, mac: Option<&MacReport>, scatter: Option<f64>, fit
         println!("model modes not measured (or not seen by the sensors): {}", list.join(", "));
     }
     if let Some(s) = scatter.filter(|_| !fit.measured().has_std()) {
-        println!("intervals from the residual scatter (no std in the data): sigma_hat = {s:.4}");
+        println!("intervals from the residual scatter (no std in the data): sigma_hat = {s:.3e}");
     }
 }

@@ -42,6 +42,10 @@ pub struct SimulateArgs {
     /// 1e2–1e9 N/m) and the mode shapes (mode-shapes.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// Write the modes and node coordinates as a universal file (datasets 164, 15, 55;
+    /// docs/test-data.md).
+    #[arg(long, value_name = "FILE.unv", conflicts_with = "sweep")]
+    pub uff: Option<PathBuf>,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -111,6 +115,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         return Ok(());
     }
     let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
+    if let Some(path) = &args.uff {
+        crate::testdata::write_uff(path, &label, &rotor, solver.as_ref(), &p, args.modes)?;
+    }
     // Frequencies and their sensitivities from one solve; a model whose modes have none
     // (repeated or rigid-body modes) still gets its frequencies, and says why.
     let (f, sens) = match Sensitivities::compute(&rotor, solver.as_ref(), &p, args.modes) {
@@ -154,6 +161,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             println!("{:>6}{v:>18.6}", i + 1);
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
+        args.uff.iter().for_each(|w| println!("wrote {}", w.display()));
     }
     Ok(())
 }

@@ -1,0 +1,183 @@
+//! Real test data through the CLI (issue 14's contract): universal files and shape CSV in,
+//! MAC pairing and shape residuals, the JSON `mac` and `pairing`.
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::Command;
+
+fn data(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/uff").join(name).display().to_string()
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs");
+    let text = |b: Vec<u8>| String::from_utf8(b).expect("utf-8");
+    (out.status.code().unwrap_or(-1), text(out.stdout), text(out.stderr))
+}
+
+fn json(args: &[&str]) -> (i32, Value) {
+    let (code, out, err) = run(args);
+    (code, serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out} {err}")))
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("eigenfit-test-data-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn truth() -> [f64; 2] {
+    let j: Value =
+        serde_json::from_str(&std::fs::read_to_string(data("symmetric_rotor.json")).unwrap()).unwrap();
+    [j["truth"]["k_drive_end"].as_f64().unwrap(), j["truth"]["k_free_end"].as_f64().unwrap()]
+}
+
+/// The contract: a pyuff-written export of an independent model of a symmetric rotor; the
+/// estimate is on the right sides (the truth inside, the mirror outside both intervals).
+#[test]
+fn a_universal_file_estimates_a_symmetric_rotor_on_the_right_sides() {
+    let (code, v) = json(&[
+        "estimate",
+        "--model",
+        &data("symmetric_rotor.toml"),
+        "--measured",
+        &data("symmetric_rotor.unv"),
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{v}");
+    let truth = truth();
+    for (i, name) in ["k_drive_end", "k_free_end"].iter().enumerate() {
+        let iv: Vec<f64> =
+            v["intervals"][name].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        let p = v["parameters"][name].as_f64().unwrap();
+        assert!(iv[0] <= p && p <= iv[1]);
+        assert!(iv[0] <= truth[i] && truth[i] <= iv[1], "{name}: {} not in {iv:?}", truth[i]);
+        assert!(!(iv[0] <= truth[1 - i] && truth[1 - i] <= iv[1]), "{name}: mirror in {iv:?}");
+    }
+    assert_eq!(v["pairing"], serde_json::json!({"1": 1, "2": 2, "3": 3}));
+    let mac: Vec<Vec<f64>> = serde_json::from_value(v["mac"].clone()).unwrap();
+    assert_eq!(mac.len(), 3);
+    for (i, row) in mac.iter().enumerate() {
+        assert_eq!(row.len(), 3);
+        for (j, &m) in row.iter().enumerate() {
+            assert!((0.0..=1.0).contains(&m));
+            // Noisy shapes at five sensors: the diagonal is near 1, the rest well below it.
+            assert!(if i == j { m > 0.99 } else { m < 0.2 }, "MAC[{i}][{j}] = {m}");
+        }
+    }
+    assert_eq!(v["sensors"].as_array().unwrap().len(), 5);
+}
+
+#[test]
+fn simulated_modes_round_trip_through_a_universal_file() {
+    let file = temp("round-trip.unv");
+    let file = file.to_str().unwrap();
+    let model = data("symmetric_rotor.toml");
+    let (code, out, err) =
+        run(&["simulate", "--model", &model, "--stiffness", "3e5,4e4", "--modes", "4", "--uff", file]);
+    assert_eq!(code, 0, "{out}{err}");
+    let (code, v) = json(&["estimate", "--model", &model, "--measured", file, "--json", "--quiet"]);
+    assert_eq!(code, 0, "{v}");
+    for (name, want) in [("k_drive_end", 3e5), ("k_free_end", 4e4)] {
+        let got = v["parameters"][name].as_f64().unwrap();
+        // The file keeps 6 significant digits (E13.5).
+        assert!((got / want - 1.0).abs() < 1e-4, "{name}: {got}");
+    }
+    assert_eq!(v["pairing"], serde_json::json!({"1": 1, "2": 2, "3": 3, "4": 4}));
+}
+
+#[test]
+fn shapes_in_csv_estimate_the_right_sides_too() {
+    // The fixture's frequencies and y shapes, as a test engineer would type them.
+    let j: Value =
+        serde_json::from_str(&std::fs::read_to_string(data("symmetric_rotor.json")).unwrap()).unwrap();
+    let nodes = [0, 2, 5, 8, 10];
+    let mut freq = String::from("mode,frequency_hz\n");
+    let mut shapes = String::from("mode,node,direction,value\n");
+    for m in j["modes"].as_array().unwrap() {
+        let k = m["mode"].as_u64().unwrap();
+        freq += &format!("{k},{}\n", m["frequency_hz"]);
+        for (n, y) in nodes.iter().zip(m["y"].as_array().unwrap()) {
+            shapes += &format!("{k},{n},y,{y}\n");
+        }
+    }
+    let (f, s) = (temp("freq.csv"), temp("shapes.csv"));
+    std::fs::write(&f, freq).unwrap();
+    std::fs::write(&s, shapes).unwrap();
+    let (code, v) = json(&[
+        "estimate",
+        "--model",
+        &data("symmetric_rotor.toml"),
+        "--measured",
+        f.to_str().unwrap(),
+        "--shapes",
+        s.to_str().unwrap(),
+        "--initial",
+        "9e4,2e5",
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{v}");
+    let truth = truth();
+    let k =
+        [v["parameters"]["k_drive_end"].as_f64().unwrap(), v["parameters"]["k_free_end"].as_f64().unwrap()];
+    assert!(k.iter().zip(truth).all(|(a, b)| (a / b - 1.0).abs() < 0.05), "{k:?}");
+}
+
+#[test]
+fn bad_test_data_is_named() {
+    let model = data("symmetric_rotor.toml");
+    let text = std::fs::read_to_string(data("symmetric_rotor.unv")).unwrap();
+    // Node 103 moved 10 mm off the shaft's nodes.
+    let moved = temp("moved.unv");
+    std::fs::write(&moved, text.replacen("2.5000000000000000e+02", "2.6000000000000000e+02", 1)).unwrap();
+    let (code, _, err) = run(&["estimate", "--model", &model, "--measured", moved.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("node 103 at (0, 0, 0.26) m") && err.contains("nearest model node 5"), "{err}");
+    // A broken number names the file and line.
+    let broken = temp("broken.unv");
+    let mut lines: Vec<&str> = text.lines().collect();
+    let at = lines.iter().position(|l| l.trim() == "55").unwrap() + 9;
+    lines[at] = "       abc";
+    std::fs::write(&broken, lines.join("\n")).unwrap();
+    let (code, _, err) = run(&["estimate", "--model", &model, "--measured", broken.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains(&format!("broken.unv:{}: a node label: `abc` is not a whole number", at + 1)),
+        "{err}"
+    );
+    // The MAC threshold: no measured mode can be paired at MAC ≥ 1 with noisy shapes → exit 3.
+    let (code, v) = json(&[
+        "estimate",
+        "--model",
+        &model,
+        "--measured",
+        &data("symmetric_rotor.unv"),
+        "--mac-threshold",
+        "1",
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(code, 3);
+    assert_eq!(v["unpaired"], serde_json::json!([1, 2, 3]));
+}
+
+#[test]
+fn plot_writes_the_mac_heatmap() {
+    let dir = temp("plots");
+    let (code, out, err) = run(&[
+        "estimate",
+        "--model",
+        &data("symmetric_rotor.toml"),
+        "--measured",
+        &data("symmetric_rotor.unv"),
+        "--plot",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    let svg = std::fs::read_to_string(dir.join("mac.svg")).unwrap();
+    assert!(svg.contains("MAC, measured against model modes"));
+    assert!(dir.join("mac.png").metadata().unwrap().len() > 1000);
+}
