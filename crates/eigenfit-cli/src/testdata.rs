@@ -5,7 +5,9 @@
 use crate::error::{input, CliError};
 use crate::measured;
 use clap::Args;
+use eigenfit_core::fixed::Fixed;
 use eigenfit_core::testdata::{sensors, uff, MacReport, SensorSet, ShapeFit};
+use eigenfit_core::StructuralModel;
 use eigenfit_core::{
     EigenSolver, Estimate, Evaluate, Linearisation, Measurement, Pairing, ParameterSet, Problem,
     ResidualError, Uncertainty,
@@ -35,6 +37,92 @@ pub struct TestDataArgs {
     /// unpaired and the run is not acceptable (exit code 3).
     #[arg(long, default_value_t = 0.6, value_name = "MAC")]
     pub mac_threshold: f64,
+    /// Hold a parameter at a value instead of estimating it, NAME=VALUE (repeatable).
+    #[arg(long = "fix", value_name = "NAME=VALUE")]
+    pub fix: Vec<String>,
+    /// Write the updated model (the estimated values as the model's nominal ones, with a header
+    /// naming the data file, the date, χ² and the intervals) as TOML.
+    #[arg(long, value_name = "OUT.toml")]
+    pub write_model: Option<PathBuf>,
+}
+
+/// The rotor with the `--fix NAME=VALUE` parameters held.
+pub fn fixed<'r>(rotor: &'r Rotor, fixes: &[String]) -> Result<Fixed<&'r Rotor>, CliError> {
+    let mut pairs = Vec::new();
+    for f in fixes {
+        let (name, value) =
+            f.split_once('=').ok_or_else(|| input(format!("--fix `{f}`: expected NAME=VALUE")))?;
+        let v: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| input(format!("--fix `{f}`: `{}` is not a finite number", value.trim())))?;
+        if pairs.iter().any(|(n, _): &(String, f64)| n == name.trim()) {
+            return Err(input(format!("--fix: `{}` is given twice", name.trim())));
+        }
+        pairs.push((name.trim().to_string(), v));
+    }
+    Fixed::new(rotor, &pairs).map_err(|e| input(format!("--fix: {e}")))
+}
+
+/// `fixed`: the held parameters (name → value), when any.
+pub fn add_fixed_json(out: &mut Value, model: &Fixed<&Rotor>) {
+    let held = model.held();
+    if !held.is_empty() {
+        out["fixed"] = Value::Object(held.into_iter().map(|(n, v)| (n, json!(v))).collect());
+    }
+}
+
+/// `--write-model`: the rotor with the estimated (and held) values as its nominal ones, as TOML
+/// with a header that reads back as comments.
+pub fn write_model(
+    path: &Path,
+    data_file: &Path,
+    model: &Fixed<&Rotor>,
+    estimate: &Estimate,
+    unc: Option<&Uncertainty>,
+) -> Result<(), CliError> {
+    let rotor = model.inner();
+    let full = model.expand(&estimate.parameters);
+    let updated = rotor.with_stiffnesses(&full).map_err(|e| CliError::Failure(e.to_string()))?;
+    let toml = updated.to_toml_string().map_err(|e| CliError::Failure(e.to_string()))?;
+    let mut head = format!(
+        "# Updated by eigenfit estimate ({} strategy, {}) on {} from {}\n\
+         # chi2 = {:.6e} on {} degrees of freedom\n",
+        estimate.strategy,
+        estimate.termination,
+        utc_date(),
+        data_file.display(),
+        estimate.last.chi2(),
+        estimate.last.dof()
+    );
+    for (i, p) in model.parameters().iter().enumerate() {
+        let interval = unc.map_or("no interval".to_string(), |u| {
+            format!("95% interval [{:.6e}, {:.6e}]", u.intervals[i][0], u.intervals[i][1])
+        });
+        head += &format!("# {} = {:.6e} {} ({interval})\n", p.name, estimate.parameters[i], p.unit);
+    }
+    for (name, v) in model.held() {
+        head += &format!("# {name} = {v:.6e} (held by --fix)\n");
+    }
+    crate::output::write_atomically(path, format!("{head}\n{toml}").as_bytes())
+}
+
+/// Today's date, UTC, as YYYY-MM-DD (Howard Hinnant's civil-from-days; no date crate needed
+/// for one header line).
+fn utc_date() -> String {
+    let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+    let z = (secs / 86_400) as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
 }
 
 /// Measured data and, with shapes, the sensors they were measured at.
@@ -56,7 +144,6 @@ pub fn write_uff(
     p: &[f64],
     modes: usize,
 ) -> Result<(), CliError> {
-    use eigenfit_core::StructuralModel;
     let system = rotor.assemble(p).map_err(|e| input(e.to_string()))?;
     let solved = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
     let (nodes, uff_modes) = rotor.uff_modes(&solved);
@@ -134,14 +221,14 @@ pub fn read(path: &Path, rotor: &Rotor, args: &TestDataArgs) -> Result<TestData,
     Ok(TestData { measurement, sensors: Some(set), notes })
 }
 
-type RotorProblem<'a> = Problem<&'a Rotor, &'a dyn EigenSolver>;
+type RotorProblem<'a> = Problem<&'a Fixed<&'a Rotor>, &'a dyn EigenSolver>;
 
 /// The fitted objective: frequencies only (order pairing), or frequencies and shapes (MAC).
 pub enum Fit<'a> {
     /// Frequencies, paired by order.
     Frequencies(RotorProblem<'a>),
     /// Frequencies and shapes, paired by MAC.
-    Shapes(ShapeFit<&'a Rotor, &'a dyn EigenSolver>),
+    Shapes(ShapeFit<&'a Fixed<&'a Rotor>, &'a dyn EigenSolver>),
 }
 
 impl<'a> Fit<'a> {

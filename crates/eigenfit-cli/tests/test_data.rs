@@ -181,3 +181,69 @@ fn plot_writes_the_mac_heatmap() {
     assert!(svg.contains("MAC, measured against model modes"));
     assert!(dir.join("mac.png").metadata().unwrap().len() > 1000);
 }
+
+#[test]
+fn the_written_model_round_trips_and_fix_holds_a_parameter() {
+    let out = temp("updated.toml");
+    let (code, v) = json(&[
+        "estimate",
+        "--model",
+        &data("symmetric_rotor.toml"),
+        "--measured",
+        &data("symmetric_rotor.unv"),
+        "--write-model",
+        out.to_str().unwrap(),
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{v}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("# Updated by eigenfit estimate (damped strategy, converged) on "), "{text}");
+    assert!(
+        text.contains("symmetric_rotor.unv") && text.contains("# chi2 = ") && text.contains("95% interval [")
+    );
+    // Read back through --model: the estimate is the new nominal, and estimating again stays there.
+    let (code, again) = json(&[
+        "estimate",
+        "--model",
+        out.to_str().unwrap(),
+        "--measured",
+        &data("symmetric_rotor.unv"),
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0);
+    for name in ["k_drive_end", "k_free_end"] {
+        assert_eq!(again["initial"][name], v["parameters"][name]);
+        let (a, b) = (again["parameters"][name].as_f64().unwrap(), v["parameters"][name].as_f64().unwrap());
+        assert!((a / b - 1.0).abs() < 1e-6, "{name}: {a} vs {b}");
+    }
+    // --fix holds one bearing: only the other is estimated, and reported.
+    let (code, v) = json(&[
+        "estimate",
+        "--model",
+        &data("symmetric_rotor.toml"),
+        "--measured",
+        &data("symmetric_rotor.unv"),
+        "--fix",
+        "k_free_end=8e4",
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{v}");
+    assert_eq!(v["fixed"], serde_json::json!({"k_free_end": 8e4}));
+    assert_eq!(v["parameters"].as_object().unwrap().len(), 1);
+    let k = v["parameters"]["k_drive_end"].as_f64().unwrap();
+    assert!((k / truth()[0] - 1.0).abs() < 0.02, "{k}");
+    let (code, _, err) = run(&[
+        "estimate",
+        "--model",
+        &data("symmetric_rotor.toml"),
+        "--measured",
+        &data("symmetric_rotor.unv"),
+        "--fix",
+        "k_nope=1",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--fix") && err.contains("k_nope"), "{err}");
+}

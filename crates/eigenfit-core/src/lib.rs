@@ -24,6 +24,7 @@ pub mod banded;
 pub mod compare;
 pub mod dense;
 pub mod discovery;
+pub mod fixed;
 mod lanczos;
 pub mod measurement;
 pub mod model;

@@ -61,7 +61,9 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         }
     };
     let initial = parameter_vector(&rotor, "--initial", args.initial.as_deref(), &[])?;
-    let np = rotor.parameters().len();
+    let model = testdata::fixed(&rotor, &args.test_data.fix)?;
+    let initial = model.reduce(&initial);
+    let np = model.parameters().len();
     if measurement.len() < np {
         return Err(input(format!(
             "{}: {} measured modes for {np} parameters: at least {np} are needed",
@@ -78,7 +80,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         )));
     }
     let has_std = measurement.has_std();
-    let problem = Problem::new(&rotor, solver.as_ref(), measurement).with_kind(kind);
+    let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
     let mut fit = testdata::Fit::new(problem, &data, &args.test_data);
     let mut strategy = strategy_kind.build();
     let pb = progress::spinner(&format!("estimating ({})", strategy_kind.name()), args.quiet);
@@ -92,7 +94,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         false => (None, None),
     };
     let mac = fit.mac(&estimate.parameters, args.test_data.mac_threshold);
-    let names: Vec<&str> = rotor.parameters().iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = model.parameters().iter().map(|p| p.name.as_str()).collect();
     // A measured mode below the MAC threshold makes the result not acceptable (exit code 3).
     let converged = estimate.termination.is_converged() && mac.as_ref().is_none_or(|r| r.unpaired.is_empty());
     let plots = match &args.plot {
@@ -145,6 +147,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 Value::Object(obj((0..np).map(|i| json!(u.covariance[(i, i)].sqrt())).collect()));
         }
         testdata::add_json(&mut out, &fit, &data, &estimate, mac.as_ref(), scatter);
+        testdata::add_fixed_json(&mut out, &model);
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
@@ -188,6 +191,12 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         }
         testdata::print(&data, mac.as_ref(), scatter, &fit);
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
+    }
+    if let Some(path) = &args.test_data.write_model {
+        testdata::write_model(path, &args.measured, &model, &estimate, unc.as_ref())?;
+        if !args.json {
+            println!("wrote {}", path.display());
+        }
     }
     Ok(if converged { 0 } else { EXIT_NOT_CONVERGED })
 }
