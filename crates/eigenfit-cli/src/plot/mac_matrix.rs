@@ -48,20 +48,24 @@ impl Figure for MacMatrix {
     fn size(&self) -> (u32, u32) {
         let cols = self.values.first().map_or(1, Vec::len) as u32;
         let rows = self.values.len() as u32;
-        ((200 + 80 * cols).max(640), 200 + 64 * rows)
+        let title = 7 * self.title.chars().count() as u32 + 420;
+        ((200 + 80 * cols).max(640).max(title), 200 + 64 * rows)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let (w, _) = root.dim_in_pixel();
         let centre = Pos::new(HPos::Center, VPos::Center);
         root.draw(&Text::new(
-            format!("{}: MAC, measured against model modes", self.title),
+            "MAC, measured against model modes".to_string(),
             (w as i32 / 2, 26),
             style::text(style::TITLE, INK).pos(centre),
         ))
         .map_err(err)?;
         root.draw(&Text::new(
-            format!("outlined: pairs (blue ≥ {}, red below: unpaired)", self.threshold),
+            format!(
+                "{} — outlined: pairs (blue: MAC ≥ {}, red: below, unpaired)",
+                self.title, self.threshold
+            ),
             (w as i32 / 2, 58),
             style::text(style::LEGEND, style::GUIDE).pos(centre),
         ))
