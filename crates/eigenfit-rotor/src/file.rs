@@ -32,6 +32,9 @@ pub struct RotorSpec {
     /// `[[effect]]` tables: effects switched on (see [`crate::effects`]).
     #[serde(default, rename = "effect", skip_serializing_if = "Vec::is_empty")]
     pub effects: Vec<crate::effects::EffectSpec>,
+    /// `[[parameter]]` tables: more updatable quantities (see [`crate::updatable`]).
+    #[serde(default, rename = "parameter", skip_serializing_if = "Vec::is_empty")]
+    pub parameters: Vec<crate::updatable::ParameterSpec>,
 }
 
 /// A named isotropic material (`[[material]]`).

@@ -59,9 +59,11 @@ mod file;
 mod layout;
 mod model;
 pub mod presets;
+pub mod updatable;
 
 pub use builder::RotorBuilder;
 pub use effects::EffectSpec;
 pub use error::RotorError;
 pub use file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section, ShaftSpec};
 pub use model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
+pub use updatable::{ParameterSpec, UpdatableRotor};
