@@ -12,7 +12,7 @@ use eigenfit_core::{
     EigenSolver, Estimate, Evaluate, Linearisation, Measurement, Pairing, ParameterSet, Problem,
     ResidualError, Uncertainty,
 };
-use eigenfit_rotor::Rotor;
+use eigenfit_rotor::{Rotor, UpdatableRotor};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -47,7 +47,7 @@ pub struct TestDataArgs {
 }
 
 /// The rotor with the `--fix NAME=VALUE` parameters held.
-pub fn fixed<'r>(rotor: &'r Rotor, fixes: &[String]) -> Result<Fixed<&'r Rotor>, CliError> {
+pub fn fixed<'r>(rotor: &'r UpdatableRotor, fixes: &[String]) -> Result<Fixed<&'r UpdatableRotor>, CliError> {
     let mut pairs = Vec::new();
     for f in fixes {
         let (name, value) =
@@ -67,7 +67,7 @@ pub fn fixed<'r>(rotor: &'r Rotor, fixes: &[String]) -> Result<Fixed<&'r Rotor>,
 }
 
 /// `fixed`: the held parameters (name → value), when any.
-pub fn add_fixed_json(out: &mut Value, model: &Fixed<&Rotor>) {
+pub fn add_fixed_json(out: &mut Value, model: &Fixed<&UpdatableRotor>) {
     let held = model.held();
     if !held.is_empty() {
         out["fixed"] = Value::Object(held.into_iter().map(|(n, v)| (n, json!(v))).collect());
@@ -79,13 +79,12 @@ pub fn add_fixed_json(out: &mut Value, model: &Fixed<&Rotor>) {
 pub fn write_model(
     path: &Path,
     data_file: &Path,
-    model: &Fixed<&Rotor>,
+    model: &Fixed<&UpdatableRotor>,
     estimate: &Estimate,
     unc: Option<&Uncertainty>,
 ) -> Result<(), CliError> {
-    let rotor = model.inner();
     let full = model.expand(&estimate.parameters);
-    let updated = rotor.with_stiffnesses(&full).map_err(|e| CliError::Failure(e.to_string()))?;
+    let updated = model.inner().with_values(&full).map_err(CliError::Failure)?;
     let toml = updated.to_toml_string().map_err(|e| CliError::Failure(e.to_string()))?;
     let mut head = format!(
         "# Updated by eigenfit estimate ({} strategy, {}) on {} from {}\n\
@@ -133,6 +132,11 @@ pub struct TestData {
     pub sensors: Option<SensorSet>,
     /// What the user should know (complex modes, ignored directions, skipped datasets).
     pub notes: Vec<String>,
+}
+
+/// The rotor with its `[[parameter]]` tables resolved (docs/rotor-model.md).
+pub fn updatable(rotor: &Rotor, label: &str) -> Result<UpdatableRotor, CliError> {
+    UpdatableRotor::new(rotor.clone()).map_err(|e| input(format!("{label}: {e}")))
 }
 
 /// `simulate --uff`: the lowest `modes` modes at `p` with the rotor's node coordinates.
@@ -221,14 +225,14 @@ pub fn read(path: &Path, rotor: &Rotor, args: &TestDataArgs) -> Result<TestData,
     Ok(TestData { measurement, sensors: Some(set), notes })
 }
 
-type RotorProblem<'a> = Problem<&'a Fixed<&'a Rotor>, &'a dyn EigenSolver>;
+type RotorProblem<'a> = Problem<&'a Fixed<&'a UpdatableRotor>, &'a dyn EigenSolver>;
 
 /// The fitted objective: frequencies only (order pairing), or frequencies and shapes (MAC).
 pub enum Fit<'a> {
     /// Frequencies, paired by order.
     Frequencies(RotorProblem<'a>),
     /// Frequencies and shapes, paired by MAC.
-    Shapes(ShapeFit<&'a Fixed<&'a Rotor>, &'a dyn EigenSolver>),
+    Shapes(ShapeFit<&'a Fixed<&'a UpdatableRotor>, &'a dyn EigenSolver>),
 }
 
 impl<'a> Fit<'a> {

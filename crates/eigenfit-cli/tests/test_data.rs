@@ -247,3 +247,64 @@ fn the_written_model_round_trips_and_fix_holds_a_parameter() {
     assert_eq!(code, 2);
     assert!(err.contains("--fix") && err.contains("k_nope"), "{err}");
 }
+
+/// A `[[parameter]]` disk mass beside the bearings: estimated from a universal file written at
+/// other values, and written back into the model.
+#[test]
+fn a_declared_disk_mass_is_estimated_and_written_back() {
+    let base = std::fs::read_to_string(data("symmetric_rotor.toml")).unwrap();
+    // The "test rig": a heavier drive-end disk and other bearings.
+    let rig = temp("rig.toml");
+    std::fs::write(&rig, base.replacen("mass = 1.0", "mass = 1.3", 1)).unwrap();
+    let file = temp("rig.unv");
+    let (code, out, err) = run(&[
+        "simulate",
+        "--model",
+        rig.to_str().unwrap(),
+        "--stiffness",
+        "2e5,1.5e5",
+        "--modes",
+        "4",
+        "--uff",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    let model = temp("with-disk-mass.toml");
+    std::fs::write(&model, format!("{base}\n[[parameter]]\nkind = \"disk-mass\"\nindex = 0\n")).unwrap();
+    let updated = temp("with-disk-mass-updated.toml");
+    let (code, v) = json(&[
+        "estimate",
+        "--model",
+        model.to_str().unwrap(),
+        "--measured",
+        file.to_str().unwrap(),
+        "--write-model",
+        updated.to_str().unwrap(),
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{v}");
+    for (name, want) in [("k_drive_end", 2e5), ("k_free_end", 1.5e5), ("m_disk_0", 1.3)] {
+        let got = v["parameters"][name].as_f64().unwrap();
+        assert!((got / want - 1.0).abs() < 1e-4, "{name}: {got}");
+    }
+    let text = std::fs::read_to_string(&updated).unwrap();
+    assert!(text.contains("# m_disk_0 = 1.3") && text.contains("kind = \"disk-mass\""), "{text}");
+    let (code, again) = json(&["simulate", "--model", updated.to_str().unwrap(), "--modes", "2", "--json"]);
+    assert_eq!(code, 0);
+    let (_, rig_f) = json(&[
+        "simulate",
+        "--model",
+        rig.to_str().unwrap(),
+        "--stiffness",
+        "2e5,1.5e5",
+        "--modes",
+        "2",
+        "--json",
+    ]);
+    for (a, b) in
+        again["frequencies_hz"].as_array().unwrap().iter().zip(rig_f["frequencies_hz"].as_array().unwrap())
+    {
+        assert!((a.as_f64().unwrap() / b.as_f64().unwrap() - 1.0).abs() < 1e-5);
+    }
+}

@@ -60,8 +60,9 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             return Err(input(format!("unknown residual `{other}`; available: relative, hz, eigenvalue")))
         }
     };
-    let initial = parameter_vector(&rotor, "--initial", args.initial.as_deref(), &[])?;
-    let model = testdata::fixed(&rotor, &args.test_data.fix)?;
+    let updatable = testdata::updatable(&rotor, &label)?;
+    let initial = parameter_vector(&updatable, "--initial", args.initial.as_deref(), &[])?;
+    let model = testdata::fixed(&updatable, &args.test_data.fix)?;
     let initial = model.reduce(&initial);
     let np = model.parameters().len();
     if measurement.len() < np {
