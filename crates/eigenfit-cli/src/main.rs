@@ -28,6 +28,8 @@ enum Command {
     Simulate(commands::simulate::SimulateArgs),
     /// Update the bearing stiffnesses to match measured frequencies.
     Estimate(commands::estimate::EstimateArgs),
+    /// Estimate jointly from several test configurations (a campaign file).
+    Campaign(commands::campaign::CampaignArgs),
     /// Compare update strategies over targets and a grid of initial guesses.
     Compare(commands::compare::CompareArgs),
     /// Find where model and measurement disagree, name the missing effect and add it.
@@ -43,6 +45,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(a) => commands::simulate::run(a).map(|()| error::EXIT_OK),
         Command::Estimate(a) => commands::estimate::run(a),
+        Command::Campaign(a) => commands::campaign::run(a),
         Command::Compare(a) => commands::compare::run(a).map(|()| error::EXIT_OK),
         Command::Discover(a) => commands::discover::run(a).map(|()| error::EXIT_OK),
         Command::Demo(a) => commands::demo::run(a).map(|()| error::EXIT_OK),

@@ -308,3 +308,102 @@ fn a_declared_disk_mass_is_estimated_and_written_back() {
         assert!((a.as_f64().unwrap() / b.as_f64().unwrap() - 1.0).abs() < 1e-5);
     }
 }
+
+/// A campaign: the symmetric rotor's frequencies (which cannot tell the sides apart) with a
+/// second run carrying a test mass off-centre (which breaks the symmetry): jointly, frequencies
+/// alone put the bearings on the right sides.
+#[test]
+fn a_campaign_with_a_test_mass_tells_the_sides_apart_from_frequencies() {
+    let dir = temp("campaign");
+    std::fs::create_dir_all(&dir).unwrap();
+    let base = std::fs::read_to_string(data("symmetric_rotor.toml")).unwrap();
+    std::fs::write(dir.join("rotor.toml"), &base).unwrap();
+    std::fs::write(
+        dir.join("rotor-test-mass.toml"),
+        format!("{base}\n[[point_mass]]\nnode = 3\nmass = 0.5\n"),
+    )
+    .unwrap();
+    let j: Value =
+        serde_json::from_str(&std::fs::read_to_string(data("symmetric_rotor.json")).unwrap()).unwrap();
+    let mut a = String::from("mode,frequency_hz\n");
+    for m in j["modes"].as_array().unwrap() {
+        a += &format!("{},{}\n", m["mode"], m["frequency_hz"]);
+    }
+    std::fs::write(dir.join("run-a.csv"), a).unwrap();
+    let truth = truth();
+    let (_, sim) = json(&[
+        "simulate",
+        "--model",
+        dir.join("rotor-test-mass.toml").to_str().unwrap(),
+        "--stiffness",
+        &format!("{},{}", truth[0], truth[1]),
+        "--modes",
+        "3",
+        "--json",
+    ]);
+    let mut b = String::from("mode,frequency_hz\n");
+    for (k, f) in sim["frequencies_hz"].as_array().unwrap().iter().enumerate() {
+        b += &format!("{},{f}\n", k + 1);
+    }
+    std::fs::write(dir.join("run-b.csv"), b).unwrap();
+    std::fs::write(
+        dir.join("campaign.toml"),
+        "[[configuration]]\nname = \"as built\"\nmodel = \"rotor.toml\"\nmeasured = \"run-a.csv\"\n\n\
+         [[configuration]]\nname = \"test mass at node 3\"\nmodel = \"rotor-test-mass.toml\"\nmeasured = \"run-b.csv\"\n",
+    )
+    .unwrap();
+    let (code, v) = json(&["campaign", dir.join("campaign.toml").to_str().unwrap(), "--json", "--quiet"]);
+    assert_eq!(code, 0, "{v}");
+    let k =
+        [v["parameters"]["k_drive_end"].as_f64().unwrap(), v["parameters"]["k_free_end"].as_f64().unwrap()];
+    assert!(k.iter().zip(truth).all(|(a, b)| (a / b - 1.0).abs() < 0.02), "{k:?}");
+    assert_eq!(v["configurations"].as_array().unwrap().len(), 2);
+    assert_eq!(v["configurations"][1]["name"], "test mass at node 3");
+    // A configuration that names a missing file is an error naming it.
+    std::fs::write(
+        dir.join("bad.toml"),
+        "[[configuration]]\nmodel = \"rotor.toml\"\nmeasured = \"nope.csv\"\n",
+    )
+    .unwrap();
+    let (code, _, err) = run(&["campaign", dir.join("bad.toml").to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("configuration 0") && err.contains("nope.csv"), "{err}");
+}
+
+#[test]
+fn a_sensor_map_ties_sensors_like_coordinates_do() {
+    let map = temp("map.csv");
+    std::fs::write(
+        &map,
+        "node,model_node,direction,sign\n101,0,y,1\n102,2,y,1\n103,5,2,1\n104,8,y,1\n105,10,y,1\n",
+    )
+    .unwrap();
+    let args = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = [
+            "estimate",
+            "--model",
+            &data("symmetric_rotor.toml"),
+            "--measured",
+            &data("symmetric_rotor.unv"),
+            "--json",
+            "--quiet",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let by_map = args(&["--sensor-map", map.to_str().unwrap()]);
+    let (code, a) = json(&by_map.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code, 0, "{a}");
+    let (_, b) = json(&args(&[]).iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(a["parameters"], b["parameters"]);
+    std::fs::write(&map, "node,model_node,direction\n101,11,y\n").unwrap();
+    let (code, _, err) = run(&by_map.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("map.csv: sensor map line 2: model_node `11` must be a node of the model, 0 … 10"),
+        "{err}"
+    );
+}

@@ -52,6 +52,7 @@
 //! ```
 
 mod builder;
+pub mod campaign;
 pub mod effects;
 pub mod element;
 mod error;

@@ -1,0 +1,71 @@
+//! Test campaigns: several configurations of one rotor (added test masses, a changed bearing),
+//! each a model file with its measured data, estimated jointly. The campaign file (TOML):
+//!
+//! ```toml
+//! [[configuration]]
+//! name = "as built"             # optional; default `configuration <i>`
+//! model = "rotor.toml"          # paths relative to the campaign file
+//! measured = "run1.unv"         # CSV or universal file
+//! # shapes = "run1-shapes.csv"  # shapes beside a CSV, optional
+//! # sensor_map = "map.csv"      # sensor map for a universal file, optional
+//! ```
+//!
+//! Parameters of the same name in several configurations are one parameter.
+
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// A campaign file.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Campaign {
+    /// The `[[configuration]]` tables, paths resolved against the campaign file's folder.
+    #[serde(rename = "configuration", default)]
+    pub configurations: Vec<Configuration>,
+}
+
+/// One `[[configuration]]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Configuration {
+    /// Name for reports.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Rotor model file.
+    pub model: PathBuf,
+    /// Measured data (CSV or universal file).
+    pub measured: PathBuf,
+    /// Shapes CSV beside a CSV `measured`.
+    #[serde(default)]
+    pub shapes: Option<PathBuf>,
+    /// Sensor map for a universal file.
+    #[serde(default)]
+    pub sensor_map: Option<PathBuf>,
+}
+
+impl Campaign {
+    /// Reads a campaign file; errors name the file (and the line for syntax errors).
+    pub fn from_toml_file(path: &Path) -> Result<Self, String> {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        let mut c: Campaign = toml::from_str(&text).map_err(|e| {
+            let line = e.span().map(|s| text[..s.start].matches('\n').count() + 1);
+            match line {
+                Some(l) => format!("{}:{l}: {}", path.display(), e.message()),
+                None => format!("{}: {}", path.display(), e.message()),
+            }
+        })?;
+        if c.configurations.is_empty() {
+            return Err(format!("{}: no [[configuration]]", path.display()));
+        }
+        let dir = path.parent().unwrap_or(Path::new("."));
+        for (i, conf) in c.configurations.iter_mut().enumerate() {
+            conf.name.get_or_insert_with(|| format!("configuration {i}"));
+            conf.model = dir.join(&conf.model);
+            conf.measured = dir.join(&conf.measured);
+            conf.shapes = conf.shapes.as_ref().map(|p| dir.join(p));
+            conf.sensor_map = conf.sensor_map.as_ref().map(|p| dir.join(p));
+        }
+        Ok(c)
+    }
+}
