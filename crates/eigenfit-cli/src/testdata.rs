@@ -205,13 +205,30 @@ pub fn read(path: &Path, rotor: &Rotor, args: &TestDataArgs) -> Result<TestData,
         return Err(input("--shapes applies to a CSV --measured; a universal file carries its own shapes"));
     }
     let at = |e: String| input(format!("{}: {e}", path.display()));
-    let file = uff::parse(&read_text(path)?)
+    let mut file = uff::parse(&read_text(path)?)
         .map_err(|e| input(format!("{}:{}: {}", path.display(), e.line, e.message)))?;
     let set = match &args.sensor_map {
         Some(map) => sensors::map_explicit(&file, rotor, &read_text(map)?)
             .map_err(|e| input(format!("{}: {e}", map.display())))?,
         None => {
-            sensors::map_by_coordinates(&file, rotor, args.node_tolerance).map_err(|e| at(e.to_string()))?
+            match sensors::map_by_coordinates(&file, rotor, args.node_tolerance) {
+                Ok(set) => set,
+                // Test systems often export millimetres without saying so (no dataset 164):
+                // accept that reading when it ties every node, and say so.
+                Err(e) if file.length_factor.is_none() => {
+                    let mut mm = file.clone();
+                    mm.nodes.iter_mut().for_each(|n| n.coordinates.iter_mut().for_each(|c| *c /= 1000.0));
+                    let set = sensors::map_by_coordinates(&mm, rotor, args.node_tolerance)
+                        .map_err(|_| at(e.to_string()))?;
+                    file.warnings.push(
+                        "no units dataset (164) and the node coordinates match the model only as millimetres: \
+                         read as mm"
+                            .into(),
+                    );
+                    set
+                }
+                Err(e) => return Err(at(e.to_string())),
+            }
         }
     };
     let measurement = sensors::measurement(&file, &set).map_err(|e| at(e.to_string()))?;

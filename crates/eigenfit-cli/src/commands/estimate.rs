@@ -65,7 +65,9 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let model = testdata::fixed(&updatable, &args.test_data.fix)?;
     let initial = model.reduce(&initial);
     let np = model.parameters().len();
-    if measurement.len() < np {
+    // With shapes every mode gives a row per sensor too: fewer modes than parameters may do.
+    let rows = measurement.len() * (1 + data.sensors.as_ref().map_or(0, |s| s.sensors.len()));
+    if rows < np {
         return Err(input(format!(
             "{}: {} measured modes for {np} parameters: at least {np} are needed",
             args.measured.display(),

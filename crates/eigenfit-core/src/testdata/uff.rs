@@ -56,6 +56,8 @@ pub struct UffFile {
     pub skipped: Vec<(String, usize)>,
     /// Things a user should know (complex modes made real, units converted).
     pub warnings: Vec<String>,
+    /// The length factor of dataset 164 (file units per metre), when the file has one.
+    pub length_factor: Option<f64>,
 }
 
 /// A universal file could not be read; `line` is 1-based.
@@ -177,7 +179,10 @@ pub fn parse(text: &str) -> Result<UffFile, UffError> {
             "15" => read_nodes(&block, false, &mut out.nodes, &mut node_lines)?,
             "2411" => read_nodes(&block, true, &mut out.nodes, &mut node_lines)?,
             "55" => out.modes.push(read_55(&block, start)?),
-            "164" => length_factor = read_164(&block)?,
+            "164" => {
+                length_factor = read_164(&block)?;
+                out.length_factor = Some(length_factor);
+            }
             other if other.ends_with('b') => {
                 return err(
                     hn,
