@@ -38,7 +38,8 @@ impl MacReport {
             .enumerate()
             .map(|(i, (&(n, _), &k))| (n + 1, k + 1, matrix[i][i]))
             .collect();
-        let unpaired = pairing.iter().filter(|p| !(p.2 >= threshold)).map(|p| p.0).collect();
+        // A NaN MAC (a zero shape) counts as unpaired too.
+        let unpaired = pairing.iter().filter(|p| p.2 < threshold || p.2.is_nan()).map(|p| p.0).collect();
         let mut swapped = Vec::new();
         for a in 0..pairing.len() {
             for b in a + 1..pairing.len() {

@@ -274,7 +274,7 @@ fn read_55(block: &Block, start: usize) -> Result<UffMode, UffError> {
             )
         }
     };
-    if !(1..=6).contains(&per_node) && !(complex && per_node == 12) {
+    if !((1..=6).contains(&per_node) || complex && per_node == 12) {
         return err(line6, format!("dataset 55: {per_node} values per node; 1 to 6 are supported"));
     }
     t.next_record();
