@@ -231,8 +231,9 @@ pub fn read(path: &Path, rotor: &Rotor, args: &TestDataArgs) -> Result<TestData,
             }
         }
     };
-    let measurement = sensors::measurement(&file, &set).map_err(|e| at(e.to_string()))?;
+    let (measurement, left_out) = sensors::measurement(&file, &set).map_err(|e| at(e.to_string()))?;
     let mut notes = file.warnings.clone();
+    notes.extend(left_out);
     for ignored in &set.ignored {
         notes.push(format!("the planar rotor has no {ignored}: ignored"));
     }

@@ -30,14 +30,27 @@ const TRUTH: [f64; 2] = [2.5e5, 0.8e5];
 fn written_modes_map_back_onto_the_model_dofs() {
     let rotor = symmetric();
     let modes = DenseSolver.lowest(&rotor.nominal_system().unwrap(), 4).unwrap();
-    let (nodes, uff_modes) = rotor.uff_modes(&modes);
+    let (nodes, mut uff_modes) = rotor.uff_modes(&modes);
+    // A horizontal-plane mode (x only), as a 3-D model would export beside the vertical ones.
+    let mut horizontal = uff_modes[0].clone();
+    horizontal.number = 5;
+    horizontal.values.iter_mut().for_each(|(_, v)| *v = vec![v[1], 0.0, 0.0, 0.0, v[3], 0.0]);
+    uff_modes.push(horizontal);
     let file = uff::parse(&uff::write("round trip", &nodes, &uff_modes)).unwrap();
     let set = sensors::map_by_coordinates(&file, &rotor, 1e-6).unwrap();
-    let measurement = sensors::measurement(&file, &set).unwrap();
+    let (measurement, notes) = sensors::measurement(&file, &set).unwrap();
+    assert_eq!(notes.len(), 1);
+    assert!(
+        notes[0].starts_with("mode 5 (")
+            && notes[0].ends_with("moves only in directions the model does not have: left out")
+    );
+    assert_eq!(
+        set.ignored,
+        ["x at node(s) 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11", "ry at node(s) 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11"]
+    );
     assert_eq!(measurement.len(), 4);
     // Every node's y and rx are sensors (x, z, ry, rz are zero: not measured).
     assert_eq!(set.sensors.len(), 2 * rotor.nodes().len());
-    assert!(set.ignored.is_empty());
     for (k, m) in measurement.modes().iter().enumerate() {
         assert!((m.frequency_hz / modes.frequencies_hz()[k] - 1.0).abs() < 5e-6);
         let big = modes.shape(k).iter().fold(0.0_f64, |a, v| a.max(v.abs()));
@@ -79,7 +92,8 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
     let (file, _) = fixture();
     let rotor = symmetric();
     let set = sensors::map_by_coordinates(&file, &rotor, 1e-3).unwrap();
-    let measured = sensors::measurement(&file, &set).unwrap();
+    let (measured, notes) = sensors::measurement(&file, &set).unwrap();
+    assert!(notes.is_empty());
     let start = [0.9e5, 2.0e5];
 
     let without_shapes =

@@ -278,7 +278,11 @@ fn build(
 /// The measured modes of `file` at `sensors`: frequencies and shapes (value × sign; a node a
 /// mode does not list counts as an error naming both). Modes keep the file's numbers when they
 /// are distinct and ≥ 1, else they are numbered 1, 2, … in file order.
-pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<Measurement, SensorError> {
+///
+/// A mode that moves (almost) only in directions the model lacks — an x-plane mode of a rotor
+/// exported from a 3-D model, for the planar rotor — is left out, with a note (the second
+/// value): its motion at the sensors is below 1e-3 of its motion overall.
+pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<(Measurement, Vec<String>), SensorError> {
     if file.modes.is_empty() {
         return Err(SensorError::Measurement("the file has no mode (dataset 55)".into()));
     }
@@ -293,6 +297,7 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<Measurement, S
         numbers = (1..=file.modes.len() as i64).collect();
     }
     let mut modes = Vec::with_capacity(file.modes.len());
+    let mut notes = Vec::new();
     for (m, &number) in file.modes.iter().zip(&numbers) {
         let shape = sensors
             .sensors
@@ -308,11 +313,20 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<Measurement, S
                 })
             })
             .collect::<Result<Vec<f64>, _>>()?;
-        if shape.iter().all(|v| *v == 0.0) {
+        let at_sensors: f64 = shape.iter().map(|v| v * v).sum();
+        let overall: f64 = m.values.iter().flat_map(|(_, v)| v.iter()).map(|v| v * v).sum();
+        if overall == 0.0 {
             return Err(SensorError::Measurement(format!(
-                "mode {} (dataset 55 at line {}) is zero at every sensor",
+                "mode {} (dataset 55 at line {}) is zero at every node",
                 m.number, m.line
             )));
+        }
+        if at_sensors <= 1e-6 * overall {
+            notes.push(format!(
+                "mode {} ({:.4} Hz, dataset 55 at line {}) moves only in directions the model does not have: left out",
+                m.number, m.frequency_hz, m.line
+            ));
+            continue;
         }
         modes.push(MeasuredMode {
             mode: (number - 1) as usize,
@@ -321,7 +335,10 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<Measurement, S
             shape: Some(shape),
         });
     }
-    Measurement::new(modes).map_err(|e| SensorError::Measurement(e.to_string()))
+    if modes.is_empty() {
+        return Err(SensorError::Measurement("no mode moves in a direction the model has".into()));
+    }
+    Ok((Measurement::new(modes).map_err(|e| SensorError::Measurement(e.to_string()))?, notes))
 }
 
 /// Adds measured shapes from CSV text to frequency data: header `mode,node,direction,value`,
