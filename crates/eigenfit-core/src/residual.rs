@@ -281,13 +281,20 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
                     .collect();
                 let mut taken = vec![false; model_at_sensors.len()];
                 let mut out = Vec::with_capacity(shapes.len());
-                for s in shapes {
-                    let best = (0..model_at_sensors.len())
-                        .filter(|&k| !taken[k])
-                        .max_by(|&a, &b| {
-                            mac(s, &model_at_sensors[a]).total_cmp(&mac(s, &model_at_sensors[b]))
-                        })
+                for (s, m) in shapes.into_iter().zip(self.measured.modes()) {
+                    let macs: Vec<f64> = model_at_sensors.iter().map(|a| mac(s, a)).collect();
+                    let free = || (0..macs.len()).filter(|&k| !taken[k]);
+                    let top = free()
+                        .map(|k| macs[k])
+                        .fold(None, |b: Option<f64>, v| Some(b.map_or(v, |b| b.max(v))))
                         .ok_or_else(|| ResidualError::Mac("more measured modes than model modes".into()))?;
+                    // MACs equal to round-off (one sensor, a symmetric layout) cannot choose:
+                    // the mode nearest in frequency does.
+                    let gap = |k: usize| (eigenvalue_to_hz(sens.modes.eigenvalues[k]) - m.frequency_hz).abs();
+                    let best = free()
+                        .filter(|&k| macs[k] >= top - 1e-9)
+                        .min_by(|&a, &b| gap(a).total_cmp(&gap(b)))
+                        .unwrap_or(0);
                     taken[best] = true;
                     out.push(best);
                 }

@@ -3,7 +3,8 @@
 //! Axes as in ROSS: the shaft axis is z, x horizontal, y vertical. The planar rotor vibrates in
 //! the y–z plane: its translation vᵢ is y (universal-file direction 2) and its rotation about x
 //! (direction 4) is rx = −θᵢ, because a right-hand rotation about x by α moves the axis point at
-//! z to y = −αz, so the slope θ = dv/dz is −α.
+//! z to y = −αz, so the slope θ = dv/dz is −α. Measured points tie to nodes by their axial
+//! position z alone (sensors sit on the surface, not on the axis).
 
 use crate::model::Rotor;
 use eigenfit_core::testdata::{NodeLayout, UffMode, UffNode};
@@ -23,6 +24,12 @@ impl NodeLayout for Rotor {
             4 => Some((Rotor::rotation_dof(node), -1.0)),
             _ => None,
         }
+    }
+
+    /// Along the axis only: a beam model's node stands for its whole cross-section, so a sensor
+    /// on the shaft's surface or a bearing housing (x, y ≠ 0) ties to the node at its z.
+    fn distance_to_node(&self, at: &[f64; 3], node: usize) -> f64 {
+        (at[2] - self.nodes()[node]).abs()
     }
 }
 

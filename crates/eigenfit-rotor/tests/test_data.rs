@@ -77,11 +77,21 @@ fn the_independent_model_agrees_and_sensors_map_by_coordinates() {
     assert_eq!(set.sensors.iter().map(|s| s.model_node).collect::<Vec<_>>(), [0, 2, 5, 8, 10]);
     assert_eq!(set.ignored, ["x at node(s) 101, 102, 103, 104, 105"]);
 
+    // A sensor off the axis (on the shaft's surface) still ties to its axial node.
+    let mut surface = file.clone();
+    surface.nodes[1].coordinates[0] = 0.007;
+    surface.nodes[1].coordinates[1] = -0.05;
+    let on_surface = sensors::map_by_coordinates(&surface, &rotor, 1e-3).unwrap();
+    assert_eq!(on_surface.sensors, set.sensors);
+
     // A node off the model names itself and its nearest model node.
     let mut moved = file.clone();
     moved.nodes[2].coordinates[2] += 0.01;
     let e = sensors::map_by_coordinates(&moved, &rotor, 1e-3).unwrap_err().to_string();
-    assert!(e.contains("node 103 at (0, 0, 0.26") && e.contains("nearest model node 5"), "{e}");
+    assert!(
+        e.contains("node 103 at (0, 0, 0.26") && e.contains("nearest model node 5 is 0.0100 m away"),
+        "{e}"
+    );
 }
 
 /// Frequencies alone cannot tell the bearings apart: a frequency-only fit and its mirror
@@ -126,4 +136,28 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
     let (at, at_mirror) =
         (Evaluate::cost(&fit, &est.parameters).unwrap(), Evaluate::cost(&fit, &mirror).unwrap());
     assert!(at_mirror > 100.0 * at, "{at} vs mirror {at_mirror}");
+}
+
+/// One sensor gives every MAC = 1 (to round-off): the mode nearest in frequency is taken.
+#[test]
+fn equal_macs_pair_with_the_lowest_mode() {
+    let rotor = symmetric();
+    let p = rotor.nominal_stiffnesses();
+    let modes = DenseSolver.lowest(&rotor.nominal_system().unwrap(), 3).unwrap();
+    let f = modes.frequencies_hz();
+    let dof = Rotor::displacement_dof(2);
+    let measured = Measurement::new(
+        (0..3)
+            .map(|k| eigenfit_core::MeasuredMode {
+                mode: k,
+                frequency_hz: f[k],
+                std_hz: None,
+                shape: Some(vec![modes.shapes[(dof, k)]]),
+            })
+            .collect(),
+    )
+    .unwrap();
+    let problem =
+        Problem::new(&rotor, DenseSolver, measured).with_pairing(Pairing::Mac { sensor_dofs: vec![dof] });
+    assert_eq!(problem.linearise(&p).unwrap().paired_modes, [0, 1, 2]);
 }

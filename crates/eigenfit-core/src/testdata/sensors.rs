@@ -20,6 +20,12 @@ pub trait NodeLayout {
     /// turns a measured value in that direction into that DOF; `None` when the model does not
     /// have that direction.
     fn dof(&self, node: usize, direction: u8) -> Option<(usize, f64)>;
+    /// How far a measured point at `at` is from model node `node`, for matching (m). Euclidean
+    /// by default; a beam model may measure along its axis only, since a sensor on the shaft's
+    /// surface or a bearing housing sees the axis node's lateral motion.
+    fn distance_to_node(&self, at: &[f64; 3], node: usize) -> f64 {
+        distance(at, &self.node_coordinates()[node])
+    }
 }
 
 /// One measured channel tied to a model DOF.
@@ -113,10 +119,8 @@ pub fn map_by_coordinates(
     let mut node_of = HashMap::new();
     for &label in &labels {
         let c = coords[&label];
-        let (best, d) = model
-            .iter()
-            .enumerate()
-            .map(|(i, m)| (i, distance(&c, m)))
+        let (best, d) = (0..model.len())
+            .map(|i| (i, layout.distance_to_node(&c, i)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap_or((0, f64::INFINITY));
         if d <= tolerance {
