@@ -64,7 +64,7 @@ const CASES: &[Case] = &[
     model("model/unclosed_table.toml", "model/unclosed_table.toml: line 1, column 11: invalid table header\nexpected `.`, `]]`"),
     model("model/unknown_key.toml", "model/unknown_key.toml: line 9, column 1: unknown field `diamter`, expected one of `nodes`, `length`, `elements`, `diameter`, `inner_diameter`, `material`, `section`"),
     model("model/unknown_material.toml", "model/unknown_material.toml: line 10: shaft: unknown material `stainless` (defined: `steel`)"),
-    model("model/unknown_table.toml", "model/unknown_table.toml: line 21, column 3: unknown field `bearings`, expected one of `material`, `shaft`, `disk`, `bearing`, `point_mass`, `effect`"),
+    model("model/unknown_table.toml", "model/unknown_table.toml: line 21, column 3: unknown field `bearings`, expected one of `material`, `shaft`, `disk`, `bearing`, `point_mass`, `effect`, `parameter`"),
     model("model/wrong_type.toml", "model/wrong_type.toml: line 8, column 12: invalid type: string \"ten\", expected usize"),
     model("model/zero_diameter.toml", "model/zero_diameter.toml: line 9: shaft: diameter = 0 is invalid: it must be finite and > 0"),
     model("model/zero_length.toml", "model/zero_length.toml: line 7: shaft: length = 0 is invalid: it must be finite and > 0"),

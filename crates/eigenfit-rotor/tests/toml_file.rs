@@ -54,7 +54,7 @@ fn unknown_key_is_named_with_position() {
     assert_eq!(
         error(&text),
         "line 12, column 3: unknown field `disc`, expected one of `material`, `shaft`, `disk`, \
-         `bearing`, `point_mass`, `effect`"
+         `bearing`, `point_mass`, `effect`, `parameter`"
     );
 }
 
@@ -66,7 +66,7 @@ fn missing_field_is_named_with_position() {
     assert_eq!(
         error(&text),
         "line 7, column 2: unknown field `axle`, expected one of `material`, `shaft`, `disk`, \
-         `bearing`, `point_mass`, `effect`"
+         `bearing`, `point_mass`, `effect`, `parameter`"
     );
 }
 
