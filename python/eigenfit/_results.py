@@ -53,7 +53,7 @@ class Result:
     @property
     def model(self) -> str:
         """The model's label: the preset name or the model file path."""
-        return self._data["model"]
+        return str(self._data["model"])
 
     def __getitem__(self, key: str) -> Any:
         return copy.deepcopy(self._data[key])
@@ -65,7 +65,7 @@ class Result:
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        return self._data == other._data and self._exit_code == other._exit_code  # type: ignore[attr-defined]
+        return self._data == other._data and self._exit_code == other._exit_code
 
     __hash__ = None  # type: ignore[assignment]  # mutable contents
 
@@ -84,7 +84,7 @@ class SimulateResult(Result):
     @property
     def solver(self) -> str:
         """The eigen-solver used."""
-        return self._data["solver"]
+        return str(self._data["solver"])
 
     @property
     def frequencies_hz(self) -> Optional[np.ndarray]:
@@ -130,12 +130,12 @@ class EstimateResult(Result):
     @property
     def termination(self) -> str:
         """Why the iteration stopped."""
-        return self._data["termination"]
+        return str(self._data["termination"])
 
     @property
     def strategy(self) -> str:
         """The update strategy used."""
-        return self._data["strategy"]
+        return str(self._data["strategy"])
 
     @property
     def iterations(self) -> int:

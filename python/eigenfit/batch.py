@@ -68,7 +68,7 @@ def map(
     n = len(merged)
     # pure=False: two identical jobs are still two tasks (Dask would otherwise merge them by key).
     futures = client.map(_run_job, [function] * n, merged, [errors] * n, pure=False)
-    return client.gather(futures)
+    return list(client.gather(futures))
 
 
 def estimate_many(

@@ -65,7 +65,8 @@ pub fn run_json(args: &[String]) -> Result<(serde_json::Value, u8), CliError> {
     if !args.iter().any(|a| a == "--json") {
         argv.push("--json".to_string());
     }
-    let cli = Cli::try_parse_from(&argv).map_err(|e| CliError::Input(e.to_string().trim_end().to_string()))?;
+    let cli =
+        Cli::try_parse_from(&argv).map_err(|e| CliError::Input(e.to_string().trim_end().to_string()))?;
     let (outcome, value) =
         output::capture_json(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&cli))));
     let code = match outcome {
