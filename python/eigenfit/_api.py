@@ -6,7 +6,7 @@ import os
 from typing import Any, Mapping, Optional, Sequence, Type, TypeVar, Union
 
 from . import _native
-from ._args import TempFiles, measured_args, model_args, option_args
+from ._args import TempFiles, is_ross_rotor, measured_args, model_args, option_args
 from ._results import CompareResult, DiscoverResult, EstimateResult, Result, SimulateResult
 
 #: A preset name (``"paper-rotor"``), a model file path, or (once the CLI reads ROSS files) a
@@ -53,7 +53,16 @@ def _call(command: str, result_class: Type[R], model: Model, measured: Optional[
         if measured is not None:
             args += measured_args(measured, tmp)
         args += option_args({**options, "quiet": True})
-        return run(args, result_class)
+        try:
+            return run(args, result_class)
+        except EigenfitError as e:
+            if is_ross_rotor(model) and e.exit_code == 2:
+                # The message names a temporary file the user never saw: say what it was.
+                raise EigenfitError(
+                    f"model: the ROSS Rotor, saved with rotor.save() for eigenfit to read: {e.message}",
+                    e.exit_code,
+                ) from None
+            raise
 
 
 def simulate(

@@ -114,10 +114,14 @@ def model_args(model: Any, tmp: TempFiles) -> list[str]:
     )
 
 
+def is_ross_rotor(model: Any) -> bool:
+    """Whether `model` is a ROSS rotor object (checked by module, so ROSS need not be installed)."""
+    return type(model).__module__.split(".")[0] == "ross" and hasattr(model, "save")
+
+
 def _save_ross_rotor(model: Any, tmp: TempFiles) -> Optional[Path]:
-    """A ROSS ``Rotor`` saved to a temporary file for the CLI's ROSS reader, or None."""
-    cls = type(model)
-    if not cls.__module__.startswith("ross") or not hasattr(model, "save"):
+    """A ROSS ``Rotor`` saved (``rotor.save``) to a temporary file for the CLI to read, or None."""
+    if not is_ross_rotor(model):
         return None
     path = tmp.path("rotor.toml")
     model.save(path)

@@ -166,3 +166,36 @@ def test_concurrent_threads_get_their_own_results():
 def test_run_passes_arguments_through():
     r = eigenfit.run(["simulate", "--preset", "uniform-rotor", "--elements", "8", "--modes", "2"], eigenfit.SimulateResult)
     assert r.model == "uniform-rotor" and r.frequencies_hz.shape == (2,)
+
+
+class _FakeRossRotor:
+    """Stands in for ross.Rotor (same module name, a save(path) method) to test the plumbing:
+    the object is saved to a temporary file that the CLI reads, and errors say what it was."""
+
+    __module__ = "ross.rotor_assembly"
+
+    def __init__(self, text):
+        self.text = text
+        self.saved_to = None
+
+    def save(self, path):
+        self.saved_to = path
+        path.write_text(self.text, encoding="utf-8")
+
+
+def test_rotor_object_is_saved_to_a_temporary_file_the_cli_reads(examples):
+    rotor = _FakeRossRotor((examples / "rotor.toml").read_text(encoding="utf-8"))
+    r = eigenfit.simulate(rotor, modes=3)
+    np.testing.assert_array_equal(r.frequencies_hz, eigenfit.simulate(examples / "rotor.toml", modes=3).frequencies_hz)
+    assert rotor.saved_to is not None and not rotor.saved_to.exists()  # removed after the call
+
+
+def test_unreadable_rotor_object_names_what_it_was():
+    with pytest.raises(eigenfit.EigenfitError, match="the ROSS Rotor, saved with rotor.save()") as info:
+        eigenfit.simulate(_FakeRossRotor("not a rotor ["), modes=2)
+    assert info.value.exit_code == 2
+
+
+def test_other_objects_are_refused():
+    with pytest.raises(TypeError, match="preset name or a model file path"):
+        eigenfit.simulate(42)
