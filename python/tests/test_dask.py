@@ -31,14 +31,21 @@ def client():
         yield c
 
 
-def test_cluster_results_equal_serial(client):
+@pytest.fixture(scope="module")
+def fleet():
     jobs = _fleet(12)
-    serial = eigenfit.batch.estimate_many(jobs)
-    on_cluster = eigenfit.batch.estimate_many(jobs, client=client)
+    return jobs, eigenfit.batch.estimate_many(jobs)
+
+
+@pytest.mark.parametrize("chunk_size", [None, 1, 5])  # automatic (2 jobs), one per task, uneven
+def test_cluster_results_equal_serial(client, fleet, chunk_size):
+    jobs, serial = fleet
+    on_cluster = eigenfit.batch.estimate_many(jobs, client=client, chunk_size=chunk_size)
     assert [r.to_dict() for r in on_cluster] == [r.to_dict() for r in serial]
     assert all(isinstance(r, eigenfit.EstimateResult) and r.converged for r in on_cluster)
-    # Both workers took part (12 tasks, one thread each).
     assert len(client.scheduler_info()["workers"]) == 2
+    with pytest.raises(ValueError, match="chunk_size"):
+        eigenfit.batch.estimate_many(jobs, client=client, chunk_size=0)
 
 
 def test_cluster_failed_job_is_returned_or_raised(client):
