@@ -183,6 +183,17 @@ class EstimateResult(Result):
         return dict(self._data.get("standard_deviations", {}))
 
     @property
+    def identifiable(self) -> Dict[str, bool]:
+        """Whether the data determine each parameter (an entry's bound, if any, is in
+        ``result["identifiable"]``); empty when no uncertainty was computed."""
+        return {k: v is True for k, v in self._data.get("identifiable", {}).items()}
+
+    @property
+    def singular_values(self) -> Optional[np.ndarray]:
+        """Singular values of the scaled Jacobian, when computed."""
+        return _array(self._data.get("singular_values"))
+
+    @property
     def condition_number(self) -> Optional[float]:
         """Condition number of the scaled Jacobian, when computed."""
         return self._data.get("condition_number")

@@ -35,6 +35,8 @@ def test_contract_estimate_matches_cli(cli, examples):
     assert set(e.intervals) == {"k_K1", "k_K2"}
     for low, high in e.intervals.values():
         assert low < high
+    assert e.identifiable == {"k_K1": True, "k_K2": True}
+    np.testing.assert_array_equal(e.singular_values, expected["singular_values"])
 
 
 def test_estimated_parameters_reproduce_the_fitted_frequencies(examples):
