@@ -47,7 +47,13 @@ def run(args: Sequence[str], result_class: Type[R]) -> R:
     raise EigenfitError(text, code)
 
 
-def _call(command: str, result_class: Type[R], model: Model, measured: Optional[Measured], options: Mapping[str, Any]) -> R:
+def _call(
+    command: str,
+    result_class: Type[R],
+    model: Model,
+    measured: Optional[Measured],
+    options: Mapping[str, Any],
+) -> R:
     with TempFiles() as tmp:
         args = [command] + model_args(model, tmp)
         if measured is not None:
@@ -97,8 +103,15 @@ def simulate(
         SimulateResult,
         model,
         None,
-        {"stiffness": stiffness, "modes": modes, "set": set, "effect": effects, "sweep": sweep,
-         "solver": solver, **options},
+        {
+            "stiffness": stiffness,
+            "modes": modes,
+            "set": set,
+            "effect": effects,
+            "sweep": sweep,
+            "solver": solver,
+            **options,
+        },
     )
 
 
@@ -138,12 +151,20 @@ def estimate(
         EstimateResult,
         model,
         measured,
-        {"strategy": strategy, "initial": initial, "residual": residual,
-         "max_iterations": max_iterations, "solver": solver, **options},
+        {
+            "strategy": strategy,
+            "initial": initial,
+            "residual": residual,
+            "max_iterations": max_iterations,
+            "solver": solver,
+            **options,
+        },
     )
 
 
-def discover(model: Model, measured: Measured, *, solver: Optional[str] = None, **options: Any) -> DiscoverResult:
+def discover(
+    model: Model, measured: Measured, *, solver: Optional[str] = None, **options: Any
+) -> DiscoverResult:
     """Find where model and measurement disagree and name the missing effect, as ``eigenfit discover``.
 
     Args:
@@ -183,6 +204,12 @@ def compare(
         CompareResult,
         model,
         None,
-        {"targets": targets, "grid": grid, "initials": initials, "strategies": strategies,
-         "solver": solver, **options},
+        {
+            "targets": targets,
+            "grid": grid,
+            "initials": initials,
+            "strategies": strategies,
+            "solver": solver,
+            **options,
+        },
     )

@@ -109,9 +109,7 @@ def model_args(model: Any, tmp: TempFiles) -> list[str]:
     saved = _save_ross_rotor(model, tmp)
     if saved is not None:
         return ["--model", os.fspath(saved)]
-    raise TypeError(
-        f"model: expected a preset name or a model file path, got {type(model).__name__}"
-    )
+    raise TypeError(f"model: expected a preset name or a model file path, got {type(model).__name__}")
 
 
 def is_ross_rotor(model: Any) -> bool:
@@ -148,7 +146,9 @@ def measured_args(measured: Any, tmp: TempFiles) -> list[str]:
         raise ValueError("measured: the mapping needs `frequency_hz`")
     freq = np.atleast_1d(np.asarray(measured["frequency_hz"], dtype=float))
     n = len(freq)
-    mode = np.arange(1, n + 1) if measured.get("mode") is None else np.atleast_1d(np.asarray(measured["mode"]))
+    mode = (
+        np.arange(1, n + 1) if measured.get("mode") is None else np.atleast_1d(np.asarray(measured["mode"]))
+    )
     columns: list[tuple[str, Iterable[Any]]] = [("mode", mode), ("frequency_hz", freq)]
     if measured.get("std_hz") is not None:
         columns.append(("std_hz", np.atleast_1d(np.asarray(measured["std_hz"], dtype=float))))

@@ -268,7 +268,9 @@ class CompareResult(Result):
 
 
 #: Result class by name, for unpickling (the name, not the class, travels in the pickle).
-RESULT_CLASSES = {c.__name__: c for c in (SimulateResult, EstimateResult, DiscoverResult, CompareResult, Result)}
+RESULT_CLASSES = {
+    c.__name__: c for c in (SimulateResult, EstimateResult, DiscoverResult, CompareResult, Result)
+}
 
 
 def _restore(class_name: str, text: str, exit_code: int) -> Result:

@@ -56,19 +56,28 @@ def main() -> None:
     parser.add_argument("--rotors", type=int, default=1000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--check", type=int, default=50, help="rotors re-run serially and compared")
-    parser.add_argument("--chunk-size", type=int, default=None, help="rotors per Dask task (default: automatic)")
+    parser.add_argument(
+        "--chunk-size", type=int, default=None, help="rotors per Dask task (default: automatic)"
+    )
     args = parser.parse_args()
     rng = np.random.default_rng(2026)
     with tempfile.TemporaryDirectory(prefix="eigenfit-fleet-") as tmp:
         jobs, truth = make_fleet(args.rotors, Path(tmp), rng)
         # silence_logs: a worker's heartbeat racing the cluster's shutdown logs a harmless error;
         # failed jobs still reach us through gather.
-        with LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None,
-                          silence_logs=logging.CRITICAL) as cluster, \
-                Client(cluster) as client:
+        with (
+            LocalCluster(
+                n_workers=args.workers,
+                threads_per_worker=1,
+                dashboard_address=None,
+                silence_logs=logging.CRITICAL,
+            ) as cluster,
+            Client(cluster) as client,
+        ):
             started = time.perf_counter()
-            results = eigenfit.batch.estimate_many(jobs, client=client, errors="return",
-                                                   chunk_size=args.chunk_size)
+            results = eigenfit.batch.estimate_many(
+                jobs, client=client, errors="return", chunk_size=args.chunk_size
+            )
             seconds = time.perf_counter() - started
         started = time.perf_counter()
         serial = eigenfit.batch.estimate_many(jobs[: args.check], errors="return")
@@ -83,12 +92,18 @@ def main() -> None:
         for a, b in zip(results[: args.check], serial)
     )
     print(f"{args.rotors} rotors on {args.workers} Dask workers in {seconds:.1f} s")
-    print(f"converged: {len(ok)}, not converged: {args.rotors - len(ok) - len(failed)}, failed: {len(failed)}")
+    print(
+        f"converged: {len(ok)}, not converged: {args.rotors - len(ok) - len(failed)}, failed: {len(failed)}"
+    )
     if len(ok):
-        print(f"|estimate/true - 1|: median {np.median(rel):.2e}, 95th percentile {np.percentile(rel, 95):.2e}")
-    print(f"first {args.check} identical to the serial run: {same} "
-          f"(serial: {1e3 * serial_seconds / max(args.check, 1):.1f} ms per rotor; "
-          f"on the cluster: {1e3 * seconds / args.rotors:.1f} ms per rotor)")
+        print(
+            f"|estimate/true - 1|: median {np.median(rel):.2e}, 95th percentile {np.percentile(rel, 95):.2e}"
+        )
+    print(
+        f"first {args.check} identical to the serial run: {same} "
+        f"(serial: {1e3 * serial_seconds / max(args.check, 1):.1f} ms per rotor; "
+        f"on the cluster: {1e3 * seconds / args.rotors:.1f} ms per rotor)"
+    )
     if not same:
         raise SystemExit(1)
 

@@ -45,8 +45,12 @@ def cli() -> Callable[[List[str]], Tuple[Dict[str, Any], int]]:
         pytest.skip("no eigenfit binary: build it with `cargo build -p eigenfit-cli` or set EIGENFIT_BIN")
 
     def run(args: List[str]) -> Tuple[Dict[str, Any], int]:
-        done = subprocess.run([str(binary), *args, "--json", "--quiet"], capture_output=True, text=True, cwd=REPO)
-        assert done.returncode in (0, 3), f"eigenfit {' '.join(args)} failed ({done.returncode}): {done.stderr}"
+        done = subprocess.run(
+            [str(binary), *args, "--json", "--quiet"], capture_output=True, text=True, cwd=REPO
+        )
+        assert done.returncode in (0, 3), (
+            f"eigenfit {' '.join(args)} failed ({done.returncode}): {done.stderr}"
+        )
         return json.loads(done.stdout), done.returncode
 
     return run

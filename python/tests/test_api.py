@@ -93,10 +93,25 @@ def test_discover_matches_cli(cli, examples):
 
 
 def test_compare_matches_cli(cli):
-    c = eigenfit.compare("paper-rotor", targets=[(2e5, 5e4)], initials=[(1e5, 1e5), (1e6, 1e4)],
-                         strategies=["newton", "damped"])
-    expected, _ = cli(["compare", "--preset", "paper-rotor", "--targets", "2e5:5e4",
-                       "--initials", "1e5:1e5,1e6:1e4", "--strategies", "newton,damped"])
+    c = eigenfit.compare(
+        "paper-rotor",
+        targets=[(2e5, 5e4)],
+        initials=[(1e5, 1e5), (1e6, 1e4)],
+        strategies=["newton", "damped"],
+    )
+    expected, _ = cli(
+        [
+            "compare",
+            "--preset",
+            "paper-rotor",
+            "--targets",
+            "2e5:5e4",
+            "--initials",
+            "1e5:1e5,1e6:1e4",
+            "--strategies",
+            "newton,damped",
+        ]
+    )
     assert c.to_dict() == expected
     assert c.estimates.shape == (4, 2)
     assert c.converged.dtype == bool and len(c.converged) == 4
@@ -105,7 +120,9 @@ def test_compare_matches_cli(cli):
 def test_not_converged_returns_the_result_with_exit_code_3(cli, examples):
     measured = examples / "measured_no_effect.csv"
     e = eigenfit.estimate("paper-rotor", measured, max_iterations=1)
-    expected, code = cli(["estimate", "--preset", "paper-rotor", "--measured", str(measured), "--max-iterations", "1"])
+    expected, code = cli(
+        ["estimate", "--preset", "paper-rotor", "--measured", str(measured), "--max-iterations", "1"]
+    )
     assert code == 3
     assert e.exit_code == eigenfit.EXIT_NOT_CONVERGED
     assert not e.converged
@@ -128,7 +145,10 @@ def test_to_dict_is_a_copy():
         (lambda: eigenfit.simulate("missing/rotor.toml"), "missing/rotor.toml"),
         (lambda: eigenfit.estimate("paper-rotor", "missing.csv"), "missing.csv"),
         (lambda: eigenfit.estimate("paper-rotor", {"frequency_hz": [30.0]}), "at least 2"),
-        (lambda: eigenfit.estimate("paper-rotor", {"frequency_hz": [30.0, 90.0]}, strategy="guess"), "unknown strategy"),
+        (
+            lambda: eigenfit.estimate("paper-rotor", {"frequency_hz": [30.0, 90.0]}, strategy="guess"),
+            "unknown strategy",
+        ),
     ],
 )
 def test_bad_input_raises_with_the_cli_message_and_exit_code_2(call, fragment):
@@ -166,7 +186,9 @@ def test_concurrent_threads_get_their_own_results():
 
 
 def test_run_passes_arguments_through():
-    r = eigenfit.run(["simulate", "--preset", "uniform-rotor", "--elements", "8", "--modes", "2"], eigenfit.SimulateResult)
+    r = eigenfit.run(
+        ["simulate", "--preset", "uniform-rotor", "--elements", "8", "--modes", "2"], eigenfit.SimulateResult
+    )
     assert r.model == "uniform-rotor" and r.frequencies_hz.shape == (2,)
 
 
@@ -188,7 +210,9 @@ class _FakeRossRotor:
 def test_rotor_object_is_saved_to_a_temporary_file_the_cli_reads(examples):
     rotor = _FakeRossRotor((examples / "rotor.toml").read_text(encoding="utf-8"))
     r = eigenfit.simulate(rotor, modes=3)
-    np.testing.assert_array_equal(r.frequencies_hz, eigenfit.simulate(examples / "rotor.toml", modes=3).frequencies_hz)
+    np.testing.assert_array_equal(
+        r.frequencies_hz, eigenfit.simulate(examples / "rotor.toml", modes=3).frequencies_hz
+    )
     assert rotor.saved_to is not None and not rotor.saved_to.exists()  # removed after the call
 
 

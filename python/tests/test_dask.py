@@ -18,16 +18,24 @@ def _fleet(n: int):
     for _ in range(n):
         k = 10.0 ** rng.uniform(4.5, 5.5, size=2)
         f = eigenfit.simulate("paper-rotor", stiffness=k, modes=6).frequencies_hz
-        jobs.append({"model": "paper-rotor", "measured": {"frequency_hz": f * (1 + 1e-4 * rng.standard_normal(6)),
-                                                          "std_hz": 1e-4 * f}})
+        jobs.append(
+            {
+                "model": "paper-rotor",
+                "measured": {"frequency_hz": f * (1 + 1e-4 * rng.standard_normal(6)), "std_hz": 1e-4 * f},
+            }
+        )
     return jobs
 
 
 @pytest.fixture(scope="module")
 def client():
     # Worker processes (not threads), as on a real cluster: the tasks and results are pickled.
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as c:
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as c,
+    ):
         yield c
 
 
@@ -49,8 +57,10 @@ def test_cluster_results_equal_serial(client, fleet, chunk_size):
 
 
 def test_cluster_failed_job_is_returned_or_raised(client):
-    jobs = [{"model": "paper-rotor", "measured": {"frequency_hz": [30.3, 97.8, 306.4]}},
-            {"model": "no-such-rotor", "measured": {"frequency_hz": [30.3, 97.8]}}]
+    jobs = [
+        {"model": "paper-rotor", "measured": {"frequency_hz": [30.3, 97.8, 306.4]}},
+        {"model": "no-such-rotor", "measured": {"frequency_hz": [30.3, 97.8]}},
+    ]
     results = eigenfit.batch.estimate_many(jobs, client=client, errors="return")
     assert isinstance(results[0], eigenfit.EstimateResult)
     assert isinstance(results[1], eigenfit.EigenfitError) and results[1].exit_code == 2
