@@ -55,7 +55,10 @@ pub use residual::{Linearisation, Pairing, Problem, ResidualError, ResidualKind}
 pub use sensitivity::{Sensitivities, SensitivityError};
 pub use solver::{EigenSolver, SolveError};
 pub use sparse::SparseSymmetric;
-pub use statistics::{alternative_solutions, uncertainty, uncertainty_within, Identifiability, Uncertainty};
+pub use statistics::{
+    alternative_solutions, alternative_solutions_within, mirror_solutions, uncertainty, uncertainty_within,
+    Identifiability, Uncertainty,
+};
 pub use subspace::BandedSolver;
 pub use system::{System, SystemDerivative, SystemError};
 pub use update::{

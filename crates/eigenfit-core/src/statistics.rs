@@ -292,24 +292,76 @@ pub fn alternatives_among(
     at: &Linearisation,
     solutions: &[Linearisation],
 ) -> Vec<Vec<f64>> {
-    let params = problem.parameters();
-    let scaled = |p: &[f64]| -> Vec<f64> { params.iter().zip(p).map(|(q, &v)| q.to_scaled(v)).collect() };
-    let distance = |a: &[f64], b: &[f64]| -> f64 {
-        scaled(a).iter().zip(scaled(b)).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
-    };
-    let good = |lin: &Linearisation| {
-        let tol = Damped::default().residual_tolerance;
-        lin.max_rel_diff() <= tol.max(at.max_rel_diff() * 10.0)
-            || (lin.has_std && 2.0 * (lin.cost() - at.cost()) <= CHI2_95_1DOF)
-    };
     let mut found: Vec<Vec<f64>> = Vec::new();
     for sol in solutions {
-        if good(sol)
-            && distance(&sol.parameters, &at.parameters) > 0.01
-            && found.iter().all(|f| distance(f, &sol.parameters) > 0.01)
+        if fits_as_well(at, sol)
+            && scaled_distance(problem, &sol.parameters, &at.parameters) > 0.01
+            && found.iter().all(|f| scaled_distance(problem, f, &sol.parameters) > 0.01)
         {
             found.push(sol.parameters.clone());
         }
     }
     found
+}
+
+/// [`alternative_solutions`] with every evaluation charged to `budget`; a spent budget ends the
+/// search with what was found.
+pub fn alternative_solutions_within(
+    problem: &dyn Evaluate,
+    at: &Linearisation,
+    starts: usize,
+    budget: &Budget,
+) -> Vec<Vec<f64>> {
+    let budgeted = budget.wrap(problem);
+    alternatives_among(problem, at, &local_solutions(&budgeted, starts))
+}
+
+/// A symmetric model's mirror solutions: for each pair of parameters `(i, j)` of the same kind
+/// (unit, scale and limits) whose exchange fits the data as well as `at`, the exchanged vector.
+/// Costs one evaluation per pair, charged to `budget`.
+pub fn mirror_solutions(
+    problem: &dyn Evaluate,
+    at: &Linearisation,
+    budget: &Budget,
+) -> Vec<(usize, usize, Vec<f64>)> {
+    let params = problem.parameters().as_slice();
+    let budgeted = budget.wrap(problem);
+    let mut found = Vec::new();
+    for i in 0..params.len() {
+        for j in i + 1..params.len() {
+            let (a, b) = (&params[i], &params[j]);
+            if a.unit != b.unit || a.scale != b.scale || a.lower != b.lower || a.upper != b.upper {
+                continue;
+            }
+            let mut p = at.parameters.clone();
+            p.swap(i, j);
+            if scaled_distance(problem, &p, &at.parameters) <= 0.01 {
+                continue; // equal values: the exchange is the same point
+            }
+            if let Ok(lin) = budgeted.linearise(&p) {
+                if fits_as_well(at, &lin) {
+                    found.push((i, j, p));
+                }
+            }
+        }
+    }
+    found
+}
+
+/// Largest scaled difference between two parameter vectors.
+fn scaled_distance(problem: &dyn Evaluate, a: &[f64], b: &[f64]) -> f64 {
+    let params = problem.parameters();
+    params
+        .iter()
+        .zip(a.iter().zip(b))
+        .map(|(q, (&x, &y))| (q.to_scaled(x) - q.to_scaled(y)).abs())
+        .fold(0.0, f64::max)
+}
+
+/// `lin` fits as well as `at`: an exact fit (to the damped strategy's tolerance, or ten times
+/// `at`'s misfit), or with std within the 95% χ² threshold of one degree of freedom.
+fn fits_as_well(at: &Linearisation, lin: &Linearisation) -> bool {
+    let tol = Damped::default().residual_tolerance;
+    lin.max_rel_diff() <= tol.max(at.max_rel_diff() * 10.0)
+        || (lin.has_std && 2.0 * (lin.cost() - at.cost()) <= CHI2_95_1DOF)
 }

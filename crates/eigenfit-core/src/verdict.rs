@@ -4,6 +4,7 @@
 use crate::discovery::chi2_upper_tail;
 use crate::parameters::ParameterSet;
 use crate::residual::Linearisation;
+use crate::update::{Budget, Evaluate};
 
 /// p-value below which a fit is rejected as poor: strong evidence that no parameter value of this
 /// model explains the data within their standard deviations.
@@ -113,6 +114,75 @@ pub fn at_limits(params: &ParameterSet, p: &[f64]) -> Vec<i8> {
                 0
             }
         })
+        .collect()
+}
+
+/// A measured mode outside every frequency the model reaches within its parameter limits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unreachable {
+    /// Position in the measured list.
+    pub index: usize,
+    /// The measured frequency, Hz.
+    pub measured_hz: f64,
+    /// Lowest and highest model frequency of this mode over the parameter box, Hz.
+    pub reachable_hz: [f64; 2],
+}
+
+/// Measured modes more than `margin` (relative) outside the frequencies the model reaches at the
+/// corners of its parameter box. A stiffness or mass parameter moves every eigenvalue
+/// monotonically, so for such models the extremes lie at the corners and a mode outside is data
+/// no parameter value can fit (a typing slip, a wrong unit). Up to four parameters every corner
+/// is tried, beyond only the all-lower and all-upper ones; corners the model cannot be evaluated
+/// at (e.g. a rigid-body mode at a vanishing support) are skipped. Charged to `budget`.
+pub fn unreachable_modes(problem: &dyn Evaluate, margin: f64, budget: &Budget) -> Vec<Unreachable> {
+    let params = problem.parameters().as_slice();
+    let np = params.len();
+    let corner = |mask: usize| -> Vec<f64> {
+        params
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let (lo, hi) = p.search_range();
+                let lo = if p.lower.is_finite() { p.lower } else { lo };
+                let hi = if p.upper.is_finite() { p.upper } else { hi };
+                if mask >> i & 1 == 1 {
+                    hi
+                } else {
+                    lo
+                }
+            })
+            .collect()
+    };
+    let masks: Vec<usize> = if np <= 4 { (0..1 << np).collect() } else { vec![0, (1 << np.min(63)) - 1] };
+    let budgeted = budget.wrap(problem);
+    let mut range: Option<(Vec<f64>, Vec<f64>, Vec<f64>)> = None;
+    let mut all_corners = true;
+    for mask in masks {
+        let Ok(lin) = budgeted.linearise(&corner(mask)) else {
+            all_corners = false;
+            continue;
+        };
+        let (lo, hi, _) = range.get_or_insert_with(|| {
+            (
+                vec![f64::INFINITY; lin.measured_hz.len()],
+                vec![0.0; lin.measured_hz.len()],
+                lin.measured_hz.clone(),
+            )
+        });
+        for (k, &f) in lin.frequencies_hz.iter().enumerate() {
+            lo[k] = lo[k].min(f);
+            hi[k] = hi[k].max(f);
+        }
+    }
+    let Some((mut lo, hi, measured)) = range else { return Vec::new() };
+    if !all_corners {
+        // A corner that could not be evaluated is a soft one (a support going to zero): the
+        // upper frequencies are still known, the lower ones are not.
+        lo.iter_mut().for_each(|l| *l = 0.0);
+    }
+    (0..measured.len())
+        .filter(|&k| measured[k] > hi[k] * (1.0 + margin) || measured[k] < lo[k] * (1.0 - margin))
+        .map(|k| Unreachable { index: k, measured_hz: measured[k], reachable_hz: [lo[k], hi[k]] })
         .collect()
 }
 
