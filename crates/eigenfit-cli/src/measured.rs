@@ -51,8 +51,15 @@ pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, CliError> {
     let cannot = |e: std::io::Error| input(format!("{}: cannot read: {e}", path.display()));
     // Checked before opening: opening a FIFO for reading blocks until a writer appears.
     let meta = std::fs::metadata(path).map_err(cannot)?;
+    if meta.is_dir() {
+        // Reading fails at once and the system's message says why.
+        return std::fs::read(path).map_err(cannot);
+    }
     if !meta.is_file() {
-        return Err(input(format!("{}: not a regular file", path.display())));
+        return Err(input(format!(
+            "{}: not a regular file (a FIFO, socket or device would block or never end)",
+            path.display()
+        )));
     }
     let file = std::fs::File::open(path).map_err(cannot)?;
     let mut bytes = Vec::with_capacity(meta.len().min(cap) as usize);
@@ -104,15 +111,18 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), String
         .comment(Some(b'#'))
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());
-    let mut records = reader.records().filter_map(|r| match r {
+    // Lines from byte offsets: the csv crate's own line count skips blank lines. Offsets only
+    // grow, so counting newlines from the previous record keeps this linear.
+    let mut lines = LineCounter { text: text.as_bytes(), byte: 0, line: 1 };
+    let mut records = reader.records().filter_map(move |r| match r {
         // Blank (or whitespace-only) lines carry nothing.
         Ok(rec) if rec.iter().all(str::is_empty) => None,
         Ok(rec) => {
-            let line = rec.position().map_or(1, |p| p.line() as usize);
+            let line = rec.position().map_or(1, |p| lines.at(p.byte()));
             Some(Ok((line, rec)))
         }
         Err(e) => {
-            let line = e.position().map_or(1, |p| p.line() as usize);
+            let line = e.position().map_or(1, |p| lines.at(p.byte()));
             Some(Err(format!("{line}: not readable as CSV: {e}")))
         }
     });
@@ -194,6 +204,35 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), String
     let measurement =
         Measurement::new(modes.into_iter().map(|(_, m)| m).collect()).map_err(|e| format!("{hline}: {e}"))?;
     Ok((measurement, notes))
+}
+
+/// The 1-based line of a byte offset, for offsets visited in increasing order.
+struct LineCounter<'a> {
+    text: &'a [u8],
+    byte: usize,
+    line: usize,
+}
+
+impl LineCounter<'_> {
+    fn at(&mut self, byte: u64) -> usize {
+        let mut byte = (byte as usize).min(self.text.len());
+        // A record's position is where the reader started, before the blank and comment lines
+        // it skipped: move to the record's own line.
+        while byte < self.text.len() && matches!(self.text[byte], b'\n' | b'\r' | b'#') {
+            if self.text[byte] == b'#' {
+                match self.text[byte..].iter().position(|&b| b == b'\n') {
+                    Some(n) => byte += n,
+                    None => break,
+                }
+            }
+            byte += 1;
+        }
+        if byte >= self.byte {
+            self.line += self.text[self.byte..byte].iter().filter(|&&b| b == b'\n').count();
+            self.byte = byte;
+        }
+        self.line
+    }
 }
 
 /// Natural frequencies increase with mode number (the model's modes are sorted): a row that
