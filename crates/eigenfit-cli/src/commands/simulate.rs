@@ -210,6 +210,9 @@ fn frequencies(
     Ok(m.frequencies_hz())
 }
 
+/// Most points of a `--sweep`: a smooth critical speed map needs a few hundred.
+const MAX_SWEEP_POINTS: usize = 100_000;
+
 fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
     let parts: Vec<&str> = text.split(':').collect();
     let bad = || input(format!("--sweep `{text}`: expected FROM:TO:COUNT with 0 < FROM < TO and COUNT ≥ 2"));
@@ -221,6 +224,12 @@ fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
     let (a, b) = (ends[0], ends[1]);
     if !(a > 0.0 && b > a && count >= 2) {
         return Err(bad());
+    }
+    // Checked before the points are allocated: each is an eigen-solve.
+    if count > MAX_SWEEP_POINTS {
+        return Err(input(format!(
+            "--sweep `{text}`: {count} points, more than the {MAX_SWEEP_POINTS} a sweep accepts"
+        )));
     }
     Ok(eigenfit_core::compare::log_space(a, b, count))
 }
