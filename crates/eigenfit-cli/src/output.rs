@@ -76,7 +76,11 @@ impl Stream {
     pub fn finish(self, total: usize) -> Result<(), CliError> {
         match self.error {
             None => self.file.sync_all().map_err(|e| {
-                CliError::Failure(format!("{}: cannot sync: {e}; {} of {total} runs written", self.path.display(), self.saved))
+                CliError::Failure(format!(
+                    "{}: cannot sync: {e}; {} of {total} runs written",
+                    self.path.display(),
+                    self.saved
+                ))
             }),
             Some(e) => Err(CliError::Failure(format!(
                 "{}: writing failed: {e}; {} of {total} runs were saved",

@@ -1,9 +1,9 @@
 //! `eigenfit compare`: strategies × targets × a grid of initial guesses on reference data.
 
 use crate::error::{input, CliError};
+use crate::output::Stream;
 use crate::plot::compare_map::{CompareMaps, MapKind};
 use crate::source::{parse_list, ModelArgs};
-use crate::output::Stream;
 use crate::{plot, progress};
 use clap::Args;
 use eigenfit_core::compare::{log_space, run_grid, tensor_grid, CompareRun, CompareSettings};
@@ -113,7 +113,9 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         .collect::<Result<Vec<_>, _>>()?;
     // Beyond ±15 decimals rounding either changes nothing a double holds or overflows to NaN.
     if let Some(d) = args.decimals.filter(|d| !(-15..=15).contains(d)) {
-        return Err(input(format!("--decimals {d}: must be between -15 and 15 (a double holds about 16 digits)")));
+        return Err(input(format!(
+            "--decimals {d}: must be between -15 and 15 (a double holds about 16 digits)"
+        )));
     }
     let total_runs = targets.len().saturating_mul(initials.len()).saturating_mul(strategies.len());
     if total_runs > MAX_RUNS {

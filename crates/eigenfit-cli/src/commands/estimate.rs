@@ -213,6 +213,8 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             (_, None) => "(not computed)".into(),
         }
     };
+    let code = if acceptable { 0 } else { EXIT_NOT_CONVERGED };
+    crate::error::set_exit_on_closed_pipe(code);
     if args.json {
         let obj = |values: Vec<Value>| -> Map<String, Value> {
             names.iter().map(|n| n.to_string()).zip(values).collect()
@@ -339,7 +341,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
-    Ok(if acceptable { 0 } else { EXIT_NOT_CONVERGED })
+    Ok(code)
 }
 
 /// Four significant digits, in exponent form outside [1e-3, 1e5).
