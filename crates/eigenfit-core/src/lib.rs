@@ -32,6 +32,7 @@ pub mod monte_carlo;
 pub mod multi;
 pub mod parameters;
 pub mod residual;
+pub mod roundoff;
 pub mod sensitivity;
 mod small_eigen;
 pub mod solver;

@@ -197,10 +197,11 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
                 fmt(s.median_iterations),
                 fmt(s.max_iterations),
                 s.max_relative_error,
-                s.ambiguous
+                // Only damped runs are checked for other solutions: a 0 elsewhere would mean nothing.
+                if s.strategy == StrategyKind::Damped { s.ambiguous.to_string() } else { "-".to_string() }
             );
         }
-        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged runs whose data also fit another solution)");
+        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged damped runs whose data also fit another solution, - where not checked)");
         if args.maps && np == 2 {
             print_maps(&runs, &targets, &strategies);
         }
@@ -309,7 +310,7 @@ impl Summary {
             "runs": self.runs,
             "converged": self.converged,
             "converged_within_1e-6": self.within_1e6,
-            "ambiguous": self.ambiguous,
+            "ambiguous": (self.strategy == StrategyKind::Damped).then_some(self.ambiguous),
             "median_iterations": self.median_iterations,
             "max_iterations": self.max_iterations,
             "max_relative_error": self.max_relative_error,

@@ -105,6 +105,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     }
     let has_std = measurement.has_std();
     let mode_numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
+    let sigma_max = measurement.modes().iter().filter_map(|m| m.std_hz).reduce(f64::max);
     let problem = Problem::new(&rotor, solver.as_ref(), measurement).with_kind(kind);
     let budget = Budget::new(args.budget);
     // Data no parameter value can produce is refused before any fitting.
@@ -135,6 +136,11 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         .map_err(|e| input(e.to_string()));
     pb.finish_and_clear();
     let estimate = estimate?;
+    // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
+    let system = rotor.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
+    if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
+        crate::commands::simulate::refuse_roundoff(&system, &modes)?;
+    }
     let converged = estimate.termination.is_converged();
     let quality = judge(&estimate.last, np);
     let limits = at_limits(rotor.parameters(), &estimate.parameters);
@@ -186,6 +192,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 runs: vec![Run::from_estimate(&estimate)],
                 target: None,
                 tolerance_hz: Some(0.01),
+                sigma_hz: sigma_max,
             };
             plot::write(&figure, dir, "convergence")?
         }
