@@ -67,6 +67,34 @@ const CASES: &[Case] = &[
         exit: 0,
         says: &["mirror solution"],
     },
+    // Frequencies a little above anything the supports can give: the fit runs to the 1e15 N/m
+    // limit, which is reported as such, never as an estimate.
+    Case {
+        args: &["estimate", "--preset", "paper-rotor", "--measured", "at_limit.csv"],
+        exit: 3,
+        says: &["not identifiable: at its upper limit", "at a parameter limit (the data cannot determine it): k_K1, k_K2"],
+    },
+    Case {
+        args: &["estimate", "--preset", "paper-rotor", "--measured", "at_limit_std.csv"],
+        exit: 3,
+        says: &["not identifiable: ≥ ", "fit quality: POOR", "modes disagreeing by more than 3σ: 1, 2"],
+    },
+    // A mesh whose lowest eigenvalues are lost to round-off, and an extreme value.
+    Case {
+        args: &["simulate", "--preset", "uniform-rotor", "--elements", "10000"],
+        exit: 2,
+        says: &["mode 1 cannot be trusted: round-off in the matrices"],
+    },
+    Case {
+        args: &["simulate", "--preset", "paper-rotor", "--effect", "point-mass@0=1e50"],
+        exit: 2,
+        says: &["cannot be trusted: round-off in the matrices"],
+    },
+    Case {
+        args: &["simulate", "--preset", "paper-rotor", "--effect", "bearing-rotational-stiffness@0=1e50"],
+        exit: 2,
+        says: &["cannot be trusted: round-off in the matrices"],
+    },
     // A decimal slip in examples/measured_hidden_effect.csv (mode 8 = 38889.557).
     Case {
         args: &["estimate", "--preset", "paper-rotor", "--measured", "decimal_slip.csv"],
