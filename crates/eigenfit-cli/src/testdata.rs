@@ -318,6 +318,20 @@ impl Evaluate for Fit<'_> {
     }
 }
 
+/// Intervals and the residual scatter they were scaled by: the frequency fit's as the statistics
+/// module gives them (within `budget`), the shape fit's from [`ShapeFit::uncertainty`].
+pub fn uncertainty(
+    fit: &mut Fit,
+    at: &Linearisation,
+    has_std: bool,
+    budget: &eigenfit_core::Budget,
+) -> (Option<Uncertainty>, Option<f64>) {
+    match fit {
+        Fit::Frequencies(p) => (eigenfit_core::statistics::uncertainty_within(p, at, has_std, budget), None),
+        Fit::Shapes(s) => s.uncertainty(at).map_or((None, None), |(u, sc)| (Some(u), Some(sc))),
+    }
+}
+
 /// `pairing`: measured mode number → model mode number, both from 1.
 pub fn pairing_json(fit: &Fit, estimate: &Estimate) -> Value {
     let map: serde_json::Map<String, Value> = fit
@@ -341,8 +355,6 @@ pub fn add_json(
     scatter: Option<f64>,
 ) {
     out["pairing"] = pairing_json(fit, estimate);
-    out["chi2"] = json!(estimate.last.chi2());
-    out["dof"] = json!(estimate.last.dof());
     if !data.notes.is_empty() {
         out["notes"] = json!(data.notes);
     }

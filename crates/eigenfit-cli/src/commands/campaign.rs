@@ -172,7 +172,7 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
                 c
             })
             .collect::<Vec<_>>());
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!(
             "{}: {} configurations, {} strategy, {} after {} iterations",
