@@ -66,7 +66,8 @@ pub fn judge(lin: &Linearisation, free: usize) -> FitQuality {
             lin.frequencies_hz.iter().zip(&lin.measured_hz).map(|(f, m)| ((f - m) / m).powi(2)).sum();
         (sum / n as f64).sqrt()
     };
-    let dof = n.saturating_sub(free);
+    // Rows of the weighted residual: the frequencies, and shape entries when shapes are fitted.
+    let dof = lin.residual.len().saturating_sub(free);
     if !lin.has_std {
         return FitQuality {
             verdict: FitVerdict::NotJudged,
