@@ -72,7 +72,10 @@ const CASES: &[Case] = &[
     Case {
         args: &["estimate", "--preset", "paper-rotor", "--measured", "at_limit.csv"],
         exit: 3,
-        says: &["not identifiable: at its upper limit", "at a parameter limit (the data cannot determine it): k_K1, k_K2"],
+        says: &[
+            "not identifiable: at its upper limit",
+            "at a parameter limit (the data cannot determine it): k_K1, k_K2",
+        ],
     },
     Case {
         args: &["estimate", "--preset", "paper-rotor", "--measured", "at_limit_std.csv"],
