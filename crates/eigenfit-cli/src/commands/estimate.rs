@@ -8,7 +8,9 @@ use clap::Args;
 use eigenfit_core::statistics::{alternative_solutions_within, mirror_solutions, uncertainty_within};
 use eigenfit_core::update::DEFAULT_EVALUATIONS;
 use eigenfit_core::verdict::{at_limits, judge, unreachable_modes, FitVerdict};
-use eigenfit_core::{Budget, Driver, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel};
+use eigenfit_core::{
+    Budget, Driver, Evaluate, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel,
+};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
 
@@ -129,10 +131,25 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             list.join("; ")
         )));
     }
+    // A start inside the bounds where the model cannot be evaluated (a support so soft its mode
+    // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
+    // the best point of its coarse grid instead, and says so.
+    let mut start = initial.clone();
+    if strategy_kind == StrategyKind::Damped {
+        let budgeted = budget.wrap(&problem);
+        if let Err(e) = budgeted.linearise(&initial) {
+            if let Some(seed) = eigenfit_core::Damped::rank_seeds(&budgeted).first() {
+                eprintln!(
+                    "eigenfit: note: the model cannot be evaluated at --initial ({e}); starting from the best point of the coarse grid"
+                );
+                start = seed.clone();
+            }
+        }
+    }
     let mut strategy = strategy_kind.build();
     let pb = progress::spinner(&format!("estimating ({})", strategy_kind.name()), args.quiet);
     let estimate = Driver { max_iterations: args.max_iterations }
-        .run_within(&problem, strategy.as_mut(), &initial, &mut [], &budget)
+        .run_within(&problem, strategy.as_mut(), &start, &mut [], &budget)
         .map_err(|e| input(e.to_string()));
     pb.finish_and_clear();
     let estimate = estimate?;
