@@ -152,7 +152,17 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         .run_within(&problem, strategy.as_mut(), &start, &mut [], &budget)
         .map_err(|e| input(e.to_string()));
     pb.finish_and_clear();
-    let estimate = estimate?;
+    let estimate = match estimate {
+        Err(_) if budget.exhausted() => {
+            crate::error::set_exit_on_closed_pipe(EXIT_NOT_CONVERGED);
+            eprintln!(
+                "eigenfit: budget-exhausted: the budget of {} model evaluations ran out before the fit could start (raise it with --budget)",
+                budget.limit()
+            );
+            return Ok(EXIT_NOT_CONVERGED);
+        }
+        other => other?,
+    };
     // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
     let system = rotor.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
     if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
