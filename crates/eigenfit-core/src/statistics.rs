@@ -198,7 +198,7 @@ impl Profile<'_> {
         let s_limit = if limit.is_finite() { par.to_scaled(limit) } else { dir * f64::INFINITY };
         let span = (s_limit - s_hat).abs();
         // On (or within round-off of) the limit: nothing lies beyond, the data bound nothing here.
-        if !(span > 1e-9 * (1.0 + s_hat.abs())) {
+        if span.is_nan() || span <= 1e-9 * (1.0 + s_hat.abs()) {
             return Ok(None);
         }
         let first = if self.sigma.is_finite() { (Z_95 * self.sigma).max(0.1) } else { 1.0 };

@@ -49,6 +49,9 @@ pub struct EstimateArgs {
     pub json: bool,
 }
 
+/// Another equally good parameter vector, with the exchanged pair when it is a mirror solution.
+type Alternative = (Vec<f64>, Option<(usize, usize)>);
+
 /// Restart-grid points refitted locally when searching for other equally good solutions.
 const ALTERNATIVE_STARTS: usize = 6;
 /// A measured mode this far (relative) outside every frequency the model reaches is refused.
@@ -173,7 +176,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let limits = at_limits(rotor.parameters(), &estimate.parameters);
     let pb = progress::spinner("intervals and other solutions", args.quiet || !converged);
     let unc = if converged { uncertainty_within(&problem, &estimate.last, has_std, &budget) } else { None };
-    let mut alternatives: Vec<(Vec<f64>, Option<(usize, usize)>)> = Vec::new();
+    let mut alternatives: Vec<Alternative> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {
         for (i, j, p) in mirror_solutions(&problem, &estimate.last, &budget) {
             alternatives.push((p, Some((i, j))));
@@ -307,10 +310,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             estimate.iterations,
             budget.used()
         );
-        println!(
-            "{:<20}{:>16}{:>16}   {}",
-            "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]"
-        );
+        println!("{:<20}{:>16}{:>16}   95% interval [N/m]", "parameter", "initial [N/m]", "estimate [N/m]");
         for (i, n) in names.iter().enumerate() {
             // A value on a limit is where the search stopped, not an estimate.
             let value =
@@ -381,7 +381,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
 /// Four significant digits, in exponent form outside [1e-3, 1e5).
 fn significant(v: f64) -> String {
     if v == 0.0 || (1e-3..1e5).contains(&v.abs()) {
-        format!("{}", format!("{v:.4}").trim_end_matches('0').trim_end_matches('.'))
+        format!("{v:.4}").trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
         format!("{v:.3e}")
     }
