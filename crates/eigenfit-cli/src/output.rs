@@ -18,6 +18,47 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
     })
 }
 
+thread_local! {
+    /// Set while [`crate::run_json`] runs a command on this thread: the command's JSON lands here
+    /// instead of on stdout. Per thread, so concurrent library calls (Dask workers' threads) never
+    /// see each other's results.
+    static CAPTURED: std::cell::RefCell<Option<Option<serde_json::Value>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Prints a command's JSON result on stdout, or hands it to [`crate::run_json`] when that is the
+/// caller. Every `--json` result goes through here, so the library's result and the binary's
+/// output are the same value by construction.
+pub fn emit_json(value: serde_json::Value) {
+    let value = CAPTURED.with(|c| match c.borrow_mut().as_mut() {
+        Some(slot) => {
+            *slot = Some(value);
+            None
+        }
+        None => Some(value),
+    });
+    if let Some(value) = value {
+        println!("{value}");
+    }
+}
+
+/// Runs `f` with the JSON results of this thread captured; returns what `f` returned and the
+/// last JSON value emitted, if any. Restores the previous state even when `f` panics.
+pub(crate) fn capture_json<T>(f: impl FnOnce() -> T) -> (T, Option<serde_json::Value>) {
+    struct Restore(Option<Option<serde_json::Value>>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let previous = self.0.take();
+            CAPTURED.with(|c| *c.borrow_mut() = previous);
+        }
+    }
+    let restore = Restore(CAPTURED.with(|c| c.borrow_mut().replace(None)));
+    let result = f();
+    let value = CAPTURED.with(|c| c.borrow_mut().as_mut().and_then(Option::take));
+    drop(restore);
+    (result, value)
+}
+
 /// A JSON-lines file that runs are appended to as they finish (`--stream`): opened for appending
 /// (a second run never deletes the first one's lines), held under an exclusive advisory lock for
 /// the whole run (two runs at once would interleave half lines), flushed line by line.

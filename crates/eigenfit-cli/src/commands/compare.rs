@@ -164,7 +164,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!(
             "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",

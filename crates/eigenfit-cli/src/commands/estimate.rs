@@ -301,7 +301,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!(
             "{label}: {} strategy, {} after {} iterations ({} model evaluations)",

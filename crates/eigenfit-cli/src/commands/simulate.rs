@@ -95,7 +95,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             if args.plot.is_some() {
                 out["plots"] = json!(plot::names(&plots));
             }
-            println!("{out}");
+            crate::output::emit_json(out);
         } else {
             println!("{label}: natural frequencies against support stiffness (all bearings equal)");
             print!("{:>14}", "k [N/m]");
@@ -147,7 +147,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!("{label} ({} DOF, {} solver)", rotor.dofs(), solver.name());
         for (n, v) in names.iter().zip(&p) {
