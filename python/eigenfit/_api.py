@@ -58,7 +58,7 @@ def _call(
         args = [command] + model_args(model, tmp)
         if measured is not None:
             args += measured_args(measured, tmp)
-        args += option_args({**options, "quiet": True})
+        args += option_args(options)
         try:
             return run(args, result_class)
         except EigenfitError as e:
