@@ -14,6 +14,7 @@ fn main() -> ExitCode {
     match eigenfit_cli::run(&cli) {
         Ok(code) => ExitCode::from(code),
         Err(e) => {
+            error::set_exit_on_closed_pipe(e.exit_code());
             eprintln!("eigenfit: {e}");
             ExitCode::from(e.exit_code())
         }
@@ -21,7 +22,7 @@ fn main() -> ExitCode {
 }
 
 /// No Rust panic text or backtrace ever reaches the user: a closed pipe (`eigenfit … | head`)
-/// ends the program quietly, anything else is reported as an internal error with exit code 1.
+/// ends the program quietly with the exit code already decided, anything else is reported as an internal error with exit code 1.
 fn quiet_panics() {
     std::panic::set_hook(Box::new(|info| {
         let msg = info
@@ -31,7 +32,9 @@ fn quiet_panics() {
             .or_else(|| info.payload().downcast_ref::<&str>().copied())
             .unwrap_or("unknown");
         if msg.contains("Broken pipe") {
-            std::process::exit(0);
+            std::process::exit(i32::from(
+                error::EXIT_ON_CLOSED_PIPE.load(std::sync::atomic::Ordering::Relaxed),
+            ));
         }
         eprintln!("eigenfit: internal error: {msg} (please report this with the input that caused it)");
         std::process::exit(i32::from(error::EXIT_FAILURE));

@@ -134,6 +134,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
         runs,
         target: Some(TARGET.to_vec()),
         tolerance_hz: Some(0.01),
+        sigma_hz: None,
     };
     plots.extend(plot::write(&figure, out, "convergence")?);
 
