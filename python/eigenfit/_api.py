@@ -39,7 +39,7 @@ def run(args: Sequence[str], result_class: Type[R]) -> R:
 
     This is what every function here calls; use it for CLI options that have no keyword yet.
     Raises :class:`EigenfitError` with the CLI's message and exit code on failure; exit code 3
-    (not converged) returns the result.
+    (not converged or not acceptable) returns the result.
     """
     code, text = _native.run_json([os.fspath(a) for a in args])
     if code in (0, EXIT_NOT_CONVERGED):
@@ -58,7 +58,7 @@ def _call(
         args = [command] + model_args(model, tmp)
         if measured is not None:
             args += measured_args(measured, tmp)
-        args += option_args({**options, "quiet": True})
+        args += option_args(options)
         try:
             return run(args, result_class)
         except EigenfitError as e:
@@ -140,8 +140,8 @@ def estimate(
         **options: any other ``eigenfit estimate`` option.
 
     Returns:
-        EstimateResult. A run that did not converge is returned too, with ``converged == False``
-        and ``exit_code == 3``.
+        EstimateResult. A run that did not converge or whose fit is not acceptable is returned
+        too, with ``acceptable == False`` and ``exit_code == 3``.
 
     Raises:
         EigenfitError: bad input (exit code 2) or an internal failure (1).

@@ -19,7 +19,7 @@ from typing import Any, Optional
 import numpy as np
 
 #: Options given as ``FROM:TO`` or ``FROM:TO:COUNT`` (a tuple in Python).
-_COLON_OPTIONS = {"range", "sweep"}
+_COLON_OPTIONS = {"range", "sweep", "speeds"}
 #: Options that repeat once per item (``--set a=1 --set b=2``); a mapping gives NAME=VALUE items.
 _REPEATED_OPTIONS = {"set": "--set", "sets": "--set", "effect": "--effect", "effects": "--effect"}
 

@@ -117,8 +117,8 @@ class SimulateResult(Result):
 class EstimateResult(Result):
     """``eigenfit estimate``: updated parameters, their uncertainty and the iteration history.
 
-    A run that did not converge is still returned, with ``converged == False`` and
-    ``exit_code == 3``."""
+    A run that did not converge, or whose fit is not acceptable, is still returned, with
+    ``acceptable == False`` and ``exit_code == 3`` (the CLI's exit code)."""
 
     command = "estimate"
 
@@ -126,6 +126,31 @@ class EstimateResult(Result):
     def converged(self) -> bool:
         """Whether the update converged."""
         return bool(self._data["converged"])
+
+    @property
+    def acceptable(self) -> bool:
+        """Whether the result can be used: converged, and a fit consistent with the data."""
+        return bool(self._data.get("acceptable", self._data["converged"]))
+
+    @property
+    def verdict(self) -> Optional[str]:
+        """The CLI's verdict on the result, in words."""
+        return self._data.get("verdict")
+
+    @property
+    def fit_quality(self) -> Optional[str]:
+        """How well the fitted model matches the data (the CLI's label)."""
+        return self._data.get("fit_quality")
+
+    @property
+    def p_value(self) -> Optional[float]:
+        """p-value of the fit's χ² (with standard deviations given)."""
+        return self._data.get("p_value")
+
+    @property
+    def parameter_status(self) -> Dict[str, str]:
+        """What the data say about each parameter, in words (interval, bound, limit)."""
+        return dict(self._data.get("parameter_status", {}))
 
     @property
     def termination(self) -> str:

@@ -29,7 +29,8 @@ def test_contract_estimate_matches_cli(cli, examples):
     e = eigenfit.estimate(model="paper-rotor", measured=str(measured))
     expected, code = cli(["estimate", "--preset", "paper-rotor", "--measured", str(measured)])
     assert e.to_dict() == expected
-    assert code == 0 and e.converged
+    assert code == 0 and e.converged and e.acceptable
+    assert set(e.parameter_status) == {"k_K1", "k_K2"}
     assert list(e.to_dict()["parameters"]) == ["k_K1", "k_K2"]
     assert e.parameter_values.shape == (2,)
     assert set(e.intervals) == {"k_K1", "k_K2"}
@@ -125,7 +126,8 @@ def test_not_converged_returns_the_result_with_exit_code_3(cli, examples):
     )
     assert code == 3
     assert e.exit_code == eigenfit.EXIT_NOT_CONVERGED
-    assert not e.converged
+    assert not e.converged and not e.acceptable
+    assert e.verdict == expected["verdict"]
     assert e.to_dict() == expected
 
 

@@ -42,6 +42,11 @@ pub fn emit_json(value: serde_json::Value) {
     }
 }
 
+/// Whether this thread's JSON results are being captured by [`crate::run_json`].
+pub fn capturing() -> bool {
+    CAPTURED.with(|c| c.borrow().is_some())
+}
+
 /// Runs `f` with the JSON results of this thread captured; returns what `f` returned and the
 /// last JSON value emitted, if any. Restores the previous state even when `f` panics.
 pub(crate) fn capture_json<T>(f: impl FnOnce() -> T) -> (T, Option<serde_json::Value>) {

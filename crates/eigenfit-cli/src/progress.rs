@@ -7,7 +7,8 @@ use std::time::Duration;
 
 /// Whether progress may be drawn.
 pub fn enabled(quiet: bool) -> bool {
-    !quiet && std::io::stderr().is_terminal()
+    // A library caller (`run_json`: the Python package) gets results, never bars.
+    !quiet && !crate::output::capturing() && std::io::stderr().is_terminal()
 }
 
 /// A bar of `len` steps with a message; hidden when progress is off.

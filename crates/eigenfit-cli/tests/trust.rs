@@ -147,7 +147,20 @@ const CASES: &[Case] = &[
         exit: 0,
         says: &["fit quality: acceptable (χ² = ", "6 dof, p = "],
     },
-    // A budget too small for the fit: said, exit 3.
+    // A budget too small for the fit: said, exit 3 (and before the fit could start).
+    Case {
+        args: &[
+            "estimate",
+            "--preset",
+            "paper-rotor",
+            "--measured",
+            "../../../../examples/measured_no_effect.csv",
+            "--budget",
+            "3",
+        ],
+        exit: 3,
+        says: &["budget-exhausted", "before the fit could start"],
+    },
     Case {
         args: &[
             "estimate",

@@ -140,10 +140,10 @@ const PROFILE_REFIT_ITERATIONS: usize = 30;
 /// Refits allowed to bracket one bound (steps growing ×3 from the linearised σ).
 const PROFILE_BRACKET_REFITS: usize = 8;
 /// Refits allowed to locate a bracketed bound.
-const PROFILE_LOCATE_REFITS: usize = 10;
-/// A bound is located when Δχ² is this close to the threshold, or the bracket this narrow
-/// (scaled units: 0.1% of a log parameter).
-const PROFILE_CHI2_TOLERANCE: f64 = 0.05;
+const PROFILE_LOCATE_REFITS: usize = 12;
+/// A bound is located when √Δχ² is this close to 1.96 (Δχ² within 0.05 of 3.84), or the
+/// bracket this narrow (scaled units: 0.1% of a log parameter).
+const PROFILE_ROOT_TOLERANCE: f64 = 0.05 / (2.0 * Z_95);
 const PROFILE_WIDTH_TOLERANCE: f64 = 1e-3;
 
 /// The profile likelihood of one parameter: Δχ² after refitting the others with it held fixed.
@@ -154,6 +154,11 @@ struct Profile<'a> {
     budget: &'a Budget,
     /// Linearised σ in scaled units (may be ∞): sets the first bracketing step.
     sigma: f64,
+}
+
+/// √Δχ² − √3.84: negative inside the 95% region, zero on its boundary.
+fn signed_root(delta_chi2: f64) -> f64 {
+    delta_chi2.max(0.0).sqrt() - Z_95
 }
 
 /// The budget ran out before a bound was found.
@@ -193,20 +198,20 @@ impl Profile<'_> {
         let s_limit = if limit.is_finite() { par.to_scaled(limit) } else { dir * f64::INFINITY };
         let span = (s_limit - s_hat).abs();
         // On (or within round-off of) the limit: nothing lies beyond, the data bound nothing here.
-        if !(span > 1e-9 * (1.0 + s_hat.abs())) {
+        if span.is_nan() || span <= 1e-9 * (1.0 + s_hat.abs()) {
             return Ok(None);
         }
         let first = if self.sigma.is_finite() { (Z_95 * self.sigma).max(0.1) } else { 1.0 };
-        let (mut inside, mut inside_val, mut warm) = (0.0, -CHI2_95_1DOF, self.at.parameters.clone());
+        let (mut inside, mut inside_val, mut warm) = (0.0, signed_root(0.0), self.at.parameters.clone());
         let mut t = first.min(span);
         let mut outside = None;
         for _ in 0..PROFILE_BRACKET_REFITS {
             match self.delta_chi2(s_hat + dir * t, &warm)? {
                 Some((d, p)) if d <= CHI2_95_1DOF => {
-                    (inside, inside_val, warm) = (t, d - CHI2_95_1DOF, p);
+                    (inside, inside_val, warm) = (t, signed_root(d), p);
                 }
                 hit => {
-                    outside = Some((t, hit.map_or(f64::INFINITY, |(d, _)| d - CHI2_95_1DOF)));
+                    outside = Some((t, hit.map_or(f64::INFINITY, |(d, _)| signed_root(d))));
                     break;
                 }
             }
@@ -218,48 +223,50 @@ impl Profile<'_> {
         let Some((mut out, mut out_val)) = outside else {
             return Ok(None); // no rise within the reach of the bracketing: unbounded this side
         };
-        let (mut side_in, mut side_out) = (0, 0);
+        // Illinois: regula falsi on f = √Δχ² − 1.96 (near linear in the parameter where Δχ² is
+        // near quadratic; Δχ² itself rises by thousands past the bound) between `inside` (f < 0) and `out`
+        // (f > 0, or ∞ where the model failed), halving the value of an end kept twice in a row
+        // so that neither end stalls; a bisection where no finite value is known.
+        let mut kept: Option<bool> = None; // which end the last step kept: Some(true) = inside
+        let root = |a: f64, fa: f64, b: f64, fb: f64| {
+            if fb.is_finite() && fb > fa {
+                a + (b - a) * (-fa) / (fb - fa)
+            } else {
+                0.5 * (a + b)
+            }
+        };
         for _ in 0..PROFILE_LOCATE_REFITS {
             if out - inside <= PROFILE_WIDTH_TOLERANCE {
                 break;
             }
-            // Regula falsi where both ends have finite values; Illinois halving of the end kept
-            // twice stops it from creeping; a bisection otherwise, and as a safeguard.
-            let mut next = if out_val.is_finite() {
-                let w_in = if side_in >= 2 { 0.5 } else { 1.0 };
-                let w_out = if side_out >= 2 { 0.5 } else { 1.0 };
-                let (a, b) = (inside_val * w_in, out_val * w_out);
-                inside + (out - inside) * (-a) / (b - a)
-            } else {
-                0.5 * (inside + out)
-            };
-            let margin = 0.05 * (out - inside);
-            if !(next > inside + margin && next < out - margin) {
-                next = 0.5 * (inside + out);
-            }
+            let next = root(inside, inside_val, out, out_val)
+                .clamp(inside + 1e-3 * (out - inside), out - 1e-3 * (out - inside));
             match self.delta_chi2(s_hat + dir * next, &warm)? {
                 Some((d, p)) if d <= CHI2_95_1DOF => {
-                    (inside, inside_val, warm) = (next, d - CHI2_95_1DOF, p);
-                    side_in = 0;
-                    side_out += 1;
-                    if -inside_val <= PROFILE_CHI2_TOLERANCE {
-                        out = inside;
-                        break;
+                    (inside, inside_val, warm) = (next, signed_root(d), p);
+                    if kept == Some(false) {
+                        out_val *= 0.5;
+                    }
+                    kept = Some(false);
+                    if -inside_val <= PROFILE_ROOT_TOLERANCE {
+                        return Ok(Some(par.from_scaled(s_hat + dir * inside).clamp(par.lower, par.upper)));
                     }
                 }
                 hit => {
                     out = next;
-                    out_val = hit.map_or(f64::INFINITY, |(d, _)| d - CHI2_95_1DOF);
-                    side_out = 0;
-                    side_in += 1;
-                    if out_val <= PROFILE_CHI2_TOLERANCE {
-                        inside = out;
-                        break;
+                    out_val = hit.map_or(f64::INFINITY, |(d, _)| signed_root(d));
+                    if kept == Some(true) {
+                        inside_val *= 0.5;
+                    }
+                    kept = Some(true);
+                    if out_val <= PROFILE_ROOT_TOLERANCE {
+                        return Ok(Some(par.from_scaled(s_hat + dir * out).clamp(par.lower, par.upper)));
                     }
                 }
             }
         }
-        Ok(Some(par.from_scaled(s_hat + dir * 0.5 * (inside + out)).clamp(par.lower, par.upper)))
+        let at = root(inside, inside_val, out, out_val);
+        Ok(Some(par.from_scaled(s_hat + dir * at).clamp(par.lower, par.upper)))
     }
 }
 
@@ -335,8 +342,8 @@ pub fn mirror_solutions(
             }
             let mut p = at.parameters.clone();
             p.swap(i, j);
-            if scaled_distance(problem, &p, &at.parameters) <= 0.01 {
-                continue; // equal values: the exchange is the same point
+            if scaled_distance(problem, &p, &at.parameters) <= MIRROR_DISTANCE {
+                continue; // (nearly) equal values: the exchange is the same point, not another solution
             }
             if let Ok(lin) = budgeted.linearise(&p) {
                 if fits_as_well(at, &lin) {
@@ -347,6 +354,9 @@ pub fn mirror_solutions(
     }
     found
 }
+
+/// Scaled distance (10 % of a log parameter) below which an exchanged pair is the same solution.
+const MIRROR_DISTANCE: f64 = 0.1;
 
 /// Largest scaled difference between two parameter vectors.
 fn scaled_distance(problem: &dyn Evaluate, a: &[f64], b: &[f64]) -> f64 {

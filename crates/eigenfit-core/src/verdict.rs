@@ -81,14 +81,17 @@ pub fn judge(lin: &Linearisation, free: usize) -> FitQuality {
     let chi2 = lin.chi2();
     let p_value = (dof > 0).then(|| chi2_upper_tail(chi2, dof));
     let poor = match p_value {
-        Some(p) => !(p >= POOR_FIT_P_VALUE),
-        None => !(chi2 <= POOR_FIT_CHI2_NO_DOF),
+        Some(p) => p.is_nan() || p < POOR_FIT_P_VALUE,
+        None => chi2.is_nan() || chi2 > POOR_FIT_CHI2_NO_DOF,
     };
     // With std the weighted residual is in σ units, whatever the residual kind.
     let mut order: Vec<usize> = (0..lin.residual.len()).collect();
     order.sort_by(|&a, &b| lin.residual[b].abs().total_cmp(&lin.residual[a].abs()));
-    let mut disagreeing: Vec<usize> =
-        order.iter().copied().filter(|&k| !(lin.residual[k].abs() <= DISAGREEING_SIGMAS)).collect();
+    let mut disagreeing: Vec<usize> = order
+        .iter()
+        .copied()
+        .filter(|&k| lin.residual[k].is_nan() || lin.residual[k].abs() > DISAGREEING_SIGMAS)
+        .collect();
     if poor && disagreeing.is_empty() {
         disagreeing.extend(order.first());
     }

@@ -8,7 +8,9 @@ use clap::Args;
 use eigenfit_core::statistics::{alternative_solutions_within, mirror_solutions};
 use eigenfit_core::update::DEFAULT_EVALUATIONS;
 use eigenfit_core::verdict::{at_limits, judge, unreachable_modes, FitVerdict};
-use eigenfit_core::{Budget, Driver, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel};
+use eigenfit_core::{
+    Budget, Driver, Evaluate, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel,
+};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
 
@@ -49,6 +51,9 @@ pub struct EstimateArgs {
     #[arg(long)]
     pub json: bool,
 }
+
+/// Another equally good parameter vector, with the exchanged pair when it is a mirror solution.
+type Alternative = (Vec<f64>, Option<(usize, usize)>);
 
 /// Restart-grid points refitted locally when searching for other equally good solutions.
 const ALTERNATIVE_STARTS: usize = 6;
@@ -139,13 +144,38 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             list.join("; ")
         )));
     }
+    // A start inside the bounds where the model cannot be evaluated (a support so soft its mode
+    // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
+    // the best point of its coarse grid instead, and says so.
+    let mut start = initial.clone();
+    if strategy_kind == StrategyKind::Damped {
+        let budgeted = budget.wrap(&fit);
+        if let Err(e) = budgeted.linearise(&initial) {
+            if let Some(seed) = eigenfit_core::Damped::rank_seeds(&budgeted).first() {
+                eprintln!(
+                    "eigenfit: note: the model cannot be evaluated at --initial ({e}); starting from the best point of the coarse grid"
+                );
+                start = seed.clone();
+            }
+        }
+    }
     let mut strategy = strategy_kind.build();
     let pb = progress::spinner(&format!("estimating ({})", strategy_kind.name()), args.quiet);
     let estimate = Driver { max_iterations: args.max_iterations }
-        .run_within(&fit, strategy.as_mut(), &initial, &mut [], &budget)
+        .run_within(&fit, strategy.as_mut(), &start, &mut [], &budget)
         .map_err(|e| input(e.to_string()));
     pb.finish_and_clear();
-    let estimate = estimate?;
+    let estimate = match estimate {
+        Err(_) if budget.exhausted() => {
+            crate::error::set_exit_on_closed_pipe(EXIT_NOT_CONVERGED);
+            eprintln!(
+                "eigenfit: budget-exhausted: the budget of {} model evaluations ran out before the fit could start (raise it with --budget)",
+                budget.limit()
+            );
+            return Ok(EXIT_NOT_CONVERGED);
+        }
+        other => other?,
+    };
     // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
     let system = model.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
     if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
@@ -161,7 +191,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         (None, None)
     };
     let mac = fit.mac(&estimate.parameters, args.test_data.mac_threshold);
-    let mut alternatives: Vec<(Vec<f64>, Option<(usize, usize)>)> = Vec::new();
+    let mut alternatives: Vec<Alternative> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {
         for (i, j, p) in mirror_solutions(&fit, &estimate.last, &budget) {
             alternatives.push((p, Some((i, j))));
@@ -304,10 +334,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             estimate.iterations,
             budget.used()
         );
-        println!(
-            "{:<20}{:>16}{:>16}   {}",
-            "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]"
-        );
+        println!("{:<20}{:>16}{:>16}   95% interval [N/m]", "parameter", "initial [N/m]", "estimate [N/m]");
         for (i, n) in names.iter().enumerate() {
             // A value on a limit is where the search stopped, not an estimate.
             let value =
@@ -385,7 +412,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
 /// Four significant digits, in exponent form outside [1e-3, 1e5).
 fn significant(v: f64) -> String {
     if v == 0.0 || (1e-3..1e5).contains(&v.abs()) {
-        format!("{}", format!("{v:.4}").trim_end_matches('0').trim_end_matches('.'))
+        format!("{v:.4}").trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
         format!("{v:.3e}")
     }

@@ -231,7 +231,7 @@ pub(crate) fn refuse_roundoff(
 ) -> Result<(), CliError> {
     use eigenfit_core::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF};
     let levels = relative_roundoff(system, modes);
-    match levels.iter().position(|&r| !(r <= MAX_RELATIVE_ROUNDOFF)) {
+    match levels.iter().position(|&r| r.is_nan() || r > MAX_RELATIVE_ROUNDOFF) {
         None => {
             if let Some(j) = levels.iter().position(|&r| r > NOTE_RELATIVE_ROUNDOFF) {
                 eprintln!(
