@@ -9,6 +9,7 @@ mod measured;
 mod output;
 mod plot;
 mod progress;
+mod rotordynamics;
 mod source;
 
 use clap::{Parser, Subcommand};
@@ -34,6 +35,9 @@ enum Command {
     /// The paper rotor end to end: Table 1, Table 3 case 1 with every strategy, a convergence map
     /// and a discovery, with every plot written to a folder.
     Demo(commands::demo::DemoArgs),
+    /// Campbell diagram of a two-plane (ROSS) rotor: damped frequencies, whirl and log
+    /// decrement against speed in rpm, with the critical speeds.
+    Campbell(commands::campbell::CampbellArgs),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +49,7 @@ fn main() -> ExitCode {
         Command::Compare(a) => commands::compare::run(a).map(|()| error::EXIT_OK),
         Command::Discover(a) => commands::discover::run(a).map(|()| error::EXIT_OK),
         Command::Demo(a) => commands::demo::run(a).map(|()| error::EXIT_OK),
+        Command::Campbell(a) => commands::campbell::run(a).map(|()| error::EXIT_OK),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -15,7 +15,8 @@ use std::path::PathBuf;
 pub struct EstimateArgs {
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Measured frequencies: CSV with header `mode,frequency_hz[,std_hz]`, modes counted from 1.
+    /// Measured frequencies: CSV with header `mode,frequency_hz[,std_hz]`, modes counted from 1
+    /// (for a ROSS rotor: `speed_rpm,mode,frequency_hz[,std_hz][,whirl]`, a run-up).
     #[arg(long, value_name = "FILE.csv")]
     pub measured: PathBuf,
     /// Update strategy: newton, p-step or damped.
@@ -43,6 +44,10 @@ pub struct EstimateArgs {
 
 /// Runs `estimate`; returns the exit code (3 when the run did not converge).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
+    // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
+    if let Some(path) = crate::rotordynamics::ross_model(args.model.model.as_deref()) {
+        return crate::rotordynamics::estimate(path, &args.measured, args.max_iterations, args.json);
+    }
     let (rotor, label) = args.model.load()?;
     let solver = args.model.solver()?;
     let measurement = measured::read(&args.measured)?;

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod campbell;
 pub mod compare;
 pub mod demo;
 pub mod discover;
