@@ -33,6 +33,7 @@ warnings.filterwarnings("ignore")
 OUT = pathlib.Path(__file__).resolve().parent.parent / "crates/eigenfit-rotordynamics/tests/data"
 OUT.mkdir(parents=True, exist_ok=True)
 LATERAL_MODES = 8
+COEFFICIENTS = ["kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy", "mxx", "mxy", "myx", "myy"]
 
 
 def speed_bearing_rotor():
@@ -119,6 +120,15 @@ def main():
         reference["rotors"][name] = {
             "speeds_rad_s": speeds,
             "modes": [lateral_modes(rotor, w) for w in speeds],
+            # The coefficients ROSS used at each speed (its smoothing-spline fit of the tables),
+            # so a test can check the element formulation apart from the curve fit.
+            "bearing_coefficients": [
+                {
+                    b.tag: {c: float(getattr(b, f"{c}_interpolated")(w)) for c in COEFFICIENTS}
+                    for b in rotor.bearing_elements
+                }
+                for w in speeds
+            ],
         }
     # ROSS 3 spelling: bearing tables over `speed`.
     text = (OUT / "speed_bearing.toml").read_text()

@@ -62,7 +62,10 @@ pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize, json_out: boo
         println!("{out}");
     } else {
         println!("{}: {} DOF two-plane rotor at {rpm} rpm", path.display(), rotor.dofs());
-        println!("{:>6}{:>16}{:>16}{:>12}{:>12}{:>10}", "mode", "damped [Hz]", "natural [Hz]", "ζ", "log dec", "whirl");
+        println!(
+            "{:>6}{:>16}{:>16}{:>12}{:>12}{:>10}",
+            "mode", "damped [Hz]", "natural [Hz]", "ζ", "log dec", "whirl"
+        );
         for (i, m) in shown.iter().enumerate() {
             println!(
                 "{:>6}{:>16.6}{:>16.6}{:>12.5}{:>12.5}{:>10}",
@@ -112,6 +115,7 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
             "parameters": obj(value.iter().map(|&v| json!(v)).collect()),
             "scales": obj(id.scales.iter().map(|&v| json!(v)).collect()),
             "cost": id.cost,
+            "identifiable": id.identifiable,
             "points": points.iter().enumerate().map(|(i, p)| json!({
                 "speed_rpm": p.speed_rpm,
                 "mode": p.mode,
@@ -137,14 +141,20 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
             if id.converged { "converged" } else { "NOT converged" },
             id.iterations
         );
-        println!("{:<28}{:>16}{:>16}{:>32}", "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]");
+        println!(
+            "{:<28}{:>16}{:>16}{:>32}",
+            "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]"
+        );
         for i in 0..params.len() {
-            let iv = intervals
-                .as_ref()
-                .map_or("(no std_hz given)".to_string(), |iv| format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]));
+            let iv = intervals.as_ref().map_or("(no std_hz given)".to_string(), |iv| {
+                format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1])
+            });
             println!("{:<28}{:>16.4e}{:>16.6e}{iv:>32}", names[i], nominal[i], value[i]);
         }
-        println!("{:>10}{:>6}{:>16}{:>16}{:>12}{:>10}", "rpm", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]", "whirl");
+        println!(
+            "{:>10}{:>6}{:>16}{:>16}{:>12}{:>10}",
+            "rpm", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]", "whirl"
+        );
         for (i, p) in points.iter().enumerate() {
             println!(
                 "{:>10.1}{:>6}{:>16.6}{:>16.6}{:>12.2e}{:>10}",
@@ -158,6 +168,12 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
         }
         if id.ln_std.is_some() {
             println!("chi² = {:.4} with {dof} degrees of freedom", id.cost);
+        }
+        if !id.identifiable {
+            println!(
+                "not identifiable: the frequencies do not determine every parameter separately \
+                 (an isotropic rotor's kxx and kyy act alike); no intervals"
+            );
         }
     }
     Ok(if id.converged { EXIT_OK } else { EXIT_NOT_CONVERGED })

@@ -91,10 +91,8 @@ pub fn campbell(rotor: &Rotor, speeds_rpm: &[f64], n_modes: usize) -> Result<Cam
     }
     critical.sort_by(|a, b| a.rpm.total_cmp(&b.rpm));
     // Curves reported by index into the N shown (ascending) lists.
-    let curves = curves
-        .into_iter()
-        .map(|c| c.into_iter().map(|i| i.filter(|&i| i < n_modes)).collect())
-        .collect();
+    let curves =
+        curves.into_iter().map(|c| c.into_iter().map(|i| i.filter(|&i| i < n_modes)).collect()).collect();
     Ok(Campbell {
         speeds_rpm: speeds_rpm.to_vec(),
         frequencies_hz: all.iter().map(|m| m[..n_modes].iter().map(Mode::frequency_hz).collect()).collect(),

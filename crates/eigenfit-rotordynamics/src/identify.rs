@@ -49,8 +49,10 @@ pub fn is_runup_header(text: &str) -> bool {
 
 /// Parses run-up CSV text (see [`read_runup`]); `#` lines are comments.
 pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, String> {
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let (_, header) = lines.next().ok_or("empty file: expected header speed_rpm,mode,frequency_hz[,std_hz][,whirl]")?;
+    let mut lines =
+        text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let (_, header) =
+        lines.next().ok_or("empty file: expected header speed_rpm,mode,frequency_hz[,std_hz][,whirl]")?;
     let cols: Vec<&str> = header.split(',').map(str::trim).collect();
     let col = |name: &str| cols.iter().position(|c| *c == name);
     let (Some(cs), Some(cm), Some(cf)) = (col("speed_rpm"), col("mode"), col("frequency_hz")) else {
@@ -58,7 +60,9 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, String> {
             "line 1: header `{header}` must name speed_rpm, mode and frequency_hz (optional std_hz, whirl)"
         ));
     };
-    if let Some(bad) = cols.iter().find(|c| !["speed_rpm", "mode", "frequency_hz", "std_hz", "whirl"].contains(c)) {
+    if let Some(bad) =
+        cols.iter().find(|c| !["speed_rpm", "mode", "frequency_hz", "std_hz", "whirl"].contains(c))
+    {
         return Err(format!("line 1: unknown column `{bad}` (speed_rpm, mode, frequency_hz, std_hz, whirl)"));
     }
     let (cstd, cw) = (col("std_hz"), col("whirl"));
@@ -81,7 +85,8 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, String> {
         if speed_rpm < 0.0 {
             return Err(format!("line {at}: speed_rpm {speed_rpm} must be ≥ 0"));
         }
-        let mode: usize = f[cm].parse().map_err(|_| format!("line {at}: mode `{}` is not a whole number ≥ 1", f[cm]))?;
+        let mode: usize =
+            f[cm].parse().map_err(|_| format!("line {at}: mode `{}` is not a whole number ≥ 1", f[cm]))?;
         if mode == 0 {
             return Err(format!("line {at}: mode counts from 1"));
         }
@@ -242,6 +247,9 @@ pub struct Identification {
     pub evaluations: usize,
     /// Whether the iteration met its tolerance.
     pub converged: bool,
+    /// Whether every parameter is determined by the data (Jacobian of full rank at the
+    /// estimate, singular values above 10⁻¹² of the largest).
+    pub identifiable: bool,
     /// Why the iteration stopped.
     pub reason: String,
 }
@@ -306,8 +314,8 @@ pub fn identify(
             let (r2, j2) = weighted(&e);
             let c2 = r2.norm_squared();
             if c2 < cost {
-                let small_step = step.amax() < 1e-10;
-                let small_gain = (cost - c2) <= 1e-14 * cost.max(1e-300);
+                let small_step = step.amax() < 1e-9;
+                let small_gain = (cost - c2) <= 1e-12 * cost.max(1e-300);
                 theta = trial;
                 eval = e;
                 r = r2;
@@ -337,8 +345,23 @@ pub fn identify(
         }
     }
     let has_std = points.iter().all(|p| p.std_hz.is_some());
+    // Covariance (JᵀJ)⁻¹ = V Σ⁻² Vᵀ from the SVD of J: no squared condition number.
+    let svd = jac.clone().svd(false, true);
+    let v_t = svd.v_t.expect("requested");
+    let smax = svd.singular_values.max();
+    let identifiable = smax > 0.0 && svd.singular_values.iter().all(|&s| s > 1e-12 * smax);
     let ln_std = if has_std {
-        (jac.transpose() * &jac).try_inverse().map(|cov| (0..np).map(|k| cov[(k, k)].max(0.0).sqrt()).collect())
+        if !identifiable {
+            None
+        } else {
+            Some(
+                (0..np)
+                    .map(|k| {
+                        (0..np).map(|i| (v_t[(i, k)] / svd.singular_values[i]).powi(2)).sum::<f64>().sqrt()
+                    })
+                    .collect(),
+            )
+        }
     } else {
         None
     };
@@ -352,6 +375,7 @@ pub fn identify(
         iterations,
         evaluations,
         converged,
+        identifiable,
         reason,
     })
 }

@@ -3,10 +3,10 @@
 //! also returns the left eigenvectors the sensitivities need.
 
 use crate::error::RotorDynError;
-use faer::linalg::evd::{evd_real, evd_scratch, ComputeEigenvectors};
 use faer::diag::Diag;
-use faer::{c64, Mat, MatRef, Par};
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::evd::{evd_real, evd_scratch, ComputeEigenvectors};
+use faer::{c64, Mat, MatRef, Par};
 
 /// Whirl direction of a mode, from the orbits of its nodes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -237,7 +237,8 @@ fn eigen_real(a: MatRef<'_, f64>, with_left: bool) -> Result<EigenParts, RotorDy
     let mut s_re = Diag::<f64>::zeros(n);
     let mut s_im = Diag::<f64>::zeros(n);
     let want_left = if with_left { ComputeEigenvectors::Yes } else { ComputeEigenvectors::No };
-    let mut mem = MemBuffer::new(evd_scratch::<f64>(n, want_left, ComputeEigenvectors::Yes, par, Default::default()));
+    let mut mem =
+        MemBuffer::new(evd_scratch::<f64>(n, want_left, ComputeEigenvectors::Yes, par, Default::default()));
     evd_real(
         a,
         s_re.as_mut(),

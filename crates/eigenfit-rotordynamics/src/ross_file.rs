@@ -41,7 +41,9 @@ pub fn read(path: &Path) -> Result<Rotor, RotorDynError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| RotorDynError::File(format!("{}: cannot read: {e}", path.display())))?;
     parse(&text).map_err(|e| match e {
-        RotorDynError::File(m) | RotorDynError::Model(m) => RotorDynError::File(format!("{}: {m}", path.display())),
+        RotorDynError::File(m) | RotorDynError::Model(m) => {
+            RotorDynError::File(format!("{}: {m}", path.display()))
+        }
         other => other,
     })
 }
@@ -51,7 +53,8 @@ pub fn parse(text: &str) -> Result<Rotor, RotorDynError> {
     let root: Value = if text.trim_start().starts_with('{') {
         serde_json::from_str(text).map_err(|e| RotorDynError::File(format!("not valid JSON: {e}")))?
     } else {
-        let t: toml::Table = toml::from_str(text).map_err(|e| RotorDynError::File(format!("not valid TOML: {e}")))?;
+        let t: toml::Table =
+            toml::from_str(text).map_err(|e| RotorDynError::File(format!("not valid TOML: {e}")))?;
         serde_json::to_value(t).map_err(|e| RotorDynError::File(e.to_string()))?
     };
     let Value::Object(root) = root else {
@@ -76,14 +79,16 @@ pub fn parse(text: &str) -> Result<Rotor, RotorDynError> {
             "ShaftElement" | "ShaftElement6DoF" => shafts.push(e.shaft(tag)?),
             "DiskElement" | "DiskElement6DoF" => disks.push(e.disk(tag)?),
             "PointMass" => masses.push(e.point_mass(tag)?),
-            c if BEARING_CLASSES.contains(&c) || t.contains_key("kxx") && (c.ends_with("Bearing") || c.ends_with("Seal")) => {
+            c if BEARING_CLASSES.contains(&c)
+                || t.contains_key("kxx") && (c.ends_with("Bearing") || c.ends_with("Seal")) =>
+            {
                 bearings.push(e.bearing(tag, c)?)
             }
             other => {
                 return Err(RotorDynError::Model(format!(
-                    "table `{key}`: ROSS element class `{other}` is not supported (eigenfit reads ShaftElement, \
+                "table `{key}`: ROSS element class `{other}` is not supported (eigenfit reads ShaftElement, \
                      DiskElement, PointMass and bearing/seal elements with saved coefficients)"
-                )))
+            )))
             }
         }
     }
@@ -107,7 +112,9 @@ impl Entry<'_> {
     fn number_opt(&self, name: &str) -> Result<Option<f64>, RotorDynError> {
         match self.table.get(name) {
             None | Some(Value::Null) => Ok(None),
-            Some(v) => number(v).map(Some).ok_or_else(|| self.err(format!("`{name}` must be a number, not {v}"))),
+            Some(v) => {
+                number(v).map(Some).ok_or_else(|| self.err(format!("`{name}` must be a number, not {v}")))
+            }
         }
     }
 
@@ -161,7 +168,9 @@ impl Entry<'_> {
         let shear_method = match self.string("shear_method_calc").as_deref() {
             None | Some("cowper") => ShearMethod::Cowper,
             Some("hutchinson") => ShearMethod::Hutchinson,
-            Some(other) => return Err(self.err(format!("unknown shear_method_calc `{other}` (cowper, hutchinson)"))),
+            Some(other) => {
+                return Err(self.err(format!("unknown shear_method_calc `{other}` (cowper, hutchinson)")))
+            }
         };
         Ok(ShaftElement {
             tag,
@@ -184,7 +193,13 @@ impl Entry<'_> {
     }
 
     fn disk(&self, tag: String) -> Result<Disk, RotorDynError> {
-        Ok(Disk { tag, n: self.node("n")?, m: self.number("m")?, id: self.number("Id")?, ip: self.number("Ip")? })
+        Ok(Disk {
+            tag,
+            n: self.node("n")?,
+            m: self.number("m")?,
+            id: self.number("Id")?,
+            ip: self.number("Ip")?,
+        })
     }
 
     fn point_mass(&self, tag: String) -> Result<PointMass, RotorDynError> {
@@ -199,19 +214,27 @@ impl Entry<'_> {
             None | Some(Value::Null) => None,
             Some(Value::Array(a)) => Some(
                 a.iter()
-                    .map(|v| number(v).ok_or_else(|| self.err(format!("speed/frequency item {v} is not a number"))))
+                    .map(|v| {
+                        number(v).ok_or_else(|| self.err(format!("speed/frequency item {v} is not a number")))
+                    })
                     .collect::<Result<_, _>>()?,
             ),
-            Some(v) => Some(vec![number(v).ok_or_else(|| self.err(format!("speed/frequency {v} is not a number")))?]),
+            Some(v) => {
+                Some(vec![number(v).ok_or_else(|| self.err(format!("speed/frequency {v} is not a number")))?])
+            }
         };
-        let coefficient = |name: &str, fallback: Option<&Coefficient>| -> Result<Coefficient, RotorDynError> {
+        let coefficient = |name: &str,
+                           fallback: Option<&Coefficient>|
+         -> Result<Coefficient, RotorDynError> {
             let what = format!("`{}` {name}", self.key);
             match self.table.get(name) {
                 None | Some(Value::Null) => Ok(fallback.cloned().unwrap_or(Coefficient::Constant(0.0))),
                 Some(Value::Array(a)) => {
                     let values: Vec<f64> = a
                         .iter()
-                        .map(|v| number(v).ok_or_else(|| self.err(format!("{name} item {v} is not a number"))))
+                        .map(|v| {
+                            number(v).ok_or_else(|| self.err(format!("{name} item {v} is not a number")))
+                        })
                         .collect::<Result<_, _>>()?;
                     if values.len() == 1 {
                         return Coefficient::from_table(&[0.0], &values, &what);
@@ -233,7 +256,12 @@ impl Entry<'_> {
         let cyy = coefficient("cyy", Some(&cxx))?;
         let k = [kxx, coefficient("kxy", None)?, coefficient("kyx", None)?, kyy];
         let c = [cxx, coefficient("cxy", None)?, coefficient("cyx", None)?, cyy];
-        let m = [coefficient("mxx", None)?, coefficient("mxy", None)?, coefficient("myx", None)?, coefficient("myy", None)?];
+        let m = [
+            coefficient("mxx", None)?,
+            coefficient("mxy", None)?,
+            coefficient("myx", None)?,
+            coefficient("myy", None)?,
+        ];
         let n_link = match self.number_opt("n_link")? {
             None => None,
             Some(_) => Some(self.node("n_link")?),

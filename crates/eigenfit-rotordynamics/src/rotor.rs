@@ -56,16 +56,19 @@ impl Rotor {
             return Err(RotorDynError::Model("the rotor has no shaft elements".into()));
         }
         shafts.sort_by_key(|s| s.n);
-        for (i, s) in shafts.iter().enumerate() {
+        // Several elements may share a node pair (ROSS's layered shafts: sleeves, fits); they add.
+        let mut expected = 0;
+        for s in &shafts {
             check_shaft(s)?;
-            if s.n != i {
+            if s.n > expected {
                 return Err(RotorDynError::Model(format!(
-                    "shaft element `{}`: node {} but the shaft elements must cover nodes 0, 1, 2, … in turn (expected {i})",
+                    "shaft element `{}`: node {} leaves a gap: no shaft element starts at node {expected}",
                     s.tag, s.n
                 )));
             }
+            expected = s.n + 1;
         }
-        let shaft_nodes = shafts.len() + 1;
+        let shaft_nodes = expected + 1;
         for d in &disks {
             if d.n >= shaft_nodes {
                 return Err(RotorDynError::Model(format!(
@@ -132,7 +135,8 @@ impl Rotor {
 
     fn fixed(&self) -> Fixed {
         let n = self.dofs();
-        let mut f = Fixed { m: Mat::zeros(n, n), k: Mat::zeros(n, n), c: Mat::zeros(n, n), g: Mat::zeros(n, n) };
+        let mut f =
+            Fixed { m: Mat::zeros(n, n), k: Mat::zeros(n, n), c: Mat::zeros(n, n), g: Mat::zeros(n, n) };
         for s in &self.shafts {
             let o = 4 * s.n;
             scatter8(&mut f.m, o, &s.mass());
@@ -239,7 +243,20 @@ fn scatter8(target: &mut Mat<f64>, offset: usize, e: &Mat8) {
 
 fn check_shaft(s: &ShaftElement) -> Result<(), RotorDynError> {
     let bad = |what: &str| Err(RotorDynError::Model(format!("shaft element `{}`: {what}", s.tag)));
-    let finite = [s.length, s.idl, s.odl, s.idr, s.odr, s.material.rho, s.material.e, s.material.g_s, s.axial_force, s.torque, s.alpha, s.beta];
+    let finite = [
+        s.length,
+        s.idl,
+        s.odl,
+        s.idr,
+        s.odr,
+        s.material.rho,
+        s.material.e,
+        s.material.g_s,
+        s.axial_force,
+        s.torque,
+        s.alpha,
+        s.beta,
+    ];
     if finite.iter().any(|v| !v.is_finite()) {
         return bad("every number must be finite");
     }

@@ -87,7 +87,8 @@ pub fn eigenvalue_derivatives(mats: &Matrices, modes: &[Mode], params: &[MatrixD
                 cluster
                     .iter()
                     .map(|m| {
-                        -q_prime(&m.left, dq, m.eigenvalue, &m.right) / b_form(&m.left, mats, m.eigenvalue, &m.right)
+                        -q_prime(&m.left, dq, m.eigenvalue, &m.right)
+                            / b_form(&m.left, mats, m.eigenvalue, &m.right)
                     })
                     .collect()
             };

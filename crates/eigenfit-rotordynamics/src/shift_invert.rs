@@ -6,9 +6,9 @@
 //! Own banded LU (LAPACK's dgbtrf scheme) because faer's sparse LU needs its heavy
 //! `sparse-linalg` feature and the band here is narrow (about 8) and known.
 
-use faer::linalg::evd::{evd_real, evd_scratch, ComputeEigenvectors};
-use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::diag::Diag;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::evd::{evd_real, evd_scratch, ComputeEigenvectors};
 use faer::{c64, Mat, MatRef, Par};
 
 /// LU factors of a banded matrix with partial pivoting (band storage, LAPACK layout in spirit).
@@ -146,7 +146,14 @@ fn matvec(a: &Mat<f64>, x: &[f64], out: &mut [f64], kl: usize, ku: usize) {
     }
 }
 
-fn arnoldi(lu: &BandLu, m: &Mat<f64>, d: &Mat<f64>, n: usize, dim: usize, wanted: usize) -> Option<Vec<(c64, Vec<c64>)>> {
+fn arnoldi(
+    lu: &BandLu,
+    m: &Mat<f64>,
+    d: &Mat<f64>,
+    n: usize,
+    dim: usize,
+    wanted: usize,
+) -> Option<Vec<(c64, Vec<c64>)>> {
     let (kl, ku) = (lu.kl, lu.ku2 - lu.kl);
     let size = 2 * n;
     // Op u = A⁻¹u: x2 = u1, K x1 = −M u2 − D u1.
@@ -195,8 +202,24 @@ fn arnoldi(lu: &BandLu, m: &Mat<f64>, d: &Mat<f64>, n: usize, dim: usize, wanted
     let mut ur = Mat::<f64>::zeros(steps, steps);
     let mut s_re = Diag::<f64>::zeros(steps);
     let mut s_im = Diag::<f64>::zeros(steps);
-    let mut mem = MemBuffer::new(evd_scratch::<f64>(steps, ComputeEigenvectors::No, ComputeEigenvectors::Yes, Par::Seq, Default::default()));
-    evd_real(hm.as_ref(), s_re.as_mut(), s_im.as_mut(), None, Some(ur.as_mut()), Par::Seq, MemStack::new(&mut mem), Default::default()).ok()?;
+    let mut mem = MemBuffer::new(evd_scratch::<f64>(
+        steps,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::Yes,
+        Par::Seq,
+        Default::default(),
+    ));
+    evd_real(
+        hm.as_ref(),
+        s_re.as_mut(),
+        s_im.as_mut(),
+        None,
+        Some(ur.as_mut()),
+        Par::Seq,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .ok()?;
     let (s_re, s_im) = (s_re.column_vector(), s_im.column_vector());
     // The wanted eigenvalues are the largest |θ| (nearest λ = 0); each must have converged:
     // residual |β sₘ|/‖s‖ ≤ 1e-10 |θ|.
@@ -209,7 +232,8 @@ fn arnoldi(lu: &BandLu, m: &Mat<f64>, d: &Mat<f64>, n: usize, dim: usize, wanted
     let mut out = Vec::new();
     for &idx in order.iter().take(wanted.min(steps)) {
         let theta = c64::new(s_re[idx], s_im[idx]);
-        let complex_first = s_im[idx] != 0.0 && idx + 1 < steps && s_im[idx] > 0.0 && s_im[idx + 1] == -s_im[idx];
+        let complex_first =
+            s_im[idx] != 0.0 && idx + 1 < steps && s_im[idx] > 0.0 && s_im[idx + 1] == -s_im[idx];
         let complex_second = s_im[idx] != 0.0 && idx > 0 && s_im[idx - 1] == -s_im[idx] && s_im[idx] < 0.0;
         let s: Vec<c64> = (0..steps)
             .map(|i| {

@@ -27,7 +27,9 @@ pub struct CampbellArgs {
 
 /// Parses `FROM:TO:COUNT` (rpm, linear).
 pub fn parse_speeds(text: &str) -> Result<Vec<f64>, CliError> {
-    let bad = |why: &str| input(format!("--speeds `{text}`: {why} (expected FROM:TO:COUNT in rpm, e.g. 0:12000:50)"));
+    let bad = |why: &str| {
+        input(format!("--speeds `{text}`: {why} (expected FROM:TO:COUNT in rpm, e.g. 0:12000:50)"))
+    };
     let parts: Vec<&str> = text.split(':').map(str::trim).collect();
     let [from, to, count] = parts[..] else { return Err(bad("three fields needed")) };
     let from: f64 = from.parse().map_err(|_| bad("FROM is not a number"))?;
@@ -51,7 +53,8 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
     if args.modes == 0 {
         return Err(input("--modes 0: at least one mode"));
     }
-    let c = campbell(&rotor, &speeds, args.modes).map_err(|e| input(format!("{}: {e}", args.model.display())))?;
+    let c =
+        campbell(&rotor, &speeds, args.modes).map_err(|e| input(format!("{}: {e}", args.model.display())))?;
     if args.json {
         let names = |v: &Vec<eigenfit_rotordynamics::Whirl>| v.iter().map(|w| w.name()).collect::<Vec<_>>();
         let out = json!({
@@ -68,7 +71,12 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
         });
         println!("{out}");
     } else {
-        println!("{}: Campbell diagram, {} modes at {} speeds", args.model.display(), args.modes, speeds.len());
+        println!(
+            "{}: Campbell diagram, {} modes at {} speeds",
+            args.model.display(),
+            args.modes,
+            speeds.len()
+        );
         print!("{:>10}", "rpm");
         (1..=args.modes).for_each(|m| print!("{:>22}", format!("f{m} [Hz] whirl")));
         println!();
