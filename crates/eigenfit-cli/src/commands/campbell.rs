@@ -2,6 +2,8 @@
 //! with whirl, log decrement and the critical speeds where followed modes cross the 1× line.
 
 use crate::error::{input, CliError};
+use crate::plot;
+use crate::plot::campbell::CampbellPlot;
 use crate::rotordynamics::load;
 use clap::Args;
 use eigenfit_rotordynamics::campbell;
@@ -20,6 +22,9 @@ pub struct CampbellArgs {
     /// Number of modes (lowest damped frequencies) per speed.
     #[arg(long, default_value_t = 6)]
     pub modes: usize,
+    /// Write the diagram (campbell.svg/.png) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -55,9 +60,16 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
     }
     let c =
         campbell(&rotor, &speeds, args.modes).map_err(|e| input(format!("{}: {e}", args.model.display())))?;
+    let plots = match &args.plot {
+        Some(dir) => {
+            let figure = CampbellPlot { title: args.model.display().to_string(), campbell: &c };
+            plot::write(&figure, dir, "campbell")?
+        }
+        None => Vec::new(),
+    };
     if args.json {
         let names = |v: &Vec<eigenfit_rotordynamics::Whirl>| v.iter().map(|w| w.name()).collect::<Vec<_>>();
-        let out = json!({
+        let mut out = json!({
             "model": args.model.display().to_string(),
             "speeds_rpm": c.speeds_rpm,
             "frequencies_hz": c.frequencies_hz,
@@ -69,6 +81,9 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
             })).collect::<Vec<_>>(),
             "curves": c.curves,
         });
+        if args.plot.is_some() {
+            out["plots"] = json!(plot::names(&plots));
+        }
         println!("{out}");
     } else {
         println!(
@@ -93,6 +108,7 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
         for k in &c.critical_speeds {
             println!("critical speed {:.1} rpm ({} whirl, log dec {:.4})", k.rpm, k.whirl.name(), k.log_dec);
         }
+        plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
     Ok(())
 }
