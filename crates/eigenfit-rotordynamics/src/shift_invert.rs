@@ -70,6 +70,8 @@ impl BandLu {
         Some(BandLu { n, kl, ku2, w, band, piv })
     }
 
+    // `b` and the band are indexed together (row i of the band holds b[i]'s coefficients).
+    #[allow(clippy::needless_range_loop)]
     fn solve(&self, b: &mut [f64]) {
         let (n, kl, w) = (self.n, self.kl, self.w);
         let idx = |i: usize, j: usize| i * w + (j + kl - i);
@@ -172,7 +174,7 @@ fn arnoldi(
     };
     let mut v: Vec<Vec<f64>> = Vec::with_capacity(dim + 1);
     // A fixed, generic start vector: results do not depend on a random seed.
-    let mut v0: Vec<f64> = (0..size).map(|i| 1.0 + 0.5 * ((i as f64) * 0.7071).sin()).collect();
+    let mut v0: Vec<f64> = (0..size).map(|i| 1.0 + 0.5 * ((i as f64) * 0.73).sin()).collect();
     let nrm = v0.iter().map(|x| x * x).sum::<f64>().sqrt();
     v0.iter_mut().for_each(|x| *x /= nrm);
     v.push(v0);

@@ -75,8 +75,8 @@ fn check(rotor: &Rotor, rpm: f64, modes: usize, one_sided: bool) -> f64 {
             fu.iter().zip(&fdn).map(|(a, b)| (a - b) / (2.0 * h)).collect()
         };
         let scale = fd.iter().chain(base.jacobian.column(j).iter()).fold(0.0f64, |m, v| m.max(v.abs()));
-        for i in 0..modes {
-            worst = worst.max((base.jacobian[(i, j)] - fd[i]).abs() / scale);
+        for (i, d) in fd.iter().enumerate() {
+            worst = worst.max((base.jacobian[(i, j)] - d).abs() / scale);
         }
     }
     worst

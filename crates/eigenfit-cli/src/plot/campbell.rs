@@ -62,6 +62,15 @@ impl Figure for CampbellPlot<'_> {
                 chart.draw_series(LineSeries::new(points, colour.stroke_width(3))).map_err(err)?;
             }
         }
+        // Every computed mode as a dot, so modes that enter the N lowest mid-range show too.
+        chart
+            .draw_series(c.speeds_rpm.iter().enumerate().flat_map(|(k, &rpm)| {
+                c.frequencies_hz[k]
+                    .iter()
+                    .zip(&c.whirl[k])
+                    .map(move |(&f, &w)| Circle::new((rpm, f), 3, whirl_colour(w).filled()))
+            }))
+            .map_err(err)?;
         for (w, name) in [(Whirl::Forward, "forward"), (Whirl::Backward, "backward"), (Whirl::Mixed, "mixed")]
         {
             let colour = whirl_colour(w);
