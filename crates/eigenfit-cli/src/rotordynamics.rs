@@ -59,7 +59,7 @@ pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize, json_out: boo
             "damping_ratio": shown.iter().map(|m| m.damping_ratio()).collect::<Vec<_>>(),
             "log_dec": shown.iter().map(|m| m.log_dec()).collect::<Vec<_>>(),
         });
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!("{}: {} DOF two-plane rotor at {rpm} rpm", path.display(), rotor.dofs());
         println!(
@@ -131,7 +131,7 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
             out["chi2"] = json!(id.cost);
             out["dof"] = json!(dof);
         }
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!(
             "{}: {} bearing stiffnesses from {} run-up frequencies: {} after {} iterations",

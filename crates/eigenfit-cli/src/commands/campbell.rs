@@ -84,7 +84,7 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!(
             "{}: Campbell diagram, {} modes at {} speeds",
