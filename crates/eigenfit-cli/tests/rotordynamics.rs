@@ -66,10 +66,10 @@ fn campbell_lists_every_speed_and_the_critical_speeds() {
 
 #[test]
 fn estimate_recovers_bearing_stiffnesses_from_a_runup() {
-    // Measured run-up made by the model itself with kxx of Bearing 0 raised 20 %.
+    // Measured run-up made by the model itself with kxx of both bearings raised 20 %.
     let model = data("rotor_example.toml");
     let text = std::fs::read_to_string(&model).unwrap();
-    let stiffer = text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1200000.0,]", 1);
+    let stiffer = text.replace("kxx = [ 1000000.0,]", "kxx = [ 1200000.0,]");
     assert_ne!(text, stiffer, "fixture layout changed");
     let dir = std::env::temp_dir().join(format!("eigenfit-rotordyn-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -95,12 +95,22 @@ fn estimate_recovers_bearing_stiffnesses_from_a_runup() {
     std::fs::write(&measured, csv).unwrap();
     let out = run(&["estimate", "--model", &model, "--measured", measured.to_str().unwrap(), "--json"]);
     let v = json(&out);
-    let kxx = v["parameters"]["kxx_Bearing 0"].as_f64().unwrap();
-    assert!((kxx - 1.2e6).abs() < 1e-3 * 1.2e6, "kxx_Bearing 0 = {kxx}");
-    for name in ["kyy_Bearing 0", "kxx_Bearing 1", "kyy_Bearing 1"] {
-        assert!(v["parameters"][name].is_number(), "{name}");
-        assert!(v["intervals"][name].is_array(), "{name}");
+    for (name, truth) in
+        [("kxx_Bearing 0", 1.2e6), ("kxx_Bearing 1", 1.2e6), ("kyy_Bearing 0", 8e5), ("kyy_Bearing 1", 8e5)]
+    {
+        let k = v["parameters"][name].as_f64().unwrap();
+        assert!((k - truth).abs() < 1e-6 * truth, "{name} = {k}");
     }
+    // rotor_example is mirror-symmetric: every mode moves both bearings alike, so the data fix
+    // the sum of the two bearings' kxx but not how it splits; eigenfit says so (no intervals).
+    assert_eq!(v["identifiable"], Value::Bool(false));
+    let mismatch = v["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p["model_hz"].as_f64().unwrap() - p["measured_hz"].as_f64().unwrap()).abs())
+        .fold(0.0, f64::max);
+    assert!(mismatch < 1e-3, "largest frequency mismatch {mismatch} Hz");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
