@@ -146,9 +146,10 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
             "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]"
         );
         for i in 0..params.len() {
-            let iv = intervals.as_ref().map_or("(no std_hz given)".to_string(), |iv| {
-                format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1])
-            });
+            let none = if id.identifiable { "(no std_hz given)" } else { "(not identifiable)" };
+            let iv = intervals
+                .as_ref()
+                .map_or(none.to_string(), |iv| format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]));
             println!("{:<28}{:>16.4e}{:>16.6e}{iv:>32}", names[i], nominal[i], value[i]);
         }
         println!(
