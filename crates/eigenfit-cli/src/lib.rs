@@ -11,6 +11,7 @@ pub mod measured;
 pub mod output;
 pub mod plot;
 pub mod progress;
+pub mod rotordynamics;
 pub mod source;
 pub mod testdata;
 
@@ -42,6 +43,9 @@ pub enum Command {
     /// The paper rotor end to end: Table 1, Table 3 case 1 with every strategy, a convergence map
     /// and a discovery, with every plot written to a folder.
     Demo(commands::demo::DemoArgs),
+    /// Campbell diagram of a two-plane (ROSS) rotor: damped frequencies, whirl and log
+    /// decrement against speed in rpm, with the critical speeds.
+    Campbell(commands::campbell::CampbellArgs),
 }
 
 /// Runs a parsed command line; returns the exit code of a run that produced results
@@ -54,6 +58,7 @@ pub fn run(cli: &Cli) -> Result<u8, CliError> {
         Command::Compare(a) => commands::compare::run(a).map(|()| error::EXIT_OK),
         Command::Discover(a) => commands::discover::run(a).map(|()| error::EXIT_OK),
         Command::Demo(a) => commands::demo::run(a).map(|()| error::EXIT_OK),
+        Command::Campbell(a) => commands::campbell::run(a).map(|()| error::EXIT_OK),
     }
 }
 

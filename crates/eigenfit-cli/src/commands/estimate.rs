@@ -20,7 +20,8 @@ pub struct EstimateArgs {
     #[command(flatten)]
     pub model: ModelArgs,
     /// Measured frequencies: CSV with header `mode,frequency_hz[,std_hz]`, modes counted from 1;
-    /// or a universal file (.unv/.uff: frequencies and shapes, docs/test-data.md).
+    /// or a universal file (.unv/.uff: frequencies and shapes, docs/test-data.md); for a ROSS
+    /// rotor, a run-up CSV `speed_rpm,mode,frequency_hz[,std_hz][,whirl]` (docs/rotordynamics.md).
     #[arg(long, value_name = "FILE.csv|FILE.unv")]
     pub measured: PathBuf,
     #[command(flatten)]
@@ -63,6 +64,10 @@ const UNREACHABLE_MARGIN: f64 = 0.1;
 /// Runs `estimate`; returns the exit code (3 when the run did not converge, the fit is poor, a
 /// parameter sits on a limit or the budget ran out).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
+    // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
+    if let Some(path) = crate::rotordynamics::ross_model(args.model.model.as_deref()) {
+        return crate::rotordynamics::estimate(path, &args.measured, args.max_iterations, args.json);
+    }
     let (rotor, label) = args.model.load()?;
     let solver = args.model.solver()?;
     let data = testdata::read(&args.measured, &rotor, &args.test_data)?;

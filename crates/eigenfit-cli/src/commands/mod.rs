@@ -1,6 +1,7 @@
 //! One module per subcommand.
 
 pub mod campaign;
+pub mod campbell;
 pub mod compare;
 pub mod demo;
 pub mod discover;

@@ -35,6 +35,9 @@ pub struct SimulateArgs {
     /// Number of modes.
     #[arg(long, default_value_t = 4)]
     pub modes: usize,
+    /// Rotor speed in rpm (two-plane ROSS rotors; default 0).
+    #[arg(long, value_name = "RPM", allow_hyphen_values = true)]
+    pub speed: Option<f64>,
     /// Critical speed map: every bearing at the same stiffness, log-spaced FROM:TO:COUNT (N/m).
     #[arg(long, value_name = "FROM:TO:COUNT")]
     pub sweep: Option<String>,
@@ -56,6 +59,13 @@ pub struct SimulateArgs {
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
+    // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics module.
+    if let Some(path) = crate::rotordynamics::ross_model(args.model.model.as_deref()) {
+        return crate::rotordynamics::simulate(path, args.speed, args.modes, args.json);
+    }
+    if args.speed.is_some() {
+        return Err(input("--speed applies to two-plane rotors (files saved by ROSS); this model is planar"));
+    }
     let (mut rotor, label) = args.model.load()?;
     for text in &args.effects {
         let effect = EffectSpec::parse(text).map_err(|e| input(format!("--effect {e}")))?;

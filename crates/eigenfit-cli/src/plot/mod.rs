@@ -5,6 +5,7 @@
 //! [`Figure`]. [`write()`] renders a figure twice — to an SVG string and to a PNG — and writes both
 //! atomically into a folder.
 
+pub mod campbell;
 pub mod compare_map;
 pub mod convergence;
 pub mod critical_speed;

@@ -1,0 +1,142 @@
+//! Campbell diagram: damped frequencies over speed, modes followed from one speed to the next
+//! by MAC (so curves stay on their mode through veering), and the critical speeds where a
+//! followed mode crosses the 1× (synchronous) line.
+
+use crate::error::RotorDynError;
+use crate::modal::{Mode, Whirl};
+use crate::rotor::Rotor;
+use crate::{rad_to_rpm, rpm_to_rad};
+use faer::c64;
+
+/// Extra modes computed beyond the N shown, so that a followed mode that climbs past another
+/// can still be found at the next speed.
+const SPARE_MODES: usize = 4;
+
+/// A Campbell diagram.
+#[derive(Debug, Clone)]
+pub struct Campbell {
+    /// Speeds (rpm).
+    pub speeds_rpm: Vec<f64>,
+    /// Per speed, the N lowest damped frequencies (Hz), ascending.
+    pub frequencies_hz: Vec<Vec<f64>>,
+    /// Per speed, their whirl directions.
+    pub whirl: Vec<Vec<Whirl>>,
+    /// Per speed, their logarithmic decrements.
+    pub log_dec: Vec<Vec<f64>>,
+    /// Modes followed by MAC: per curve, per speed, the index into that speed's list (`None`
+    /// where the curve left the N lowest).
+    pub curves: Vec<Vec<Option<usize>>>,
+    /// Critical speeds: where a followed mode crosses the 1× line.
+    pub critical_speeds: Vec<CriticalSpeed>,
+}
+
+/// A crossing of a followed mode with the synchronous line.
+#[derive(Debug, Clone)]
+pub struct CriticalSpeed {
+    /// Speed (rpm).
+    pub rpm: f64,
+    /// Curve (index into `Campbell::curves`).
+    pub curve: usize,
+    /// Whirl of the mode at the nearer computed speed.
+    pub whirl: Whirl,
+    /// Log decrement there (interpolated).
+    pub log_dec: f64,
+}
+
+/// Modal assurance criterion of two complex shapes.
+pub fn mac(a: &[c64], b: &[c64]) -> f64 {
+    let mut dot = c64::new(0.0, 0.0);
+    let (mut na, mut nb) = (0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        dot += x.conj() * y;
+        na += x.norm_sqr();
+        nb += y.norm_sqr();
+    }
+    if na == 0.0 || nb == 0.0 {
+        0.0
+    } else {
+        dot.norm_sqr() / (na * nb)
+    }
+}
+
+/// Computes the Campbell diagram of the `n_modes` lowest modes at the given speeds (rpm).
+pub fn campbell(rotor: &Rotor, speeds_rpm: &[f64], n_modes: usize) -> Result<Campbell, RotorDynError> {
+    let speeds: Vec<f64> = speeds_rpm.iter().map(|&r| rpm_to_rad(r)).collect();
+    let all = rotor.lowest_modes_over(&speeds, n_modes + SPARE_MODES)?;
+    for (s, modes) in speeds_rpm.iter().zip(&all) {
+        if modes.len() < n_modes {
+            return Err(RotorDynError::Model(format!(
+                "at {s} rpm the rotor has only {} oscillating modes, fewer than the {n_modes} asked for",
+                modes.len()
+            )));
+        }
+    }
+    let kept: Vec<&[Mode]> = all.iter().map(|m| &m[..m.len().min(n_modes + SPARE_MODES)]).collect();
+    let curves = follow(&kept, n_modes);
+    let mut critical = Vec::new();
+    for (c, curve) in curves.iter().enumerate() {
+        for k in 1..speeds.len() {
+            let (Some(i0), Some(i1)) = (curve[k - 1], curve[k]) else { continue };
+            let (m0, m1) = (&kept[k - 1][i0], &kept[k][i1]);
+            let g0 = m0.frequency_hz() - speeds_rpm[k - 1] / 60.0;
+            let g1 = m1.frequency_hz() - speeds_rpm[k] / 60.0;
+            if g0 == 0.0 || (g0 > 0.0) != (g1 > 0.0) {
+                let t = if g0 == g1 { 0.0 } else { g0 / (g0 - g1) };
+                let rpm = speeds_rpm[k - 1] + t * (speeds_rpm[k] - speeds_rpm[k - 1]);
+                let near = if t < 0.5 { m0 } else { m1 };
+                let log_dec = m0.log_dec() + t * (m1.log_dec() - m0.log_dec());
+                critical.push(CriticalSpeed { rpm, curve: c, whirl: near.whirl, log_dec });
+            }
+        }
+    }
+    critical.sort_by(|a, b| a.rpm.total_cmp(&b.rpm));
+    // Curves reported by index into the N shown (ascending) lists.
+    let curves =
+        curves.into_iter().map(|c| c.into_iter().map(|i| i.filter(|&i| i < n_modes)).collect()).collect();
+    Ok(Campbell {
+        speeds_rpm: speeds_rpm.to_vec(),
+        frequencies_hz: all.iter().map(|m| m[..n_modes].iter().map(Mode::frequency_hz).collect()).collect(),
+        whirl: all.iter().map(|m| m[..n_modes].iter().map(|x| x.whirl).collect()).collect(),
+        log_dec: all.iter().map(|m| m[..n_modes].iter().map(Mode::log_dec).collect()).collect(),
+        curves,
+        critical_speeds: critical,
+    })
+}
+
+/// Follows the first `n` modes of the first speed through the others: at each step every curve
+/// takes the unclaimed mode with the highest MAC against its last shape (greedy, best pairs
+/// first), so two modes that veer past each other keep their own curves.
+fn follow(modes: &[&[Mode]], n: usize) -> Vec<Vec<Option<usize>>> {
+    let mut curves: Vec<Vec<Option<usize>>> = (0..n).map(|i| vec![Some(i)]).collect();
+    let mut last: Vec<usize> = (0..n).collect();
+    for k in 1..modes.len() {
+        let (prev, cur) = (modes[k - 1], modes[k]);
+        let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+        for (c, &i) in last.iter().enumerate() {
+            for (j, m) in cur.iter().enumerate() {
+                pairs.push((mac(&prev[i].right, &m.right), c, j));
+            }
+        }
+        pairs.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut taken_c = vec![false; n];
+        let mut taken_j = vec![false; cur.len()];
+        let mut next = last.clone();
+        for (_, c, j) in pairs {
+            if !taken_c[c] && !taken_j[j] {
+                taken_c[c] = true;
+                taken_j[j] = true;
+                next[c] = j;
+            }
+        }
+        for (c, curve) in curves.iter_mut().enumerate() {
+            curve.push(Some(next[c]));
+        }
+        last = next;
+    }
+    curves
+}
+
+/// Converts rad/s speeds to rpm (re-exported convenience for callers).
+pub fn speeds_in_rpm(speeds: &[f64]) -> Vec<f64> {
+    speeds.iter().map(|&w| rad_to_rpm(w)).collect()
+}

@@ -1,0 +1,381 @@
+//! Identification at speed: the bearings' kxx and kyy from whirl frequencies measured over a
+//! run-up. Each parameter scales one coefficient curve of one bearing (kxx(Ω) → s·kxx(Ω)); a
+//! small Levenberg–Marquardt works in ln s so stiffnesses stay positive and the steps are
+//! relative, with the Jacobian from the analytic eigenvalue sensitivities.
+//!
+//! Own LM rather than core's `update/` strategies: those drive a `StructuralModel` whose
+//! eigen-solve is the symmetric (undamped) problem with sorted real eigenvalues, while here a
+//! "mode" is a damped complex eigenpair at one of many speeds.
+
+use crate::error::RotorDynError;
+use crate::interpolation::Coefficient;
+use crate::modal::Whirl;
+use crate::rotor::Rotor;
+use crate::rpm_to_rad;
+use crate::sensitivity::{eigenvalue_derivatives, MatrixDerivative};
+use faer::Mat;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+use std::path::Path;
+
+/// One measured whirl frequency.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunupPoint {
+    /// Rotor speed (rpm).
+    pub speed_rpm: f64,
+    /// Mode number at that speed, from 1, in ascending damped frequency.
+    pub mode: usize,
+    /// Measured damped natural frequency (Hz).
+    pub frequency_hz: f64,
+    /// Standard deviation (Hz), if known.
+    pub std_hz: Option<f64>,
+    /// Whirl direction, if recorded.
+    pub whirl: Option<Whirl>,
+}
+
+/// Reads a run-up CSV with header `speed_rpm,mode,frequency_hz[,std_hz][,whirl]`.
+pub fn read_runup(path: &Path) -> Result<Vec<RunupPoint>, RotorDynError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| RotorDynError::Data(format!("{}: cannot read: {e}", path.display())))?;
+    parse_runup(&text).map_err(|e| RotorDynError::Data(format!("{}: {e}", path.display())))
+}
+
+/// Whether a CSV header is a run-up header (first column `speed_rpm`).
+pub fn is_runup_header(text: &str) -> bool {
+    text.lines()
+        .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .is_some_and(|l| l.split(',').next().map(str::trim) == Some("speed_rpm"))
+}
+
+/// Parses run-up CSV text (see [`read_runup`]); `#` lines are comments.
+pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, String> {
+    let mut lines =
+        text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let (_, header) =
+        lines.next().ok_or("empty file: expected header speed_rpm,mode,frequency_hz[,std_hz][,whirl]")?;
+    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+    let col = |name: &str| cols.iter().position(|c| *c == name);
+    let (Some(cs), Some(cm), Some(cf)) = (col("speed_rpm"), col("mode"), col("frequency_hz")) else {
+        return Err(format!(
+            "line 1: header `{header}` must name speed_rpm, mode and frequency_hz (optional std_hz, whirl)"
+        ));
+    };
+    if let Some(bad) =
+        cols.iter().find(|c| !["speed_rpm", "mode", "frequency_hz", "std_hz", "whirl"].contains(c))
+    {
+        return Err(format!("line 1: unknown column `{bad}` (speed_rpm, mode, frequency_hz, std_hz, whirl)"));
+    }
+    let (cstd, cw) = (col("std_hz"), col("whirl"));
+    let mut out = Vec::new();
+    for (i, line) in lines {
+        let at = i + 1;
+        let f: Vec<&str> = line.split(',').map(str::trim).collect();
+        if f.len() != cols.len() {
+            return Err(format!("line {at}: {} fields, the header has {}", f.len(), cols.len()));
+        }
+        let num = |c: usize, name: &str| -> Result<f64, String> {
+            let v: f64 = f[c].parse().map_err(|_| format!("line {at}: {name} `{}` is not a number", f[c]))?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(format!("line {at}: {name} `{}` is not finite", f[c]))
+            }
+        };
+        let speed_rpm = num(cs, "speed_rpm")?;
+        if speed_rpm < 0.0 {
+            return Err(format!("line {at}: speed_rpm {speed_rpm} must be ≥ 0"));
+        }
+        let mode: usize =
+            f[cm].parse().map_err(|_| format!("line {at}: mode `{}` is not a whole number ≥ 1", f[cm]))?;
+        if mode == 0 {
+            return Err(format!("line {at}: mode counts from 1"));
+        }
+        let frequency_hz = num(cf, "frequency_hz")?;
+        if frequency_hz <= 0.0 {
+            return Err(format!("line {at}: frequency_hz {frequency_hz} must be > 0"));
+        }
+        let std_hz = match cstd {
+            Some(c) if !f[c].is_empty() => {
+                let s = num(c, "std_hz")?;
+                if s <= 0.0 {
+                    return Err(format!("line {at}: std_hz {s} must be > 0"));
+                }
+                Some(s)
+            }
+            _ => None,
+        };
+        let whirl = match cw.map(|c| f[c].to_ascii_lowercase()) {
+            None => None,
+            Some(w) if w.is_empty() => None,
+            Some(w) => Some(match w.as_str() {
+                "forward" => Whirl::Forward,
+                "backward" => Whirl::Backward,
+                "mixed" => Whirl::Mixed,
+                _ => return Err(format!("line {at}: whirl `{w}` is not forward, backward or mixed")),
+            }),
+        };
+        if out.iter().any(|p: &RunupPoint| p.speed_rpm == speed_rpm && p.mode == mode) {
+            return Err(format!("line {at}: mode {mode} at {speed_rpm} rpm appears twice"));
+        }
+        out.push(RunupPoint { speed_rpm, mode, frequency_hz, std_hz, whirl });
+    }
+    if out.is_empty() {
+        return Err("no data rows".into());
+    }
+    let with_std = out.iter().filter(|p| p.std_hz.is_some()).count();
+    if with_std != 0 && with_std != out.len() {
+        return Err("std_hz must be given on every row or on none".into());
+    }
+    Ok(out)
+}
+
+/// Which coefficient of which bearing a parameter scales.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    /// `kxx_<tag>` or `kyy_<tag>`.
+    pub name: String,
+    /// Bearing index.
+    pub bearing: usize,
+    /// 0 = kxx, 3 = kyy (index into `Bearing::k`).
+    pub entry: usize,
+}
+
+/// The kxx and kyy of every bearing, in file order.
+pub fn stiffness_parameters(rotor: &Rotor) -> Vec<Parameter> {
+    let mut out = Vec::new();
+    for (b, brg) in rotor.bearings.iter().enumerate() {
+        out.push(Parameter { name: format!("kxx_{}", brg.tag), bearing: b, entry: 0 });
+        out.push(Parameter { name: format!("kyy_{}", brg.tag), bearing: b, entry: 3 });
+    }
+    out
+}
+
+/// A rotor with its stiffness parameters scaled.
+pub fn scaled_rotor(rotor: &Rotor, params: &[Parameter], scales: &[f64]) -> Rotor {
+    let mut r = rotor.clone();
+    for (p, &s) in params.iter().zip(scales) {
+        let c = &mut r.bearings[p.bearing].k[p.entry];
+        *c = scale(c, s);
+    }
+    r
+}
+
+fn scale(c: &Coefficient, s: f64) -> Coefficient {
+    match c {
+        Coefficient::Constant(v) => Coefficient::Constant(v * s),
+        Coefficient::Table(t) => Coefficient::Table(t.scaled(s)),
+    }
+}
+
+/// Model frequencies (Hz) of the measured points and their derivatives d f/d ln s.
+pub struct Evaluation {
+    /// Model damped frequency for each point.
+    pub frequencies_hz: Vec<f64>,
+    /// Model whirl for each point.
+    pub whirl: Vec<Whirl>,
+    /// d f_i / d ln s_j (Hz).
+    pub jacobian: DMatrix<f64>,
+}
+
+/// Evaluates the scaled rotor at every measured speed.
+pub fn evaluate(
+    rotor: &Rotor,
+    params: &[Parameter],
+    scales: &[f64],
+    points: &[RunupPoint],
+) -> Result<Evaluation, RotorDynError> {
+    let r = scaled_rotor(rotor, params, scales);
+    let mut speeds: Vec<f64> = points.iter().map(|p| p.speed_rpm).collect();
+    speeds.sort_by(f64::total_cmp);
+    speeds.dedup();
+    let mut freqs = vec![0.0; points.len()];
+    let mut whirl = vec![Whirl::Mixed; points.len()];
+    let mut jac = DMatrix::zeros(points.len(), params.len());
+    for &rpm in &speeds {
+        let w = rpm_to_rad(rpm);
+        let mats = r.matrices(w);
+        let modes = r.modes_of(&mats, true)?;
+        let derivs: Vec<MatrixDerivative> = params
+            .iter()
+            .map(|p| {
+                let b = &r.bearings[p.bearing];
+                let mut block = [[0.0; 2]; 2];
+                // d(s·k)/d ln s = s·k: the scaled coefficient itself.
+                block[p.entry / 2][p.entry % 2] = b.k[p.entry].at(w);
+                let mut k = Mat::<f64>::zeros(r.dofs(), r.dofs());
+                r.add_bearing_block(&mut k, b, block);
+                MatrixDerivative { k: Some(k), ..Default::default() }
+            })
+            .collect();
+        let d = eigenvalue_derivatives(&mats, &modes, &derivs);
+        for (i, p) in points.iter().enumerate().filter(|(_, p)| p.speed_rpm == rpm) {
+            let Some(m) = modes.get(p.mode - 1) else {
+                return Err(RotorDynError::Data(format!(
+                    "mode {} measured at {rpm} rpm but the model has only {} oscillating modes there",
+                    p.mode,
+                    modes.len()
+                )));
+            };
+            freqs[i] = m.frequency_hz();
+            whirl[i] = m.whirl;
+            for j in 0..params.len() {
+                jac[(i, j)] = d[p.mode - 1][j].im / (2.0 * PI);
+            }
+        }
+    }
+    Ok(Evaluation { frequencies_hz: freqs, whirl, jacobian: jac })
+}
+
+/// Result of an identification.
+#[derive(Debug, Clone)]
+pub struct Identification {
+    /// Parameters identified.
+    pub parameters: Vec<Parameter>,
+    /// Estimated scale factors on the nominal curves.
+    pub scales: Vec<f64>,
+    /// Standard deviation of ln s (from the weighted Jacobian; only with std_hz).
+    pub ln_std: Option<Vec<f64>>,
+    /// Model frequencies at the estimate (Hz).
+    pub model_hz: Vec<f64>,
+    /// Model whirl at the estimate.
+    pub model_whirl: Vec<Whirl>,
+    /// Σ r² (weighted by std_hz, or relative residuals without).
+    pub cost: f64,
+    /// Iterations taken.
+    pub iterations: usize,
+    /// Eigen-solve rounds (one per measured speed each).
+    pub evaluations: usize,
+    /// Whether the iteration met its tolerance.
+    pub converged: bool,
+    /// Whether every parameter is determined by the data (Jacobian of full rank at the
+    /// estimate, singular values above 10⁻¹² of the largest).
+    pub identifiable: bool,
+    /// Why the iteration stopped.
+    pub reason: String,
+}
+
+/// Levenberg–Marquardt in ln s from `initial` scales.
+pub fn identify(
+    rotor: &Rotor,
+    params: &[Parameter],
+    points: &[RunupPoint],
+    initial: &[f64],
+    max_iterations: usize,
+) -> Result<Identification, RotorDynError> {
+    let m = points.len();
+    let np = params.len();
+    if m < np {
+        return Err(RotorDynError::Data(format!(
+            "{m} measured frequencies for {np} parameters ({}): at least {np} are needed",
+            params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    let sigma: Vec<f64> = points.iter().map(|p| p.std_hz.unwrap_or(p.frequency_hz)).collect();
+    let weighted = |e: &Evaluation| -> (DVector<f64>, DMatrix<f64>) {
+        let r = DVector::from_fn(m, |i, _| (e.frequencies_hz[i] - points[i].frequency_hz) / sigma[i]);
+        let j = DMatrix::from_fn(m, np, |i, k| e.jacobian[(i, k)] / sigma[i]);
+        (r, j)
+    };
+    let mut theta = DVector::from_iterator(np, initial.iter().map(|s| s.ln()));
+    let mut eval = evaluate(rotor, params, initial, points)?;
+    let mut evaluations = 1;
+    let (mut r, mut jac) = weighted(&eval);
+    let mut cost = r.norm_squared();
+    let mut mu = 1e-3;
+    let mut converged = false;
+    let mut reason = format!("iteration limit {max_iterations} reached");
+    let mut iterations = 0;
+    while iterations < max_iterations {
+        iterations += 1;
+        let jtj = jac.transpose() * &jac;
+        let g = jac.transpose() * &r;
+        if g.amax() <= 1e-12 * (1.0 + cost) {
+            converged = true;
+            reason = "gradient vanished".into();
+            break;
+        }
+        let mut accepted = false;
+        for _ in 0..30 {
+            let mut a = jtj.clone();
+            for k in 0..np {
+                a[(k, k)] += mu * jtj[(k, k)].max(1e-12);
+            }
+            let Some(step) = a.clone().cholesky().map(|c| c.solve(&(-&g))) else {
+                mu *= 10.0;
+                continue;
+            };
+            // Keep steps moderate in ln s (a factor e per iteration at most).
+            let largest = step.amax();
+            let step = if largest > 1.0 { step / largest } else { step };
+            let trial = &theta + &step;
+            let scales: Vec<f64> = trial.iter().map(|t| t.exp()).collect();
+            let e = evaluate(rotor, params, &scales, points)?;
+            evaluations += 1;
+            let (r2, j2) = weighted(&e);
+            let c2 = r2.norm_squared();
+            if c2 < cost {
+                let small_step = step.amax() < 1e-9;
+                let small_gain = (cost - c2) <= 1e-12 * cost.max(1e-300);
+                theta = trial;
+                eval = e;
+                r = r2;
+                jac = j2;
+                cost = c2;
+                mu = (mu / 3.0).max(1e-12);
+                accepted = true;
+                if small_step || small_gain || cost < 1e-28 {
+                    converged = true;
+                    reason = "step below tolerance".into();
+                }
+                break;
+            }
+            mu *= 4.0;
+            if step.amax() < 1e-12 {
+                break;
+            }
+        }
+        if converged {
+            break;
+        }
+        if !accepted {
+            // No descent at any damping: a minimum to working precision.
+            converged = true;
+            reason = "no further descent (minimum to working precision)".into();
+            break;
+        }
+    }
+    let has_std = points.iter().all(|p| p.std_hz.is_some());
+    // Covariance (JᵀJ)⁻¹ = V Σ⁻² Vᵀ from the SVD of J: no squared condition number.
+    let svd = jac.clone().svd(false, true);
+    let v_t = svd.v_t.expect("requested");
+    let smax = svd.singular_values.max();
+    let identifiable = smax > 0.0 && svd.singular_values.iter().all(|&s| s > 1e-12 * smax);
+    let ln_std = if has_std {
+        if !identifiable {
+            None
+        } else {
+            Some(
+                (0..np)
+                    .map(|k| {
+                        (0..np).map(|i| (v_t[(i, k)] / svd.singular_values[i]).powi(2)).sum::<f64>().sqrt()
+                    })
+                    .collect(),
+            )
+        }
+    } else {
+        None
+    };
+    Ok(Identification {
+        parameters: params.to_vec(),
+        scales: theta.iter().map(|t| t.exp()).collect(),
+        ln_std,
+        model_hz: eval.frequencies_hz.clone(),
+        model_whirl: eval.whirl.clone(),
+        cost,
+        iterations,
+        evaluations,
+        converged,
+        identifiable,
+        reason,
+    })
+}

@@ -1,0 +1,280 @@
+//! Reader for rotor files written by ROSS `Rotor.save` (TOML or JSON): one table per element
+//! keyed `<Class>_<tag>` holding the constructor's arguments. Unknown element classes are
+//! refused by name rather than silently dropped.
+
+use crate::elements::{Bearing, Disk, Material, PointMass, ShaftElement, ShearMethod};
+use crate::error::RotorDynError;
+use crate::interpolation::Coefficient;
+use crate::rotor::Rotor;
+use serde_json::{Map, Value};
+use std::path::Path;
+
+/// Element classes read as bearings: each saves its eight coefficients (and added masses) over
+/// `frequency` (ROSS 2) or `speed` (ROSS 3), whatever model produced them.
+const BEARING_CLASSES: &[&str] = &[
+    "BearingElement",
+    "SealElement",
+    "BallBearingElement",
+    "RollerBearingElement",
+    "BearingFluidFlow",
+    "CylindricalBearing",
+    "MagneticBearingElement",
+    "THDBearing",
+    "TiltingPad",
+    "LabyrinthSeal",
+    "HolePatternSeal",
+    "BearingElement6DoF",
+];
+
+/// Top-level keys that are not elements.
+fn is_metadata(key: &str) -> bool {
+    key == "parameters" || key == "ross_version" || key.starts_with('_')
+}
+
+/// Whether a file's text is a ROSS rotor (a table named `ShaftElement_…`), judged by content.
+pub fn looks_like_ross(text: &str) -> bool {
+    text.contains("\"ShaftElement_") || text.contains("[ShaftElement_") || text.contains("\nShaftElement_")
+}
+
+/// Reads a ROSS rotor file (`.json` by extension or a leading `{`, TOML otherwise).
+pub fn read(path: &Path) -> Result<Rotor, RotorDynError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| RotorDynError::File(format!("{}: cannot read: {e}", path.display())))?;
+    parse(&text).map_err(|e| match e {
+        RotorDynError::File(m) | RotorDynError::Model(m) => {
+            RotorDynError::File(format!("{}: {m}", path.display()))
+        }
+        other => other,
+    })
+}
+
+/// Parses the text of a ROSS rotor file.
+pub fn parse(text: &str) -> Result<Rotor, RotorDynError> {
+    let root: Value = if text.trim_start().starts_with('{') {
+        serde_json::from_str(text).map_err(|e| RotorDynError::File(format!("not valid JSON: {e}")))?
+    } else {
+        let t: toml::Table =
+            toml::from_str(text).map_err(|e| RotorDynError::File(format!("not valid TOML: {e}")))?;
+        serde_json::to_value(t).map_err(|e| RotorDynError::File(e.to_string()))?
+    };
+    let Value::Object(root) = root else {
+        return Err(RotorDynError::File("expected a table of elements".into()));
+    };
+    let (mut shafts, mut disks, mut bearings, mut masses) = (vec![], vec![], vec![], vec![]);
+    for (key, value) in &root {
+        if is_metadata(key) {
+            continue;
+        }
+        let Some((class, tag)) = key.split_once('_') else {
+            return Err(RotorDynError::Model(format!(
+                "table `{key}` is not a ROSS element (expected `<Class>_<tag>`)"
+            )));
+        };
+        let Value::Object(t) = value else {
+            return Err(RotorDynError::Model(format!("`{key}` must be a table")));
+        };
+        let e = Entry { key, table: t };
+        let tag = e.string("tag").unwrap_or_else(|| tag.to_string());
+        match class {
+            "ShaftElement" | "ShaftElement6DoF" => shafts.push(e.shaft(tag)?),
+            "DiskElement" | "DiskElement6DoF" => disks.push(e.disk(tag)?),
+            "PointMass" => masses.push(e.point_mass(tag)?),
+            c if BEARING_CLASSES.contains(&c)
+                || t.contains_key("kxx") && (c.ends_with("Bearing") || c.ends_with("Seal")) =>
+            {
+                bearings.push(e.bearing(tag, c)?)
+            }
+            other => {
+                return Err(RotorDynError::Model(format!(
+                "table `{key}`: ROSS element class `{other}` is not supported (eigenfit reads ShaftElement, \
+                     DiskElement, PointMass and bearing/seal elements with saved coefficients)"
+            )))
+            }
+        }
+    }
+    Rotor::new(shafts, disks, bearings, masses)
+}
+
+struct Entry<'a> {
+    key: &'a str,
+    table: &'a Map<String, Value>,
+}
+
+impl Entry<'_> {
+    fn err(&self, what: String) -> RotorDynError {
+        RotorDynError::Model(format!("`{}`: {what}", self.key))
+    }
+
+    fn string(&self, name: &str) -> Option<String> {
+        self.table.get(name).and_then(Value::as_str).map(str::to_string)
+    }
+
+    fn number_opt(&self, name: &str) -> Result<Option<f64>, RotorDynError> {
+        match self.table.get(name) {
+            None | Some(Value::Null) => Ok(None),
+            Some(v) => {
+                number(v).map(Some).ok_or_else(|| self.err(format!("`{name}` must be a number, not {v}")))
+            }
+        }
+    }
+
+    fn number(&self, name: &str) -> Result<f64, RotorDynError> {
+        self.number_opt(name)?.ok_or_else(|| self.err(format!("missing `{name}`")))
+    }
+
+    fn node(&self, name: &str) -> Result<usize, RotorDynError> {
+        let v = self.number(name)?;
+        if v < 0.0 || v.fract() != 0.0 || v > 1e9 {
+            return Err(self.err(format!("`{name}` = {v} is not a node number")));
+        }
+        Ok(v as usize)
+    }
+
+    fn flag(&self, name: &str, default: bool) -> Result<bool, RotorDynError> {
+        match self.table.get(name) {
+            None | Some(Value::Null) => Ok(default),
+            Some(Value::Bool(b)) => Ok(*b),
+            Some(Value::Number(n)) => Ok(n.as_f64() != Some(0.0)),
+            Some(v) => Err(self.err(format!("`{name}` must be true or false, not {v}"))),
+        }
+    }
+
+    fn shaft(&self, tag: String) -> Result<ShaftElement, RotorDynError> {
+        let idl = self.number("idl")?;
+        let odl = self.number("odl")?;
+        let material = match self.table.get("material") {
+            Some(Value::Object(m)) => {
+                let sub = Entry { key: self.key, table: m };
+                let rho = sub.number("rho")?;
+                let e = sub.number_opt("E")?;
+                let g = sub.number_opt("G_s")?;
+                let nu = sub.number_opt("Poisson")?;
+                // ROSS accepts any two of E, G_s, Poisson.
+                let (e, g_s) = match (e, g, nu) {
+                    (Some(e), Some(g), _) => (e, g),
+                    (Some(e), None, Some(nu)) => (e, e / (2.0 * (1.0 + nu))),
+                    (None, Some(g), Some(nu)) => (g * 2.0 * (1.0 + nu), g),
+                    _ => return Err(self.err("material needs two of E, G_s, Poisson".into())),
+                };
+                Material { rho, e, g_s }
+            }
+            Some(v) => {
+                return Err(self.err(format!(
+                    "material {v} is a name; save the rotor with ROSS ≥ 1.0 so the material's rho, E, G_s are in the file"
+                )))
+            }
+            None => return Err(self.err("missing `material`".into())),
+        };
+        let shear_method = match self.string("shear_method_calc").as_deref() {
+            None | Some("cowper") => ShearMethod::Cowper,
+            Some("hutchinson") => ShearMethod::Hutchinson,
+            Some(other) => {
+                return Err(self.err(format!("unknown shear_method_calc `{other}` (cowper, hutchinson)")))
+            }
+        };
+        Ok(ShaftElement {
+            tag,
+            n: self.node("n")?,
+            length: self.number("L")?,
+            idl,
+            odl,
+            idr: self.number_opt("idr")?.unwrap_or(idl),
+            odr: self.number_opt("odr")?.unwrap_or(odl),
+            material,
+            shear_effects: self.flag("shear_effects", true)?,
+            rotary_inertia: self.flag("rotary_inertia", true)?,
+            gyroscopic: self.flag("gyroscopic", true)?,
+            shear_method,
+            axial_force: self.number_opt("axial_force")?.unwrap_or(0.0),
+            torque: self.number_opt("torque")?.unwrap_or(0.0),
+            alpha: self.number_opt("alpha")?.unwrap_or(0.0),
+            beta: self.number_opt("beta")?.unwrap_or(0.0),
+        })
+    }
+
+    fn disk(&self, tag: String) -> Result<Disk, RotorDynError> {
+        Ok(Disk {
+            tag,
+            n: self.node("n")?,
+            m: self.number("m")?,
+            id: self.number("Id")?,
+            ip: self.number("Ip")?,
+        })
+    }
+
+    fn point_mass(&self, tag: String) -> Result<PointMass, RotorDynError> {
+        let m = self.number_opt("m")?;
+        let mx = self.number_opt("mx")?.or(m).ok_or_else(|| self.err("missing `m` (or `mx`)".into()))?;
+        let my = self.number_opt("my")?.or(m).ok_or_else(|| self.err("missing `m` (or `my`)".into()))?;
+        Ok(PointMass { tag, n: self.node("n")?, mx, my })
+    }
+
+    fn bearing(&self, tag: String, class: &str) -> Result<Bearing, RotorDynError> {
+        let speeds: Option<Vec<f64>> = match self.table.get("speed").or_else(|| self.table.get("frequency")) {
+            None | Some(Value::Null) => None,
+            Some(Value::Array(a)) => Some(
+                a.iter()
+                    .map(|v| {
+                        number(v).ok_or_else(|| self.err(format!("speed/frequency item {v} is not a number")))
+                    })
+                    .collect::<Result<_, _>>()?,
+            ),
+            Some(v) => {
+                Some(vec![number(v).ok_or_else(|| self.err(format!("speed/frequency {v} is not a number")))?])
+            }
+        };
+        let coefficient = |name: &str,
+                           fallback: Option<&Coefficient>|
+         -> Result<Coefficient, RotorDynError> {
+            let what = format!("`{}` {name}", self.key);
+            match self.table.get(name) {
+                None | Some(Value::Null) => Ok(fallback.cloned().unwrap_or(Coefficient::Constant(0.0))),
+                Some(Value::Array(a)) => {
+                    let values: Vec<f64> = a
+                        .iter()
+                        .map(|v| {
+                            number(v).ok_or_else(|| self.err(format!("{name} item {v} is not a number")))
+                        })
+                        .collect::<Result<_, _>>()?;
+                    if values.len() == 1 {
+                        return Coefficient::from_table(&[0.0], &values, &what);
+                    }
+                    let s = speeds.as_ref().ok_or_else(|| {
+                        self.err(format!("{name} is a list but the bearing has no `frequency`/`speed` list"))
+                    })?;
+                    Coefficient::from_table(s, &values, &what)
+                }
+                Some(v) => number(v)
+                    .filter(|x| x.is_finite())
+                    .map(Coefficient::Constant)
+                    .ok_or_else(|| self.err(format!("{name} must be a number or a list, not {v}"))),
+            }
+        };
+        let kxx = coefficient("kxx", None)?;
+        let kyy = coefficient("kyy", Some(&kxx))?;
+        let cxx = coefficient("cxx", None)?;
+        let cyy = coefficient("cyy", Some(&cxx))?;
+        let k = [kxx, coefficient("kxy", None)?, coefficient("kyx", None)?, kyy];
+        let c = [cxx, coefficient("cxy", None)?, coefficient("cyx", None)?, cyy];
+        let m = [
+            coefficient("mxx", None)?,
+            coefficient("mxy", None)?,
+            coefficient("myx", None)?,
+            coefficient("myy", None)?,
+        ];
+        let n_link = match self.number_opt("n_link")? {
+            None => None,
+            Some(_) => Some(self.node("n_link")?),
+        };
+        Ok(Bearing { tag, class: class.to_string(), n: self.node("n")?, n_link, k, c, m })
+    }
+}
+
+fn number(v: &Value) -> Option<f64> {
+    match v {
+        Value::Number(n) => n.as_f64(),
+        // ROSS writes complex or special values as strings at times; only plain numbers pass.
+        Value::String(s) => s.trim().parse().ok(),
+        _ => None,
+    }
+}

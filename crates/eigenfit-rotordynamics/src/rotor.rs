@@ -1,0 +1,273 @@
+//! A two-plane rotor: elements on a line of nodes, its DOF numbering (x, y, α, β per shaft node,
+//! then x, y per extra support node, as ROSS orders them) and its matrices at a speed.
+
+use crate::elements::{Bearing, Disk, Mat8, PointMass, ShaftElement};
+use crate::error::RotorDynError;
+use crate::modal::{self, Mode};
+use faer::Mat;
+
+/// A rotor model.
+#[derive(Debug, Clone)]
+pub struct Rotor {
+    /// Shaft elements, in node order.
+    pub shafts: Vec<ShaftElement>,
+    /// Disks.
+    pub disks: Vec<Disk>,
+    /// Bearings and seals.
+    pub bearings: Vec<Bearing>,
+    /// Point masses.
+    pub point_masses: Vec<PointMass>,
+    shaft_nodes: usize,
+    /// Extra (support) nodes beyond the shaft, in increasing node number.
+    extra_nodes: Vec<usize>,
+}
+
+/// The speed-independent part of the matrices, assembled once.
+#[derive(Debug, Clone)]
+struct Fixed {
+    m: Mat<f64>,
+    k: Mat<f64>,
+    c: Mat<f64>,
+    g: Mat<f64>,
+}
+
+/// Mass, damping (C + ΩG), stiffness at one speed.
+#[derive(Debug, Clone)]
+pub struct Matrices {
+    /// Mass M.
+    pub m: Mat<f64>,
+    /// Velocity matrix C + ΩG.
+    pub d: Mat<f64>,
+    /// Stiffness K.
+    pub k: Mat<f64>,
+    /// Gyroscopic matrix G (not multiplied by Ω).
+    pub g: Mat<f64>,
+}
+
+impl Rotor {
+    /// Builds a rotor, checking that every element sits on an existing node.
+    pub fn new(
+        mut shafts: Vec<ShaftElement>,
+        disks: Vec<Disk>,
+        bearings: Vec<Bearing>,
+        point_masses: Vec<PointMass>,
+    ) -> Result<Self, RotorDynError> {
+        if shafts.is_empty() {
+            return Err(RotorDynError::Model("the rotor has no shaft elements".into()));
+        }
+        shafts.sort_by_key(|s| s.n);
+        // Several elements may share a node pair (ROSS's layered shafts: sleeves, fits); they add.
+        let mut expected = 0;
+        for s in &shafts {
+            check_shaft(s)?;
+            if s.n > expected {
+                return Err(RotorDynError::Model(format!(
+                    "shaft element `{}`: node {} leaves a gap: no shaft element starts at node {expected}",
+                    s.tag, s.n
+                )));
+            }
+            expected = s.n + 1;
+        }
+        let shaft_nodes = expected + 1;
+        for d in &disks {
+            if d.n >= shaft_nodes {
+                return Err(RotorDynError::Model(format!(
+                    "disk `{}`: node {} is not on the shaft (nodes 0–{})",
+                    d.tag,
+                    d.n,
+                    shaft_nodes - 1
+                )));
+            }
+            if !(d.m >= 0.0 && d.id >= 0.0 && d.ip >= 0.0) {
+                return Err(RotorDynError::Model(format!("disk `{}`: m, Id, Ip must be ≥ 0", d.tag)));
+            }
+        }
+        let mut extra: Vec<usize> = point_masses
+            .iter()
+            .map(|p| p.n)
+            .chain(bearings.iter().filter_map(|b| b.n_link))
+            .filter(|&n| n >= shaft_nodes)
+            .collect();
+        extra.sort_unstable();
+        extra.dedup();
+        for b in &bearings {
+            if b.n >= shaft_nodes && !extra.contains(&b.n) {
+                return Err(RotorDynError::Model(format!(
+                    "bearing `{}`: node {} is neither a shaft node (0–{}) nor a point mass node",
+                    b.tag,
+                    b.n,
+                    shaft_nodes - 1
+                )));
+            }
+        }
+        for p in &point_masses {
+            if !(p.mx >= 0.0 && p.my >= 0.0) {
+                return Err(RotorDynError::Model(format!("point mass `{}`: masses must be ≥ 0", p.tag)));
+            }
+        }
+        Ok(Rotor { shafts, disks, bearings, point_masses, shaft_nodes, extra_nodes: extra })
+    }
+
+    /// Number of degrees of freedom.
+    pub fn dofs(&self) -> usize {
+        4 * self.shaft_nodes + 2 * self.extra_nodes.len()
+    }
+
+    /// Number of shaft nodes.
+    pub fn shaft_nodes(&self) -> usize {
+        self.shaft_nodes
+    }
+
+    /// Index of the x DOF of a node (y follows it).
+    pub fn x_dof(&self, node: usize) -> usize {
+        if node < self.shaft_nodes {
+            4 * node
+        } else {
+            let k = self.extra_nodes.iter().position(|&e| e == node).unwrap_or(0);
+            4 * self.shaft_nodes + 2 * k
+        }
+    }
+
+    /// Each shaft node's (x, y) DOFs, for the whirl direction.
+    pub fn translation_pairs(&self) -> Vec<(usize, usize)> {
+        (0..self.shaft_nodes).map(|n| (4 * n, 4 * n + 1)).collect()
+    }
+
+    fn fixed(&self) -> Fixed {
+        let n = self.dofs();
+        let mut f =
+            Fixed { m: Mat::zeros(n, n), k: Mat::zeros(n, n), c: Mat::zeros(n, n), g: Mat::zeros(n, n) };
+        for s in &self.shafts {
+            let o = 4 * s.n;
+            scatter8(&mut f.m, o, &s.mass());
+            scatter8(&mut f.k, o, &s.stiffness());
+            scatter8(&mut f.g, o, &s.gyroscopic());
+            scatter8(&mut f.c, o, &s.damping());
+        }
+        for d in &self.disks {
+            let o = 4 * d.n;
+            f.m[(o, o)] += d.m;
+            f.m[(o + 1, o + 1)] += d.m;
+            f.m[(o + 2, o + 2)] += d.id;
+            f.m[(o + 3, o + 3)] += d.id;
+            f.g[(o + 2, o + 3)] += d.ip;
+            f.g[(o + 3, o + 2)] -= d.ip;
+        }
+        for p in &self.point_masses {
+            let o = self.x_dof(p.n);
+            f.m[(o, o)] += p.mx;
+            f.m[(o + 1, o + 1)] += p.my;
+        }
+        f
+    }
+
+    /// Adds a bearing's 2×2 block (between its node and its link node, or to ground).
+    pub fn add_bearing_block(&self, target: &mut Mat<f64>, b: &Bearing, block: [[f64; 2]; 2]) {
+        let i = self.x_dof(b.n);
+        let link = b.n_link.map(|l| self.x_dof(l));
+        for r in 0..2 {
+            for c in 0..2 {
+                let v = block[r][c];
+                target[(i + r, i + c)] += v;
+                if let Some(j) = link {
+                    target[(j + r, j + c)] += v;
+                    target[(i + r, j + c)] -= v;
+                    target[(j + r, i + c)] -= v;
+                }
+            }
+        }
+    }
+
+    /// The matrices at speed Ω (rad/s); bearing coefficients are taken at that speed (ROSS's
+    /// default: excitation frequency = speed).
+    pub fn matrices(&self, speed: f64) -> Matrices {
+        self.matrices_from(&self.fixed(), speed)
+    }
+
+    fn matrices_from(&self, f: &Fixed, speed: f64) -> Matrices {
+        let mut m = f.m.clone();
+        let mut k = f.k.clone();
+        let mut d = f.c.clone();
+        for b in &self.bearings {
+            self.add_bearing_block(&mut k, b, Bearing::block(&b.k, speed));
+            self.add_bearing_block(&mut d, b, Bearing::block(&b.c, speed));
+            self.add_bearing_block(&mut m, b, Bearing::block(&b.m, speed));
+        }
+        let n = self.dofs();
+        for j in 0..n {
+            for i in 0..n {
+                d[(i, j)] += speed * f.g[(i, j)];
+            }
+        }
+        Matrices { m, d, k, g: f.g.clone() }
+    }
+
+    /// The oscillating modes at speed Ω (rad/s), ascending in damped frequency.
+    pub fn modes(&self, speed: f64, with_left: bool) -> Result<Vec<Mode>, RotorDynError> {
+        let mats = self.matrices(speed);
+        self.modes_of(&mats, with_left)
+    }
+
+    /// Modes of already assembled matrices.
+    pub fn modes_of(&self, mats: &Matrices, with_left: bool) -> Result<Vec<Mode>, RotorDynError> {
+        modal::solve(mats.m.as_ref(), mats.d.as_ref(), mats.k.as_ref(), &self.translation_pairs(), with_left)
+    }
+
+    /// The `count` lowest modes at speed Ω (rad/s), by the fastest exact route for the size.
+    pub fn lowest_modes(&self, speed: f64, count: usize) -> Result<Vec<Mode>, RotorDynError> {
+        let mats = self.matrices(speed);
+        modal::solve_lowest(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count)
+    }
+
+    /// The `count` lowest modes at several speeds, assembling the speed-independent part once.
+    pub fn lowest_modes_over(&self, speeds: &[f64], count: usize) -> Result<Vec<Vec<Mode>>, RotorDynError> {
+        let f = self.fixed();
+        let pairs = self.translation_pairs();
+        speeds
+            .iter()
+            .map(|&s| {
+                let mats = self.matrices_from(&f, s);
+                modal::solve_lowest(&mats.m, &mats.d, &mats.k, &pairs, count)
+            })
+            .collect()
+    }
+}
+
+fn scatter8(target: &mut Mat<f64>, offset: usize, e: &Mat8) {
+    for i in 0..8 {
+        for j in 0..8 {
+            target[(offset + i, offset + j)] += e[i][j];
+        }
+    }
+}
+
+fn check_shaft(s: &ShaftElement) -> Result<(), RotorDynError> {
+    let bad = |what: &str| Err(RotorDynError::Model(format!("shaft element `{}`: {what}", s.tag)));
+    let finite = [
+        s.length,
+        s.idl,
+        s.odl,
+        s.idr,
+        s.odr,
+        s.material.rho,
+        s.material.e,
+        s.material.g_s,
+        s.axial_force,
+        s.torque,
+        s.alpha,
+        s.beta,
+    ];
+    if finite.iter().any(|v| !v.is_finite()) {
+        return bad("every number must be finite");
+    }
+    if s.length <= 0.0 {
+        return bad("length L must be > 0");
+    }
+    if s.odl <= s.idl || s.odr <= s.idr || s.idl < 0.0 || s.idr < 0.0 {
+        return bad("outer diameters must exceed inner diameters (≥ 0)");
+    }
+    if s.material.rho <= 0.0 || s.material.e <= 0.0 || s.material.g_s <= 0.0 {
+        return bad("material rho, E and G_s must be > 0");
+    }
+    Ok(())
+}

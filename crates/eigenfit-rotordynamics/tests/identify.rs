@@ -1,0 +1,97 @@
+//! Identification at speed: bearings' kxx and kyy recovered from run-up whirl frequencies
+//! computed with known stiffnesses, and the reported intervals covering them.
+
+use eigenfit_rotordynamics::identify::{evaluate, identify, parse_runup, stiffness_parameters, RunupPoint};
+use eigenfit_rotordynamics::ross_file;
+use std::path::PathBuf;
+
+fn rotor() -> eigenfit_rotordynamics::Rotor {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/rotor_example.toml");
+    ross_file::read(&path).unwrap()
+}
+
+fn runup(truth: &[f64], std_hz: Option<f64>) -> Vec<RunupPoint> {
+    let r = rotor();
+    let params = stiffness_parameters(&r);
+    let mut points = Vec::new();
+    for rpm in [500.0, 2500.0, 5000.0, 7500.0, 9000.0] {
+        for mode in 1..=6 {
+            points.push(RunupPoint { speed_rpm: rpm, mode, frequency_hz: 1.0, std_hz, whirl: None });
+        }
+    }
+    let e = evaluate(&r, &params, truth, &points).unwrap();
+    for (p, f) in points.iter_mut().zip(e.frequencies_hz) {
+        p.frequency_hz = f;
+    }
+    points
+}
+
+#[test]
+fn recovers_every_bearings_kxx_and_kyy_from_a_runup() {
+    let r = rotor();
+    let params = stiffness_parameters(&r);
+    let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["kxx_Bearing 0", "kyy_Bearing 0", "kxx_Bearing 1", "kyy_Bearing 1"]);
+    let truth = [1.3, 0.75, 0.9, 1.2];
+    let points = runup(&truth, Some(0.01));
+    let id = identify(&r, &params, &points, &[1.0; 4], 100).unwrap();
+    assert!(id.converged, "{}", id.reason);
+    for (k, (s, t)) in id.scales.iter().zip(truth).enumerate() {
+        assert!((s - t).abs() < 1e-6 * t, "{}: {s} vs {t}", names[k]);
+    }
+    // Exact data: the 95 % intervals (log-normal, from std_hz) contain the truth and are finite.
+    let sd = id.ln_std.expect("std given, so intervals");
+    for (k, s) in sd.iter().enumerate() {
+        assert!(s.is_finite() && *s > 0.0, "{}: {s}", names[k]);
+    }
+    assert!(id.cost < 1e-10, "cost {}", id.cost);
+}
+
+#[test]
+fn interval_width_follows_the_measurement_noise() {
+    let r = rotor();
+    let params = stiffness_parameters(&r);
+    // Anisotropic: with kxx = kyy every mode is equally sensitive to both (a 90° turn maps one
+    // on the other) and they are not separately identifiable, which the next test checks.
+    let truth = [1.3, 0.75, 0.9, 1.2];
+    let narrow = identify(&r, &params, &runup(&truth, Some(0.001)), &truth, 5).unwrap();
+    let wide = identify(&r, &params, &runup(&truth, Some(0.1)), &truth, 5).unwrap();
+    let info = format!(
+        "{} {} {} / {} {} {}",
+        narrow.iterations, narrow.reason, narrow.cost, wide.iterations, wide.reason, wide.cost
+    );
+    let (a, b) = (narrow.ln_std.unwrap(), wide.ln_std.unwrap());
+    for k in 0..4 {
+        // σ(ln k) is linear in std_hz at the same point: 100× the noise, 100× the width.
+        assert!((b[k] / a[k] - 100.0).abs() < 1e-6 * 100.0, "{k}: {} {} {info}", a[k], b[k]);
+    }
+}
+
+#[test]
+fn kxx_and_kyy_of_an_isotropic_rotor_are_reported_not_identifiable() {
+    let r = rotor();
+    let params = stiffness_parameters(&r);
+    let id = identify(&r, &params, &runup(&[1.0; 4], Some(0.01)), &[1.0; 4], 5).unwrap();
+    assert!(id.ln_std.is_none(), "intervals given for a rank-deficient Jacobian: {:?}", id.ln_std);
+    assert!(!id.identifiable);
+}
+
+#[test]
+fn runup_csv_errors_name_the_line() {
+    let ok = parse_runup(
+        "speed_rpm,mode,frequency_hz,std_hz,whirl\n1000,1,20.5,0.1,backward\n1000,2,21.0,0.1,forward\n",
+    )
+    .unwrap();
+    assert_eq!(ok.len(), 2);
+    for (text, needle) in [
+        ("mode,frequency_hz\n1,2\n", "speed_rpm"),
+        ("speed_rpm,mode,frequency_hz\n1000,0,20\n", "line 2"),
+        ("speed_rpm,mode,frequency_hz\n1000,1,abc\n", "line 2"),
+        ("speed_rpm,mode,frequency_hz,whirl\n1000,1,20,sideways\n", "sideways"),
+        ("speed_rpm,mode,frequency_hz\n1000,1,20\n1000,1,21\n", "twice"),
+        ("speed_rpm,mode,frequency_hz,std_hz\n1000,1,20,0.1\n1000,2,21,\n", "every row"),
+    ] {
+        let e = parse_runup(text).unwrap_err();
+        assert!(e.contains(needle), "{text:?}: {e}");
+    }
+}
