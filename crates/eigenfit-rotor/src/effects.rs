@@ -11,7 +11,7 @@
 //! | `point-mass` | node | unmodelled lumped mass, kg |
 //! | `shaft-stiffness-loss` | element | fraction of EI lost in that element (0–1) |
 //! | `modulus-error` | none | relative change of the shaft's Young's modulus |
-//! | `shear-deformation` | none | Timoshenko shear on (value ignored; ν = 0.3, Cowper's κ) |
+//! | `shear-deformation` | none | Timoshenko shear on, no rotary inertia (value ignored; ν = 0.3, Cowper's κ) |
 //! | `shaft-rotary-inertia` | none | fraction of the shaft sections' rotary inertia ρI (1 = all) |
 //! | `timoshenko-shaft` | none | fraction of the Timoshenko correction, shear and rotary inertia (1 = all) |
 //! | `section-change` | first element (`elements = [first, last]`) | relative change of the diameter |
@@ -149,7 +149,7 @@ pub(crate) fn unit_contribution(
     }
     let location_given = match (spec.kind.as_str(), spec.position_m, spec.elements) {
         ("point-mass", Some(x), _) => Some(node_near(parts, x, &bad)?),
-        ("section-change", _, Some([a, _])) => spec.location.or(Some(a)),
+        ("section-change" | "shaft-stiffness-loss", _, Some([a, _])) => spec.location.or(Some(a)),
         _ => spec.location,
     };
     let location = match (location_kind(&spec.kind), location_given) {
@@ -193,13 +193,7 @@ pub(crate) fn unit_contribution(
             }
         },
         "section-change" => {
-            let [a, b] = spec.elements.unwrap_or([location, location]);
-            if a > b || b >= parts.elements.len() {
-                return Err(bad(format!(
-                    "elements [{a}, {b}]: need first ≤ last < {} (the rotor's element count)",
-                    parts.elements.len()
-                )));
-            }
+            let [a, b] = element_run(parts, spec, location, &bad)?;
             for e in a..=b {
                 add_element(&mut dk, e, &bending(parts, e));
                 add_element(&mut dm, e, &translational_mass(parts, e));
@@ -213,16 +207,9 @@ pub(crate) fn unit_contribution(
         }
         "timoshenko-shaft" => {
             // Timoshenko element (shear, rotary inertia, Φ-dependent mass) minus Euler–Bernoulli.
-            for (e, el) in parts.elements.iter().enumerate() {
+            for e in 0..parts.elements.len() {
                 let (rho_a, rho_i, ei, l) = section(parts, e);
-                let mat = &parts.materials[el.material];
-                let phi = element::shear_parameter(
-                    mat.youngs_modulus,
-                    el.outer_diameter,
-                    el.inner_diameter,
-                    l,
-                    element::POISSON_RATIO,
-                );
+                let phi = shear_phi(parts, e);
                 add_element(&mut dk, e, &(element::timoshenko_stiffness(ei, phi, l) - element::stiffness(ei, l)));
                 let m = element::timoshenko_translational_mass(rho_a, phi, l)
                     + element::timoshenko_rotary_mass(rho_i, phi, l)
@@ -230,26 +217,26 @@ pub(crate) fn unit_contribution(
                 add_element(&mut dm, e, &m);
             }
         }
-        "shaft-stiffness-loss" => add_element(&mut dk, location, &-bending(parts, location)),
+        "shaft-stiffness-loss" => {
+            let [a, b] = element_run(parts, spec, location, &bad)?;
+            for e in a..=b {
+                add_element(&mut dk, e, &-bending(parts, e));
+            }
+        }
         "modulus-error" => {
             for e in 0..parts.elements.len() {
                 add_element(&mut dk, e, &bending(parts, e));
             }
         }
         _ => {
-            // shear-deformation: Timoshenko minus Euler–Bernoulli, element by element.
-            for (e, el) in parts.elements.iter().enumerate() {
-                let mat = &parts.materials[el.material];
-                let ei =
-                    mat.youngs_modulus * element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
-                let g = mat.youngs_modulus / (2.0 * (1.0 + element::POISSON_RATIO));
-                let kappa =
-                    element::shear_coefficient(el.inner_diameter / el.outer_diameter, element::POISSON_RATIO);
-                let ga = kappa * g * element::area(el.outer_diameter, el.inner_diameter);
-                let phi = 12.0 * ei / (ga * el.length * el.length);
-                let diff =
-                    element::timoshenko_stiffness(ei, phi, el.length) - element::stiffness(ei, el.length);
-                add_element(&mut dk, e, &diff);
+            // shear-deformation: the Timoshenko element without rotary inertia (stiffness and
+            // Φ-dependent translational mass, as ROSS's shear-only element) minus Euler–Bernoulli.
+            for e in 0..parts.elements.len() {
+                let (rho_a, _, ei, l) = section(parts, e);
+                let phi = shear_phi(parts, e);
+                add_element(&mut dk, e, &(element::timoshenko_stiffness(ei, phi, l) - element::stiffness(ei, l)));
+                let m = element::timoshenko_translational_mass(rho_a, phi, l) - element::consistent_mass(rho_a, l);
+                add_element(&mut dm, e, &m);
             }
         }
     }
@@ -284,6 +271,23 @@ pub(crate) fn check_value(spec: &EffectSpec, entry: usize) -> Result<f64, RotorE
     }
 }
 
+/// The checked element run `[first, last]` of an effect (its location alone when not given).
+fn element_run(
+    parts: &Parts<'_>,
+    spec: &EffectSpec,
+    location: usize,
+    bad: &dyn Fn(String) -> RotorError,
+) -> Result<[usize; 2], RotorError> {
+    let [a, b] = spec.elements.unwrap_or([location, location]);
+    if a > b || b >= parts.elements.len() {
+        return Err(bad(format!(
+            "elements [{a}, {b}]: need first ≤ last < {} (the rotor's element count)",
+            parts.elements.len()
+        )));
+    }
+    Ok([a, b])
+}
+
 /// How an effect's value enters K and M (see [`ValueLaw`]).
 pub(crate) fn law(kind: &str) -> ValueLaw {
     match kind {
@@ -298,6 +302,13 @@ fn section(parts: &Parts<'_>, e: usize) -> (f64, f64, f64, f64) {
     let mat = &parts.materials[el.material];
     let i = element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
     (mat.density * element::area(el.outer_diameter, el.inner_diameter), mat.density * i, mat.youngs_modulus * i, el.length)
+}
+
+/// Shear parameter Φ of element `e` (ν = [`element::POISSON_RATIO`], Cowper's κ).
+fn shear_phi(parts: &Parts<'_>, e: usize) -> f64 {
+    let el = &parts.elements[e];
+    let mat = &parts.materials[el.material];
+    element::shear_parameter(mat.youngs_modulus, el.outer_diameter, el.inner_diameter, el.length, element::POISSON_RATIO)
 }
 
 fn translational_mass(parts: &Parts<'_>, e: usize) -> nalgebra::Matrix4<f64> {
@@ -340,11 +351,19 @@ fn add_element(s: &mut SparseSymmetric, e: usize, local: &nalgebra::Matrix4<f64>
 /// Every candidate effect of `rotor` for the discovery workflow, with bounds and plausible
 /// ranges scaled to the rotor (its total mass, its disks' masses).
 pub fn candidates(rotor: &Rotor) -> Vec<Candidate> {
+    candidates_on(rotor, rotor, 1)
+}
+
+/// The candidates of `rotor` (locations in its mesh) with their contributions assembled on
+/// `fine`, the same rotor refined by `factor` ([`crate::mesh::refined`]): for discovery on a
+/// mesh fine enough for the noise, reported in the user's mesh.
+pub fn candidates_on(rotor: &Rotor, fine: &Rotor, factor: usize) -> Vec<Candidate> {
     let parts = rotor.parts();
+    let fine_parts = fine.parts();
     let mass = rotor.total_mass();
     let mut out = Vec::new();
     let mut push = |spec: EffectSpec, parameter: Option<Parameter>, plausible: (f64, f64)| {
-        if let Ok((stiffness, mass_m)) = unit_contribution(&parts, &spec, 0) {
+        if let Ok((stiffness, mass_m)) = unit_contribution(&fine_parts, &on_refined(&spec, factor), 0) {
             let location = match (spec.position_m, spec.elements) {
                 (Some(x), _) => node_near(&parts, x, &|why| RotorError::Effect { entry: 0, kind: "point-mass".into(), why }).ok(),
                 (_, Some([a, _])) => Some(a),
@@ -443,5 +462,24 @@ pub fn candidates(rotor: &Rotor) -> Vec<Candidate> {
         Some(Parameter::new("timoshenko_fraction", "", 0.0).with_bounds(0.0, 5.0)),
         (0.6, 1.4),
     );
+    out
+}
+
+/// `spec` (in a rotor's mesh) carried to the mesh refined by `factor`: nodes n → factor·n,
+/// element e → the run factor·e … factor·e + factor − 1.
+fn on_refined(spec: &EffectSpec, factor: usize) -> EffectSpec {
+    if factor == 1 {
+        return spec.clone();
+    }
+    let mut out = spec.clone();
+    match (spec.kind.as_str(), spec.location) {
+        ("point-mass", Some(n)) if spec.position_m.is_none() => out.location = Some(n * factor),
+        ("shaft-stiffness-loss" | "section-change", Some(e)) => {
+            let [a, b] = spec.elements.unwrap_or([e, e]);
+            out.location = Some(a * factor);
+            out.elements = Some([a * factor, b * factor + factor - 1]);
+        }
+        _ => {}
+    }
     out
 }

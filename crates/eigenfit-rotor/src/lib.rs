@@ -52,10 +52,12 @@
 //! ```
 
 mod builder;
+pub mod discovery;
 pub mod effects;
 pub mod element;
 mod error;
 mod file;
+pub mod mesh;
 mod model;
 pub mod presets;
 

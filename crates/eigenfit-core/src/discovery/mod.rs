@@ -14,6 +14,7 @@ mod candidate;
 mod chi2;
 
 pub use candidate::{Augmented, Candidate, ValueLaw};
+
 pub use chi2::chi2_upper_tail;
 
 use crate::measurement::{MeasuredMode, Measurement};
@@ -51,6 +52,8 @@ pub struct DiscoveryOptions {
     /// An effect is named only if, with it, the misfit is one noise can explain: P(χ² ≥ observed)
     /// at least this (default 1e-3). A better but still inconsistent fit is reported, not named.
     pub min_after_p_value: f64,
+    /// Candidates of each kind refitted whatever their screening rank (default 1).
+    pub refits_per_kind: usize,
     /// Most effects added by forward selection (default 3).
     pub max_effects: usize,
     /// Alternatives within this AICc of a named effect are reported as ambiguous (default 2).
@@ -65,6 +68,7 @@ impl Default for DiscoveryOptions {
             min_aicc_gain: 4.0,
             assumed_relative_std: 1e-3,
             min_after_p_value: 1e-3,
+            refits_per_kind: 1,
             max_effects: 3,
             ambiguity_aicc: 2.0,
         }
@@ -384,10 +388,24 @@ where
         if round == 0 {
             report.screening = scored.iter().map(|&(i, s)| (candidates[i].label(), s)).collect();
         }
-        let to_refit: Vec<usize> = scored
-            .iter()
-            .take(options.refits)
-            .map(|&(i, _)| i)
+        // The best few overall, and the best of every kind: a linear screen misjudges large
+        // effects, and one kind's many locations must not crowd out the other kinds.
+        let mut per_kind: Vec<(&str, usize)> = Vec::new();
+        let mut picks: Vec<usize> = Vec::new();
+        for (rank, &(i, _)) in scored.iter().enumerate() {
+            let kind = candidates[i].kind.as_str();
+            let seen = per_kind.iter().position(|(k, _)| *k == kind);
+            let taken = seen.map_or(0, |s| per_kind[s].1);
+            if rank < options.refits || taken < options.refits_per_kind {
+                picks.push(i);
+                match seen {
+                    Some(s) => per_kind[s].1 += 1,
+                    None => per_kind.push((kind, 1)),
+                }
+            }
+        }
+        let to_refit: Vec<usize> = picks
+            .into_iter()
             .chain(
                 candidates.iter().enumerate().filter(|&(i, c)| c.parameter.is_none() && open(i)).map(|(i, _)| i),
             )
