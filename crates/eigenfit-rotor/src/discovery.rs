@@ -52,7 +52,7 @@ impl RotorDiscovery {
 
 /// Runs discovery on `rotor` against `measured`, starting the calibration from `initial`.
 ///
-/// When the user's mesh shows a significant misfit, the workflow is run again on the mesh
+/// When the user's mesh shows a significant misfit that no candidate explains, the workflow is run again on the mesh
 /// refined [`REFINEMENT`]-fold (candidates still located in the user's mesh); the refined
 /// result is kept only if its final AICc beats the user's mesh by `min_aicc_gain`, and then
 /// `mesh-refinement` is named with that gain.
@@ -65,7 +65,9 @@ pub fn discover_rotor<S: EigenSolver>(
 ) -> Result<RotorDiscovery, DiscoveryError> {
     let coarse = discover(rotor, solver, measured, &effects::candidates(rotor), initial, options)?;
     let coarse_result = RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
-    if !coarse_result.report.disagreement_significant {
+    // The refined mesh is tried only when the user's mesh leaves a misfit the noise does not
+    // explain: it costs a second, larger discovery run.
+    if !coarse_result.report.disagreement_significant || coarse_result.report.selected.is_some() {
         return Ok(coarse_result);
     }
     let Ok(fine_rotor) = mesh::refined(rotor, REFINEMENT) else { return Ok(coarse_result) };

@@ -12,6 +12,7 @@
 
 mod candidate;
 mod chi2;
+mod interval;
 
 pub use candidate::{Augmented, Candidate, ValueLaw};
 
@@ -20,7 +21,6 @@ pub use chi2::chi2_upper_tail;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::multi::Stacked;
 use crate::residual::{Linearisation, Problem};
-use crate::statistics::uncertainty;
 use crate::update::{Damped, Driver, Evaluate};
 use crate::{EigenSolver, StructuralModel};
 use nalgebra::DVector;
@@ -605,13 +605,12 @@ fn refit<M: StructuralModel, S: EigenSolver>(
     start.extend(candidate.parameter.as_ref().map(|p| p.nominal));
     let n: usize = measured.iter().map(Measurement::len).sum();
     with_augmented(models, solver, measured, set, |problem| {
-        let est = Driver::default().run(problem, &mut Damped::default(), &start, &mut []).ok()?;
+        // Bounded work per candidate: a refit that has not converged in 60 steps is not the
+        // explanation (the same limit the profile bounds use).
+        let est = Driver { max_iterations: 60 }.run(problem, &mut Damped::default(), &start, &mut []).ok()?;
         let k = problem.parameters().len();
         let chi2 = 2.0 * est.last.cost();
-        let intervals: Vec<Option<[f64; 2]>> = match uncertainty(problem, &est.last, true) {
-            Some(u) => u.intervals.iter().map(|&iv| Some(iv)).collect(),
-            None => vec![None; k],
-        };
+        let intervals = interval::covariance_intervals(problem, &est.last);
         // Every fitted effect value (not only the new one) must stay plausible.
         let nb = k - set.iter().filter(|c| c.parameter.is_some()).count();
         let mut index = nb;
