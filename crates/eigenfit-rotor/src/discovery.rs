@@ -6,7 +6,7 @@ use crate::effects::{self, EffectSpec};
 use crate::mesh;
 use crate::model::Rotor;
 use crate::RotorError;
-use eigenfit_core::discovery::{chi2_upper_tail, discover, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect};
+use eigenfit_core::discovery::{chi2_upper_tail, discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect};
 use eigenfit_core::{EigenSolver, Measurement};
 
 /// Sub-elements per element of the refined mesh: Hermite elements converge as h⁴ in frequency,
@@ -65,12 +65,25 @@ pub fn discover_rotor<S: EigenSolver>(
 ) -> Result<RotorDiscovery, DiscoveryError> {
     let coarse = discover(rotor, solver, measured, &effects::candidates(rotor), initial, options)?;
     let coarse_result = RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
-    // The refined mesh is tried only when the user's mesh leaves a misfit the noise does not
-    // explain: it costs a second, larger discovery run.
-    if !coarse_result.report.disagreement_significant || coarse_result.report.selected.is_some() {
+    if !coarse_result.report.disagreement_significant {
         return Ok(coarse_result);
     }
     let Ok(fine_rotor) = mesh::refined(rotor, REFINEMENT) else { return Ok(coarse_result) };
+    // First the refined mesh alone (one calibration): if it explains the data, that is the
+    // answer — said instead of a physical effect, or beside one that fits about as well.
+    if let Ok(fine_base) = discover(&fine_rotor, solver, measured, &[], initial, options) {
+        if !fine_base.disagreement_significant {
+            let gain = final_aicc(&coarse_result.report) - fine_base.aicc_before;
+            if gain > -options.ambiguity_aicc {
+                return Ok(mesh_explains(coarse_result, fine_base, gain, options));
+            }
+        }
+    }
+    // The full search on the refined mesh only when nothing explained the user's mesh: it costs
+    // a second, larger discovery run.
+    if coarse_result.report.selected.is_some() {
+        return Ok(coarse_result);
+    }
     let candidates = effects::candidates_on(rotor, &fine_rotor, REFINEMENT);
     let Ok(mut fine) = discover(&fine_rotor, solver, measured, &candidates, initial, options) else {
         return Ok(coarse_result);
@@ -95,7 +108,56 @@ pub fn discover_rotor<S: EigenSolver>(
     fine.p_value = c.p_value;
     fine.aicc_before = c.aicc_before;
     fine.disagreement_significant = c.disagreement_significant;
-    let mesh_effect = NamedEffect {
+    let mut named = fine.effects.clone();
+    named.push(mesh_effect(gain, Vec::new()));
+    named.sort_by(|a, b| b.delta_aicc.total_cmp(&a.delta_aicc));
+    Ok(RotorDiscovery { report: fine, effects: named, mesh_factor: REFINEMENT })
+}
+
+/// The refined mesh alone explains the data (`fine`: its calibration, nothing named): name
+/// `mesh-refinement`, and list the user's-mesh explanation as an alternative when it is within
+/// the ambiguity margin.
+fn mesh_explains(
+    coarse: RotorDiscovery,
+    mut fine: DiscoveryReport,
+    gain: f64,
+    options: &DiscoveryOptions,
+) -> RotorDiscovery {
+    let c = coarse.report;
+    let ambiguous_with = if gain < options.ambiguity_aicc {
+        coarse
+            .effects
+            .iter()
+            .map(|e| Alternative {
+                label: e.label.clone(),
+                kind: e.kind.clone(),
+                location: e.location,
+                position_m: e.position_m,
+                elements: e.elements,
+                value: e.value,
+                unit: e.unit.clone(),
+                delta_aicc: gain,
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    for (m, before) in fine.modes.iter_mut().zip(&c.modes) {
+        m.before_hz = before.before_hz;
+    }
+    fine.rms_before_hz = c.rms_before_hz;
+    fine.chi2_before = c.chi2_before;
+    fine.p_value = c.p_value;
+    fine.aicc_before = c.aicc_before;
+    fine.disagreement_significant = c.disagreement_significant;
+    fine.fits = c.fits;
+    fine.screening = c.screening;
+    let effect = mesh_effect(gain, ambiguous_with);
+    RotorDiscovery { report: fine, effects: vec![effect], mesh_factor: REFINEMENT }
+}
+
+fn mesh_effect(gain: f64, ambiguous_with: Vec<Alternative>) -> NamedEffect {
+    NamedEffect {
         label: "mesh-refinement".into(),
         kind: "mesh-refinement".into(),
         location: None,
@@ -105,12 +167,8 @@ pub fn discover_rotor<S: EigenSolver>(
         interval: None,
         unit: "sub-elements per element".into(),
         delta_aicc: gain,
-        ambiguous_with: Vec::new(),
-    };
-    let mut named = fine.effects.clone();
-    named.push(mesh_effect);
-    named.sort_by(|a, b| b.delta_aicc.total_cmp(&a.delta_aicc));
-    Ok(RotorDiscovery { report: fine, effects: named, mesh_factor: REFINEMENT })
+        ambiguous_with,
+    }
 }
 
 /// AICc of what a run ends with: its named effects, or the calibrated base.
