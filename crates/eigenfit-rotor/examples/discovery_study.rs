@@ -16,7 +16,8 @@ fn main() {
     println!("|---|---|---|---|---|---|---|");
     let mut slowest = 0.0f64;
     for case in &fixtures.case {
-        let mut noises: Vec<f64> = fixtures.draw.iter().filter(|d| d.case == case.name).map(|d| d.noise).collect();
+        let mut noises: Vec<f64> =
+            fixtures.draw.iter().filter(|d| d.case == case.name).map(|d| d.noise).collect();
         noises.dedup();
         for noise in noises {
             let mut counts = [0usize; 4];

@@ -6,7 +6,9 @@ use crate::effects::{self, EffectSpec};
 use crate::mesh;
 use crate::model::Rotor;
 use crate::RotorError;
-use eigenfit_core::discovery::{chi2_upper_tail, discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect};
+use eigenfit_core::discovery::{
+    chi2_upper_tail, discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect,
+};
 use eigenfit_core::{EigenSolver, Measurement};
 
 /// Sub-elements per element of the refined mesh: Hermite elements converge as h⁴ in frequency,
@@ -90,7 +92,8 @@ pub fn discover_rotor<S: EigenSolver>(
     };
     let gain = final_aicc(&coarse_result.report) - final_aicc(&fine);
     // Like any effect, the refinement is named only if what is left is noise.
-    let (chi2, k) = fine.selected.as_ref().map_or((fine.chi2_before, initial.len()), |s| (s.chi2, s.parameters.len()));
+    let (chi2, k) =
+        fine.selected.as_ref().map_or((fine.chi2_before, initial.len()), |s| (s.chi2, s.parameters.len()));
     let n = fine.modes.len();
     let consistent = n > k && chi2_upper_tail(chi2, n - k) >= options.min_after_p_value;
     if gain < options.min_aicc_gain || !consistent {

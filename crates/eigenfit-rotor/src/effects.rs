@@ -210,7 +210,11 @@ pub(crate) fn unit_contribution(
             for e in 0..parts.elements.len() {
                 let (rho_a, rho_i, ei, l) = section(parts, e);
                 let phi = shear_phi(parts, e);
-                add_element(&mut dk, e, &(element::timoshenko_stiffness(ei, phi, l) - element::stiffness(ei, l)));
+                add_element(
+                    &mut dk,
+                    e,
+                    &(element::timoshenko_stiffness(ei, phi, l) - element::stiffness(ei, l)),
+                );
                 let m = element::timoshenko_translational_mass(rho_a, phi, l)
                     + element::timoshenko_rotary_mass(rho_i, phi, l)
                     - element::consistent_mass(rho_a, l);
@@ -234,8 +238,13 @@ pub(crate) fn unit_contribution(
             for e in 0..parts.elements.len() {
                 let (rho_a, _, ei, l) = section(parts, e);
                 let phi = shear_phi(parts, e);
-                add_element(&mut dk, e, &(element::timoshenko_stiffness(ei, phi, l) - element::stiffness(ei, l)));
-                let m = element::timoshenko_translational_mass(rho_a, phi, l) - element::consistent_mass(rho_a, l);
+                add_element(
+                    &mut dk,
+                    e,
+                    &(element::timoshenko_stiffness(ei, phi, l) - element::stiffness(ei, l)),
+                );
+                let m = element::timoshenko_translational_mass(rho_a, phi, l)
+                    - element::consistent_mass(rho_a, l);
                 add_element(&mut dm, e, &m);
             }
         }
@@ -301,14 +310,25 @@ fn section(parts: &Parts<'_>, e: usize) -> (f64, f64, f64, f64) {
     let el = &parts.elements[e];
     let mat = &parts.materials[el.material];
     let i = element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
-    (mat.density * element::area(el.outer_diameter, el.inner_diameter), mat.density * i, mat.youngs_modulus * i, el.length)
+    (
+        mat.density * element::area(el.outer_diameter, el.inner_diameter),
+        mat.density * i,
+        mat.youngs_modulus * i,
+        el.length,
+    )
 }
 
 /// Shear parameter Φ of element `e` (ν = [`element::POISSON_RATIO`], Cowper's κ).
 fn shear_phi(parts: &Parts<'_>, e: usize) -> f64 {
     let el = &parts.elements[e];
     let mat = &parts.materials[el.material];
-    element::shear_parameter(mat.youngs_modulus, el.outer_diameter, el.inner_diameter, el.length, element::POISSON_RATIO)
+    element::shear_parameter(
+        mat.youngs_modulus,
+        el.outer_diameter,
+        el.inner_diameter,
+        el.length,
+        element::POISSON_RATIO,
+    )
 }
 
 fn translational_mass(parts: &Parts<'_>, e: usize) -> nalgebra::Matrix4<f64> {
@@ -365,7 +385,12 @@ pub fn candidates_on(rotor: &Rotor, fine: &Rotor, factor: usize) -> Vec<Candidat
     let mut push = |spec: EffectSpec, parameter: Option<Parameter>, plausible: (f64, f64)| {
         if let Ok((stiffness, mass_m)) = unit_contribution(&fine_parts, &on_refined(&spec, factor), 0) {
             let location = match (spec.position_m, spec.elements) {
-                (Some(x), _) => node_near(&parts, x, &|why| RotorError::Effect { entry: 0, kind: "point-mass".into(), why }).ok(),
+                (Some(x), _) => node_near(&parts, x, &|why| RotorError::Effect {
+                    entry: 0,
+                    kind: "point-mass".into(),
+                    why,
+                })
+                .ok(),
                 (_, Some([a, _])) => Some(a),
                 _ => spec.location,
             };

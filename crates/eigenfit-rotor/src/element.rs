@@ -138,7 +138,12 @@ pub fn shear_parameter(youngs_modulus: f64, outer: f64, inner: f64, l: f64, pois
 /// v(x) = N·[v₁, θ₁, v₂, θ₂]. A point mass m there adds m·NNᵀ (consistent lumping).
 pub fn displacement_shape(xi: f64, l: f64) -> nalgebra::Vector4<f64> {
     let (x2, x3) = (xi * xi, xi * xi * xi);
-    nalgebra::Vector4::new(1.0 - 3.0 * x2 + 2.0 * x3, l * (xi - 2.0 * x2 + x3), 3.0 * x2 - 2.0 * x3, l * (x3 - x2))
+    nalgebra::Vector4::new(
+        1.0 - 3.0 * x2 + 2.0 * x3,
+        l * (xi - 2.0 * x2 + x3),
+        3.0 * x2 - 2.0 * x3,
+        l * (x3 - x2),
+    )
 }
 
 #[cfg(test)]

@@ -77,7 +77,8 @@ mod tests {
         let coarse = presets::paper_rotor();
         let k = [2e5, 5e4];
         let f = |r: &crate::Rotor| DenseSolver.lowest(&r.system_at(&k).unwrap(), 8).unwrap().frequencies_hz();
-        let (f1, f2, f4) = (f(&coarse), f(&super::refined(&coarse, 2).unwrap()), f(&super::refined(&coarse, 4).unwrap()));
+        let (f1, f2, f4) =
+            (f(&coarse), f(&super::refined(&coarse, 2).unwrap()), f(&super::refined(&coarse, 4).unwrap()));
         assert_eq!(super::refined(&coarse, 1).unwrap().nodes(), coarse.nodes());
         for m in 0..8 {
             // Consistent-mass Hermite elements bound the frequencies from above.

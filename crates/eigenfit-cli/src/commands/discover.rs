@@ -161,7 +161,9 @@ fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], labe
     match (found.effects.is_empty(), r.disagreement_significant) {
         (_, false) => println!("no significant disagreement: nothing added."),
         (true, true) => {
-            println!("no candidate effect, alone or with others, explains the disagreement down to the noise.");
+            println!(
+                "no candidate effect, alone or with others, explains the disagreement down to the noise."
+            );
             if let Some(best) = r.fits.iter().find(|f| f.plausible) {
                 println!(
                     "  best partial explanation: {} (χ² {:.2} → {:.2})",
@@ -181,22 +183,20 @@ fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], labe
                     println!("    the model's mesh is too coarse for this noise: refining it explains part of the gap");
                 }
                 for a in &e.ambiguous_with {
-                    println!("    ambiguous with {} (ΔAICc {:+.2}): the data cannot tell them apart", a.label, a.delta_aicc);
+                    println!(
+                        "    ambiguous with {} (ΔAICc {:+.2}): the data cannot tell them apart",
+                        a.label, a.delta_aicc
+                    );
                 }
             }
-            let (chi2, aicc) = r.selected.as_ref().map_or((r.chi2_before, r.aicc_before), |s| (s.chi2, s.aicc));
+            let (chi2, aicc) =
+                r.selected.as_ref().map_or((r.chi2_before, r.aicc_before), |s| (s.chi2, s.aicc));
             println!(
                 "  evidence: χ² {:.2} → {:.2}, AICc {:.2} → {:.2}, RMS residual {:.4} → {:.4} Hz",
                 r.chi2_before, chi2, r.aicc_before, aicc, r.rms_before_hz, r.rms_after_hz
             );
             if let Some(u) = &r.runner_up {
-                if let Some(s) = &r.selected {
-                    println!(
-                        "  runner-up to the first: {} (AICc {:.2} as the only effect)",
-                        u.label, u.aicc
-                    );
-                    let _ = s;
-                }
+                println!("  runner-up to the first effect: {} (AICc {:.2} on its own)", u.label, u.aicc);
             }
         }
     }

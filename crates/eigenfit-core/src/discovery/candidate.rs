@@ -180,7 +180,10 @@ impl<M: StructuralModel + ?Sized> StructuralModel for Augmented<'_, M> {
         for (c, (value, index)) in self.candidates.iter().zip(self.values(p)) {
             if index == Some(i) {
                 let (dk, dm) = c.law.derivatives(value);
-                return Ok(SystemDerivative { stiffness: scaled(&c.stiffness, dk), mass: scaled(&c.mass, dm) });
+                return Ok(SystemDerivative {
+                    stiffness: scaled(&c.stiffness, dk),
+                    mass: scaled(&c.mass, dm),
+                });
             }
         }
         Err(ModelError::ParameterIndex { index: i, count: self.params.len() })

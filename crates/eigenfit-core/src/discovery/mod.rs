@@ -369,21 +369,23 @@ where
         }
         let chosen_refs: Vec<&Candidate> = chosen.iter().map(|&i| &candidates[i]).collect();
         let open = |i: usize| !chosen.iter().any(|&c| same_place(&candidates[c], &candidates[i]));
-        let mut scored: Vec<(usize, f64)> = with_augmented(&models, solver, &measured, &chosen_refs, |problem| {
-            let lin = problem.linearise(&current.parameters).ok()?;
-            let projector = Projector::new(problem, &lin);
-            Some(
-                candidates
-                    .iter()
-                    .enumerate()
-                    .filter(|&(i, c)| c.parameter.is_some() && open(i))
-                    .filter_map(|(i, c)| {
-                        screen(&models, solver, &measured, &chosen_refs, c, &lin, &projector).map(|s| (i, s))
-                    })
-                    .collect(),
-            )
-        })
-        .unwrap_or_default();
+        let mut scored: Vec<(usize, f64)> =
+            with_augmented(&models, solver, &measured, &chosen_refs, |problem| {
+                let lin = problem.linearise(&current.parameters).ok()?;
+                let projector = Projector::new(problem, &lin);
+                Some(
+                    candidates
+                        .iter()
+                        .enumerate()
+                        .filter(|&(i, c)| c.parameter.is_some() && open(i))
+                        .filter_map(|(i, c)| {
+                            screen(&models, solver, &measured, &chosen_refs, c, &lin, &projector)
+                                .map(|s| (i, s))
+                        })
+                        .collect(),
+                )
+            })
+            .unwrap_or_default();
         scored.sort_by(|a, b| b.1.total_cmp(&a.1));
         if round == 0 {
             report.screening = scored.iter().map(|&(i, s)| (candidates[i].label(), s)).collect();
@@ -407,7 +409,11 @@ where
         let to_refit: Vec<usize> = picks
             .into_iter()
             .chain(
-                candidates.iter().enumerate().filter(|&(i, c)| c.parameter.is_none() && open(i)).map(|(i, _)| i),
+                candidates
+                    .iter()
+                    .enumerate()
+                    .filter(|&(i, c)| c.parameter.is_none() && open(i))
+                    .map(|(i, _)| i),
             )
             .collect();
         let mut fits: Vec<(usize, Fit)> = to_refit

@@ -138,7 +138,13 @@ pub fn run(draw: &Draw) -> Vec<NamedEffect> {
         .map(|(m, (&f, &s))| MeasuredMode::new(m, f).with_std(s))
         .collect();
     let measured = Measurement::new(modes).expect("fixture frequencies are valid");
-    discover_rotor(&rotor, &BandedSolver::default(), &measured, &rotor.nominal_stiffnesses(), &DiscoveryOptions::default())
-        .expect("discovery runs on valid data")
-        .effects
+    discover_rotor(
+        &rotor,
+        &BandedSolver::default(),
+        &measured,
+        &rotor.nominal_stiffnesses(),
+        &DiscoveryOptions::default(),
+    )
+    .expect("discovery runs on valid data")
+    .effects
 }
