@@ -32,6 +32,7 @@ pub mod monte_carlo;
 pub mod multi;
 pub mod parameters;
 pub mod residual;
+pub mod roundoff;
 pub mod sensitivity;
 mod small_eigen;
 pub mod solver;
@@ -43,6 +44,7 @@ pub mod system;
 #[cfg(test)]
 mod test_chain;
 pub mod update;
+pub mod verdict;
 
 pub use banded::{BandCholesky, BandedSymmetric};
 pub use dense::DenseSolver;
@@ -54,12 +56,15 @@ pub use residual::{Linearisation, Pairing, Problem, ResidualError, ResidualKind}
 pub use sensitivity::{Sensitivities, SensitivityError};
 pub use solver::{EigenSolver, SolveError};
 pub use sparse::SparseSymmetric;
-pub use statistics::{alternative_solutions, uncertainty, Identifiability, Uncertainty};
+pub use statistics::{
+    alternative_solutions, alternative_solutions_within, mirror_solutions, uncertainty, uncertainty_within,
+    Identifiability, Uncertainty,
+};
 pub use subspace::BandedSolver;
 pub use system::{System, SystemDerivative, SystemError};
 pub use update::{
-    Damped, Driver, Estimate, Evaluate, IterationRecord, IterationRecordSink, Newton, Observer, PStep, Step,
-    StepStatus, StrategyKind, Termination, UpdateError, UpdateStrategy,
+    Budget, Damped, Driver, Estimate, Evaluate, IterationRecord, IterationRecordSink, Newton, Observer,
+    PStep, Step, StepStatus, StrategyKind, Termination, UpdateError, UpdateStrategy,
 };
 
 /// Converts an eigenvalue λ = ω² (rad/s)² to a frequency in Hz.

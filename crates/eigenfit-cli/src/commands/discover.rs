@@ -64,7 +64,7 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
         written.extend(plot::names(&plot::write(&figure, dir, "discovery")?));
     }
     if args.json {
-        println!("{}", report_json(&found, &names, &label, &written));
+        crate::output::emit_json(report_json(&found, &names, &label, &written));
     } else {
         let units: Vec<String> = rotor.parameters().iter().map(|p| p.unit.clone()).collect();
         print_report(&found, &names, &units, &label);
