@@ -111,14 +111,7 @@ pub mod model {
                 let theta = Parameter::new(format!("added_mass_{}", j + 1), "", 0.0).with_bounds(-0.5, 2.0);
                 let (kind, stiffness) =
                     ("added-storey-mass".to_string(), SparseSymmetric::zeros(self.dofs()));
-                Candidate {
-                    kind,
-                    location: Some(j + 1),
-                    parameter: Some(theta),
-                    plausible: (0.0, 1.0),
-                    stiffness,
-                    mass,
-                }
+                Candidate::linear(kind, Some(j + 1), Some(theta), (0.0, 1.0), stiffness, mass)
             };
             (0..self.dofs()).map(storey).collect()
         }

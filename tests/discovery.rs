@@ -73,11 +73,11 @@ fn a_candidate_at_a_value_is_the_same_model_as_the_effect_in_a_file() {
             p.push(value);
         }
         let a = aug.assemble(&p).unwrap();
-        let b = base
-            .with_effect(EffectSpec::new(c.kind.clone(), c.location, value))
-            .unwrap()
-            .nominal_system()
-            .unwrap();
+        let mut spec = EffectSpec::new(c.kind.clone(), c.location, value);
+        // Placed by coordinate or over a run of elements: the file says so the same way.
+        spec.position_m = c.position_m;
+        spec.elements = c.elements;
+        let b = base.with_effect(spec).unwrap().nominal_system().unwrap();
         let scale = b.stiffness().amax();
         assert!((a.stiffness() - b.stiffness()).amax() <= 1e-12 * scale, "{}", c.label());
         assert!((a.mass() - b.mass()).amax() <= 1e-12, "{}", c.label());

@@ -11,7 +11,15 @@
 //! | `point-mass` | node | unmodelled lumped mass, kg |
 //! | `shaft-stiffness-loss` | element | fraction of EI lost in that element (0–1) |
 //! | `modulus-error` | none | relative change of the shaft's Young's modulus |
-//! | `shear-deformation` | none | Timoshenko shear on (value ignored; ν = 0.3, Cowper's κ) |
+//! | `shear-deformation` | none | Timoshenko shear on, no rotary inertia (value ignored; ν = 0.3, Cowper's κ) |
+//! | `shaft-rotary-inertia` | none | fraction of the shaft sections' rotary inertia ρI (1 = all) |
+//! | `timoshenko-shaft` | none | fraction of the Timoshenko correction, shear and rotary inertia (1 = all) |
+//! | `section-change` | first element (`elements = [first, last]`) | relative change of the diameter |
+//!
+//! `point-mass` also takes `position_m` (m along the shaft) instead of a node: the mass is then
+//! distributed over the element's nodes by its displacement shape functions (consistent mass).
+//! `section-change` scales the elements' outer and inner diameters by 1 + value: their bending
+//! stiffness goes as (1 + value)⁴, their mass as (1 + value)² (not linear in the value).
 //!
 //! Locations are 0-based indices, in file order, of the node, element, bearing or disk.
 //! `modulus-error` and `shaft-stiffness-loss` scale the Euler–Bernoulli bending stiffness; with
@@ -20,13 +28,13 @@
 use crate::element;
 use crate::error::RotorError;
 use crate::model::{Bearing, Rotor, ShaftElement};
-use eigenfit_core::discovery::Candidate;
+use eigenfit_core::discovery::{Candidate, ValueLaw};
 use eigenfit_core::{Parameter, SparseSymmetric};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 /// The effect kinds, in the order of the table above.
-pub const KINDS: [&str; 7] = [
+pub const KINDS: [&str; 10] = [
     "disk-rotary-inertia",
     "bearing-rotational-stiffness",
     "support-mass",
@@ -34,6 +42,9 @@ pub const KINDS: [&str; 7] = [
     "shaft-stiffness-loss",
     "modulus-error",
     "shear-deformation",
+    "shaft-rotary-inertia",
+    "timoshenko-shaft",
+    "section-change",
 ];
 
 /// An `[[effect]]` entry: one effect switched on at a value.
@@ -48,12 +59,30 @@ pub struct EffectSpec {
     /// The effect's value (ignored by `shear-deformation`).
     #[serde(default)]
     pub value: f64,
+    /// Position along the shaft (m) of a `point-mass` placed by coordinate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_m: Option<f64>,
+    /// First and last element of a `section-change` over a run of elements.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elements: Option<[usize; 2]>,
 }
 
 impl EffectSpec {
     /// An effect of `kind` at `location` with `value`.
     pub fn new(kind: impl Into<String>, location: Option<usize>, value: f64) -> Self {
-        Self { kind: kind.into(), location, value }
+        Self { kind: kind.into(), location, value, position_m: None, elements: None }
+    }
+
+    /// The same effect placed at `x` m along the shaft (`point-mass`).
+    pub fn at_position(mut self, x: f64) -> Self {
+        self.position_m = Some(x);
+        self
+    }
+
+    /// The same effect over elements `first..=last` (`section-change`).
+    pub fn over_elements(mut self, first: usize, last: usize) -> Self {
+        self.elements = Some([first, last]);
+        self
     }
 
     /// Parses `KIND[@LOCATION]=VALUE` (the value may be left out for `shear-deformation`).
@@ -91,7 +120,7 @@ fn location_kind(kind: &str) -> Option<&'static str> {
         "disk-rotary-inertia" => Some("disk"),
         "bearing-rotational-stiffness" | "support-mass" => Some("bearing"),
         "point-mass" => Some("node"),
-        "shaft-stiffness-loss" => Some("element"),
+        "shaft-stiffness-loss" | "section-change" => Some("element"),
         _ => None,
     }
 }
@@ -99,6 +128,7 @@ fn location_kind(kind: &str) -> Option<&'static str> {
 /// The rotor parts an effect's contribution depends on.
 pub(crate) struct Parts<'a> {
     pub nodes: usize,
+    pub positions: &'a [f64],
     pub elements: &'a [ShaftElement],
     pub bearings: &'a [Bearing],
     pub disk_nodes: Vec<usize>,
@@ -117,7 +147,12 @@ pub(crate) fn unit_contribution(
     if !KINDS.contains(&spec.kind.as_str()) {
         return Err(bad(format!("unknown kind; known: {}", KINDS.join(", "))));
     }
-    let location = match (location_kind(&spec.kind), spec.location) {
+    let location_given = match (spec.kind.as_str(), spec.position_m, spec.elements) {
+        ("point-mass", Some(x), _) => Some(node_near(parts, x, &bad)?),
+        ("section-change" | "shaft-stiffness-loss", _, Some([a, _])) => spec.location.or(Some(a)),
+        _ => spec.location,
+    };
+    let location = match (location_kind(&spec.kind), location_given) {
         (Some(what), Some(l)) => {
             let count = match what {
                 "disk" => parts.disk_nodes.len(),
@@ -149,27 +184,68 @@ pub(crate) fn unit_contribution(
             let j = 2 * parts.bearings[location].node;
             dm.add(j, j, 1.0)
         }
-        "point-mass" => dm.add(2 * location, 2 * location, 1.0),
-        "shaft-stiffness-loss" => add_element(&mut dk, location, &-bending(parts, location)),
+        "point-mass" => match spec.position_m {
+            None => dm.add(2 * location, 2 * location, 1.0),
+            Some(x) => {
+                let (e, xi) = element_at(parts, x);
+                let n = element::displacement_shape(xi, parts.elements[e].length);
+                add_element(&mut dm, e, &(n * n.transpose()));
+            }
+        },
+        "section-change" => {
+            let [a, b] = element_run(parts, spec, location, &bad)?;
+            for e in a..=b {
+                add_element(&mut dk, e, &bending(parts, e));
+                add_element(&mut dm, e, &translational_mass(parts, e));
+            }
+        }
+        "shaft-rotary-inertia" => {
+            for e in 0..parts.elements.len() {
+                let (_, rho_i, _, l) = section(parts, e);
+                add_element(&mut dm, e, &element::rotary_inertia_mass(rho_i, l));
+            }
+        }
+        "timoshenko-shaft" => {
+            // Timoshenko element (shear, rotary inertia, Φ-dependent mass) minus Euler–Bernoulli.
+            for e in 0..parts.elements.len() {
+                let (rho_a, rho_i, ei, l) = section(parts, e);
+                let phi = shear_phi(parts, e);
+                add_element(
+                    &mut dk,
+                    e,
+                    &(element::timoshenko_stiffness(ei, phi, l) - element::stiffness(ei, l)),
+                );
+                let m = element::timoshenko_translational_mass(rho_a, phi, l)
+                    + element::timoshenko_rotary_mass(rho_i, phi, l)
+                    - element::consistent_mass(rho_a, l);
+                add_element(&mut dm, e, &m);
+            }
+        }
+        "shaft-stiffness-loss" => {
+            let [a, b] = element_run(parts, spec, location, &bad)?;
+            for e in a..=b {
+                add_element(&mut dk, e, &-bending(parts, e));
+            }
+        }
         "modulus-error" => {
             for e in 0..parts.elements.len() {
                 add_element(&mut dk, e, &bending(parts, e));
             }
         }
         _ => {
-            // shear-deformation: Timoshenko minus Euler–Bernoulli, element by element.
-            for (e, el) in parts.elements.iter().enumerate() {
-                let mat = &parts.materials[el.material];
-                let ei =
-                    mat.youngs_modulus * element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
-                let g = mat.youngs_modulus / (2.0 * (1.0 + element::POISSON_RATIO));
-                let kappa =
-                    element::shear_coefficient(el.inner_diameter / el.outer_diameter, element::POISSON_RATIO);
-                let ga = kappa * g * element::area(el.outer_diameter, el.inner_diameter);
-                let phi = 12.0 * ei / (ga * el.length * el.length);
-                let diff =
-                    element::timoshenko_stiffness(ei, phi, el.length) - element::stiffness(ei, el.length);
-                add_element(&mut dk, e, &diff);
+            // shear-deformation: the Timoshenko element without rotary inertia (stiffness and
+            // Φ-dependent translational mass, as ROSS's shear-only element) minus Euler–Bernoulli.
+            for e in 0..parts.elements.len() {
+                let (rho_a, _, ei, l) = section(parts, e);
+                let phi = shear_phi(parts, e);
+                add_element(
+                    &mut dk,
+                    e,
+                    &(element::timoshenko_stiffness(ei, phi, l) - element::stiffness(ei, l)),
+                );
+                let m = element::timoshenko_translational_mass(rho_a, phi, l)
+                    - element::consistent_mass(rho_a, l);
+                add_element(&mut dm, e, &m);
             }
         }
     }
@@ -182,6 +258,8 @@ pub(crate) fn check_value(spec: &EffectSpec, entry: usize) -> Result<f64, RotorE
     let ok = match spec.kind.as_str() {
         "shear-deformation" => return Ok(1.0),
         "shaft-stiffness-loss" => v.is_finite() && (0.0..1.0).contains(&v),
+        "section-change" => v.is_finite() && v > -1.0,
+        "shaft-rotary-inertia" | "timoshenko-shaft" => v.is_finite() && v >= 0.0,
         "modulus-error" => v.is_finite() && v > -1.0,
         _ => v.is_finite() && v >= 0.0,
     };
@@ -190,7 +268,7 @@ pub(crate) fn check_value(spec: &EffectSpec, entry: usize) -> Result<f64, RotorE
     } else {
         let requirement = match spec.kind.as_str() {
             "shaft-stiffness-loss" => "a fraction in [0, 1)",
-            "modulus-error" => "finite and > −1",
+            "modulus-error" | "section-change" => "finite and > −1",
             _ => "finite and ≥ 0",
         };
         Err(RotorError::InvalidValue {
@@ -200,6 +278,80 @@ pub(crate) fn check_value(spec: &EffectSpec, entry: usize) -> Result<f64, RotorE
             requirement,
         })
     }
+}
+
+/// The checked element run `[first, last]` of an effect (its location alone when not given).
+fn element_run(
+    parts: &Parts<'_>,
+    spec: &EffectSpec,
+    location: usize,
+    bad: &dyn Fn(String) -> RotorError,
+) -> Result<[usize; 2], RotorError> {
+    let [a, b] = spec.elements.unwrap_or([location, location]);
+    if a > b || b >= parts.elements.len() {
+        return Err(bad(format!(
+            "elements [{a}, {b}]: need first ≤ last < {} (the rotor's element count)",
+            parts.elements.len()
+        )));
+    }
+    Ok([a, b])
+}
+
+/// How an effect's value enters K and M (see [`ValueLaw`]).
+pub(crate) fn law(kind: &str) -> ValueLaw {
+    match kind {
+        "section-change" => ValueLaw::Scale { stiffness_power: 4, mass_power: 2 },
+        _ => ValueLaw::Linear,
+    }
+}
+
+/// ρA (kg/m), ρI (kg·m), EI (N·m²) and length (m) of element `e`.
+fn section(parts: &Parts<'_>, e: usize) -> (f64, f64, f64, f64) {
+    let el = &parts.elements[e];
+    let mat = &parts.materials[el.material];
+    let i = element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
+    (
+        mat.density * element::area(el.outer_diameter, el.inner_diameter),
+        mat.density * i,
+        mat.youngs_modulus * i,
+        el.length,
+    )
+}
+
+/// Shear parameter Φ of element `e` (ν = [`element::POISSON_RATIO`], Cowper's κ).
+fn shear_phi(parts: &Parts<'_>, e: usize) -> f64 {
+    let el = &parts.elements[e];
+    let mat = &parts.materials[el.material];
+    element::shear_parameter(
+        mat.youngs_modulus,
+        el.outer_diameter,
+        el.inner_diameter,
+        el.length,
+        element::POISSON_RATIO,
+    )
+}
+
+fn translational_mass(parts: &Parts<'_>, e: usize) -> nalgebra::Matrix4<f64> {
+    let (rho_a, _, _, l) = section(parts, e);
+    element::consistent_mass(rho_a, l)
+}
+
+/// The element holding position `x` (m) and the fraction ξ of its length there (x inside the shaft).
+fn element_at(parts: &Parts<'_>, x: f64) -> (usize, f64) {
+    let last = parts.elements.len() - 1;
+    let e = parts.positions.partition_point(|&p| p <= x).saturating_sub(1).min(last);
+    let (a, b) = (parts.positions[e], parts.positions[e + 1]);
+    (e, ((x - a) / (b - a)).clamp(0.0, 1.0))
+}
+
+/// The node nearest position `x`, or an error when `x` is off the shaft.
+fn node_near(parts: &Parts<'_>, x: f64, bad: &dyn Fn(String) -> RotorError) -> Result<usize, RotorError> {
+    let (first, last) = (parts.positions[0], parts.positions[parts.positions.len() - 1]);
+    if !(x.is_finite() && x >= first && x <= last) {
+        return Err(bad(format!("position_m {x}: off the shaft, which runs from {first} m to {last} m")));
+    }
+    let (e, xi) = element_at(parts, x);
+    Ok(if xi < 0.5 { e } else { e + 1 })
 }
 
 fn bending(parts: &Parts<'_>, e: usize) -> nalgebra::Matrix4<f64> {
@@ -219,21 +371,39 @@ fn add_element(s: &mut SparseSymmetric, e: usize, local: &nalgebra::Matrix4<f64>
 /// Every candidate effect of `rotor` for the discovery workflow, with bounds and plausible
 /// ranges scaled to the rotor (its total mass, its disks' masses).
 pub fn candidates(rotor: &Rotor) -> Vec<Candidate> {
+    candidates_on(rotor, rotor, 1)
+}
+
+/// The candidates of `rotor` (locations in its mesh) with their contributions assembled on
+/// `fine`, the same rotor refined by `factor` ([`crate::mesh::refined`]): for discovery on a
+/// mesh fine enough for the noise, reported in the user's mesh.
+pub fn candidates_on(rotor: &Rotor, fine: &Rotor, factor: usize) -> Vec<Candidate> {
     let parts = rotor.parts();
+    let fine_parts = fine.parts();
     let mass = rotor.total_mass();
     let mut out = Vec::new();
-    let mut push = |kind: &str,
-                    location: Option<usize>,
-                    parameter: Option<Parameter>,
-                    plausible: (f64, f64)| {
-        if let Ok((stiffness, mass_m)) = unit_contribution(&parts, &EffectSpec::new(kind, location, 0.0), 0) {
+    let mut push = |spec: EffectSpec, parameter: Option<Parameter>, plausible: (f64, f64)| {
+        if let Ok((stiffness, mass_m)) = unit_contribution(&fine_parts, &on_refined(&spec, factor), 0) {
+            let location = match (spec.position_m, spec.elements) {
+                (Some(x), _) => node_near(&parts, x, &|why| RotorError::Effect {
+                    entry: 0,
+                    kind: "point-mass".into(),
+                    why,
+                })
+                .ok(),
+                (_, Some([a, _])) => Some(a),
+                _ => spec.location,
+            };
             out.push(Candidate {
-                kind: kind.into(),
+                kind: spec.kind.clone(),
                 location,
                 parameter,
                 plausible,
                 stiffness,
                 mass: mass_m,
+                law: law(&spec.kind),
+                position_m: spec.position_m,
+                elements: spec.elements,
             });
         }
     };
@@ -242,42 +412,99 @@ pub fn candidates(rotor: &Rotor) -> Vec<Candidate> {
         let p = Parameter::new(name, unit, 0.0).with_bounds(lo, hi);
         Some(if lo == 0.0 { p.with_search_range(hi * 1e-4, hi * 0.1) } else { p })
     };
+    let at = |kind: &str, location: Option<usize>| EffectSpec::new(kind, location, 0.0);
     for (d, disk) in rotor.disks().iter().enumerate() {
         // A disk of radius r has Id ≈ m r²/4; r up to 0.25 m is plausible on a rig like this.
         let plausible = disk.mass * 0.25f64.powi(2) / 4.0;
         push(
-            "disk-rotary-inertia",
-            Some(d),
+            at("disk-rotary-inertia", Some(d)),
             value(format!("Id_disk_{d}"), "kg·m²", 0.0, 10.0 * plausible),
             (0.0, plausible),
         );
     }
     for b in 0..rotor.bearings().len() {
         push(
-            "bearing-rotational-stiffness",
-            Some(b),
+            at("bearing-rotational-stiffness", Some(b)),
             value(format!("kr_bearing_{b}"), "N·m/rad", 0.0, 1e9),
             (0.0, 1e7),
         );
         push(
-            "support-mass",
-            Some(b),
+            at("support-mass", Some(b)),
             value(format!("m_support_{b}"), "kg", 0.0, 10.0 * mass),
             (0.0, 2.0 * mass),
         );
     }
-    for node in 0..rotor.nodes().len() {
+    // Point masses at every node and at the quarter points of every element (placed in metres).
+    let nodes = rotor.nodes();
+    for (node, &x) in nodes.iter().enumerate() {
         push(
-            "point-mass",
-            Some(node),
+            at("point-mass", Some(node)),
             value(format!("m_node_{node}"), "kg", 0.0, 2.0 * mass),
             (0.0, 0.5 * mass),
         );
+        if node + 1 < nodes.len() {
+            for q in [0.25, 0.5, 0.75] {
+                let xq = x + q * (nodes[node + 1] - x);
+                push(
+                    at("point-mass", None).at_position(xq),
+                    value(format!("m_at_{xq:.4}m"), "kg", 0.0, 2.0 * mass),
+                    (0.0, 0.5 * mass),
+                );
+            }
+        }
     }
-    for e in 0..rotor.elements().len() {
-        push("shaft-stiffness-loss", Some(e), value(format!("loss_element_{e}"), "", 0.0, 0.99), (0.0, 0.9));
+    let elements = rotor.elements().len();
+    for e in 0..elements {
+        push(
+            at("shaft-stiffness-loss", Some(e)),
+            value(format!("loss_element_{e}"), "", 0.0, 0.99),
+            (0.0, 0.9),
+        );
     }
-    push("modulus-error", None, value("modulus_error".into(), "", -0.5, 0.5), (-0.15, 0.15));
-    push("shear-deformation", None, None, (1.0, 1.0));
+    // Section changes of one to three consecutive elements: a relative diameter change; ±35 %
+    // is plausible for a step or a groove a drawing missed.
+    for run in 1..=3usize.min(elements) {
+        for first in 0..=elements - run {
+            let last = first + run - 1;
+            push(
+                at("section-change", Some(first)).over_elements(first, last),
+                Some(Parameter::new(format!("dD_elements_{first}_{last}"), "", 0.0).with_bounds(-0.6, 0.6)),
+                (-0.35, 0.35),
+            );
+        }
+    }
+    push(at("modulus-error", None), value("modulus_error".into(), "", -0.5, 0.5), (-0.15, 0.15));
+    push(at("shear-deformation", None), None, (1.0, 1.0));
+    // The shaft's own rotary inertia and the full Timoshenko correction, as fractions of the
+    // textbook value: a fit near 1 is the physics, far from 1 a proxy for something else.
+    push(
+        at("shaft-rotary-inertia", None),
+        Some(Parameter::new("rotary_inertia_fraction", "", 0.0).with_bounds(0.0, 5.0)),
+        (0.6, 1.4),
+    );
+    push(
+        at("timoshenko-shaft", None),
+        Some(Parameter::new("timoshenko_fraction", "", 0.0).with_bounds(0.0, 5.0)),
+        (0.6, 1.4),
+    );
+    out
+}
+
+/// `spec` (in a rotor's mesh) carried to the mesh refined by `factor`: nodes n → factor·n,
+/// element e → the run factor·e … factor·e + factor − 1.
+fn on_refined(spec: &EffectSpec, factor: usize) -> EffectSpec {
+    if factor == 1 {
+        return spec.clone();
+    }
+    let mut out = spec.clone();
+    match (spec.kind.as_str(), spec.location) {
+        ("point-mass", Some(n)) if spec.position_m.is_none() => out.location = Some(n * factor),
+        ("shaft-stiffness-loss" | "section-change", Some(e)) => {
+            let [a, b] = spec.elements.unwrap_or([e, e]);
+            out.location = Some(a * factor);
+            out.elements = Some([a * factor, b * factor + factor - 1]);
+        }
+        _ => {}
+    }
     out
 }

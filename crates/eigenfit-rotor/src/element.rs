@@ -78,8 +78,108 @@ pub fn timoshenko_stiffness(ei: f64, phi: f64, l: f64) -> Matrix4<f64> {
     k * c
 }
 
+/// Rotary-inertia mass matrix of a Euler–Bernoulli section (ρI per length `rho_i`, kg·m):
+/// ρI/(30L) [[36, 3L, −36, 3L], [3L, 4L², −3L, −L²], [−36, −3L, 36, −3L], [3L, −L², −3L, 4L²]]
+/// (Przemieniecki; Timoshenko's with Φ = 0).
+pub fn rotary_inertia_mass(rho_i: f64, l: f64) -> Matrix4<f64> {
+    timoshenko_rotary_mass(rho_i, 0.0, l)
+}
+
+/// Consistent translational mass of a Timoshenko element with shear parameter Φ
+/// (Friedman & Kosmatka's interpolation, as ROSS uses): ρAL/(840(1+Φ)²) × polynomials in Φ.
+/// Φ = 0 gives [`consistent_mass`].
+pub fn timoshenko_translational_mass(rho_a: f64, phi: f64, l: f64) -> Matrix4<f64> {
+    let c = rho_a * l / (840.0 * (1.0 + phi).powi(2));
+    let (p, p2, l2) = (phi, phi * phi, l * l);
+    let a = 312.0 + 588.0 * p + 280.0 * p2;
+    let b = (44.0 + 77.0 * p + 35.0 * p2) * l;
+    let d = 108.0 + 252.0 * p + 140.0 * p2;
+    let e = (26.0 + 63.0 * p + 35.0 * p2) * l;
+    let f = (8.0 + 14.0 * p + 7.0 * p2) * l2;
+    let g = (6.0 + 14.0 * p + 7.0 * p2) * l2;
+    #[rustfmt::skip]
+    let m = Matrix4::new(
+        a,  b,  d,  -e,
+        b,  f,  e,  -g,
+        d,  e,  a,  -b,
+        -e, -g, -b, f,
+    );
+    m * c
+}
+
+/// Rotary-inertia mass of a Timoshenko element with shear parameter Φ:
+/// ρI/(30(1+Φ)²L) [[36, (3−15Φ)L, −36, (3−15Φ)L], [·, (4+5Φ+10Φ²)L², −(3−15Φ)L, (−1−5Φ+5Φ²)L²],
+/// [·, ·, 36, −(3−15Φ)L], [·, ·, ·, (4+5Φ+10Φ²)L²]].
+pub fn timoshenko_rotary_mass(rho_i: f64, phi: f64, l: f64) -> Matrix4<f64> {
+    let c = rho_i / (30.0 * (1.0 + phi).powi(2) * l);
+    let (p, l2) = (phi, l * l);
+    let a = (3.0 - 15.0 * p) * l;
+    let b = (4.0 + 5.0 * p + 10.0 * p * p) * l2;
+    let d = (-1.0 - 5.0 * p + 5.0 * p * p) * l2;
+    #[rustfmt::skip]
+    let m = Matrix4::new(
+        36.0,  a,  -36.0, a,
+        a,     b,  -a,    d,
+        -36.0, -a, 36.0,  -a,
+        a,     d,  -a,    b,
+    );
+    m * c
+}
+
+/// Shear parameter Φ = 12EI/(κGAL²) of an element, with G = E/(2(1+ν)) and Cowper's κ.
+pub fn shear_parameter(youngs_modulus: f64, outer: f64, inner: f64, l: f64, poisson: f64) -> f64 {
+    let ei = youngs_modulus * second_moment_of_area(outer, inner);
+    let g = youngs_modulus / (2.0 * (1.0 + poisson));
+    let kappa = shear_coefficient(inner / outer, poisson);
+    12.0 * ei / (kappa * g * area(outer, inner) * l * l)
+}
+
+/// Hermite shape functions of the transverse displacement at ξ = x/L ∈ [0, 1] of an element:
+/// v(x) = N·[v₁, θ₁, v₂, θ₂]. A point mass m there adds m·NNᵀ (consistent lumping).
+pub fn displacement_shape(xi: f64, l: f64) -> nalgebra::Vector4<f64> {
+    let (x2, x3) = (xi * xi, xi * xi * xi);
+    nalgebra::Vector4::new(
+        1.0 - 3.0 * x2 + 2.0 * x3,
+        l * (xi - 2.0 * x2 + x3),
+        3.0 * x2 - 2.0 * x3,
+        l * (x3 - x2),
+    )
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn timoshenko_masses_reduce_to_euler_bernoulli_and_keep_rigid_body_energy() {
+        let (rho_a, rho_i, l) = (1.2, 3e-6, 0.07);
+        assert!((timoshenko_translational_mass(rho_a, 0.0, l) - consistent_mass(rho_a, l)).amax() < 1e-15);
+        for phi in [0.0, 0.05, 0.4] {
+            let mt = timoshenko_translational_mass(rho_a, phi, l);
+            let mr = timoshenko_rotary_mass(rho_i, phi, l);
+            // A rigid translation carries the element mass and no rotary inertia …
+            let t = Vector4::new(1.0, 0.0, 1.0, 0.0);
+            assert!((t.dot(&(mt * t)) - rho_a * l).abs() < 1e-13, "Φ = {phi}");
+            assert!(t.dot(&(mr * t)).abs() < 1e-18, "Φ = {phi}");
+            // … a rigid rotation θ = 1 (v = x) the section's rotary inertia ρI·L.
+            let r = Vector4::new(0.0, 1.0, l, 1.0);
+            assert!((r.dot(&(mr * r)) - rho_i * l).abs() < 1e-12 * rho_i * l, "Φ = {phi}");
+            assert_eq!(mt, mt.transpose());
+            assert_eq!(mr, mr.transpose());
+        }
+    }
+
+    #[test]
+    fn a_point_mass_at_a_node_lumps_there_and_shapes_sum_to_rigid_translation() {
+        let l = 0.05;
+        let n0 = displacement_shape(0.0, l);
+        assert_eq!(n0, Vector4::new(1.0, 0.0, 0.0, 0.0));
+        for xi in [0.1, 0.5, 0.9] {
+            let n = displacement_shape(xi, l);
+            assert!((n[0] + n[2] - 1.0).abs() < 1e-15);
+            // A rigid rotation v = x is reproduced exactly: N·[0, 1, L, 1] = ξL.
+            assert!((n.dot(&Vector4::new(0.0, 1.0, l, 1.0)) - xi * l).abs() < 1e-15);
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -53,11 +53,13 @@
 
 mod builder;
 pub mod campaign;
+pub mod discovery;
 pub mod effects;
 pub mod element;
 mod error;
 mod file;
 mod layout;
+pub mod mesh;
 mod model;
 pub mod presets;
 pub mod updatable;

@@ -111,8 +111,9 @@ impl Rotor {
         for (i, e) in effects.iter().enumerate() {
             let value = effects::check_value(e, i)?;
             let (dk, dm) = effects::unit_contribution(&self.parts(), e, i)?;
-            add_sparse(&mut self.base_stiffness, &dk, value);
-            add_sparse(&mut self.base_mass, &dm, value);
+            let (fk, fm) = effects::law(&e.kind).factors(value);
+            add_sparse(&mut self.base_stiffness, &dk, fk);
+            add_sparse(&mut self.base_mass, &dm, fm);
         }
         Ok(self)
     }
@@ -121,6 +122,7 @@ impl Rotor {
     pub(crate) fn parts(&self) -> effects::Parts<'_> {
         effects::Parts {
             nodes: self.nodes.len(),
+            positions: &self.nodes,
             elements: &self.elements,
             bearings: &self.bearings,
             disk_nodes: self.spec.disks.iter().map(|d| d.node).collect(),

@@ -115,7 +115,8 @@ fn the_offending_key_of_each_kind_of_entry() {
             "kind = \"magic\"",
             37,
             "effect 0 `magic`: unknown kind; known: disk-rotary-inertia, bearing-rotational-stiffness, \
-             support-mass, point-mass, shaft-stiffness-loss, modulus-error, shear-deformation",
+             support-mass, point-mass, shaft-stiffness-loss, modulus-error, shear-deformation, \
+             shaft-rotary-inertia, timoshenko-shaft, section-change",
         ),
     ];
     for (from, to, line, message) in cases {

@@ -6,9 +6,9 @@ use crate::plot::discovery::DiscoveryPlot;
 use crate::source::ModelArgs;
 use crate::{measured, plot, progress};
 use clap::Args;
-use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit};
+use eigenfit_core::discovery::{Alternative, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
 use eigenfit_core::StructuralModel;
-use eigenfit_rotor::EffectSpec;
+use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
@@ -46,35 +46,28 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
         return Err(input(format!("--assumed-std {}: must be a positive number", args.assumed_std)));
     }
     let options = DiscoveryOptions { assumed_relative_std: args.assumed_std, ..Default::default() };
-    let candidates = rotor.candidates();
     let pb = progress::spinner("discovering: calibrate, detect, screen and refit candidates", args.quiet);
-    let report =
-        discover(&rotor, &solver.as_ref(), &data, &candidates, &rotor.nominal_stiffnesses(), &options);
+    let found = discover_rotor(&rotor, &solver.as_ref(), &data, &rotor.nominal_stiffnesses(), &options);
     pb.finish_and_clear();
-    let report = report.map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
+    let found = found.map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
+    let report = &found.report;
     let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
     let mut written = Vec::new();
     if let Some(path) = &args.write_model {
-        let nb = names.len();
-        let fitted = report.selected.as_ref().map_or(&report.base_parameters[..], |s| &s.parameters[..nb]);
-        let mut augmented = rotor.with_stiffnesses(fitted).map_err(|e| CliError::Failure(e.to_string()))?;
-        if let Some(sel) = &report.selected {
-            let effect = EffectSpec::new(sel.kind.clone(), sel.location, sel.value.unwrap_or(1.0));
-            augmented = augmented.with_effect(effect).map_err(|e| CliError::Failure(e.to_string()))?;
-        }
+        let augmented = found.augmented_model(&rotor).map_err(|e| CliError::Failure(e.to_string()))?;
         let text = augmented.to_toml_string().map_err(|e| CliError::Failure(e.to_string()))?;
         write_atomically(path, text.as_bytes())?;
         written.push(path.display().to_string());
     }
     if let Some(dir) = &args.plot {
-        let figure = DiscoveryPlot::from_report(&label, &report);
+        let figure = DiscoveryPlot::from_report(&label, report);
         written.extend(plot::names(&plot::write(&figure, dir, "discovery")?));
     }
     if args.json {
-        crate::output::emit_json(report_json(&report, &names, &label, &written));
+        crate::output::emit_json(report_json(&found, &names, &label, &written));
     } else {
         let units: Vec<String> = rotor.parameters().iter().map(|p| p.unit.clone()).collect();
-        print_report(&report, &names, &units, &label);
+        print_report(&found, &names, &units, &label);
         for w in written {
             println!("wrote {w}");
         }
@@ -83,21 +76,48 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
 }
 
 fn fit_json(f: &Fit) -> Value {
-    json!({"kind": f.kind, "location": f.location, "value": f.value, "unit": f.unit, "interval": f.interval,
-           "chi2": f.chi2, "aicc": f.aicc, "plausible": f.plausible})
+    let mut v = json!({"kind": f.kind, "location": f.location, "value": f.value, "unit": f.unit, "interval": f.interval,
+           "chi2": f.chi2, "aicc": f.aicc, "plausible": f.plausible});
+    place(&mut v, f.position_m, f.elements);
+    v
 }
 
-fn report_json(r: &DiscoveryReport, names: &[String], label: &str, written: &[String]) -> Value {
-    let missing = r.selected.as_ref().map(|s| {
-        json!({"kind": s.kind, "location": s.location, "value": s.value.unwrap_or(1.0), "unit": s.unit,
-               "interval": s.interval, "delta_aicc": r.aicc_before - s.aicc})
-    });
+/// Adds `position_m` and `elements` where the effect has them.
+fn place(v: &mut Value, position_m: Option<f64>, elements: Option<[usize; 2]>) {
+    if let Some(x) = position_m {
+        v["position_m"] = json!(x);
+    }
+    if let Some(e) = elements {
+        v["elements"] = json!(e);
+    }
+}
+
+fn alternative_json(a: &Alternative) -> Value {
+    let mut v = json!({"kind": a.kind, "location": a.location, "value": a.value, "unit": a.unit,
+                       "delta_aicc": a.delta_aicc});
+    place(&mut v, a.position_m, a.elements);
+    v
+}
+
+fn effect_json(e: &NamedEffect) -> Value {
+    let mut v = json!({"kind": e.kind, "location": e.location, "value": e.value.unwrap_or(1.0), "unit": e.unit,
+        "interval": e.interval, "delta_aicc": e.delta_aicc,
+        "ambiguous_with": e.ambiguous_with.iter().map(alternative_json).collect::<Vec<_>>()});
+    place(&mut v, e.position_m, e.elements);
+    v
+}
+
+fn report_json(found: &RotorDiscovery, names: &[String], label: &str, written: &[String]) -> Value {
+    let r = &found.report;
+    let missing = found.effects.first().map(effect_json);
     let base: serde_json::Map<String, Value> =
         names.iter().cloned().zip(r.base_parameters.iter().map(|&v| json!(v))).collect();
     json!({
         "model": label,
         "disagreement_significant": r.disagreement_significant,
         "missing_effect": missing,
+        "missing_effects": found.effects.iter().map(effect_json).collect::<Vec<_>>(),
+        "mesh_refinement": found.mesh_factor,
         "rms_residual_before_hz": r.rms_before_hz,
         "rms_residual_after_hz": r.rms_after_hz,
         "chi2_before": r.chi2_before,
@@ -112,7 +132,8 @@ fn report_json(r: &DiscoveryReport, names: &[String], label: &str, written: &[St
     })
 }
 
-fn print_report(r: &DiscoveryReport, names: &[String], units: &[String], label: &str) {
+fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], label: &str) {
+    let r: &DiscoveryReport = &found.report;
     println!("{label}: calibrated the nominal parameters:");
     for ((n, v), u) in names.iter().zip(&r.base_parameters).zip(units) {
         println!("  {n} = {v:.6e} {u}");
@@ -137,10 +158,12 @@ fn print_report(r: &DiscoveryReport, names: &[String], units: &[String], label: 
     if !flagged.is_empty() {
         println!("modes off by more than 2σ: {}", flagged.join(", "));
     }
-    match (&r.selected, r.disagreement_significant) {
+    match (found.effects.is_empty(), r.disagreement_significant) {
         (_, false) => println!("no significant disagreement: nothing added."),
-        (None, true) => {
-            println!("no single candidate effect explains the disagreement down to the noise.");
+        (true, true) => {
+            println!(
+                "no candidate effect, alone or with others, explains the disagreement down to the noise."
+            );
             if let Some(best) = r.fits.iter().find(|f| f.plausible) {
                 println!(
                     "  best partial explanation: {} (χ² {:.2} → {:.2})",
@@ -148,28 +171,32 @@ fn print_report(r: &DiscoveryReport, names: &[String], units: &[String], label: 
                 );
             }
         }
-        (Some(s), true) => {
-            let value = s.value.map_or("on".to_string(), |v| format!("{v:.4e} {}", s.unit));
-            let interval =
-                s.interval.map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
-            println!("missing effect: {} = {value}{interval}", s.label);
+        (false, true) => {
+            let title = if found.effects.len() == 1 { "missing effect" } else { "missing effects" };
+            println!("{title}:");
+            for e in &found.effects {
+                let value = e.value.map_or("on".to_string(), |v| format!("{v:.4e} {}", e.unit));
+                let interval =
+                    e.interval.map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
+                println!("  {} = {value}{interval} (ΔAICc {:.2})", e.label, e.delta_aicc);
+                if e.kind == "mesh-refinement" {
+                    println!("    the model's mesh is too coarse for this noise: refining it explains part of the gap");
+                }
+                for a in &e.ambiguous_with {
+                    println!(
+                        "    ambiguous with {} (ΔAICc {:+.2}): the data cannot tell them apart",
+                        a.label, a.delta_aicc
+                    );
+                }
+            }
+            let (chi2, aicc) =
+                r.selected.as_ref().map_or((r.chi2_before, r.aicc_before), |s| (s.chi2, s.aicc));
             println!(
-                "  evidence: χ² {:.2} → {:.2}, AICc {:.2} → {:.2} (Δ = {:.2}), RMS residual {:.4} → {:.4} Hz",
-                r.chi2_before,
-                s.chi2,
-                r.aicc_before,
-                s.aicc,
-                r.aicc_before - s.aicc,
-                r.rms_before_hz,
-                r.rms_after_hz
+                "  evidence: χ² {:.2} → {:.2}, AICc {:.2} → {:.2}, RMS residual {:.4} → {:.4} Hz",
+                r.chi2_before, chi2, r.aicc_before, aicc, r.rms_before_hz, r.rms_after_hz
             );
             if let Some(u) = &r.runner_up {
-                println!(
-                    "  runner-up: {} (AICc {:.2}, Δ to the named effect {:.2})",
-                    u.label,
-                    u.aicc,
-                    u.aicc - s.aicc
-                );
+                println!("  runner-up to the first effect: {} (AICc {:.2} on its own)", u.label, u.aicc);
             }
         }
     }

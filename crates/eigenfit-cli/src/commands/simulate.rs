@@ -29,7 +29,8 @@ pub struct SimulateArgs {
     pub sets: Vec<String>,
     /// Switch an effect on for a what-if study, `KIND[@LOCATION]=VALUE` (repeatable); kinds:
     /// disk-rotary-inertia, bearing-rotational-stiffness, support-mass, point-mass,
-    /// shaft-stiffness-loss, modulus-error, shear-deformation.
+    /// shaft-stiffness-loss, modulus-error, shear-deformation, shaft-rotary-inertia, timoshenko-shaft,
+    /// section-change.
     #[arg(long = "effect", value_name = "KIND[@LOCATION]=VALUE")]
     pub effects: Vec<String>,
     /// Number of modes.

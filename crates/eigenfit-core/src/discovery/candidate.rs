@@ -5,11 +5,51 @@ use crate::parameters::{Parameter, ParameterSet};
 use crate::sparse::SparseSymmetric;
 use crate::system::{System, SystemDerivative};
 
+/// How a candidate's value enters K and M.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum ValueLaw {
+    /// K + v·ΔK, M + v·ΔM (a lumped mass, a stiffness loss, …).
+    #[default]
+    Linear,
+    /// A part scaled by a factor s = 1 + v whose stiffness goes as sᵖ and mass as s^q (a shaft
+    /// section whose diameter changes: p = 4, q = 2): K + ((1+v)ᵖ − 1)·ΔK, M + ((1+v)^q − 1)·ΔM,
+    /// with ΔK, ΔM the part's nominal contribution.
+    Scale {
+        /// Exponent p of the stiffness.
+        stiffness_power: i32,
+        /// Exponent q of the mass.
+        mass_power: i32,
+    },
+}
+
+impl ValueLaw {
+    /// The factors multiplying ΔK and ΔM at value `v`.
+    pub fn factors(self, v: f64) -> (f64, f64) {
+        match self {
+            Self::Linear => (v, v),
+            Self::Scale { stiffness_power, mass_power } => {
+                ((1.0 + v).powi(stiffness_power) - 1.0, (1.0 + v).powi(mass_power) - 1.0)
+            }
+        }
+    }
+
+    /// d(factors)/dv at value `v` (exact).
+    pub fn derivatives(self, v: f64) -> (f64, f64) {
+        match self {
+            Self::Linear => (1.0, 1.0),
+            Self::Scale { stiffness_power: p, mass_power: q } => {
+                (p as f64 * (1.0 + v).powi(p - 1), q as f64 * (1.0 + v).powi(q - 1))
+            }
+        }
+    }
+}
+
 /// A physical effect a model may be missing, at one location.
 ///
-/// The effect adds `value · (stiffness, mass)` to the model's K and M: linear in its value, so
-/// its derivative is exact and cheap. A candidate without a [`parameter`](Self::parameter) is a
-/// switch (e.g. "shear deformation on"), applied at value 1 with nothing to fit.
+/// The effect adds `factors(value) · (stiffness, mass)` to the model's K and M (see
+/// [`ValueLaw`]); its derivative is exact and cheap. A candidate without a
+/// [`parameter`](Self::parameter) is a switch (e.g. "shear deformation on"), applied at value 1
+/// with nothing to fit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Candidate {
     /// Kind, e.g. `disk-rotary-inertia`.
@@ -20,18 +60,48 @@ pub struct Candidate {
     pub parameter: Option<Parameter>,
     /// Physically plausible values: a fit outside this range is not accepted as an explanation.
     pub plausible: (f64, f64),
-    /// ∂K/∂value.
+    /// ΔK (per unit value for [`ValueLaw::Linear`]).
     pub stiffness: SparseSymmetric,
-    /// ∂M/∂value.
+    /// ΔM (per unit value for [`ValueLaw::Linear`]).
     pub mass: SparseSymmetric,
+    /// How the value enters K and M.
+    pub law: ValueLaw,
+    /// Position along the structure (m) for an effect placed by coordinate, if any.
+    pub position_m: Option<f64>,
+    /// First and last element of an effect spread over a run of elements, if any.
+    pub elements: Option<[usize; 2]>,
 }
 
 impl Candidate {
-    /// `kind@location`, or `kind` without a location.
+    /// A candidate linear in its value, with no position or element run.
+    pub fn linear(
+        kind: impl Into<String>,
+        location: Option<usize>,
+        parameter: Option<Parameter>,
+        plausible: (f64, f64),
+        stiffness: SparseSymmetric,
+        mass: SparseSymmetric,
+    ) -> Self {
+        Self {
+            kind: kind.into(),
+            location,
+            parameter,
+            plausible,
+            stiffness,
+            mass,
+            law: ValueLaw::Linear,
+            position_m: None,
+            elements: None,
+        }
+    }
+
+    /// `kind@location` (or `kind@first-last`, `kind@x=…m`), or `kind` without a location.
     pub fn label(&self) -> String {
-        match self.location {
-            Some(l) => format!("{}@{l}", self.kind),
-            None => self.kind.clone(),
+        match (self.elements, self.position_m, self.location) {
+            (Some([a, b]), _, _) if a != b => format!("{}@{a}-{b}", self.kind),
+            (_, Some(x), _) => format!("{}@{x:.4}m", self.kind),
+            (_, _, Some(l)) => format!("{}@{l}", self.kind),
+            _ => self.kind.clone(),
         }
     }
 
@@ -41,28 +111,40 @@ impl Candidate {
     }
 }
 
-/// A base model with one candidate effect added; its parameters are the base's followed by the
-/// effect's value (none for a switch).
+/// A base model with candidate effects added; its parameters are the base's followed by each
+/// effect's value (none for a switch), in order.
 pub struct Augmented<'a, M: ?Sized> {
     base: &'a M,
-    candidate: &'a Candidate,
+    candidates: Vec<&'a Candidate>,
     params: ParameterSet,
 }
 
 impl<'a, M: StructuralModel + ?Sized> Augmented<'a, M> {
     /// Augments `base` with `candidate`.
     pub fn new(base: &'a M, candidate: &'a Candidate) -> Result<Self, ModelError> {
-        let mut list = base.parameters().as_slice().to_vec();
-        list.extend(candidate.parameter.clone());
-        Ok(Self { base, candidate, params: ParameterSet::new(list)? })
+        Self::with_all(base, &[candidate])
     }
 
-    fn split<'p>(&self, p: &'p [f64]) -> (&'p [f64], f64) {
-        let nb = self.base.parameters().len();
-        match self.candidate.parameter {
-            Some(_) => (&p[..nb], p[nb]),
-            None => (p, 1.0),
-        }
+    /// Augments `base` with every candidate of `candidates` at once.
+    pub fn with_all(base: &'a M, candidates: &[&'a Candidate]) -> Result<Self, ModelError> {
+        let mut list = base.parameters().as_slice().to_vec();
+        list.extend(candidates.iter().filter_map(|c| c.parameter.clone()));
+        Ok(Self { base, candidates: candidates.to_vec(), params: ParameterSet::new(list)? })
+    }
+
+    /// The candidates' values (1 for a switch) and, for each, its parameter index if it has one.
+    fn values(&self, p: &[f64]) -> Vec<(f64, Option<usize>)> {
+        let mut next = self.base.parameters().len();
+        self.candidates
+            .iter()
+            .map(|c| match c.parameter {
+                Some(_) => {
+                    next += 1;
+                    (p[next - 1], Some(next - 1))
+                }
+                None => (1.0, None),
+            })
+            .collect()
     }
 }
 
@@ -77,34 +159,53 @@ impl<M: StructuralModel + ?Sized> StructuralModel for Augmented<'_, M> {
 
     fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
         self.params.check(p)?;
-        let (base_p, value) = self.split(p);
-        let (mut k, mut m) = self.base.assemble(base_p)?.into_parts();
-        add_scaled(&mut k, &self.candidate.stiffness, value);
-        add_scaled(&mut m, &self.candidate.mass, value);
+        let nb = self.base.parameters().len();
+        let (mut k, mut m) = self.base.assemble(&p[..nb])?.into_parts();
+        for (c, (value, _)) in self.candidates.iter().zip(self.values(p)) {
+            let (fk, fm) = match c.parameter {
+                Some(_) => c.law.factors(value),
+                None => (1.0, 1.0),
+            };
+            add_scaled(&mut k, &c.stiffness, fk);
+            add_scaled(&mut m, &c.mass, fm);
+        }
         Ok(System::new(k, m)?)
     }
 
     fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
         let nb = self.base.parameters().len();
         if i < nb {
-            let (base_p, _) = self.split(p);
-            return self.base.derivative(base_p, i);
+            return self.base.derivative(&p[..nb], i);
         }
-        if i == nb && self.candidate.parameter.is_some() {
-            return Ok(SystemDerivative {
-                stiffness: self.candidate.stiffness.clone(),
-                mass: self.candidate.mass.clone(),
-            });
+        for (c, (value, index)) in self.candidates.iter().zip(self.values(p)) {
+            if index == Some(i) {
+                let (dk, dm) = c.law.derivatives(value);
+                return Ok(SystemDerivative {
+                    stiffness: scaled(&c.stiffness, dk),
+                    mass: scaled(&c.mass, dm),
+                });
+            }
         }
         Err(ModelError::ParameterIndex { index: i, count: self.params.len() })
     }
 }
 
 fn add_scaled(a: &mut nalgebra::DMatrix<f64>, s: &SparseSymmetric, factor: f64) {
+    if factor == 0.0 {
+        return;
+    }
     for &(i, j, v) in s.entries() {
         a[(i, j)] += factor * v;
         if i != j {
             a[(j, i)] += factor * v;
         }
     }
+}
+
+fn scaled(s: &SparseSymmetric, factor: f64) -> SparseSymmetric {
+    let mut out = SparseSymmetric::zeros(s.dim());
+    for &(i, j, v) in s.entries() {
+        out.add(i, j, factor * v);
+    }
+    out
 }

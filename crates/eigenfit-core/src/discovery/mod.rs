@@ -12,14 +12,15 @@
 
 mod candidate;
 mod chi2;
+mod interval;
 
-pub use candidate::{Augmented, Candidate};
+pub use candidate::{Augmented, Candidate, ValueLaw};
+
 pub use chi2::chi2_upper_tail;
 
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::multi::Stacked;
 use crate::residual::{Linearisation, Problem};
-use crate::statistics::uncertainty;
 use crate::update::{Damped, Driver, Evaluate};
 use crate::{EigenSolver, StructuralModel};
 use nalgebra::DVector;
@@ -51,6 +52,12 @@ pub struct DiscoveryOptions {
     /// An effect is named only if, with it, the misfit is one noise can explain: P(χ² ≥ observed)
     /// at least this (default 1e-3). A better but still inconsistent fit is reported, not named.
     pub min_after_p_value: f64,
+    /// Candidates of each kind refitted whatever their screening rank (default 1).
+    pub refits_per_kind: usize,
+    /// Most effects added by forward selection (default 3).
+    pub max_effects: usize,
+    /// Alternatives within this AICc of a named effect are reported as ambiguous (default 2).
+    pub ambiguity_aicc: f64,
 }
 
 impl Default for DiscoveryOptions {
@@ -61,6 +68,9 @@ impl Default for DiscoveryOptions {
             min_aicc_gain: 4.0,
             assumed_relative_std: 1e-3,
             min_after_p_value: 1e-3,
+            refits_per_kind: 1,
+            max_effects: 3,
+            ambiguity_aicc: 2.0,
         }
     }
 }
@@ -108,8 +118,14 @@ pub struct Fit {
     pub unit: String,
     /// 95% interval of the value.
     pub interval: Option<[f64; 2]>,
-    /// All fitted parameters: the base's, then the value.
+    /// Position along the structure (m), for an effect placed by coordinate.
+    pub position_m: Option<f64>,
+    /// First and last element, for an effect over a run of elements.
+    pub elements: Option<[usize; 2]>,
+    /// All fitted parameters: the base's, then the values of every effect in the fit.
     pub parameters: Vec<f64>,
+    /// 95% (covariance) intervals of all fitted parameters, where they could be computed.
+    pub intervals: Vec<Option<[f64; 2]>>,
     /// χ² of the fit.
     pub chi2: f64,
     /// AICc of the fit.
@@ -118,6 +134,106 @@ pub struct Fit {
     pub plausible: bool,
     /// Model frequencies of the measured modes, Hz.
     pub frequencies_hz: Vec<f64>,
+}
+
+impl Fit {
+    /// The calibrated base model as a "fit" with no effect.
+    fn base(lin: &Linearisation, aicc: f64) -> Self {
+        Self {
+            label: String::new(),
+            kind: String::new(),
+            location: None,
+            value: None,
+            unit: String::new(),
+            interval: None,
+            position_m: None,
+            elements: None,
+            parameters: lin.parameters.clone(),
+            intervals: vec![None; lin.parameters.len()],
+            chi2: 2.0 * lin.cost(),
+            aicc,
+            plausible: true,
+            frequencies_hz: lin.frequencies_hz.clone(),
+        }
+    }
+}
+
+/// An alternative that explains the data about as well as a named effect.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Alternative {
+    /// `kind@location`.
+    pub label: String,
+    /// Kind.
+    pub kind: String,
+    /// Location.
+    pub location: Option<usize>,
+    /// Position along the structure (m), if placed by coordinate.
+    pub position_m: Option<f64>,
+    /// Element run, if any.
+    pub elements: Option<[usize; 2]>,
+    /// Its fitted value.
+    pub value: Option<f64>,
+    /// Unit of the value.
+    pub unit: String,
+    /// Its AICc minus the named effect's (≥ 0).
+    pub delta_aicc: f64,
+}
+
+impl Alternative {
+    fn new(c: &Candidate, fit: &Fit, named_aicc: f64) -> Self {
+        Self {
+            label: c.label(),
+            kind: c.kind.clone(),
+            location: c.location,
+            position_m: c.position_m,
+            elements: c.elements,
+            value: fit.value,
+            unit: c.unit().to_string(),
+            delta_aicc: fit.aicc - named_aicc,
+        }
+    }
+}
+
+/// One effect named by forward selection, with its value from the final joint fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedEffect {
+    /// `kind@location`.
+    pub label: String,
+    /// Kind.
+    pub kind: String,
+    /// Location.
+    pub location: Option<usize>,
+    /// Position along the structure (m), if placed by coordinate.
+    pub position_m: Option<f64>,
+    /// Element run, if any.
+    pub elements: Option<[usize; 2]>,
+    /// Fitted value in the final joint fit (`None` for a switch).
+    pub value: Option<f64>,
+    /// Its 95% interval.
+    pub interval: Option<[f64; 2]>,
+    /// Unit of the value.
+    pub unit: String,
+    /// AICc gained when the effect was added.
+    pub delta_aicc: f64,
+    /// Alternatives within [`DiscoveryOptions::ambiguity_aicc`] when it was chosen.
+    pub ambiguous_with: Vec<Alternative>,
+}
+
+impl NamedEffect {
+    fn new(c: &Candidate, delta_aicc: f64, ambiguous_with: Vec<Alternative>) -> Self {
+        Self {
+            label: c.label(),
+            kind: c.kind.clone(),
+            location: c.location,
+            position_m: c.position_m,
+            elements: c.elements,
+            value: None,
+            interval: None,
+            unit: c.unit().to_string(),
+            delta_aicc,
+            ambiguous_with,
+        }
+    }
 }
 
 /// Everything the workflow found, for reports.
@@ -139,8 +255,11 @@ pub struct DiscoveryReport {
     pub screening: Vec<(String, f64)>,
     /// Refitted candidates, best AICc first.
     pub fits: Vec<Fit>,
-    /// The named effect, if any.
+    /// The final joint fit, labelled by the strongest (first) named effect; `None` when nothing
+    /// is named.
     pub selected: Option<Fit>,
+    /// Every named effect, in the order forward selection added them (strongest first).
+    pub effects: Vec<NamedEffect>,
     /// The best plausible alternative to the named effect.
     pub runner_up: Option<Fit>,
     /// Per mode, before and after.
@@ -229,6 +348,7 @@ where
         fits: Vec::new(),
         selected: None,
         runner_up: None,
+        effects: Vec::new(),
         modes: compare_modes(&measured, &base_lin, &base_lin),
         rms_before_hz: rms_diff(&base_lin),
         rms_after_hz: rms_diff(&base_lin),
@@ -236,46 +356,133 @@ where
     if !disagreement_significant {
         return Ok(report);
     }
-    // (c) screen, then refit the most promising
-    let projector = Projector::new(&base, &base_lin);
-    let mut scored: Vec<(usize, f64)> = candidates
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.parameter.is_some())
-        .filter_map(|(i, c)| screen(&models, solver, &measured, c, &base_lin, &projector).map(|s| (i, s)))
-        .collect();
-    scored.sort_by(|a, b| b.1.total_cmp(&a.1));
-    report.screening = scored.iter().map(|&(i, s)| (candidates[i].label(), s)).collect();
-    let to_refit = scored
-        .iter()
-        .take(options.refits)
-        .map(|&(i, _)| i)
-        .chain(candidates.iter().enumerate().filter(|(_, c)| c.parameter.is_none()).map(|(i, _)| i));
-    for i in to_refit {
-        if let Some(fit) = refit(&models, solver, &measured, &candidates[i], &base_lin.parameters) {
-            report.fits.push(fit);
+    // (b) forward selection: each round screens the candidates not yet chosen against the model
+    // with the chosen ones, refits the most promising jointly with everything already fitted, and
+    // adds the best plausible one if it earns its parameter (AICc); it stops when the noise
+    // explains what is left.
+    let mut chosen: Vec<usize> = Vec::new();
+    let mut current = Fit::base(&base_lin, aicc_before);
+    let mut named: Vec<NamedEffect> = Vec::new();
+    for round in 0..options.max_effects {
+        if round > 0 && chi2_upper_tail(current.chi2, n - current.parameters.len()) >= options.significance {
+            break;
+        }
+        let chosen_refs: Vec<&Candidate> = chosen.iter().map(|&i| &candidates[i]).collect();
+        let open = |i: usize| !chosen.iter().any(|&c| same_place(&candidates[c], &candidates[i]));
+        let mut scored: Vec<(usize, f64)> =
+            with_augmented(&models, solver, &measured, &chosen_refs, |problem| {
+                let lin = problem.linearise(&current.parameters).ok()?;
+                let projector = Projector::new(problem, &lin);
+                Some(
+                    candidates
+                        .iter()
+                        .enumerate()
+                        .filter(|&(i, c)| c.parameter.is_some() && open(i))
+                        .filter_map(|(i, c)| {
+                            screen(&models, solver, &measured, &chosen_refs, c, &lin, &projector)
+                                .map(|s| (i, s))
+                        })
+                        .collect(),
+                )
+            })
+            .unwrap_or_default();
+        scored.sort_by(|a, b| b.1.total_cmp(&a.1));
+        if round == 0 {
+            report.screening = scored.iter().map(|&(i, s)| (candidates[i].label(), s)).collect();
+        }
+        // The best few overall, and the best of every kind: a linear screen misjudges large
+        // effects, and one kind's many locations must not crowd out the other kinds.
+        let mut per_kind: Vec<(&str, usize)> = Vec::new();
+        let mut picks: Vec<usize> = Vec::new();
+        for (rank, &(i, _)) in scored.iter().enumerate() {
+            let kind = candidates[i].kind.as_str();
+            let seen = per_kind.iter().position(|(k, _)| *k == kind);
+            let taken = seen.map_or(0, |s| per_kind[s].1);
+            if rank < options.refits || taken < options.refits_per_kind {
+                picks.push(i);
+                match seen {
+                    Some(s) => per_kind[s].1 += 1,
+                    None => per_kind.push((kind, 1)),
+                }
+            }
+        }
+        let to_refit: Vec<usize> = picks
+            .into_iter()
+            .chain(
+                candidates
+                    .iter()
+                    .enumerate()
+                    .filter(|&(i, c)| c.parameter.is_none() && open(i))
+                    .map(|(i, _)| i),
+            )
+            .collect();
+        let mut fits: Vec<(usize, Fit)> = to_refit
+            .into_iter()
+            .filter_map(|i| {
+                let mut set = chosen_refs.clone();
+                set.push(&candidates[i]);
+                refit(&models, solver, &measured, &set, &current.parameters).map(|f| (i, f))
+            })
+            .collect();
+        fits.sort_by(|a, b| a.1.aicc.total_cmp(&b.1.aicc));
+        if round == 0 {
+            report.fits = fits.iter().map(|(_, f)| f.clone()).collect();
+        }
+        let mut plausible = fits.iter().filter(|(_, f)| f.plausible);
+        let Some((best_i, best)) = plausible.next().cloned() else { break };
+        if current.aicc - best.aicc < options.min_aicc_gain {
+            break;
+        }
+        if round == 0 {
+            report.runner_up = plausible.next().map(|(_, f)| f.clone());
+        }
+        let ambiguous_with = fits
+            .iter()
+            .filter(|(i, f)| *i != best_i && f.plausible && f.aicc - best.aicc < options.ambiguity_aicc)
+            .map(|(i, f)| Alternative::new(&candidates[*i], f, best.aicc))
+            .collect();
+        named.push(NamedEffect::new(&candidates[best_i], current.aicc - best.aicc, ambiguous_with));
+        chosen.push(best_i);
+        current = best;
+    }
+    // (c) name the effects only if, with them, the misfit is one the noise can explain.
+    let k = current.parameters.len();
+    let consistent = n > k && chi2_upper_tail(current.chi2, n - k) >= options.min_after_p_value;
+    if named.is_empty() || !consistent {
+        return Ok(report);
+    }
+    // Values and intervals of the final joint fit, in the order the effects were added.
+    let mut next = nb;
+    for (effect, &i) in named.iter_mut().zip(&chosen) {
+        if candidates[i].parameter.is_some() {
+            effect.value = Some(current.parameters[next]);
+            effect.interval = current.intervals.get(next).copied().flatten();
+            next += 1;
         }
     }
-    report.fits.sort_by(|a, b| a.aicc.total_cmp(&b.aicc));
-    // (d) select by AICc among plausible fits
-    let mut plausible = report.fits.iter().filter(|f| f.plausible);
-    if let Some(best) = plausible.next() {
-        let k = best.parameters.len();
-        let consistent = n > k && chi2_upper_tail(best.chi2, n - k) >= options.min_after_p_value;
-        if aicc_before - best.aicc >= options.min_aicc_gain && consistent {
-            report.selected = Some(best.clone());
-            report.runner_up = plausible.next().cloned();
-        }
+    let first = &named[0];
+    let mut selected = current.clone();
+    selected.label = first.label.clone();
+    selected.kind = first.kind.clone();
+    selected.location = first.location;
+    selected.value = first.value;
+    selected.unit = first.unit.clone();
+    selected.interval = first.interval;
+    selected.position_m = first.position_m;
+    selected.elements = first.elements;
+    for (m, f) in report.modes.iter_mut().zip(&selected.frequencies_hz) {
+        m.after_hz = *f;
     }
-    if let Some(sel) = &report.selected {
-        let after: Vec<f64> = sel.frequencies_hz.clone();
-        for (m, f) in report.modes.iter_mut().zip(&after) {
-            m.after_hz = *f;
-        }
-        let diffs: Vec<f64> = report.modes.iter().map(|m| m.after_hz - m.measured_hz).collect();
-        report.rms_after_hz = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
-    }
+    let diffs: Vec<f64> = report.modes.iter().map(|m| m.after_hz - m.measured_hz).collect();
+    report.rms_after_hz = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
+    report.selected = Some(selected);
+    report.effects = named;
     Ok(report)
+}
+
+/// Two candidates that describe the same thing at the same place (never chosen twice).
+fn same_place(a: &Candidate, b: &Candidate) -> bool {
+    a.kind == b.kind && a.location == b.location && a.position_m == b.position_m && a.elements == b.elements
 }
 
 /// Gives every mode a standard deviation (the assumed relative one where none was measured).
@@ -341,12 +548,12 @@ impl Projector {
     }
 }
 
-/// The candidate added to every configuration, stacked into one problem, evaluated by `f`.
+/// The candidates added to every configuration, stacked into one problem, evaluated by `f`.
 fn with_augmented<M, S, T>(
     models: &[&M],
     solver: &S,
     measured: &[Measurement],
-    candidate: &Candidate,
+    set: &[&Candidate],
     f: impl FnOnce(&dyn Evaluate) -> Option<T>,
 ) -> Option<T>
 where
@@ -354,27 +561,30 @@ where
     S: EigenSolver,
 {
     let augmented: Vec<Augmented<'_, M>> =
-        models.iter().map(|&m| Augmented::new(m, candidate)).collect::<Result<_, _>>().ok()?;
+        models.iter().map(|&m| Augmented::with_all(m, set)).collect::<Result<_, _>>().ok()?;
     let problems: Vec<Problem<&Augmented<'_, M>, &S>> =
         augmented.iter().zip(measured).map(|(a, d)| Problem::new(a, solver, d.clone())).collect();
     let stacked = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect())?;
     f(&stacked)
 }
 
-/// Predicted χ² reduction of fitting the candidate's value alone, after the base parameters
+/// Predicted χ² reduction of fitting the candidate's value alone, after the current parameters
 /// have absorbed what they can; 0 when the fit would need a value outside the bounds' sign.
 fn screen<M: StructuralModel, S: EigenSolver>(
     models: &[&M],
     solver: &S,
     measured: &[Measurement],
+    chosen: &[&Candidate],
     candidate: &Candidate,
-    base: &Linearisation,
+    current: &Linearisation,
     projector: &Projector,
 ) -> Option<f64> {
     let par = candidate.parameter.as_ref()?;
-    let mut p = base.parameters.clone();
+    let mut p = current.parameters.clone();
     p.push(par.nominal);
-    let lin = with_augmented(models, solver, measured, candidate, |problem| problem.linearise(&p).ok())?;
+    let mut set = chosen.to_vec();
+    set.push(candidate);
+    let lin = with_augmented(models, solver, measured, &set, |problem| problem.linearise(&p).ok())?;
     let j = projector.apply(&lin.jacobian.column(lin.jacobian.ncols() - 1).into_owned());
     let r = projector.apply(&lin.residual);
     let jj = j.norm_squared();
@@ -387,29 +597,45 @@ fn screen<M: StructuralModel, S: EigenSolver>(
     Some((2.0 * admissible * j.dot(&r) - admissible * admissible * jj).max(0.0))
 }
 
-/// Refits the base parameters with the candidate added.
+/// Refits the current parameters with the candidate set `set` (the chosen ones, then the new
+/// one, last); intervals are the covariance ones (cheap: no profile per candidate).
 fn refit<M: StructuralModel, S: EigenSolver>(
     models: &[&M],
     solver: &S,
     measured: &[Measurement],
-    candidate: &Candidate,
-    base_parameters: &[f64],
+    set: &[&Candidate],
+    current: &[f64],
 ) -> Option<Fit> {
-    let mut start = base_parameters.to_vec();
+    let candidate = *set.last()?;
+    let mut start = current.to_vec();
     start.extend(candidate.parameter.as_ref().map(|p| p.nominal));
     let n: usize = measured.iter().map(Measurement::len).sum();
-    with_augmented(models, solver, measured, candidate, |problem| {
-        let est = Driver::default().run(problem, &mut Damped::default(), &start, &mut []).ok()?;
+    with_augmented(models, solver, measured, set, |problem| {
+        // Bounded work per candidate: a refit that has not converged in 60 steps is not the
+        // explanation (the same limit the profile bounds use).
+        let est = Driver { max_iterations: 60 }.run(problem, &mut Damped::default(), &start, &mut []).ok()?;
         let k = problem.parameters().len();
         let chi2 = 2.0 * est.last.cost();
-        let value = candidate.parameter.as_ref().map(|_| est.parameters[k - 1]);
-        let interval = value.and_then(|_| uncertainty(problem, &est.last, true)).map(|u| u.intervals[k - 1]);
-        let (lo, hi) = candidate.plausible;
-        let plausible = match (value, interval) {
-            (Some(v), Some(iv)) => v >= lo && v <= hi && (iv[0] > 0.0 || iv[1] < 0.0),
-            (Some(v), None) => v >= lo && v <= hi,
-            (None, _) => true,
-        };
+        let intervals = interval::covariance_intervals(problem, &est.last);
+        // Every fitted effect value (not only the new one) must stay plausible.
+        let nb = k - set.iter().filter(|c| c.parameter.is_some()).count();
+        let mut index = nb;
+        let mut plausible = true;
+        let mut value = None;
+        let mut interval = None;
+        for c in set {
+            if c.parameter.is_none() {
+                continue;
+            }
+            let (v, iv) = (est.parameters[index], intervals[index]);
+            let (lo, hi) = c.plausible;
+            plausible &= v >= lo && v <= hi && iv.is_none_or(|iv| iv[0] > 0.0 || iv[1] < 0.0);
+            (value, interval) = (Some(v), iv);
+            index += 1;
+        }
+        if candidate.parameter.is_none() {
+            (value, interval) = (None, None);
+        }
         Some(Fit {
             label: candidate.label(),
             kind: candidate.kind.clone(),
@@ -417,11 +643,14 @@ fn refit<M: StructuralModel, S: EigenSolver>(
             value,
             unit: candidate.unit().to_string(),
             interval,
+            position_m: candidate.position_m,
+            elements: candidate.elements,
             chi2,
             aicc: aicc(chi2, n, k),
             plausible,
             frequencies_hz: est.last.frequencies_hz.clone(),
             parameters: est.parameters,
+            intervals,
         })
     })
 }

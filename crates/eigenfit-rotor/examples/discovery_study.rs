@@ -1,0 +1,60 @@
+//! The independent-data discovery study of docs/discovery.md: every draw of
+//! `tests/fixtures/discovery/independent.toml` (numpy-generated, see `generate.py` there),
+//! scored per case and noise level, with the slowest run's wall time.
+//!
+//! cargo run --release -p eigenfit-rotor --example discovery_study
+
+#[path = "../tests/common/study.rs"]
+mod study;
+
+use std::time::Instant;
+use study::Outcome;
+
+fn main() {
+    let fixtures = study::load();
+    println!("| case | noise | named | ambiguous (honest) | nothing | wrong | truth in 95 % interval |");
+    println!("|---|---|---|---|---|---|---|");
+    let mut slowest = 0.0f64;
+    for case in &fixtures.case {
+        let mut noises: Vec<f64> =
+            fixtures.draw.iter().filter(|d| d.case == case.name).map(|d| d.noise).collect();
+        noises.dedup();
+        for noise in noises {
+            let mut counts = [0usize; 4];
+            let (mut covered, mut total) = (0, 0);
+            for draw in fixtures.draw.iter().filter(|d| d.case == case.name && d.noise == noise) {
+                let t = Instant::now();
+                let named = study::run(draw);
+                slowest = slowest.max(t.elapsed().as_secs_f64());
+                let (outcome, inside) = study::score(&case.expect, &named);
+                counts[outcome as usize] += 1;
+                if matches!(outcome, Outcome::Named) {
+                    total += 1;
+                    covered += usize::from(inside);
+                }
+                if std::env::var_os("STUDY_VERBOSE").is_some() {
+                    let labels: Vec<String> = named
+                        .iter()
+                        .map(|n| {
+                            let alts: Vec<&str> = n.ambiguous_with.iter().map(|a| a.label.as_str()).collect();
+                            format!("{}={:?} ~{:?}", n.label, n.value, alts)
+                        })
+                        .collect();
+                    eprintln!("{} {noise} {}: {outcome:?} {labels:?}", case.name, draw.draw);
+                }
+            }
+            let n: usize = counts.iter().sum();
+            println!(
+                "| {} | {:.2} % | {}/{n} | {}/{n} | {}/{n} | {}/{n} | {} |",
+                case.name,
+                noise * 100.0,
+                counts[0],
+                counts[1],
+                counts[2],
+                counts[3],
+                if total > 0 { format!("{covered}/{total}") } else { "–".into() }
+            );
+        }
+    }
+    println!("\nslowest discovery run: {slowest:.2} s");
+}

@@ -1,0 +1,150 @@
+//! The independent-data discovery study (issue #15): reads the fixtures written by
+//! `tests/fixtures/discovery/generate.py` (numpy, sharing nothing with the plugin), runs rotor
+//! discovery on each draw and scores the answer. Shared by the test and the
+//! `discovery_study` example.
+
+#![allow(dead_code)]
+
+use eigenfit_core::discovery::{DiscoveryOptions, NamedEffect};
+use eigenfit_core::{BandedSolver, MeasuredMode, Measurement};
+use eigenfit_rotor::discovery::discover_rotor;
+use eigenfit_rotor::presets;
+use serde::Deserialize;
+
+/// The fixture file.
+pub const FIXTURES: &str =
+    include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/discovery/independent.toml"));
+
+#[derive(Debug, Deserialize)]
+pub struct Fixtures {
+    pub case: Vec<Case>,
+    pub draw: Vec<Draw>,
+}
+
+#[derive(Debug, Deserialize)]
+pub struct Case {
+    pub name: String,
+    #[serde(default)]
+    pub expect: Vec<Expected>,
+}
+
+#[derive(Debug, Deserialize)]
+pub struct Expected {
+    pub kind: String,
+    pub location: Option<usize>,
+    pub position_m: Option<f64>,
+    pub elements: Option<[usize; 2]>,
+    pub value: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+pub struct Draw {
+    pub case: String,
+    pub noise: f64,
+    pub draw: usize,
+    pub frequency_hz: Vec<f64>,
+    pub std_hz: Vec<f64>,
+}
+
+/// How one draw was answered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Every expected effect named at its place, nothing else.
+    Named,
+    /// Every expected effect named or listed as an equally good alternative of a named one.
+    Ambiguous,
+    /// Nothing named.
+    Nothing,
+    /// Something else named (for a clean case: a false alarm).
+    Wrong,
+}
+
+pub fn load() -> Fixtures {
+    toml::from_str(FIXTURES).expect("the committed fixtures parse")
+}
+
+/// Does the named effect (or alternative) `kind`/place match `e`? Positions match within a
+/// quarter of the element they fall in (the candidate grid's spacing).
+fn matches(
+    e: &Expected,
+    kind: &str,
+    location: Option<usize>,
+    position_m: Option<f64>,
+    elements: Option<[usize; 2]>,
+) -> bool {
+    if e.kind != kind {
+        return false;
+    }
+    if let Some(x) = e.position_m {
+        return position_m.is_some_and(|p| (p - x).abs() <= 0.0125);
+    }
+    if let Some(el) = e.elements {
+        return elements.unwrap_or([location.unwrap_or(usize::MAX); 2]) == el;
+    }
+    e.location.is_none() || e.location == location
+}
+
+/// Scores the named effects against the expected ones; also says whether every expected value
+/// with an interval lies inside it.
+pub fn score(expected: &[Expected], named: &[NamedEffect]) -> (Outcome, bool) {
+    if named.is_empty() {
+        return (Outcome::Nothing, true);
+    }
+    if expected.is_empty() {
+        return (Outcome::Wrong, true);
+    }
+    let mut ambiguous = false;
+    let mut covered = true;
+    for e in expected {
+        let direct = named.iter().find(|n| matches(e, &n.kind, n.location, n.position_m, n.elements));
+        match direct {
+            Some(n) => {
+                if let (Some(v), Some(iv)) = (e.value, n.interval) {
+                    covered &= iv[0] <= v && v <= iv[1];
+                }
+            }
+            None => {
+                let alt = named.iter().any(|n| {
+                    n.ambiguous_with.iter().any(|a| matches(e, &a.kind, a.location, a.position_m, a.elements))
+                });
+                if !alt {
+                    return (Outcome::Wrong, covered);
+                }
+                ambiguous = true;
+            }
+        }
+    }
+    // Every named effect must be one of the expected ones (or ambiguous with one).
+    let extra = named.iter().any(|n| {
+        !expected.iter().any(|e| {
+            matches(e, &n.kind, n.location, n.position_m, n.elements)
+                || n.ambiguous_with.iter().any(|a| matches(e, &a.kind, a.location, a.position_m, a.elements))
+        })
+    });
+    if extra {
+        return (Outcome::Wrong, covered);
+    }
+    (if ambiguous { Outcome::Ambiguous } else { Outcome::Named }, covered)
+}
+
+/// Runs discovery on one draw; returns the named effects.
+pub fn run(draw: &Draw) -> Vec<NamedEffect> {
+    let rotor = presets::paper_rotor();
+    let modes: Vec<MeasuredMode> = draw
+        .frequency_hz
+        .iter()
+        .zip(&draw.std_hz)
+        .enumerate()
+        .map(|(m, (&f, &s))| MeasuredMode::new(m, f).with_std(s))
+        .collect();
+    let measured = Measurement::new(modes).expect("fixture frequencies are valid");
+    discover_rotor(
+        &rotor,
+        &BandedSolver::default(),
+        &measured,
+        &rotor.nominal_stiffnesses(),
+        &DiscoveryOptions::default(),
+    )
+    .expect("discovery runs on valid data")
+    .effects
+}
