@@ -3,6 +3,7 @@
 //! Exit codes: 0 success, 1 internal failure, 2 bad input (arguments, files, data),
 //! 3 an estimation that did not converge (its results are still printed).
 
+mod any_model;
 mod commands;
 mod error;
 mod measured;

@@ -22,6 +22,7 @@
 
 pub mod banded;
 pub mod compare;
+pub mod csc;
 pub mod dense;
 pub mod discovery;
 mod lanczos;
@@ -36,6 +37,7 @@ pub mod sensitivity;
 mod small_eigen;
 pub mod solver;
 pub mod sparse;
+pub mod sparse_solver;
 pub mod statistics;
 pub mod subspace;
 pub mod synthetic;
@@ -45,6 +47,7 @@ mod test_chain;
 pub mod update;
 
 pub use banded::{BandCholesky, BandedSymmetric};
+pub use csc::CscSymmetric;
 pub use dense::DenseSolver;
 pub use measurement::{MeasuredMode, Measurement, MeasurementError};
 pub use model::{finite_difference_derivative, ModelError, StructuralModel};
@@ -54,6 +57,7 @@ pub use residual::{Linearisation, Pairing, Problem, ResidualError, ResidualKind}
 pub use sensitivity::{Sensitivities, SensitivityError};
 pub use solver::{EigenSolver, SolveError};
 pub use sparse::SparseSymmetric;
+pub use sparse_solver::SparseSolver;
 pub use statistics::{alternative_solutions, uncertainty, Identifiability, Uncertainty};
 pub use subspace::BandedSolver;
 pub use system::{System, SystemDerivative, SystemError};

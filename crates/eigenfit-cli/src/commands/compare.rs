@@ -69,7 +69,8 @@ pub struct CompareArgs {
 
 /// Runs `compare`.
 pub fn run(args: &CompareArgs) -> Result<(), CliError> {
-    let (rotor, label) = args.model.load()?;
+    let (model, label) = args.model.load_any()?;
+    let rotor = &model;
     let solver = args.model.solver()?;
     let np = rotor.parameters().len();
     let targets = points("--targets", &args.targets, np)?;

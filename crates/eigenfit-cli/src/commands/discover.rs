@@ -39,7 +39,8 @@ pub struct DiscoverArgs {
 
 /// Runs `discover`.
 pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
-    let (rotor, label) = args.model.load()?;
+    let (model, label) = args.model.load_any()?;
+    let rotor = &model;
     let solver = args.model.solver()?;
     let data = measured::read(&args.measured)?;
     if !(args.assumed_std.is_finite() && args.assumed_std > 0.0) {
@@ -48,8 +49,14 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
     let options = DiscoveryOptions { assumed_relative_std: args.assumed_std, ..Default::default() };
     let candidates = rotor.candidates();
     let pb = progress::spinner("discovering: calibrate, detect, screen and refit candidates", args.quiet);
-    let report =
-        discover(&rotor, &solver.as_ref(), &data, &candidates, &rotor.nominal_stiffnesses(), &options);
+    let report = discover(
+        &rotor,
+        &solver.as_ref(),
+        &data,
+        &candidates,
+        &rotor.parameters().nominal_values(),
+        &options,
+    );
     pb.finish_and_clear();
     let report = report.map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
     let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
@@ -57,7 +64,10 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
     if let Some(path) = &args.write_model {
         let nb = names.len();
         let fitted = report.selected.as_ref().map_or(&report.base_parameters[..], |s| &s.parameters[..nb]);
-        let mut augmented = rotor.with_stiffnesses(fitted).map_err(|e| CliError::Failure(e.to_string()))?;
+        let mut augmented = rotor
+            .rotor("--write-model")?
+            .with_stiffnesses(fitted)
+            .map_err(|e| CliError::Failure(e.to_string()))?;
         if let Some(sel) = &report.selected {
             let effect = EffectSpec::new(sel.kind.clone(), sel.location, sel.value.unwrap_or(1.0));
             augmented = augmented.with_effect(effect).map_err(|e| CliError::Failure(e.to_string()))?;

@@ -43,7 +43,8 @@ pub struct EstimateArgs {
 
 /// Runs `estimate`; returns the exit code (3 when the run did not converge).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
-    let (rotor, label) = args.model.load()?;
+    let (model, label) = args.model.load_any()?;
+    let rotor = &model;
     let solver = args.model.solver()?;
     let measurement = measured::read(&args.measured)?;
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {

@@ -1,5 +1,6 @@
 //! Candidate effects: physics a model may lack, as extra matrix contributions with a value.
 
+use crate::csc::CscSymmetric;
 use crate::model::{ModelError, StructuralModel};
 use crate::parameters::{Parameter, ParameterSet};
 use crate::sparse::SparseSymmetric;
@@ -78,7 +79,20 @@ impl<M: StructuralModel + ?Sized> StructuralModel for Augmented<'_, M> {
     fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
         self.params.check(p)?;
         let (base_p, value) = self.split(p);
-        let (mut k, mut m) = self.base.assemble(base_p)?.into_parts();
+        let base = self.base.assemble(base_p)?;
+        if let Some((k, m)) = base.sparse_pair() {
+            // A sparse base stays sparse: a dense copy of 10⁵ DOFs would take 80 GB.
+            let add = |a: &CscSymmetric, s: &SparseSymmetric| {
+                CscSymmetric::combination(
+                    1.0,
+                    a,
+                    value,
+                    &CscSymmetric::from_triplets(a.dim(), s.entries().iter().copied()),
+                )
+            };
+            return Ok(System::sparse(add(k, &self.candidate.stiffness), add(m, &self.candidate.mass))?);
+        }
+        let (mut k, mut m) = base.into_parts();
         add_scaled(&mut k, &self.candidate.stiffness, value);
         add_scaled(&mut m, &self.candidate.mass, value);
         Ok(System::new(k, m)?)
