@@ -33,11 +33,6 @@ impl AnyModel {
             ))),
         }
     }
-
-    /// Whether this is a matrices model.
-    pub fn is_matrices(&self) -> bool {
-        matches!(self, AnyModel::Matrices(_))
-    }
 }
 
 /// Whether the model file at `path` declares `kind = "matrices"` (unreadable files are left to

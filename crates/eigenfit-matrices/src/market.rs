@@ -49,19 +49,20 @@ pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetr
         Some(other) => return Err(format!("header `{}`: `{other}` matrices cannot be stiffness or mass matrices; use `symmetric` or `general`", header.trim())),
         None => return Err(format!("header `{}`: the symmetry field is missing", header.trim())),
     };
-    // Read every file as `general`, entries as they are stored: the triangle logic below is the
-    // same for both headers, and an upper-triangle `symmetric` file needs no special case.
-    let text = if symmetric {
+    // Read every file as `real general`, entries as they are stored: the triangle logic below
+    // is the same for both headers, an upper-triangle `symmetric` file needs no special case,
+    // and nalgebra-sparse reads `integer` entries only into integer types.
+    let text = if symmetric || words.get(3) == Some(&"integer") {
         let mut owned = String::with_capacity(text.len());
-        let (first, rest) = text.split_once('\n').unwrap_or((text, ""));
-        owned.push_str(&first.to_ascii_lowercase().replacen("symmetric", "general", 1));
+        let (_, rest) = text.split_once('\n').unwrap_or((text, ""));
+        owned.push_str("%%MatrixMarket matrix coordinate real general");
         owned.push('\n');
         owned.push_str(rest);
         std::borrow::Cow::Owned(owned)
     } else {
         std::borrow::Cow::Borrowed(text)
     };
-    let coo = load_coo_from_matrix_market_str::<f64>(&text).map_err(|e| format!("{}", e.message()))?;
+    let coo = load_coo_from_matrix_market_str::<f64>(&text).map_err(|e| e.message().to_string())?;
     let (rows, cols) = (coo.nrows(), coo.ncols());
     if rows != cols {
         return Err(format!("the matrix is {rows}×{cols}: it must be square"));

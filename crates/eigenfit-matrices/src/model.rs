@@ -307,16 +307,16 @@ fn parameter(
     if !nominal.is_finite() || lower.is_nan() || upper.is_nan() {
         return Err("nominal, lower and upper must be numbers (nominal finite)".into());
     }
+    if scale == Scale::Log && (nominal <= 0.0 || lower < 0.0) {
+        return Err(format!(
+            "scale = \"log\" needs a positive nominal and lower bound (nominal = {nominal}, lower = {lower})"
+        ));
+    }
     if lower > upper {
         return Err(format!("lower = {lower} is above upper = {upper}"));
     }
     if nominal < lower || nominal > upper {
         return Err(format!("nominal = {nominal} lies outside [{lower}, {upper}]"));
-    }
-    if scale == Scale::Log && (nominal <= 0.0 || lower < 0.0) {
-        return Err(format!(
-            "scale = \"log\" needs a positive nominal and lower bound (nominal = {nominal}, lower = {lower})"
-        ));
     }
     let lower = if scale == Scale::Log { lower.max(f64::MIN_POSITIVE) } else { lower };
     Ok(Parameter::new(name, unit.unwrap_or(""), nominal).with_bounds(lower, upper).with_scale(scale))
