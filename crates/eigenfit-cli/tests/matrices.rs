@@ -139,3 +139,59 @@ fn a_bad_matrix_file_is_bad_input_naming_it() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("K.mtx: not symmetric: entry (2, 1) = 3 but (1, 2) = 1"), "{err}");
 }
+
+#[test]
+fn discover_names_a_user_supplied_candidate_matrix() {
+    // The plate with 3 kg added at DOF 33 (w of node 17): the "measured" frequencies come from
+    // eigenfit itself with the mass as a parameter; discover starts from the plate without it
+    // and must pick the candidate from the model file's [[candidate]] tables.
+    let dir = std::env::temp_dir().join(format!("eigenfit-cli-discover-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for f in ["K0.mtx", "K1.mtx", "K2.mtx", "K3.mtx", "K4.mtx", "M0.mtx"] {
+        std::fs::copy(plate(f), dir.join(f)).unwrap();
+    }
+    std::fs::write(
+        dir.join("Mc.mtx"),
+        "%%MatrixMarket matrix coordinate real symmetric\n920 920 1\n33 33 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("Kc.mtx"),
+        "%%MatrixMarket matrix coordinate real symmetric\n920 920 1\n500 500 1\n",
+    )
+    .unwrap();
+    let zones: String = (1..=4)
+        .map(|i| format!("[[parameter]]\nname = \"zone{i}\"\nnominal = 1.0\nlower = 0.05\nupper = 20\nscale = \"log\"\nstiffness = \"K{i}.mtx\"\n"))
+        .collect();
+    let head = "kind = \"matrices\"\nstiffness = \"K0.mtx\"\nmass = \"M0.mtx\"\n";
+    let truth = dir.join("truth.toml");
+    std::fs::write(
+        &truth,
+        format!("{head}{zones}[[parameter]]\nname = \"mass\"\nnominal = 3.0\nmass = \"Mc.mtx\"\n"),
+    )
+    .unwrap();
+    let (code, v, err) =
+        eigenfit(&["simulate", "--model", truth.to_str().unwrap(), "--modes", "10", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let csv: String =
+        floats(&v["frequencies_hz"]).iter().enumerate().map(|(k, f)| format!("{},{f}\n", k + 1)).collect();
+    let measured = dir.join("measured.csv");
+    std::fs::write(&measured, format!("mode,frequency_hz\n{csv}")).unwrap();
+    let candidates = "[[candidate]]\nname = \"added-mass\"\nmass = \"Mc.mtx\"\nupper = 100\n\
+                      [[candidate]]\nname = \"spring\"\nstiffness = \"Kc.mtx\"\nupper = 1e9\n";
+    let base = dir.join("model.toml");
+    std::fs::write(&base, format!("{head}{zones}{candidates}")).unwrap();
+    let (code, v, err) = eigenfit(&[
+        "discover",
+        "--model",
+        base.to_str().unwrap(),
+        "--measured",
+        measured.to_str().unwrap(),
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}\n{v}");
+    assert_eq!(v["missing_effect"]["kind"], "added-mass", "{v}");
+    let value = v["missing_effect"]["value"].as_f64().unwrap();
+    assert!((value / 3.0 - 1.0).abs() < 1e-3, "fitted mass {value}");
+}
