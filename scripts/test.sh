@@ -14,3 +14,24 @@ if ! dpkg -s libopenblas-dev >/dev/null 2>&1; then
 fi
 
 cargo test --workspace --all-features
+
+# The Python package (python/), as a user installs it: `pip install ./python` into a fresh virtual
+# environment (pip builds the wheel with maturin), then its pytest suite. EIGENFIT_BIN is the
+# binary cargo built above, which the tests compare the package's results with.
+if ! python3 -c 'import ensurepip, venv' >/dev/null 2>&1; then
+  echo "scripts/test.sh: installing python3-venv (the Python package is tested in a virtual environment)" >&2
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq python3-venv
+fi
+py_venv="$(mktemp -d)/venv"
+trap 'rm -rf "$(dirname "$py_venv")"' EXIT
+python3 -m venv "$py_venv"
+"$py_venv/bin/python" -m pip install --quiet --disable-pip-version-check ./python pytest numpy dask distributed
+py_status=0
+EIGENFIT_BIN="$PWD/target/debug/eigenfit" "$py_venv/bin/python" -m pytest python/tests -p no:cacheprovider -q \
+  || py_status=$?
+if [ "$py_status" -eq 5 ]; then
+  echo "scripts/test.sh: pytest collected no tests in python/tests: the Python suite is missing" >&2
+  exit 1
+fi
+exit "$py_status"

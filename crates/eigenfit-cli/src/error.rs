@@ -36,3 +36,12 @@ impl CliError {
 pub fn input(msg: impl Into<String>) -> CliError {
     CliError::Input(msg.into())
 }
+
+/// The exit code the run ends with if output fails on a closed pipe (`eigenfit … | head`): set
+/// before the results (or the error) are printed, so a verdict of 2 or 3 is not turned into 0.
+pub static EXIT_ON_CLOSED_PIPE: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(EXIT_OK);
+
+/// Records the exit code a closed pipe must not hide.
+pub fn set_exit_on_closed_pipe(code: u8) {
+    EXIT_ON_CLOSED_PIPE.store(code, std::sync::atomic::Ordering::Relaxed);
+}

@@ -1,13 +1,35 @@
 //! The measured-data file: CSV with header `mode,frequency_hz[,std_hz]`, modes numbered from 1.
+//!
+//! Read with the `csv` crate (RFC 4180 quoting), so a quoted field with a comma is one field.
+//! Before any fit the data are checked for what no model can produce: frequencies that do not
+//! increase with mode number, and a mode listed twice.
 
 use crate::error::{input, CliError};
 use eigenfit_core::{MeasuredMode, Measurement};
+use std::collections::HashMap;
+use std::io::Read;
 use std::path::Path;
 
+/// Largest measured file read (bytes): far above any modal survey, small enough that a wrong
+/// path (a disk image, `/dev/zero`) is refused instead of filling memory.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
+/// Columns some export tools add that eigenfit does not use: accepted and ignored with a note.
+const IGNORED_COLUMNS: [&str; 3] = ["damping_ratio", "damping", "mac"];
+
 /// Reads and validates a measured-data file. Every error names the file and, where it applies,
-/// the line.
+/// the line. Notes (ignored columns) go to stderr.
 pub fn read(path: &Path) -> Result<Measurement, CliError> {
-    let bytes = std::fs::read(path).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
+    let (measurement, notes) = read_with_notes(path)?;
+    for note in notes {
+        eprintln!("eigenfit: note: {note}");
+    }
+    Ok(measurement)
+}
+
+/// [`read`], returning the notes instead of printing them.
+pub fn read_with_notes(path: &Path) -> Result<(Measurement, Vec<String>), CliError> {
+    let bytes = read_regular_file(path, MAX_FILE_BYTES)?;
     let text = String::from_utf8(bytes).map_err(|e| {
         // Say where the first bad byte is: a binary file, or text saved in another encoding.
         let valid = std::str::from_utf8(&e.as_bytes()[..e.utf8_error().valid_up_to()]).unwrap_or_default();
@@ -17,29 +39,112 @@ pub fn read(path: &Path) -> Result<Measurement, CliError> {
     })?;
     // Spreadsheets often save CSV as "UTF-8 with BOM"; the BOM is not part of the first column's name.
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-    parse(text).map_err(|e| input(format!("{}:{e}", path.display())))
+    let (measurement, notes) =
+        parse_with_notes(text).map_err(|e| input(format!("{}:{e}", path.display())))?;
+    let notes = notes.into_iter().map(|n| format!("{}:{n}", path.display())).collect();
+    Ok((measurement, notes))
+}
+
+/// The bytes of `path`, refusing anything but a regular file (a FIFO would block, a device never
+/// end) and files above `cap` bytes.
+pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, CliError> {
+    let cannot = |e: std::io::Error| input(format!("{}: cannot read: {e}", path.display()));
+    // Checked before opening: opening a FIFO for reading blocks until a writer appears.
+    let meta = std::fs::metadata(path).map_err(cannot)?;
+    if meta.is_dir() {
+        // Reading fails at once and the system's message says why.
+        return std::fs::read(path).map_err(cannot);
+    }
+    if !meta.is_file() {
+        return Err(input(format!(
+            "{}: not a regular file (a FIFO, socket or device would block or never end)",
+            path.display()
+        )));
+    }
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let mut bytes = Vec::with_capacity(meta.len().min(cap) as usize);
+    // `take` bounds the read even if the file grows after the check.
+    file.take(cap + 1).read_to_end(&mut bytes).map_err(cannot)?;
+    if bytes.len() as u64 > cap {
+        return Err(input(format!(
+            "{}: larger than the {} MB a measured file may have",
+            path.display(),
+            cap >> 20
+        )));
+    }
+    Ok(bytes)
 }
 
 /// Parses the CSV text; errors start with `LINE: `.
 pub fn parse(text: &str) -> Result<Measurement, String> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) =
-        lines.next().ok_or("1: empty file: expected the header `mode,frequency_hz[,std_hz]`")?;
-    let columns: Vec<&str> = header.split(',').map(str::trim).collect();
+    parse_with_notes(text).map(|(m, _)| m)
+}
+
+/// A field as shown in a message: invisible and control characters escaped, at most 40 characters.
+pub fn shown(field: &str) -> String {
+    const MAX: usize = 40;
+    let count = field.chars().count();
+    let cut: String = field.chars().take(MAX).collect();
+    let escaped: String = cut.escape_debug().collect();
+    if count > MAX {
+        format!("{escaped}… ({count} characters)")
+    } else {
+        escaped
+    }
+}
+
+/// A number as shown in a message: plain when moderate, in exponent form when it would print
+/// hundreds of digits (1e300).
+pub fn shown_number(v: f64) -> String {
+    if v.is_finite() && v != 0.0 && !(1e-4..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// [`parse`] with the notes for the user (ignored columns), each starting with `LINE: `.
+pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), String> {
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    // Lines from byte offsets: the csv crate's own line count skips blank lines. Offsets only
+    // grow, so counting newlines from the previous record keeps this linear.
+    let mut lines = LineCounter { text: text.as_bytes(), byte: 0, line: 1 };
+    let mut records = reader.records().filter_map(move |r| match r {
+        // Blank (or whitespace-only) lines carry nothing.
+        Ok(rec) if rec.iter().all(str::is_empty) => None,
+        Ok(rec) => {
+            let line = rec.position().map_or(1, |p| lines.at(p.byte()));
+            Some(Ok((line, rec)))
+        }
+        Err(e) => {
+            let line = e.position().map_or(1, |p| lines.at(p.byte()));
+            Some(Err(format!("{line}: not readable as CSV: {e}")))
+        }
+    });
+    let (hline, header) = records
+        .next()
+        .transpose()?
+        .ok_or("1: empty file: expected the header `mode,frequency_hz[,std_hz]`")?;
     let mut col = [None; 3];
-    for (i, c) in columns.iter().enumerate() {
-        let slot = match *c {
+    let mut notes = Vec::new();
+    for (i, c) in header.iter().enumerate() {
+        let slot = match c {
             "mode" => 0,
             "frequency_hz" => 1,
             "std_hz" => 2,
+            known if IGNORED_COLUMNS.contains(&known) => {
+                notes.push(format!("{hline}: column `{known}` is not used by eigenfit and is ignored"));
+                continue;
+            }
             other => {
                 return Err(format!(
                     "{hline}: unknown column `{}`; the header must be `mode,frequency_hz[,std_hz]`",
-                    other.escape_debug()
+                    shown(other)
                 ))
             }
         };
@@ -54,38 +159,40 @@ pub fn parse(text: &str) -> Result<Measurement, String> {
             ));
         }
     }
+    // Line of each mode seen: a hash map keeps the duplicate check linear in the row count.
+    let mut first_line: HashMap<usize, usize> = HashMap::new();
     let mut modes: Vec<(usize, MeasuredMode)> = Vec::new();
-    for (line, row) in lines {
-        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
-        if fields.len() != columns.len() {
-            return Err(format!("{line}: {} fields, but the header has {}", fields.len(), columns.len()));
+    for record in records {
+        let (line, row) = record?;
+        if row.len() != header.len() {
+            return Err(format!("{line}: {} fields, but the header has {}", row.len(), header.len()));
         }
-        let field = |slot: usize| col[slot].map(|i| fields[i]);
+        let field = |slot: usize| col[slot].and_then(|i| row.get(i));
         let number = |slot: usize, name: &str| -> Result<Option<f64>, String> {
             field(slot)
                 .map(|s| match s {
                     "" => Err(format!("{line}: {name} is empty")),
-                    _ => s
-                        .parse::<f64>()
-                        .map_err(|_| format!("{line}: {name} `{}` is not a number", s.escape_debug())),
+                    _ => {
+                        s.parse::<f64>().map_err(|_| format!("{line}: {name} `{}` is not a number", shown(s)))
+                    }
                 })
                 .transpose()
         };
         let mode_text = field(0).unwrap_or_default();
         let mode: usize = mode_text.parse().ok().filter(|&m| m >= 1).ok_or_else(|| {
-            format!("{line}: mode `{mode_text}` must be a whole number ≥ 1 (modes count from 1)")
+            format!("{line}: mode `{}` must be a whole number ≥ 1 (modes count from 1)", shown(mode_text))
         })?;
         let f = number(1, "frequency_hz")?.unwrap_or_default();
         if !(f.is_finite() && f > 0.0) {
-            return Err(format!("{line}: frequency_hz {f} must be a positive finite number"));
+            return Err(format!("{line}: frequency_hz {} must be a positive finite number", shown_number(f)));
         }
         let std = number(2, "std_hz")?;
         if let Some(s) = std {
             if !(s.is_finite() && s > 0.0) {
-                return Err(format!("{line}: std_hz {s} must be a positive finite number"));
+                return Err(format!("{line}: std_hz {} must be a positive finite number", shown_number(s)));
             }
         }
-        if let Some((first, _)) = modes.iter().find(|(_, m)| m.mode == mode - 1) {
+        if let Some(first) = first_line.insert(mode, line) {
             return Err(format!("{line}: mode {mode} is listed twice (first on line {first})"));
         }
         modes.push((line, MeasuredMode { mode: mode - 1, frequency_hz: f, std_hz: std, shape: None }));
@@ -93,12 +200,75 @@ pub fn parse(text: &str) -> Result<Measurement, String> {
     if modes.is_empty() {
         return Err(format!("{hline}: no data rows after the header"));
     }
-    Measurement::new(modes.into_iter().map(|(_, m)| m).collect()).map_err(|e| format!("{hline}: {e}"))
+    check_order(&modes)?;
+    let measurement =
+        Measurement::new(modes.into_iter().map(|(_, m)| m).collect()).map_err(|e| format!("{hline}: {e}"))?;
+    Ok((measurement, notes))
+}
+
+/// The 1-based line of a byte offset, for offsets visited in increasing order.
+struct LineCounter<'a> {
+    text: &'a [u8],
+    byte: usize,
+    line: usize,
+}
+
+impl LineCounter<'_> {
+    fn at(&mut self, byte: u64) -> usize {
+        let mut byte = (byte as usize).min(self.text.len());
+        // A record's position is where the reader started, before the blank and comment lines
+        // it skipped: move to the record's own line.
+        while byte < self.text.len() && matches!(self.text[byte], b'\n' | b'\r' | b'#') {
+            if self.text[byte] == b'#' {
+                match self.text[byte..].iter().position(|&b| b == b'\n') {
+                    Some(n) => byte += n,
+                    None => break,
+                }
+            }
+            byte += 1;
+        }
+        if byte >= self.byte {
+            self.line += self.text[self.byte..byte].iter().filter(|&&b| b == b'\n').count();
+            self.byte = byte;
+        }
+        self.line
+    }
+}
+
+/// Natural frequencies increase with mode number (the model's modes are sorted): a row that
+/// breaks the order is a swapped row or a typing slip, and no stiffness can fit it.
+fn check_order(modes: &[(usize, MeasuredMode)]) -> Result<(), String> {
+    let mut sorted: Vec<&(usize, MeasuredMode)> = modes.iter().collect();
+    sorted.sort_by_key(|(_, m)| m.mode);
+    for pair in sorted.windows(2) {
+        let ((l0, a), (l1, b)) = (pair[0], pair[1]);
+        let later = l0.max(l1);
+        if b.frequency_hz == a.frequency_hz {
+            return Err(format!(
+                "{later}: mode {} has the same frequency as mode {} ({} Hz, lines {l0} and {l1}): \
+                 the model's modes are distinct, so the two cannot both be paired",
+                b.mode + 1,
+                a.mode + 1,
+                a.frequency_hz
+            ));
+        }
+        if b.frequency_hz < a.frequency_hz {
+            return Err(format!(
+                "{later}: mode {} ({} Hz, line {l1}) is below mode {} ({} Hz, line {l0}): natural \
+                 frequencies increase with mode number (a swapped row or a typing slip?)",
+                b.mode + 1,
+                b.frequency_hz,
+                a.mode + 1,
+                a.frequency_hz
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
-    use super::parse;
+    use super::{parse, parse_with_notes, shown};
 
     #[test]
     fn reads_frequencies_and_std() {
@@ -143,5 +313,56 @@ mod tests {
             "1: missing column `mode`; the header must be `mode,frequency_hz[,std_hz]`"
         );
         assert_eq!(parse("mode,frequency_hz\n").unwrap_err(), "1: no data rows after the header");
+    }
+
+    #[test]
+    fn rfc4180_quoting_keeps_a_decimal_comma_in_one_field() {
+        assert_eq!(
+            parse("mode,frequency_hz\n1,\"36,9\"\n").unwrap_err(),
+            "2: frequency_hz `36,9` is not a number"
+        );
+        let m = parse("\"mode\",\"frequency_hz\"\n\"1\",\"36.9\"\n").unwrap();
+        assert_eq!(m.modes()[0].frequency_hz, 36.9);
+    }
+
+    #[test]
+    fn frequencies_must_increase_with_mode_number() {
+        assert_eq!(
+            parse("mode,frequency_hz\n1,84.5\n2,36.1\n").unwrap_err(),
+            "3: mode 2 (36.1 Hz, line 3) is below mode 1 (84.5 Hz, line 2): natural frequencies \
+             increase with mode number (a swapped row or a typing slip?)"
+        );
+        assert!(parse("mode,frequency_hz\n1,36.1\n2,36.1\n")
+            .unwrap_err()
+            .starts_with("3: mode 2 has the same frequency as mode 1 (36.1 Hz, lines 2 and 3)"));
+        // Rows in any order are fine when the frequencies follow the mode numbers.
+        assert_eq!(parse("mode,frequency_hz\n3,300\n1,36\n").unwrap().len(), 2);
+    }
+
+    #[test]
+    fn known_extra_columns_are_ignored_with_a_note() {
+        let (m, notes) = parse_with_notes("mode,frequency_hz,damping_ratio\n1,36.9,0.01\n").unwrap();
+        assert_eq!(m.modes()[0].frequency_hz, 36.9);
+        assert_eq!(
+            notes,
+            vec!["1: column `damping_ratio` is not used by eigenfit and is ignored".to_string()]
+        );
+    }
+
+    #[test]
+    fn shown_fields_are_escaped_and_cut() {
+        assert_eq!(shown("\u{feff}mode\u{200b}"), "\\u{feff}mode\\u{200b}");
+        let long = "x".repeat(100_000);
+        assert_eq!(shown(&long), format!("{}… (100000 characters)", "x".repeat(40)));
+    }
+
+    #[test]
+    fn a_million_rows_are_checked_in_linear_time() {
+        // Bounded work, not a timing: a quadratic duplicate check over 10⁶ rows would not finish.
+        let mut text = String::from("mode,frequency_hz\n");
+        for k in 1..=1_000_000u32 {
+            text.push_str(&format!("{k},{}\n", k as f64));
+        }
+        assert_eq!(parse(&text).unwrap().len(), 1_000_000);
     }
 }

@@ -17,3 +17,117 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
         fail(e)
     })
 }
+
+thread_local! {
+    /// Set while [`crate::run_json`] runs a command on this thread: the command's JSON lands here
+    /// instead of on stdout. Per thread, so concurrent library calls (Dask workers' threads) never
+    /// see each other's results.
+    static CAPTURED: std::cell::RefCell<Option<Option<serde_json::Value>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Prints a command's JSON result on stdout, or hands it to [`crate::run_json`] when that is the
+/// caller. Every `--json` result goes through here, so the library's result and the binary's
+/// output are the same value by construction.
+pub fn emit_json(value: serde_json::Value) {
+    let value = CAPTURED.with(|c| match c.borrow_mut().as_mut() {
+        Some(slot) => {
+            *slot = Some(value);
+            None
+        }
+        None => Some(value),
+    });
+    if let Some(value) = value {
+        println!("{value}");
+    }
+}
+
+/// Runs `f` with the JSON results of this thread captured; returns what `f` returned and the
+/// last JSON value emitted, if any. Restores the previous state even when `f` panics.
+pub(crate) fn capture_json<T>(f: impl FnOnce() -> T) -> (T, Option<serde_json::Value>) {
+    struct Restore(Option<Option<serde_json::Value>>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let previous = self.0.take();
+            CAPTURED.with(|c| *c.borrow_mut() = previous);
+        }
+    }
+    let restore = Restore(CAPTURED.with(|c| c.borrow_mut().replace(None)));
+    let result = f();
+    let value = CAPTURED.with(|c| c.borrow_mut().as_mut().and_then(Option::take));
+    drop(restore);
+    (result, value)
+}
+
+/// A JSON-lines file that runs are appended to as they finish (`--stream`): opened for appending
+/// (a second run never deletes the first one's lines), held under an exclusive advisory lock for
+/// the whole run (two runs at once would interleave half lines), flushed line by line.
+pub struct Stream {
+    path: std::path::PathBuf,
+    file: std::fs::File,
+    saved: usize,
+    error: Option<std::io::Error>,
+}
+
+impl Stream {
+    /// Opens `path` for appending, creating it; refuses an existing path that is not a regular
+    /// file (a FIFO would block, a device swallow or refuse the lines) and a file another run holds.
+    pub fn open(path: &Path) -> Result<Self, CliError> {
+        match std::fs::metadata(path) {
+            Ok(meta) if !meta.is_file() => {
+                return Err(input(format!("{}: --stream needs a regular file", path.display())))
+            }
+            _ => {}
+        }
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .create(true)
+            .open(path)
+            .map_err(|e| input(format!("{}: cannot open for appending: {e}", path.display())))?;
+        // fs4 rather than std's File::try_lock: the workspace's MSRV (1.85) predates it.
+        match fs4::fs_std::FileExt::try_lock_exclusive(&file) {
+            Ok(true) => {}
+            Ok(false) => {
+                return Err(input(format!(
+                    "{}: another eigenfit run is streaming into this file; choose another --stream file",
+                    path.display()
+                )))
+            }
+            Err(e) => return Err(input(format!("{}: cannot lock: {e}", path.display()))),
+        }
+        Ok(Self { path: path.to_path_buf(), file, saved: 0, error: None })
+    }
+
+    /// Appends one line; after the first failure nothing more is written (see [`Stream::finish`]).
+    pub fn append(&mut self, line: &str) {
+        if self.error.is_some() {
+            return;
+        }
+        // One write call per line, so a line is never split between two writers' bytes.
+        let mut bytes = Vec::with_capacity(line.len() + 1);
+        bytes.extend_from_slice(line.as_bytes());
+        bytes.push(b'\n');
+        match self.file.write_all(&bytes).and_then(|()| self.file.flush()) {
+            Ok(()) => self.saved += 1,
+            Err(e) => self.error = Some(e),
+        }
+    }
+
+    /// Ok when every line was written; otherwise an error saying how many of `total` were saved.
+    pub fn finish(self, total: usize) -> Result<(), CliError> {
+        match self.error {
+            None => self.file.sync_all().map_err(|e| {
+                CliError::Failure(format!(
+                    "{}: cannot sync: {e}; {} of {total} runs written",
+                    self.path.display(),
+                    self.saved
+                ))
+            }),
+            Some(e) => Err(CliError::Failure(format!(
+                "{}: writing failed: {e}; {} of {total} runs were saved",
+                self.path.display(),
+                self.saved
+            ))),
+        }
+    }
+}

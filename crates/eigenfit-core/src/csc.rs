@@ -198,6 +198,21 @@ impl CscSymmetric {
         self.values.iter().fold(0.0_f64, |a, v| a.max(v.abs()))
     }
 
+    /// ‖A‖∞: the largest absolute row sum over both triangles.
+    pub fn inf_norm(&self) -> f64 {
+        let mut sums = vec![0.0; self.dim];
+        for c in 0..self.dim {
+            let (rows, values) = self.column(c);
+            for (&r, &v) in rows.iter().zip(values) {
+                sums[c] += v.abs();
+                if r != c {
+                    sums[r] += v.abs();
+                }
+            }
+        }
+        sums.into_iter().fold(0.0, f64::max)
+    }
+
     /// Largest diagonal entry (0 for an empty diagonal).
     pub fn diagonal_max(&self) -> f64 {
         (0..self.dim).map(|c| self.get(c, c)).fold(0.0_f64, f64::max)
@@ -287,6 +302,8 @@ mod tests {
         assert_eq!(d, d.transpose());
         assert_eq!(CscSymmetric::from_dense(&d), a);
         assert_eq!(a.to_sparse_symmetric().to_dense(), d);
+        let row_sums = d.row_iter().map(|r| r.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
+        assert_eq!(a.inf_norm(), row_sums);
     }
 
     #[test]

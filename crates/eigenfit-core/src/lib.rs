@@ -33,6 +33,7 @@ pub mod monte_carlo;
 pub mod multi;
 pub mod parameters;
 pub mod residual;
+pub mod roundoff;
 pub mod sensitivity;
 mod small_eigen;
 pub mod solver;
@@ -45,6 +46,7 @@ pub mod system;
 #[cfg(test)]
 mod test_chain;
 pub mod update;
+pub mod verdict;
 
 pub use banded::{BandCholesky, BandedSymmetric};
 pub use csc::CscSymmetric;
@@ -58,12 +60,15 @@ pub use sensitivity::{Sensitivities, SensitivityError};
 pub use solver::{EigenSolver, SolveError};
 pub use sparse::SparseSymmetric;
 pub use sparse_solver::SparseSolver;
-pub use statistics::{alternative_solutions, uncertainty, Identifiability, Uncertainty};
+pub use statistics::{
+    alternative_solutions, alternative_solutions_within, mirror_solutions, uncertainty, uncertainty_within,
+    Identifiability, Uncertainty,
+};
 pub use subspace::BandedSolver;
 pub use system::{System, SystemDerivative, SystemError};
 pub use update::{
-    Damped, Driver, Estimate, Evaluate, IterationRecord, IterationRecordSink, Newton, Observer, PStep, Step,
-    StepStatus, StrategyKind, Termination, UpdateError, UpdateStrategy,
+    Budget, Damped, Driver, Estimate, Evaluate, IterationRecord, IterationRecordSink, Newton, Observer,
+    PStep, Step, StepStatus, StrategyKind, Termination, UpdateError, UpdateStrategy,
 };
 
 /// Converts an eigenvalue λ = ω² (rad/s)² to a frequency in Hz.

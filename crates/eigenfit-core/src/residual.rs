@@ -49,6 +49,12 @@ pub enum ResidualError {
     /// MAC pairing was asked for data without shapes, or with the wrong sensor count.
     #[error("MAC pairing: {0}")]
     Mac(String),
+    /// The task's evaluation budget is spent ([`crate::update::Budget`]).
+    #[error("the evaluation budget of {limit} model evaluations is spent")]
+    BudgetExhausted {
+        /// The budget's limit.
+        limit: usize,
+    },
 }
 
 /// Everything an update step needs at one parameter vector.

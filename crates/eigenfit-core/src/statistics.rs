@@ -2,7 +2,7 @@
 //! parameters the data cannot determine (with the one-sided bound they do support).
 
 use crate::residual::Linearisation;
-use crate::update::{damped::scaled_jacobian, Damped, Driver, Evaluate};
+use crate::update::{damped::scaled_jacobian, Budget, Damped, Driver, Evaluate};
 use nalgebra::DMatrix;
 
 /// χ² quantile of one degree of freedom at 95%: the profile-likelihood threshold.
@@ -54,11 +54,29 @@ pub struct Uncertainty {
     pub condition_number: f64,
     /// Per parameter: does the data determine it?
     pub identifiability: Vec<Identifiability>,
+    /// True when the evaluation budget ran out during the profile refits: the bounds of the
+    /// parameters still being profiled then fall back to the parameter limits.
+    pub budget_exhausted: bool,
 }
 
+/// Evaluations one call of [`uncertainty`] may spend on profile refits.
+pub const UNCERTAINTY_EVALUATIONS: usize = 2_000;
+
 /// Uncertainty at the estimate `at` (a converged linearisation whose residual is weighted by
-/// the measurement standard deviations). Returns `None` when the data carry no std.
+/// the measurement standard deviations). Returns `None` when the data carry no std. Profile
+/// refits spend at most [`UNCERTAINTY_EVALUATIONS`]; see [`uncertainty_within`] to set the budget.
 pub fn uncertainty(problem: &dyn Evaluate, at: &Linearisation, has_std: bool) -> Option<Uncertainty> {
+    uncertainty_within(problem, at, has_std, &Budget::new(UNCERTAINTY_EVALUATIONS))
+}
+
+/// [`uncertainty`] charging every profile refit to `budget` (shared with the fit, so one limit
+/// bounds the whole task).
+pub fn uncertainty_within(
+    problem: &dyn Evaluate,
+    at: &Linearisation,
+    has_std: bool,
+    budget: &Budget,
+) -> Option<Uncertainty> {
     if !has_std {
         return None;
     }
@@ -81,6 +99,7 @@ pub fn uncertainty(problem: &dyn Evaluate, at: &Linearisation, has_std: bool) ->
     let covariance = DMatrix::from_fn(np, np, |i, j| scaled_cov[(i, j)] * jac[i] * jac[j]);
     let mut intervals = Vec::with_capacity(np);
     let mut identifiability = Vec::with_capacity(np);
+    let mut budget_exhausted = false;
     for (i, par) in params.iter().enumerate() {
         let s = par.to_scaled(at.parameters[i]);
         let sigma = scaled_cov[(i, i)].sqrt();
@@ -89,8 +108,15 @@ pub fn uncertainty(problem: &dyn Evaluate, at: &Linearisation, has_std: bool) ->
             identifiability.push(Identifiability::Determined);
             continue;
         }
-        let lower = profile_bound(problem, at, i, -1.0);
-        let upper = profile_bound(problem, at, i, 1.0);
+        let profile = Profile { problem, at, i, budget, sigma };
+        let lower = profile.bound(-1.0);
+        let upper = profile.bound(1.0);
+        budget_exhausted |= budget.exhausted();
+        let (lower, upper) = match (lower, upper) {
+            (Ok(l), Ok(u)) => (l, u),
+            // Out of budget: say nothing the refits did not establish.
+            _ => (None, None),
+        };
         intervals.push([lower.unwrap_or(par.lower), upper.unwrap_or(par.upper)]);
         identifiability.push(match (lower, upper) {
             (Some(_), Some(_)) => Identifiability::Determined,
@@ -99,58 +125,142 @@ pub fn uncertainty(problem: &dyn Evaluate, at: &Linearisation, has_std: bool) ->
             (None, None) => Identifiability::Undetermined,
         });
     }
-    Some(Uncertainty { covariance, intervals, singular_values, condition_number, identifiability })
+    Some(Uncertainty {
+        covariance,
+        intervals,
+        singular_values,
+        condition_number,
+        identifiability,
+        budget_exhausted,
+    })
 }
 
-/// χ² after refitting every other parameter with parameter `i` held at `value`.
-fn profile_chi2(problem: &dyn Evaluate, at: &Linearisation, i: usize, value: f64) -> Option<f64> {
-    let mut p = at.parameters.clone();
-    p[i] = value;
-    let fixed = (0..p.len()).map(|j| j == i).collect();
-    let mut damped = Damped::default().with_fixed(fixed).with_max_restarts(0);
-    let est = Driver { max_iterations: 60 }.run(problem, &mut damped, &p, &mut []).ok()?;
-    Some(2.0 * est.last.cost())
+/// Iterations of one warm-started profile refit: it starts next to its solution.
+const PROFILE_REFIT_ITERATIONS: usize = 30;
+/// Refits allowed to bracket one bound (steps growing ×3 from the linearised σ).
+const PROFILE_BRACKET_REFITS: usize = 8;
+/// Refits allowed to locate a bracketed bound.
+const PROFILE_LOCATE_REFITS: usize = 10;
+/// A bound is located when Δχ² is this close to the threshold, or the bracket this narrow
+/// (scaled units: 0.1% of a log parameter).
+const PROFILE_CHI2_TOLERANCE: f64 = 0.05;
+const PROFILE_WIDTH_TOLERANCE: f64 = 1e-3;
+
+/// The profile likelihood of one parameter: Δχ² after refitting the others with it held fixed.
+struct Profile<'a> {
+    problem: &'a dyn Evaluate,
+    at: &'a Linearisation,
+    i: usize,
+    budget: &'a Budget,
+    /// Linearised σ in scaled units (may be ∞): sets the first bracketing step.
+    sigma: f64,
 }
 
-/// The 95% profile-likelihood bound of parameter `i` in direction `dir` (−1 lower, +1 upper),
-/// or `None` when χ² stays within the threshold all the way to the parameter's limit.
-fn profile_bound(problem: &dyn Evaluate, at: &Linearisation, i: usize, dir: f64) -> Option<f64> {
-    let par = &problem.parameters().as_slice()[i];
-    let limit = if dir < 0.0 { par.lower } else { par.upper };
-    if !limit.is_finite() {
-        return None;
-    }
-    let chi2_min = 2.0 * at.cost();
-    let exceeds = |s: f64| {
-        profile_chi2(problem, at, i, par.from_scaled(s).clamp(par.lower, par.upper))
-            .is_none_or(|c| c - chi2_min > CHI2_95_1DOF)
-    };
-    let s_hat = par.to_scaled(at.parameters[i]);
-    let s_limit = par.to_scaled(limit);
-    let span = (s_limit - s_hat).abs();
-    // Bracket: march out in steps of a tenth of the range (at least 0.5 scaled units).
-    let step = (span / 10.0).max(0.5).min(span);
-    let (mut inside, mut outside) = (s_hat, None);
-    let mut t = step;
-    while t <= span + 1e-12 {
-        let s = s_hat + dir * t;
-        if exceeds(s) {
-            outside = Some(s);
-            break;
+/// The budget ran out before a bound was found.
+struct OutOfBudget;
+
+impl Profile<'_> {
+    /// Δχ² at scaled value `s`, refitting the other parameters from `warm` (the solution at the
+    /// nearest point already profiled); with it, the refitted parameters. `None` when the
+    /// model cannot be evaluated there (counts as beyond the bound).
+    fn delta_chi2(&self, s: f64, warm: &[f64]) -> Result<Option<(f64, Vec<f64>)>, OutOfBudget> {
+        let par = &self.problem.parameters().as_slice()[self.i];
+        let mut p = warm.to_vec();
+        p[self.i] = par.from_scaled(s).clamp(par.lower, par.upper);
+        let fixed = (0..p.len()).map(|j| j == self.i).collect();
+        let mut local = Damped::default().with_fixed(fixed).with_max_restarts(0);
+        let run = Driver { max_iterations: PROFILE_REFIT_ITERATIONS }.run_within(
+            self.problem,
+            &mut local,
+            &p,
+            &mut [],
+            self.budget,
+        );
+        if self.budget.exhausted() {
+            return Err(OutOfBudget);
         }
-        inside = s;
-        t += step;
+        Ok(run.ok().map(|est| (2.0 * (est.last.cost() - self.at.cost()), est.parameters)))
     }
-    let mut outside = outside?;
-    for _ in 0..40 {
-        let mid = 0.5 * (inside + outside);
-        if exceeds(mid) {
-            outside = mid;
-        } else {
-            inside = mid;
+
+    /// The 95% profile-likelihood bound in direction `dir` (−1 lower, +1 upper), or `None` when
+    /// Δχ² stays within the threshold all the way to the parameter's limit (or the estimate sits
+    /// on that limit). Warm-started local refits only: a handful to bracket (steps growing ×3
+    /// from the linearised σ), then a safeguarded regula falsi (Illinois) on Δχ² − threshold.
+    fn bound(&self, dir: f64) -> Result<Option<f64>, OutOfBudget> {
+        let par = &self.problem.parameters().as_slice()[self.i];
+        let limit = if dir < 0.0 { par.lower } else { par.upper };
+        let s_hat = par.to_scaled(self.at.parameters[self.i]);
+        let s_limit = if limit.is_finite() { par.to_scaled(limit) } else { dir * f64::INFINITY };
+        let span = (s_limit - s_hat).abs();
+        // On (or within round-off of) the limit: nothing lies beyond, the data bound nothing here.
+        if !(span > 1e-9 * (1.0 + s_hat.abs())) {
+            return Ok(None);
         }
+        let first = if self.sigma.is_finite() { (Z_95 * self.sigma).max(0.1) } else { 1.0 };
+        let (mut inside, mut inside_val, mut warm) = (0.0, -CHI2_95_1DOF, self.at.parameters.clone());
+        let mut t = first.min(span);
+        let mut outside = None;
+        for _ in 0..PROFILE_BRACKET_REFITS {
+            match self.delta_chi2(s_hat + dir * t, &warm)? {
+                Some((d, p)) if d <= CHI2_95_1DOF => {
+                    (inside, inside_val, warm) = (t, d - CHI2_95_1DOF, p);
+                }
+                hit => {
+                    outside = Some((t, hit.map_or(f64::INFINITY, |(d, _)| d - CHI2_95_1DOF)));
+                    break;
+                }
+            }
+            if t >= span {
+                return Ok(None); // the limit itself fits the data
+            }
+            t = (3.0 * t).min(span);
+        }
+        let Some((mut out, mut out_val)) = outside else {
+            return Ok(None); // no rise within the reach of the bracketing: unbounded this side
+        };
+        let (mut side_in, mut side_out) = (0, 0);
+        for _ in 0..PROFILE_LOCATE_REFITS {
+            if out - inside <= PROFILE_WIDTH_TOLERANCE {
+                break;
+            }
+            // Regula falsi where both ends have finite values; Illinois halving of the end kept
+            // twice stops it from creeping; a bisection otherwise, and as a safeguard.
+            let mut next = if out_val.is_finite() {
+                let w_in = if side_in >= 2 { 0.5 } else { 1.0 };
+                let w_out = if side_out >= 2 { 0.5 } else { 1.0 };
+                let (a, b) = (inside_val * w_in, out_val * w_out);
+                inside + (out - inside) * (-a) / (b - a)
+            } else {
+                0.5 * (inside + out)
+            };
+            let margin = 0.05 * (out - inside);
+            if !(next > inside + margin && next < out - margin) {
+                next = 0.5 * (inside + out);
+            }
+            match self.delta_chi2(s_hat + dir * next, &warm)? {
+                Some((d, p)) if d <= CHI2_95_1DOF => {
+                    (inside, inside_val, warm) = (next, d - CHI2_95_1DOF, p);
+                    side_in = 0;
+                    side_out += 1;
+                    if -inside_val <= PROFILE_CHI2_TOLERANCE {
+                        out = inside;
+                        break;
+                    }
+                }
+                hit => {
+                    out = next;
+                    out_val = hit.map_or(f64::INFINITY, |(d, _)| d - CHI2_95_1DOF);
+                    side_out = 0;
+                    side_in += 1;
+                    if out_val <= PROFILE_CHI2_TOLERANCE {
+                        inside = out;
+                        break;
+                    }
+                }
+            }
+        }
+        Ok(Some(par.from_scaled(s_hat + dir * 0.5 * (inside + out)).clamp(par.lower, par.upper)))
     }
-    Some(par.from_scaled(0.5 * (inside + outside)))
 }
 
 /// Other parameter vectors that fit the data as well as `at` does: with as many frequencies as
@@ -182,24 +292,76 @@ pub fn alternatives_among(
     at: &Linearisation,
     solutions: &[Linearisation],
 ) -> Vec<Vec<f64>> {
-    let params = problem.parameters();
-    let scaled = |p: &[f64]| -> Vec<f64> { params.iter().zip(p).map(|(q, &v)| q.to_scaled(v)).collect() };
-    let distance = |a: &[f64], b: &[f64]| -> f64 {
-        scaled(a).iter().zip(scaled(b)).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
-    };
-    let good = |lin: &Linearisation| {
-        let tol = Damped::default().residual_tolerance;
-        lin.max_rel_diff() <= tol.max(at.max_rel_diff() * 10.0)
-            || (lin.has_std && 2.0 * (lin.cost() - at.cost()) <= CHI2_95_1DOF)
-    };
     let mut found: Vec<Vec<f64>> = Vec::new();
     for sol in solutions {
-        if good(sol)
-            && distance(&sol.parameters, &at.parameters) > 0.01
-            && found.iter().all(|f| distance(f, &sol.parameters) > 0.01)
+        if fits_as_well(at, sol)
+            && scaled_distance(problem, &sol.parameters, &at.parameters) > 0.01
+            && found.iter().all(|f| scaled_distance(problem, f, &sol.parameters) > 0.01)
         {
             found.push(sol.parameters.clone());
         }
     }
     found
+}
+
+/// [`alternative_solutions`] with every evaluation charged to `budget`; a spent budget ends the
+/// search with what was found.
+pub fn alternative_solutions_within(
+    problem: &dyn Evaluate,
+    at: &Linearisation,
+    starts: usize,
+    budget: &Budget,
+) -> Vec<Vec<f64>> {
+    let budgeted = budget.wrap(problem);
+    alternatives_among(problem, at, &local_solutions(&budgeted, starts))
+}
+
+/// A symmetric model's mirror solutions: for each pair of parameters `(i, j)` of the same kind
+/// (unit, scale and limits) whose exchange fits the data as well as `at`, the exchanged vector.
+/// Costs one evaluation per pair, charged to `budget`.
+pub fn mirror_solutions(
+    problem: &dyn Evaluate,
+    at: &Linearisation,
+    budget: &Budget,
+) -> Vec<(usize, usize, Vec<f64>)> {
+    let params = problem.parameters().as_slice();
+    let budgeted = budget.wrap(problem);
+    let mut found = Vec::new();
+    for i in 0..params.len() {
+        for j in i + 1..params.len() {
+            let (a, b) = (&params[i], &params[j]);
+            if a.unit != b.unit || a.scale != b.scale || a.lower != b.lower || a.upper != b.upper {
+                continue;
+            }
+            let mut p = at.parameters.clone();
+            p.swap(i, j);
+            if scaled_distance(problem, &p, &at.parameters) <= 0.01 {
+                continue; // equal values: the exchange is the same point
+            }
+            if let Ok(lin) = budgeted.linearise(&p) {
+                if fits_as_well(at, &lin) {
+                    found.push((i, j, p));
+                }
+            }
+        }
+    }
+    found
+}
+
+/// Largest scaled difference between two parameter vectors.
+fn scaled_distance(problem: &dyn Evaluate, a: &[f64], b: &[f64]) -> f64 {
+    let params = problem.parameters();
+    params
+        .iter()
+        .zip(a.iter().zip(b))
+        .map(|(q, (&x, &y))| (q.to_scaled(x) - q.to_scaled(y)).abs())
+        .fold(0.0, f64::max)
+}
+
+/// `lin` fits as well as `at`: an exact fit (to the damped strategy's tolerance, or ten times
+/// `at`'s misfit), or with std within the 95% χ² threshold of one degree of freedom.
+fn fits_as_well(at: &Linearisation, lin: &Linearisation) -> bool {
+    let tol = Damped::default().residual_tolerance;
+    lin.max_rel_diff() <= tol.max(at.max_rel_diff() * 10.0)
+        || (lin.has_std && 2.0 * (lin.cost() - at.cost()) <= CHI2_95_1DOF)
 }

@@ -1,6 +1,7 @@
 //! `eigenfit compare`: strategies × targets × a grid of initial guesses on reference data.
 
 use crate::error::{input, CliError};
+use crate::output::Stream;
 use crate::plot::compare_map::{CompareMaps, MapKind};
 use crate::source::{parse_list, ModelArgs};
 use crate::{plot, progress};
@@ -67,6 +68,10 @@ pub struct CompareArgs {
     pub json: bool,
 }
 
+/// Most runs one `compare` accepts: far beyond any study (the paper's maps are 10⁴), checked
+/// before anything is allocated.
+pub const MAX_RUNS: usize = 1_000_000;
+
 /// Runs `compare`.
 pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     let (model, label) = args.model.load_any()?;
@@ -81,6 +86,16 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             if r.len() != 2 || !(r[0] > 0.0 && r[1] > r[0]) {
                 return Err(input(format!("--range `{}`: expected FROM:TO with 0 < FROM < TO", args.range)));
             }
+            // Counted before the grid is built: 10000^2 points would exhaust memory first.
+            u32::try_from(np)
+                .ok()
+                .and_then(|d| n.checked_pow(d))
+                .filter(|&c| c <= MAX_RUNS)
+                .ok_or_else(|| {
+                    input(format!(
+                        "--grid {n}: {n}^{np} initial guesses, more than the {MAX_RUNS} runs compare accepts; use a smaller --grid"
+                    ))
+                })?;
             tensor_grid(&log_space(r[0], r[1], n), np)
         }
         _ => return Err(input("give --grid N (N ≥ 2) or --initials K1:K2,…")),
@@ -97,6 +112,21 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
+    // Beyond ±15 decimals rounding either changes nothing a double holds or overflows to NaN.
+    if let Some(d) = args.decimals.filter(|d| !(-15..=15).contains(d)) {
+        return Err(input(format!(
+            "--decimals {d}: must be between -15 and 15 (a double holds about 16 digits)"
+        )));
+    }
+    let total_runs = targets.len().saturating_mul(initials.len()).saturating_mul(strategies.len());
+    if total_runs > MAX_RUNS {
+        return Err(input(format!(
+            "{} targets × {} initial guesses × {} strategies = {total_runs} runs, more than the {MAX_RUNS} compare accepts",
+            targets.len(),
+            initials.len(),
+            strategies.len()
+        )));
+    }
     if let Some(s) = args.std_hz {
         if !(s.is_finite() && s > 0.0) {
             return Err(input(format!("--std-hz {s}: must be a positive finite number")));
@@ -110,27 +140,16 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     };
     let total = (targets.len() * initials.len() * strategies.len()) as u64;
     let pb = progress::bar(total, "compare runs", args.quiet);
-    let mut stream = match &args.stream {
-        Some(path) => Some(std::io::BufWriter::new(
-            std::fs::File::create(path)
-                .map_err(|e| input(format!("{}: cannot create: {e}", path.display())))?,
-        )),
-        None => None,
-    };
-    let mut stream_error = None;
+    // Opened after every argument is checked; run_grid checks the reference data before its
+    // first run, and the file is appended to, so a run refused there loses nothing written before.
+    let mut stream = args.stream.as_deref().map(Stream::open).transpose()?;
     let runs = run_grid(&rotor, &solver.as_ref(), &targets, &initials, &strategies, &settings, |r| {
         pb.inc(1);
-        if let (Some(w), None) = (stream.as_mut(), &stream_error) {
-            use std::io::Write;
-            if let Err(e) = writeln!(w, "{}", run_json(r, args.timing)).and_then(|()| w.flush()) {
-                stream_error = Some(e);
-            }
+        if let Some(w) = stream.as_mut() {
+            w.append(&run_json(r, args.timing).to_string());
         }
     });
     pb.finish_and_clear();
-    if let (Some(e), Some(path)) = (stream_error, &args.stream) {
-        eprintln!("eigenfit: warning: {}: streaming stopped: {e}", path.display());
-    }
     let runs = runs.map_err(|e| input(format!("reference data: {e}")))?;
     let summary = summarise(&runs, &targets, &strategies);
     let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
@@ -146,7 +165,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!(
             "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",
@@ -179,16 +198,18 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
                 fmt(s.median_iterations),
                 fmt(s.max_iterations),
                 s.max_relative_error,
-                s.ambiguous
+                // Only damped runs are checked for other solutions: a 0 elsewhere would mean nothing.
+                if s.strategy == StrategyKind::Damped { s.ambiguous.to_string() } else { "-".to_string() }
             );
         }
-        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged runs whose data also fit another solution)");
+        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged damped runs whose data also fit another solution, - where not checked)");
         if args.maps && np == 2 {
             print_maps(&runs, &targets, &strategies);
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
-    Ok(())
+    // A write failure ends the command non-zero after the results are printed.
+    stream.map_or(Ok(()), |w| w.finish(runs.len()))
 }
 
 /// Writes the convergence and iteration maps; a note on stderr (and nothing written) unless the
@@ -290,7 +311,7 @@ impl Summary {
             "runs": self.runs,
             "converged": self.converged,
             "converged_within_1e-6": self.within_1e6,
-            "ambiguous": self.ambiguous,
+            "ambiguous": (self.strategy == StrategyKind::Damped).then_some(self.ambiguous),
             "median_iterations": self.median_iterations,
             "max_iterations": self.max_iterations,
             "max_relative_error": self.max_relative_error,

@@ -134,6 +134,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
         runs,
         target: Some(TARGET.to_vec()),
         tolerance_hz: Some(0.01),
+        sigma_hz: None,
     };
     plots.extend(plot::write(&figure, out, "convergence")?);
 
@@ -202,20 +203,17 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
 
     let seconds = started.elapsed().as_secs_f64();
     if args.json {
-        println!(
-            "{}",
-            json!({
-                "model": label,
-                "table_1": table,
-                "table_3_case_1": {"target": TARGET, "initial": INITIAL, "reference_hz": reference,
-                                   "estimates": estimates},
-                "convergence_map": {"grid": args.grid, "strategies": basin},
-                "discovery": discovery_json,
-                "out": out.display().to_string(),
-                "plots": plot::names(&plots),
-                "seconds": seconds,
-            })
-        );
+        crate::output::emit_json(json!({
+            "model": label,
+            "table_1": table,
+            "table_3_case_1": {"target": TARGET, "initial": INITIAL, "reference_hz": reference,
+                               "estimates": estimates},
+            "convergence_map": {"grid": args.grid, "strategies": basin},
+            "discovery": discovery_json,
+            "out": out.display().to_string(),
+            "plots": plot::names(&plots),
+            "seconds": seconds,
+        }));
     } else {
         for line in &report {
             println!("{line}");

@@ -81,7 +81,7 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
         written.extend(plot::names(&plot::write(&figure, dir, "discovery")?));
     }
     if args.json {
-        println!("{}", report_json(&report, &names, &label, &written));
+        crate::output::emit_json(report_json(&report, &names, &label, &written));
     } else {
         let units: Vec<String> = rotor.parameters().iter().map(|p| p.unit.clone()).collect();
         print_report(&report, &names, &units, &label);

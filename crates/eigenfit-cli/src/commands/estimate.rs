@@ -5,8 +5,10 @@ use crate::plot::convergence::{Convergence, Run};
 use crate::source::{parameter_vector, ModelArgs};
 use crate::{measured, plot, progress};
 use clap::Args;
-use eigenfit_core::statistics::uncertainty;
-use eigenfit_core::{Driver, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel};
+use eigenfit_core::statistics::{alternative_solutions_within, mirror_solutions, uncertainty_within};
+use eigenfit_core::update::DEFAULT_EVALUATIONS;
+use eigenfit_core::verdict::{at_limits, judge, unreachable_modes, FitVerdict};
+use eigenfit_core::{Budget, Driver, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
 
@@ -30,6 +32,10 @@ pub struct EstimateArgs {
     /// Iteration limit.
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) the fit, its intervals and the search for other
+    /// solutions may spend together; when it runs out the run ends with exit code 3 and says so.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_EVALUATIONS)]
+    pub budget: usize,
     /// Write the convergence history (convergence.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
@@ -41,23 +47,38 @@ pub struct EstimateArgs {
     pub json: bool,
 }
 
-/// Runs `estimate`; returns the exit code (3 when the run did not converge).
+/// Restart-grid points refitted locally when searching for other equally good solutions.
+const ALTERNATIVE_STARTS: usize = 6;
+/// A measured mode this far (relative) outside every frequency the model reaches is refused.
+const UNREACHABLE_MARGIN: f64 = 0.1;
+
+/// Runs `estimate`; returns the exit code (3 when the run did not converge, the fit is poor, a
+/// parameter sits on a limit or the budget ran out).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let (model, label) = args.model.load_any()?;
     let rotor = &model;
     let solver = args.model.solver()?;
     let measurement = measured::read(&args.measured)?;
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
-        input(format!("unknown strategy `{}`; available: newton, p-step, damped", args.strategy))
+        input(format!(
+            "unknown strategy `{}`; available: newton, p-step, damped",
+            measured::shown(&args.strategy)
+        ))
     })?;
     let kind = match args.residual.as_str() {
         "relative" => ResidualKind::Relative,
         "hz" => ResidualKind::FrequencyHz,
         "eigenvalue" => ResidualKind::Eigenvalue,
         other => {
-            return Err(input(format!("unknown residual `{other}`; available: relative, hz, eigenvalue")))
+            return Err(input(format!(
+                "unknown residual `{}`; available: relative, hz, eigenvalue",
+                measured::shown(other)
+            )))
         }
     };
+    if args.budget == 0 {
+        return Err(input("--budget 0: at least one model evaluation is needed"));
+    }
     let initial = parameter_vector(&rotor, "--initial", args.initial.as_deref(), &[])?;
     let np = rotor.parameters().len();
     if measurement.len() < np {
@@ -75,22 +96,94 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             rotor.dofs()
         )));
     }
+    if matches!(strategy_kind, StrategyKind::Newton | StrategyKind::PStep) && measurement.len() > np {
+        eprintln!(
+            "eigenfit: note: the {} strategy solves the paper's square system: it uses the first {np} of the {} measured modes; \
+             the damped strategy uses all",
+            strategy_kind.name(),
+            measurement.len()
+        );
+    }
     let has_std = measurement.has_std();
+    let mode_numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
+    let sigma_max = measurement.modes().iter().filter_map(|m| m.std_hz).reduce(f64::max);
     let problem = Problem::new(&rotor, solver.as_ref(), measurement).with_kind(kind);
+    let budget = Budget::new(args.budget);
+    // Data no parameter value can produce is refused before any fitting.
+    let unreachable = unreachable_modes(&problem, UNREACHABLE_MARGIN, &budget);
+    if !unreachable.is_empty() {
+        let list: Vec<String> = unreachable
+            .iter()
+            .map(|u| {
+                format!(
+                    "mode {} at {} Hz (the model reaches {:.4}–{:.4} Hz)",
+                    mode_numbers[u.index],
+                    measured::shown_number(u.measured_hz),
+                    u.reachable_hz[0],
+                    u.reachable_hz[1]
+                )
+            })
+            .collect();
+        return Err(input(format!(
+            "{}: no stiffness within the limits can produce {}: a typing slip or a wrong unit?",
+            args.measured.display(),
+            list.join("; ")
+        )));
+    }
     let mut strategy = strategy_kind.build();
     let pb = progress::spinner(&format!("estimating ({})", strategy_kind.name()), args.quiet);
     let estimate = Driver { max_iterations: args.max_iterations }
-        .run(&problem, strategy.as_mut(), &initial, &mut [])
+        .run_within(&problem, strategy.as_mut(), &initial, &mut [], &budget)
         .map_err(|e| input(e.to_string()));
     pb.finish_and_clear();
     let estimate = estimate?;
-    let unc = if estimate.termination.is_converged() {
-        uncertainty(&problem, &estimate.last, has_std)
-    } else {
-        None
-    };
-    let names: Vec<&str> = rotor.parameters().iter().map(|p| p.name.as_str()).collect();
+    // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
+    let system = rotor.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
+    if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
+        crate::commands::simulate::refuse_roundoff(&system, &modes)?;
+    }
     let converged = estimate.termination.is_converged();
+    let quality = judge(&estimate.last, np);
+    let limits = at_limits(rotor.parameters(), &estimate.parameters);
+    let pb = progress::spinner("intervals and other solutions", args.quiet || !converged);
+    let unc = if converged { uncertainty_within(&problem, &estimate.last, has_std, &budget) } else { None };
+    let mut alternatives: Vec<(Vec<f64>, Option<(usize, usize)>)> = Vec::new();
+    if converged && quality.verdict != FitVerdict::Poor {
+        for (i, j, p) in mirror_solutions(&problem, &estimate.last, &budget) {
+            alternatives.push((p, Some((i, j))));
+        }
+        for p in alternative_solutions_within(&problem, &estimate.last, ALTERNATIVE_STARTS, &budget) {
+            let same = |q: &[f64]| {
+                rotor
+                    .parameters()
+                    .iter()
+                    .zip(q.iter().zip(&p))
+                    .all(|(par, (&a, &b))| (par.to_scaled(a) - par.to_scaled(b)).abs() <= 0.01)
+            };
+            if !alternatives.iter().any(|(q, _)| same(q)) {
+                alternatives.push((p, None));
+            }
+        }
+    }
+    pb.finish_and_clear();
+    let budget_spent = budget.exhausted();
+    let names: Vec<&str> = rotor.parameters().iter().map(|p| p.name.as_str()).collect();
+    let pinned: Vec<&str> = (0..np).filter(|&i| limits[i] != 0).map(|i| names[i]).collect();
+    let acceptable = converged && quality.verdict != FitVerdict::Poor && pinned.is_empty() && !budget_spent;
+    let verdict = if !converged {
+        estimate.termination.label()
+    } else if budget_spent {
+        "budget-exhausted"
+    } else if quality.verdict == FitVerdict::Poor {
+        "poor-fit"
+    } else if !pinned.is_empty() {
+        "not-identifiable"
+    } else if quality.verdict == FitVerdict::NotJudged {
+        "converged (fit quality not judged: no std)"
+    } else {
+        "converged"
+    };
+    let disagreeing: Vec<usize> = quality.disagreeing.iter().map(|&k| mode_numbers[k]).collect();
     let plots = match &args.plot {
         Some(dir) => {
             let figure = Convergence {
@@ -100,11 +193,36 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 runs: vec![Run::from_estimate(&estimate)],
                 target: None,
                 tolerance_hz: Some(0.01),
+                sigma_hz: sigma_max,
             };
             plot::write(&figure, dir, "convergence")?
         }
         None => Vec::new(),
     };
+    // What the data say about each parameter, in words.
+    let status = |i: usize| -> String {
+        let bound = unc.as_ref().map(|u| &u.identifiability[i]);
+        match (limits[i], bound) {
+            (_, Some(Identifiability::LowerBoundOnly { lower })) => {
+                format!("not identifiable: ≥ {lower:.4e}")
+            }
+            (_, Some(Identifiability::UpperBoundOnly { upper })) => {
+                format!("not identifiable: ≤ {upper:.4e}")
+            }
+            (0, Some(Identifiability::Determined)) => {
+                let u = unc.as_ref().map_or([0.0; 2], |u| u.intervals[i]);
+                format!("[{:.4e}, {:.4e}]", u[0], u[1])
+            }
+            (1, _) => "not identifiable: at its upper limit, the data see no upper bound".into(),
+            (-1, _) => "not identifiable: at its lower limit".into(),
+            (_, Some(_)) => "not identifiable".into(),
+            (_, None) if !converged => "(not computed: the run did not converge)".into(),
+            (_, None) if !has_std => "(no std given)".into(),
+            (_, None) => "(not computed)".into(),
+        }
+    };
+    let code = if acceptable { 0 } else { EXIT_NOT_CONVERGED };
+    crate::error::set_exit_on_closed_pipe(code);
     if args.json {
         let obj = |values: Vec<Value>| -> Map<String, Value> {
             names.iter().map(|n| n.to_string()).zip(values).collect()
@@ -113,11 +231,26 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             "model": label,
             "strategy": estimate.strategy,
             "converged": converged,
+            "acceptable": acceptable,
+            "verdict": verdict,
+            "fit_quality": quality.verdict.label(),
+            "chi2": quality.chi2,
+            "dof": quality.dof,
+            "p_value": quality.p_value,
+            "relative_rms_residual": quality.relative_rms,
+            "disagreeing_modes": disagreeing,
             "termination": estimate.termination.to_string(),
             "iterations": estimate.iterations,
             "evaluations": estimate.evaluations,
+            "budget": {"limit": budget.limit(), "used": budget.used(), "exhausted": budget_spent},
             "initial": obj(initial.iter().map(|&v| json!(v)).collect()),
             "parameters": obj(estimate.parameters.iter().map(|&v| json!(v)).collect()),
+            "parameter_status": obj((0..np).map(|i| json!(status(i))).collect()),
+            "at_limit": pinned,
+            "alternative_solutions": alternatives.iter().map(|(p, mirror)| json!({
+                "parameters": obj(p.iter().map(|&v| json!(v)).collect()),
+                "mirror_of": mirror.map(|(i, j)| vec![names[i], names[j]]),
+            })).collect::<Vec<_>>(),
             "frequencies_hz": estimate.last.frequencies_hz,
             "measured_hz": estimate.last.measured_hz,
             "history": estimate.history.iter().map(|r| json!({
@@ -139,47 +272,97 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!(
-            "{label}: {} strategy, {} after {} iterations",
-            estimate.strategy, estimate.termination, estimate.iterations
+            "{label}: {} strategy, {} after {} iterations ({} model evaluations)",
+            estimate.strategy,
+            estimate.termination,
+            estimate.iterations,
+            budget.used()
         );
         println!(
-            "{:<20}{:>16}{:>16}{:>30}",
+            "{:<20}{:>16}{:>16}   {}",
             "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]"
         );
         for (i, n) in names.iter().enumerate() {
-            let interval = match &unc {
-                Some(u) => match &u.identifiability[i] {
-                    Identifiability::Determined => {
-                        format!("[{:.4e}, {:.4e}]", u.intervals[i][0], u.intervals[i][1])
-                    }
-                    Identifiability::LowerBoundOnly { lower } => {
-                        format!("not identifiable: ≥ {lower:.3e}")
-                    }
-                    Identifiability::UpperBoundOnly { upper } => {
-                        format!("not identifiable: ≤ {upper:.3e}")
-                    }
-                    Identifiability::Undetermined => "not identifiable".to_string(),
-                },
-                None => "(no std given)".to_string(),
-            };
-            println!("{n:<20}{:>16.4e}{:>16.6e}{interval:>30}", initial[i], estimate.parameters[i]);
+            // A value on a limit is where the search stopped, not an estimate.
+            let value =
+                if limits[i] != 0 { "—".to_string() } else { format!("{:.6e}", estimate.parameters[i]) };
+            println!("{n:<20}{:>16.4e}{value:>16}   {}", initial[i], status(i));
         }
         println!("{:>6}{:>16}{:>16}{:>14}", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]");
         for (k, (m, f)) in estimate.last.measured_hz.iter().zip(&estimate.last.frequencies_hz).enumerate() {
-            println!("{:>6}{m:>16.6}{f:>16.6}{:>14.2e}", problem.measured.modes()[k].mode + 1, f - m);
+            println!("{:>6}{m:>16.6}{f:>16.6}{:>14.2e}", mode_numbers[k], f - m);
+        }
+        match (quality.verdict, quality.chi2) {
+            (FitVerdict::NotJudged, _) => println!(
+                "fit quality: cannot be judged without std_hz; relative RMS residual {:.3e}",
+                quality.relative_rms
+            ),
+            (v, Some(chi2)) => println!(
+                "fit quality: {} (χ² = {}, {} dof, p = {}){}",
+                if v == FitVerdict::Poor {
+                    "POOR, no stiffness within noise explains the data"
+                } else {
+                    "acceptable"
+                },
+                significant(chi2),
+                quality.dof,
+                quality.p_value.map_or("n/a (no dof)".to_string(), significant),
+                if disagreeing.is_empty() {
+                    String::new()
+                } else {
+                    format!("; modes disagreeing by more than 3σ: {}", join(&disagreeing))
+                }
+            ),
+            _ => {}
         }
         if let Some(u) = &unc {
+            let sv: Vec<String> = u.singular_values.iter().map(|v| format!("{v:.3e}")).collect();
             println!(
-                "scaled Jacobian: singular values {:?}, condition number {:.3e}",
-                u.singular_values, u.condition_number
+                "scaled Jacobian: singular values [{}], condition number {:.3e}",
+                sv.join(", "),
+                u.condition_number
+            );
+        }
+        if !pinned.is_empty() {
+            println!("at a parameter limit (the data cannot determine it): {}", pinned.join(", "));
+        }
+        for (p, mirror) in &alternatives {
+            let values: Vec<String> = names.iter().zip(p).map(|(n, v)| format!("{n} = {v:.4e}")).collect();
+            match mirror {
+                Some((i, j)) => println!(
+                    "equally good mirror solution ({} ↔ {} exchanged, a symmetric model): {}",
+                    names[*i],
+                    names[*j],
+                    values.join(", ")
+                ),
+                None => println!("equally good other solution: {}", values.join(", ")),
+            }
+        }
+        if budget_spent {
+            println!(
+                "the evaluation budget ({} model evaluations) ran out: results are incomplete; raise it with --budget",
+                budget.limit()
             );
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
-    Ok(if converged { 0 } else { EXIT_NOT_CONVERGED })
+    Ok(code)
+}
+
+/// Four significant digits, in exponent form outside [1e-3, 1e5).
+fn significant(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e5).contains(&v.abs()) {
+        format!("{}", format!("{v:.4}").trim_end_matches('0').trim_end_matches('.'))
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+fn join(v: &[usize]) -> String {
+    v.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")
 }
 
 fn identifiability_json(i: &Identifiability) -> Value {

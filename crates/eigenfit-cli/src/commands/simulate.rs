@@ -102,7 +102,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             if args.plot.is_some() {
                 out["plots"] = json!(plot::names(&plots));
             }
-            println!("{out}");
+            crate::output::emit_json(out);
         } else {
             println!("{label}: natural frequencies against support stiffness (all bearings equal)");
             print!("{:>14}", "k [N/m]");
@@ -121,7 +121,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     // Frequencies and their sensitivities from one solve; a model whose modes have none
     // (repeated or rigid-body modes) still gets its frequencies, and says why.
     let (f, sens) = match Sensitivities::compute(&rotor, solver.as_ref(), &p, args.modes) {
-        Ok(s) => (s.modes.frequencies_hz(), Ok(s.frequencies_hz)),
+        Ok(s) => {
+            let system = rotor.assemble(&p).map_err(|e| input(e.to_string()))?;
+            refuse_roundoff(&system, &s.modes)?;
+            (s.modes.frequencies_hz(), Ok(s.frequencies_hz))
+        }
         Err(e) => (frequencies(&rotor, solver.as_ref(), &p, args.modes)?, Err(e.to_string())),
     };
     let plots = match &args.plot {
@@ -150,7 +154,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
-        println!("{out}");
+        crate::output::emit_json(out);
     } else {
         println!("{label} ({} DOF, {} solver)", rotor.dofs(), solver.name());
         for (n, v) in names.iter().zip(&p) {
@@ -214,8 +218,42 @@ fn frequencies(
 ) -> Result<Vec<f64>, CliError> {
     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
     let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
+    refuse_roundoff(&system, &m)?;
     Ok(m.frequencies_hz())
 }
+
+/// Never a frequency lost to round-off with exit 0 (issue 13): a fine mesh or an extreme value
+/// whose lowest eigenvalue the matrices cannot resolve is refused, saying why.
+pub(crate) fn refuse_roundoff(
+    system: &eigenfit_core::System,
+    modes: &eigenfit_core::Modes,
+) -> Result<(), CliError> {
+    use eigenfit_core::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF};
+    let levels = relative_roundoff(system, modes);
+    match levels.iter().position(|&r| !(r <= MAX_RELATIVE_ROUNDOFF)) {
+        None => {
+            if let Some(j) = levels.iter().position(|&r| r > NOTE_RELATIVE_ROUNDOFF) {
+                eprintln!(
+                    "eigenfit: note: mode {}: round-off may reach {:.1e} of its eigenvalue (a fine mesh or an extreme value); \
+                     the trailing digits are not significant",
+                    j + 1,
+                    levels[j]
+                );
+            }
+            Ok(())
+        }
+        Some(j) => Err(input(format!(
+            "mode {} cannot be trusted: round-off in the matrices (ε·(‖K‖/λ + ‖M‖)·‖φ‖² ≈ {:.1e}) exceeds {MAX_RELATIVE_ROUNDOFF:e} \
+             of its eigenvalue; the mesh is too fine or a value too extreme for double precision (use fewer elements, \
+             or values closer to the rest of the model)",
+            j + 1,
+            levels[j]
+        ))),
+    }
+}
+
+/// Most points of a `--sweep`: a smooth critical speed map needs a few hundred.
+const MAX_SWEEP_POINTS: usize = 100_000;
 
 fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
     let parts: Vec<&str> = text.split(':').collect();
@@ -228,6 +266,12 @@ fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
     let (a, b) = (ends[0], ends[1]);
     if !(a > 0.0 && b > a && count >= 2) {
         return Err(bad());
+    }
+    // Checked before the points are allocated: each is an eigen-solve.
+    if count > MAX_SWEEP_POINTS {
+        return Err(input(format!(
+            "--sweep `{text}`: {count} points, more than the {MAX_SWEEP_POINTS} a sweep accepts"
+        )));
     }
     Ok(eigenfit_core::compare::log_space(a, b, count))
 }

@@ -51,6 +51,9 @@ pub struct Convergence {
     pub target: Option<Vec<f64>>,
     /// Frequency tolerance to mark on the residual panel (Hz), e.g. the paper's 0.01 Hz.
     pub tolerance_hz: Option<f64>,
+    /// The measurement's largest standard deviation (Hz), marked on the residual panel when
+    /// given: a fit converged at the noise level ends near this line, not at the tolerance.
+    pub sigma_hz: Option<f64>,
 }
 
 /// Width of the legend column on the right (px).
@@ -133,7 +136,8 @@ impl Figure for Convergence {
             self.runs
                 .iter()
                 .flat_map(|r| r.history.iter().map(|h| h.2.max(FLOOR_HZ)))
-                .chain(self.tolerance_hz),
+                .chain(self.tolerance_hz)
+                .chain(self.sigma_hz),
             3.0,
         );
         let mut chart = ChartBuilder::on(&bottom)
@@ -161,6 +165,17 @@ impl Figure for Convergence {
                 .draw_series(DashedLineSeries::new([(0.0, tol), (x_end, tol)], 4, 5, INK.stroke_width(1)))
                 .map_err(err)?;
             entries.push((Swatch::Guide, format!("paper's tolerance, {tol} Hz")));
+        }
+        if let Some(sigma) = self.sigma_hz {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(0.0, sigma), (x_end, sigma)],
+                    10,
+                    4,
+                    INK.mix(0.6).stroke_width(2),
+                ))
+                .map_err(err)?;
+            entries.push((Swatch::Guide, format!("largest measurement σ, {} Hz", log_tick(&sigma))));
         }
         for run in &self.runs {
             let c = strategy_colour(&run.strategy);

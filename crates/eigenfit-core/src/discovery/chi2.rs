@@ -5,6 +5,9 @@ pub fn chi2_upper_tail(x: f64, dof: usize) -> f64 {
     if x <= 0.0 {
         return 1.0;
     }
+    if !(x < f64::INFINITY) {
+        return 0.0; // an infinite (or undefined) misfit is never explained by noise
+    }
     1.0 - regularized_lower_gamma(dof as f64 / 2.0, x / 2.0)
 }
 

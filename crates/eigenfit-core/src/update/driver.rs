@@ -1,6 +1,6 @@
 //! The iteration loop: termination reasons, observers, history.
 
-use super::{Evaluate, StepStatus, UpdateError, UpdateStrategy};
+use super::{Budget, Evaluate, StepStatus, UpdateError, UpdateStrategy};
 use crate::residual::Linearisation;
 
 /// Why a run ended.
@@ -14,6 +14,11 @@ pub enum Termination {
     Diverged(String),
     /// No acceptable step could be found.
     Stalled(String),
+    /// The evaluation budget ran out first ([`Budget`]); the last point is not a solution.
+    BudgetExhausted {
+        /// The budget's limit, in model evaluations.
+        limit: usize,
+    },
 }
 
 impl Termination {
@@ -22,13 +27,14 @@ impl Termination {
         matches!(self, Termination::Converged)
     }
 
-    /// Short label: `converged`, `iteration-limit`, `diverged`, `stalled`.
+    /// Short label: `converged`, `iteration-limit`, `diverged`, `stalled`, `budget-exhausted`.
     pub fn label(&self) -> &'static str {
         match self {
             Termination::Converged => "converged",
             Termination::IterationLimit => "iteration-limit",
             Termination::Diverged(_) => "diverged",
             Termination::Stalled(_) => "stalled",
+            Termination::BudgetExhausted { .. } => "budget-exhausted",
         }
     }
 }
@@ -38,6 +44,13 @@ impl std::fmt::Display for Termination {
         match self {
             Termination::Diverged(why) | Termination::Stalled(why) => {
                 write!(f, "{}: {why}", self.label())
+            }
+            Termination::BudgetExhausted { limit } => {
+                write!(
+                    f,
+                    "{}: the budget of {limit} model evaluations ran out (raise it with --budget)",
+                    self.label()
+                )
             }
             _ => f.write_str(self.label()),
         }
@@ -120,6 +133,22 @@ impl Driver {
         initial: &[f64],
         observers: &mut [&mut dyn Observer],
     ) -> Result<Estimate, UpdateError> {
+        self.run_within(problem, strategy, initial, observers, &Budget::unlimited())
+    }
+
+    /// [`Driver::run`] charging every evaluation, including the strategy's trials and restart
+    /// seeds, to `budget`: the run ends with [`Termination::BudgetExhausted`] as soon as an
+    /// evaluation is refused, keeping the best point reached.
+    pub fn run_within(
+        &self,
+        problem: &dyn Evaluate,
+        strategy: &mut dyn UpdateStrategy,
+        initial: &[f64],
+        observers: &mut [&mut dyn Observer],
+        budget: &Budget,
+    ) -> Result<Estimate, UpdateError> {
+        let budgeted = budget.wrap(problem);
+        let problem: &dyn Evaluate = &budgeted;
         if problem.parameters().is_empty() {
             return Err(UpdateError::Setup("the model has no parameter: nothing to estimate".into()));
         }
@@ -137,7 +166,21 @@ impl Driver {
                 if iterations >= self.max_iterations {
                     break Termination::IterationLimit;
                 }
-                match strategy.step(problem, &current) {
+                let step = strategy.step(problem, &current);
+                // A refused evaluation makes any verdict of this step (a strategy may read a
+                // failed trial as "no better point") meaningless: the run is cut short.
+                if budget.exhausted() {
+                    if let Some(step) = step.ok().filter(|s| s.next.cost() < current.cost()) {
+                        iterations += 1;
+                        evaluations += step.evaluations;
+                        current = step.next;
+                        let record = IterationRecord::new(iterations, &current);
+                        observers.iter_mut().for_each(|o| o.observe(&record));
+                        history.push(record);
+                    }
+                    break Termination::BudgetExhausted { limit: budget.limit() };
+                }
+                match step {
                     Ok(step) => {
                         iterations += 1;
                         evaluations += step.evaluations;

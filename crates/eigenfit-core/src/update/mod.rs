@@ -4,6 +4,7 @@
 //! point; the [`Driver`] owns the loop, the iteration limit, the history and the termination
 //! reason, like argmin's `Executor`.
 
+mod budget;
 pub(crate) mod damped;
 mod driver;
 mod newton;
@@ -11,6 +12,7 @@ mod pstep;
 #[cfg(test)]
 mod tests;
 
+pub use budget::{Budget, Budgeted, DEFAULT_EVALUATIONS};
 pub use damped::Damped;
 pub use driver::{Driver, Estimate, IterationRecord, IterationRecordSink, Observer, Termination};
 pub use newton::Newton;
