@@ -113,10 +113,12 @@ pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetr
                     disagreeing = Some((r, c, v, w));
                 }
             }
-        } else if r < c && !sums.contains_key(&(c, r)) && v.abs() > tolerance {
-            if disagreeing.is_none_or(|(r0, c0, _, _)| (r, c) < (c0, r0)) {
-                disagreeing = Some((c, r, 0.0, v));
-            }
+        } else if r < c
+            && !sums.contains_key(&(c, r))
+            && v.abs() > tolerance
+            && disagreeing.is_none_or(|(r0, c0, _, _)| (r, c) < (c0, r0))
+        {
+            disagreeing = Some((c, r, 0.0, v));
         }
     }
     if let Some((r, c, v, w)) = disagreeing {
