@@ -1,8 +1,9 @@
 //! Where the model and the solver come from: `--model FILE.toml` / `--preset NAME`, `--solver`.
 
+use crate::any_model::{self, AnyModel};
 use crate::error::{input, CliError};
 use clap::Args;
-use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
+use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, SparseSolver, StructuralModel};
 use eigenfit_rotor::{presets, Rotor, RotorError};
 use std::path::PathBuf;
 
@@ -13,7 +14,8 @@ pub const DENSE_MAX_DOFS: usize = 4002;
 /// Model selection shared by every command.
 #[derive(Debug, Args)]
 pub struct ModelArgs {
-    /// Rotor model file (TOML, see docs/rotor-model.md).
+    /// Model file (TOML): a rotor (docs/rotor-model.md) or, with `kind = "matrices"`, sparse
+    /// K and M from any FE tool (docs/matrices.md).
     #[arg(long, value_name = "FILE.toml", conflicts_with = "preset", required_unless_present = "preset")]
     pub model: Option<PathBuf>,
     /// Built-in model: paper-rotor, ross-example, uniform-rotor.
@@ -22,9 +24,10 @@ pub struct ModelArgs {
     /// Shaft elements of the uniform-rotor preset (4 … 100000; default 100).
     #[arg(long, value_name = "N", requires = "preset")]
     pub elements: Option<usize>,
-    /// Eigen-solver backend: auto (default: banded), banded (shift-invert Lanczos on a band
-    /// factor, the fastest at every size), dense (the reference) or lapack (when built with the
-    /// `lapack` feature).
+    /// Eigen-solver backend: auto (default: banded for rotors, sparse for matrices models),
+    /// banded (shift-invert Lanczos on a band factor, the fastest for beams), sparse
+    /// (shift-invert Lanczos on a fill-reducing sparse Cholesky factor, for plates, shells,
+    /// solids), dense (the reference) or lapack (when built with the `lapack` feature).
     #[arg(long, default_value = "auto", value_name = "NAME")]
     pub solver: String,
 }
@@ -43,6 +46,24 @@ impl ModelArgs {
             )));
         }
         Ok((rotor, label))
+    }
+
+    /// Loads a rotor or a matrices model (`kind = "matrices"`) and a label for reports.
+    pub fn load_any(&self) -> Result<(AnyModel, String), CliError> {
+        let Some(path) = self.model.as_ref().filter(|p| any_model::is_matrices_file(p)) else {
+            return self.load().map(|(rotor, label)| (AnyModel::Rotor(rotor), label));
+        };
+        let model = any_model::load_matrices(path)?;
+        // A matrices model is stored sparse: the dense and band solvers would densify it.
+        if matches!(self.solver.as_str(), "dense" | "lapack" | "banded") && model.dofs() > DENSE_MAX_DOFS {
+            return Err(input(format!(
+                "--solver {}: the model has {} DOFs, more than the {DENSE_MAX_DOFS} a dense or band copy \
+                 allows; use --solver sparse (or auto)",
+                self.solver,
+                model.dofs()
+            )));
+        }
+        Ok((AnyModel::Matrices(model), path.display().to_string()))
     }
 
     fn load_model(&self) -> Result<(Rotor, String), CliError> {
@@ -80,7 +101,11 @@ impl ModelArgs {
     /// The chosen eigen-solver.
     pub fn solver(&self) -> Result<Box<dyn EigenSolver>, CliError> {
         match self.solver.as_str() {
+            "auto" if self.model.as_ref().is_some_and(|p| any_model::is_matrices_file(p)) => {
+                Ok(Box::new(SparseSolver::default()))
+            }
             "auto" | "banded" => Ok(Box::new(BandedSolver::default())),
+            "sparse" => Ok(Box::new(SparseSolver::default())),
             "dense" => Ok(Box::new(DenseSolver)),
             #[cfg(feature = "lapack")]
             "lapack" => Ok(Box::new(eigenfit_lapack::LapackSolver::default())),
@@ -88,7 +113,9 @@ impl ModelArgs {
             "lapack" => Err(input(
                 "this eigenfit was built without the `lapack` feature; rebuild with --features lapack",
             )),
-            other => Err(input(format!("unknown solver `{other}`; available: auto, dense, banded, lapack"))),
+            other => Err(input(format!(
+                "unknown solver `{other}`; available: auto, dense, banded, sparse, lapack"
+            ))),
         }
     }
 }

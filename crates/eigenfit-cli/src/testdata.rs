@@ -2,16 +2,20 @@
 //! and the MAC part of the `estimate` report (docs/test-data.md). The reading, mapping and
 //! fitting themselves live in `eigenfit_core::testdata` and the rotor's `NodeLayout`.
 
+use crate::any_model::AnyModel;
 use crate::error::{input, CliError};
 use crate::measured;
 use clap::Args;
 use eigenfit_core::fixed::Fixed;
+use eigenfit_core::testdata::sensors::NodeLayout;
 use eigenfit_core::testdata::{sensors, uff, MacReport, SensorSet, ShapeFit};
 use eigenfit_core::StructuralModel;
 use eigenfit_core::{
     EigenSolver, Estimate, Evaluate, Linearisation, Measurement, Pairing, ParameterSet, Problem,
     ResidualError, Uncertainty,
 };
+use eigenfit_core::{ModelError, System, SystemDerivative};
+use eigenfit_matrices::MatricesModel;
 use eigenfit_rotor::{Rotor, UpdatableRotor};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -46,8 +50,47 @@ pub struct TestDataArgs {
     pub write_model: Option<PathBuf>,
 }
 
-/// The rotor with the `--fix NAME=VALUE` parameters held.
-pub fn fixed<'r>(rotor: &'r UpdatableRotor, fixes: &[String]) -> Result<Fixed<&'r UpdatableRotor>, CliError> {
+/// The model `estimate` updates: a rotor with its `[[parameter]]` tables resolved, or a
+/// matrices model as it is (its parameters are already declared in its file).
+pub enum Updatable<'a> {
+    /// A planar rotor.
+    Rotor(UpdatableRotor),
+    /// K(p) = K₀ + Σ pᵢKᵢ, M(p) = M₀ + Σ pᵢMᵢ.
+    Matrices(&'a MatricesModel),
+}
+
+impl StructuralModel for Updatable<'_> {
+    fn parameters(&self) -> &ParameterSet {
+        match self {
+            Updatable::Rotor(m) => m.parameters(),
+            Updatable::Matrices(m) => m.parameters(),
+        }
+    }
+    fn dofs(&self) -> usize {
+        match self {
+            Updatable::Rotor(m) => m.dofs(),
+            Updatable::Matrices(m) => m.dofs(),
+        }
+    }
+    fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+        match self {
+            Updatable::Rotor(m) => m.assemble(p),
+            Updatable::Matrices(m) => m.assemble(p),
+        }
+    }
+    fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
+        match self {
+            Updatable::Rotor(m) => m.derivative(p, i),
+            Updatable::Matrices(m) => m.derivative(p, i),
+        }
+    }
+}
+
+/// The model with the `--fix NAME=VALUE` parameters held.
+pub fn fixed<'r, 'a>(
+    rotor: &'r Updatable<'a>,
+    fixes: &[String],
+) -> Result<Fixed<&'r Updatable<'a>>, CliError> {
     let mut pairs = Vec::new();
     for f in fixes {
         let (name, value) =
@@ -67,7 +110,7 @@ pub fn fixed<'r>(rotor: &'r UpdatableRotor, fixes: &[String]) -> Result<Fixed<&'
 }
 
 /// `fixed`: the held parameters (name → value), when any.
-pub fn add_fixed_json(out: &mut Value, model: &Fixed<&UpdatableRotor>) {
+pub fn add_fixed_json(out: &mut Value, model: &Fixed<&Updatable<'_>>) {
     let held = model.held();
     if !held.is_empty() {
         out["fixed"] = Value::Object(held.into_iter().map(|(n, v)| (n, json!(v))).collect());
@@ -79,12 +122,17 @@ pub fn add_fixed_json(out: &mut Value, model: &Fixed<&UpdatableRotor>) {
 pub fn write_model(
     path: &Path,
     data_file: &Path,
-    model: &Fixed<&UpdatableRotor>,
+    model: &Fixed<&Updatable<'_>>,
     estimate: &Estimate,
     unc: Option<&Uncertainty>,
 ) -> Result<(), CliError> {
     let full = model.expand(&estimate.parameters);
-    let updated = model.inner().with_values(&full).map_err(CliError::Failure)?;
+    let Updatable::Rotor(rotor) = model.inner() else {
+        return Err(input(
+            "--write-model applies to rotor models only, not to a `kind = \"matrices\"` model",
+        ));
+    };
+    let updated = rotor.with_values(&full).map_err(CliError::Failure)?;
     let toml = updated.to_toml_string().map_err(|e| CliError::Failure(e.to_string()))?;
     let mut head = format!(
         "# Updated by eigenfit estimate ({} strategy, {}) on {} from {}\n\
@@ -134,9 +182,15 @@ pub struct TestData {
     pub notes: Vec<String>,
 }
 
-/// The rotor with its `[[parameter]]` tables resolved (docs/rotor-model.md).
-pub fn updatable(rotor: &Rotor, label: &str) -> Result<UpdatableRotor, CliError> {
-    UpdatableRotor::new(rotor.clone()).map_err(|e| input(format!("{label}: {e}")))
+/// The rotor with its `[[parameter]]` tables resolved (docs/rotor-model.md), or the matrices
+/// model as it is.
+pub fn updatable<'a>(model: &'a AnyModel, label: &str) -> Result<Updatable<'a>, CliError> {
+    match model {
+        AnyModel::Rotor(rotor) => UpdatableRotor::new(rotor.clone())
+            .map(Updatable::Rotor)
+            .map_err(|e| input(format!("{label}: {e}"))),
+        AnyModel::Matrices(m) => Ok(Updatable::Matrices(m)),
+    }
 }
 
 /// `simulate --uff`: the lowest `modes` modes at `p` with the rotor's node coordinates.
@@ -175,7 +229,13 @@ fn read_text(path: &Path) -> Result<String, CliError> {
 
 /// Reads `--measured` (CSV or universal file) and `--shapes`, checking every option against
 /// the data they apply to.
-pub fn read(path: &Path, rotor: &Rotor, args: &TestDataArgs) -> Result<TestData, CliError> {
+pub fn read(path: &Path, layout: Option<&dyn NodeLayout>, args: &TestDataArgs) -> Result<TestData, CliError> {
+    // Shapes are tied to model DOFs through node coordinates, which a matrices model lacks.
+    let rotor = || {
+        layout.ok_or_else(|| {
+            input("measured shapes (a universal file or --shapes) need a rotor model; a matrices model takes frequencies only")
+        })
+    };
     if !(args.node_tolerance.is_finite() && args.node_tolerance >= 0.0) {
         return Err(input(format!(
             "--node-tolerance {}: must be a finite distance ≥ 0 m",
@@ -197,7 +257,7 @@ pub fn read(path: &Path, rotor: &Rotor, args: &TestDataArgs) -> Result<TestData,
             return Ok(TestData { measurement, sensors: None, notes: Vec::new() });
         };
         let text = read_text(shapes)?;
-        let (measurement, set) = sensors::shapes_from_csv(&text, rotor, &measurement)
+        let (measurement, set) = sensors::shapes_from_csv(&text, rotor()?, &measurement)
             .map_err(|e| input(format!("{}: {e}", shapes.display())))?;
         return Ok(TestData { measurement, sensors: Some(set), notes: Vec::new() });
     }
@@ -208,17 +268,17 @@ pub fn read(path: &Path, rotor: &Rotor, args: &TestDataArgs) -> Result<TestData,
     let mut file = uff::parse(&read_text(path)?)
         .map_err(|e| input(format!("{}:{}: {}", path.display(), e.line, e.message)))?;
     let set = match &args.sensor_map {
-        Some(map) => sensors::map_explicit(&file, rotor, &read_text(map)?)
+        Some(map) => sensors::map_explicit(&file, rotor()?, &read_text(map)?)
             .map_err(|e| input(format!("{}: {e}", map.display())))?,
         None => {
-            match sensors::map_by_coordinates(&file, rotor, args.node_tolerance) {
+            match sensors::map_by_coordinates(&file, rotor()?, args.node_tolerance) {
                 Ok(set) => set,
                 // Test systems often export millimetres without saying so (no dataset 164):
                 // accept that reading when it ties every node, and say so.
                 Err(e) if file.length_factor.is_none() => {
                     let mut mm = file.clone();
                     mm.nodes.iter_mut().for_each(|n| n.coordinates.iter_mut().for_each(|c| *c /= 1000.0));
-                    let set = sensors::map_by_coordinates(&mm, rotor, args.node_tolerance)
+                    let set = sensors::map_by_coordinates(&mm, rotor()?, args.node_tolerance)
                         .map_err(|_| at(e.to_string()))?;
                     file.warnings.push(
                         "no units dataset (164) and the node coordinates match the model only as millimetres: \
@@ -243,14 +303,14 @@ pub fn read(path: &Path, rotor: &Rotor, args: &TestDataArgs) -> Result<TestData,
     Ok(TestData { measurement, sensors: Some(set), notes })
 }
 
-type RotorProblem<'a> = Problem<&'a Fixed<&'a UpdatableRotor>, &'a dyn EigenSolver>;
+type RotorProblem<'a> = Problem<&'a Fixed<&'a Updatable<'a>>, &'a dyn EigenSolver>;
 
 /// The fitted objective: frequencies only (order pairing), or frequencies and shapes (MAC).
 pub enum Fit<'a> {
     /// Frequencies, paired by order.
     Frequencies(RotorProblem<'a>),
     /// Frequencies and shapes, paired by MAC.
-    Shapes(ShapeFit<&'a Fixed<&'a UpdatableRotor>, &'a dyn EigenSolver>),
+    Shapes(ShapeFit<&'a Fixed<&'a Updatable<'a>>, &'a dyn EigenSolver>),
 }
 
 impl<'a> Fit<'a> {

@@ -1,5 +1,6 @@
 //! Shift-invert Lanczos with full reorthogonalisation: the fast path of
-//! [`BandedSolver`](crate::BandedSolver).
+//! [`BandedSolver`](crate::BandedSolver) and of [`SparseSolver`](crate::SparseSolver), which
+//! differ only in how they store M and factor K + σM ([`ShiftInvert`], [`MassProduct`]).
 //!
 //! On the inverted operator (K + σM)⁻¹M the lowest modes are the largest, best separated
 //! eigenvalues μ = 1/(λ + σ), and a Krylov space finds them in a few steps more than the modes
@@ -9,8 +10,53 @@
 //! check catches that and falls back to block subspace iteration.
 
 use crate::banded::{BandCholesky, BandedSymmetric};
+use crate::csc::CscSymmetric;
 use crate::small_eigen::{tridiagonal_eigen, tridiagonal_top};
 use crate::subspace::pseudo_random;
+
+/// A factor of K + σM: solves (K + σM) x = b in place.
+pub(crate) trait ShiftInvert {
+    fn solve_in_place(&mut self, x: &mut [f64]);
+}
+
+/// The mass matrix's product `out += α·M x`.
+pub(crate) trait MassProduct {
+    fn dim(&self) -> usize;
+    fn mul_add(&self, alpha: f64, x: &[f64], out: &mut [f64]);
+}
+
+impl ShiftInvert for BandCholesky {
+    fn solve_in_place(&mut self, x: &mut [f64]) {
+        BandCholesky::solve_in_place(self, x);
+    }
+}
+
+impl MassProduct for BandedSymmetric {
+    fn dim(&self) -> usize {
+        BandedSymmetric::dim(self)
+    }
+    fn mul_add(&self, alpha: f64, x: &[f64], out: &mut [f64]) {
+        BandedSymmetric::mul_add(self, alpha, x, out);
+    }
+}
+
+impl MassProduct for CscSymmetric {
+    fn dim(&self) -> usize {
+        CscSymmetric::dim(self)
+    }
+    fn mul_add(&self, alpha: f64, x: &[f64], out: &mut [f64]) {
+        CscSymmetric::mul_add(self, alpha, x, out);
+    }
+}
+
+/// Modes already found (M-orthonormal vectors and their M products, each contiguous) whose span
+/// a run must stay out of: a rerun after a Sturm count found a missed mode (a repeated
+/// eigenvalue, which one start vector sees once) then finds the missing copies.
+#[derive(Clone, Copy)]
+pub(crate) struct Locked<'a> {
+    pub vectors: &'a [f64],
+    pub m_vectors: &'a [f64],
+}
 
 /// Reusable work arrays of Lanczos runs (grown on demand, never shrunk).
 #[derive(Debug, Default)]
@@ -56,14 +102,19 @@ fn step_limit(n: usize, count: usize) -> usize {
 /// The `count` largest eigenpairs of (K + σM)⁻¹M (factor given) with relative inverse residual
 /// ‖ν·Op y − y‖_M ≤ `tolerance` (ν = 1/μ), or `None` when the step limit is reached first.
 pub(crate) fn largest<'a>(
-    factor: &BandCholesky,
-    m: &BandedSymmetric,
+    factor: &mut impl ShiftInvert,
+    m: &impl MassProduct,
     count: usize,
     tolerance: f64,
+    locked: Option<Locked<'_>>,
     work: &'a mut LanczosWork,
 ) -> Option<Ritz<'a>> {
     let n = m.dim();
-    let cap = step_limit(n, count);
+    let free = n - locked.map_or(0, |l| l.vectors.len() / n);
+    if count > free {
+        return None;
+    }
+    let cap = step_limit(free, count);
     let LanczosWork { q, mq, w, mw, alpha, beta, ritz, coefficients, start } = work;
     // Every entry is written before it is read: the basis grows with the steps taken (not to the
     // step limit: 10⁵ DOFs × 85 vectors would be 136 MB) and is never cleared.
@@ -78,6 +129,7 @@ pub(crate) fn largest<'a>(
     w.extend_from_slice(start);
     mw.clear();
     mw.resize(n, 0.0);
+    deflate(w, locked, coefficients);
     alpha.clear();
     beta.clear();
     let mut restarts = 0;
@@ -99,10 +151,12 @@ pub(crate) fn largest<'a>(
         // converging Lanczos step always cancels much): the rest would be round-off along the
         // basis, as in the last steps of a run through the whole space. In the M norm the
         // removed part is Σcᵢ² (the basis is M-orthonormal), so the test needs no extra product.
+        deflate(w, locked, coefficients);
         let mut a = orthogonalise(w, &q[..(j + 1) * n], &mq[..(j + 1) * n], coefficients);
         let mut b = m_norm(m, w, mw);
         let removed: f64 = coefficients.iter().map(|c| c * c).sum();
-        if j >= SINGLE_PASS_STEPS || b * b < 1e-6 * (removed + b * b) {
+        if j >= SINGLE_PASS_STEPS || b * b < 1e-6 * (removed + b * b) || locked.is_some() {
+            deflate(w, locked, coefficients);
             a += orthogonalise(w, &q[..(j + 1) * n], &mq[..(j + 1) * n], coefficients);
             b = m_norm(m, w, mw);
         }
@@ -123,6 +177,7 @@ pub(crate) fn largest<'a>(
                 *v = pseudo_random((restarts * n + i) as u64 + (1 << 40));
             }
             for _ in 0..2 {
+                deflate(w, locked, coefficients);
                 orthogonalise(w, &q[..steps * n], &mq[..steps * n], coefficients);
             }
             beta[j] = 0.0;
@@ -257,6 +312,13 @@ fn orthogonalise(w: &mut [f64], q: &[f64], mq: &[f64], coefficients: &mut Vec<f6
     coefficients.last().copied().unwrap_or(0.0)
 }
 
+/// Removes the locked modes' components from `w` (one Gram–Schmidt pass in the M product).
+fn deflate(w: &mut [f64], locked: Option<Locked<'_>>, coefficients: &mut Vec<f64>) {
+    if let Some(l) = locked {
+        orthogonalise(w, l.vectors, l.m_vectors, coefficients);
+    }
+}
+
 /// Makes `v` at least `len` long (amortised growth; contents beyond the old length are zero).
 fn grow(v: &mut Vec<f64>, len: usize) {
     if v.len() < len {
@@ -265,7 +327,7 @@ fn grow(v: &mut Vec<f64>, len: usize) {
 }
 
 /// ‖w‖_M, leaving M w in `mw`.
-fn m_norm(m: &BandedSymmetric, w: &[f64], mw: &mut [f64]) -> f64 {
+fn m_norm(m: &impl MassProduct, w: &[f64], mw: &mut [f64]) -> f64 {
     mw.fill(0.0);
     m.mul_add(1.0, w, mw);
     dot(w, mw).max(0.0).sqrt()

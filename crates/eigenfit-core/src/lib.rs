@@ -22,6 +22,7 @@
 
 pub mod banded;
 pub mod compare;
+pub mod csc;
 pub mod dense;
 pub mod discovery;
 pub mod fixed;
@@ -38,6 +39,7 @@ pub mod sensitivity;
 mod small_eigen;
 pub mod solver;
 pub mod sparse;
+pub mod sparse_solver;
 pub mod statistics;
 pub mod subspace;
 pub mod synthetic;
@@ -49,6 +51,7 @@ pub mod update;
 pub mod verdict;
 
 pub use banded::{BandCholesky, BandedSymmetric};
+pub use csc::CscSymmetric;
 pub use dense::DenseSolver;
 pub use measurement::{MeasuredMode, Measurement, MeasurementError};
 pub use model::{finite_difference_derivative, ModelError, StructuralModel};
@@ -58,6 +61,7 @@ pub use residual::{Linearisation, Pairing, Problem, ResidualError, ResidualKind}
 pub use sensitivity::{Sensitivities, SensitivityError};
 pub use solver::{EigenSolver, SolveError};
 pub use sparse::SparseSymmetric;
+pub use sparse_solver::SparseSolver;
 pub use statistics::{
     alternative_solutions, alternative_solutions_within, mirror_solutions, uncertainty, uncertainty_within,
     Identifiability, Uncertainty,

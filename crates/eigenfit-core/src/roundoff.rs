@@ -38,6 +38,10 @@ pub fn relative_roundoff(system: &System, modes: &Modes) -> Vec<f64> {
 /// (‖K‖∞, ‖M‖∞): largest absolute row sums (≥ the 2-norms of symmetric matrices), without
 /// densifying a band.
 fn inf_norms(system: &System) -> (f64, f64) {
+    if let Some((k, m)) = system.sparse_pair() {
+        // A sparse system (10⁵–10⁶ DOFs) must not be densified.
+        return (k.inf_norm(), m.inf_norm());
+    }
     match system.band() {
         Some((k, m)) => (band_inf_norm(k), band_inf_norm(m)),
         None => (dense_inf_norm(system.stiffness()), dense_inf_norm(system.mass())),

@@ -312,7 +312,9 @@ impl BandedSolver {
         ws: &mut Workspace,
     ) -> Result<Modes, SolveError> {
         let lanczos = match method {
-            Method::Lanczos => lanczos::largest(&ws.factor, m, count, self.tolerance, &mut ws.lanczos),
+            Method::Lanczos => {
+                lanczos::largest(&mut ws.factor, m, count, self.tolerance, None, &mut ws.lanczos)
+            }
             Method::Subspace => None,
         };
         if let Some(ritz) = lanczos {

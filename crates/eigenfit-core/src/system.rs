@@ -1,6 +1,7 @@
 //! Assembled matrices K, M of a structure at one parameter vector, and their parameter derivatives.
 
 use crate::banded::BandedSymmetric;
+use crate::csc::CscSymmetric;
 use crate::sparse::SparseSymmetric;
 use nalgebra::DMatrix;
 use std::sync::OnceLock;
@@ -26,11 +27,13 @@ pub enum SystemError {
 
 /// Stiffness K and mass M of a structure (n×n, symmetric; M positive definite for a solve).
 ///
-/// Stored densely ([`System::new`]) or by band ([`System::banded`], for large beam-like models
-/// whose dense matrices would not fit: 10⁴ DOFs are 800 MB per dense matrix, 320 kB per band).
+/// Stored densely ([`System::new`]), by band ([`System::banded`], for large beam-like models
+/// whose dense matrices would not fit: 10⁴ DOFs are 800 MB per dense matrix, 320 kB per band) or
+/// as general sparse matrices ([`System::sparse`], for plates, shells and solids from any FE tool).
 /// [`stiffness`](Self::stiffness) and [`mass`](Self::mass) always answer with dense matrices —
-/// for a banded system they are built on first use and kept, at O(n²) memory — so dense solvers
-/// work on either; band-aware code asks [`band`](Self::band) first.
+/// for a banded or sparse system they are built on first use and kept, at O(n²) memory — so dense
+/// solvers work on any; band- and sparse-aware code asks [`band`](Self::band) or
+/// [`sparse`](Self::sparse_pair) first.
 #[derive(Debug, Clone)]
 pub struct System {
     storage: Storage,
@@ -47,6 +50,11 @@ enum Storage {
         mass: BandedSymmetric,
         dense: OnceLock<(DMatrix<f64>, DMatrix<f64>)>,
     },
+    Sparse {
+        stiffness: CscSymmetric,
+        mass: CscSymmetric,
+        dense: OnceLock<(DMatrix<f64>, DMatrix<f64>)>,
+    },
 }
 
 impl PartialEq for System {
@@ -57,6 +65,10 @@ impl PartialEq for System {
                 Storage::Banded { stiffness: k1, mass: m1, .. },
                 Storage::Banded { stiffness: k2, mass: m2, .. },
             ) if k1.bandwidth() == k2.bandwidth() && m1.bandwidth() == m2.bandwidth() => k1 == k2 && m1 == m2,
+            (
+                Storage::Sparse { stiffness: k1, mass: m1, .. },
+                Storage::Sparse { stiffness: k2, mass: m2, .. },
+            ) if k1.same_pattern(k2) && m1.same_pattern(m2) => k1 == k2 && m1 == m2,
             _ => self.stiffness() == other.stiffness() && self.mass() == other.mass(),
         }
     }
@@ -99,19 +111,46 @@ impl System {
         Ok(Self { storage: Storage::Banded { stiffness, mass, dense: OnceLock::new() } })
     }
 
+    /// A system stored as general sparse matrices (symmetric by construction): checks size and
+    /// finiteness, O(nnz).
+    pub fn sparse(stiffness: CscSymmetric, mass: CscSymmetric) -> Result<Self, SystemError> {
+        let n = stiffness.dim();
+        if mass.dim() != n {
+            return Err(SystemError::Shape { k_rows: n, k_cols: n, m_rows: mass.dim(), m_cols: mass.dim() });
+        }
+        if n == 0 {
+            return Err(SystemError::Empty);
+        }
+        for (name, a) in [("K", &stiffness), ("M", &mass)] {
+            if let Some((row, col, value)) = a.first_non_finite() {
+                return Err(SystemError::NonFinite { matrix: name, row, col, value });
+            }
+        }
+        Ok(Self { storage: Storage::Sparse { stiffness, mass, dense: OnceLock::new() } })
+    }
+
     /// Number of degrees of freedom n.
     pub fn dofs(&self) -> usize {
         match &self.storage {
             Storage::Dense { stiffness, .. } => stiffness.nrows(),
             Storage::Banded { stiffness, .. } => stiffness.dim(),
+            Storage::Sparse { stiffness, .. } => stiffness.dim(),
         }
     }
 
     /// (K, M) by band when the system is stored so.
     pub fn band(&self) -> Option<(&BandedSymmetric, &BandedSymmetric)> {
         match &self.storage {
-            Storage::Dense { .. } => None,
             Storage::Banded { stiffness, mass, .. } => Some((stiffness, mass)),
+            _ => None,
+        }
+    }
+
+    /// (K, M) as general sparse matrices when the system is stored so.
+    pub fn sparse_pair(&self) -> Option<(&CscSymmetric, &CscSymmetric)> {
+        match &self.storage {
+            Storage::Sparse { stiffness, mass, .. } => Some((stiffness, mass)),
+            _ => None,
         }
     }
 
@@ -122,24 +161,29 @@ impl System {
                 let (k, m) = dense.get_or_init(|| (stiffness.to_dense(), mass.to_dense()));
                 (k, m)
             }
+            Storage::Sparse { stiffness, mass, dense } => {
+                let (k, m) = dense.get_or_init(|| (stiffness.to_dense(), mass.to_dense()));
+                (k, m)
+            }
         }
     }
 
-    /// Stiffness matrix K (dense; built and kept on first use for a banded system).
+    /// Stiffness matrix K (dense; built and kept on first use for a banded or sparse system).
     pub fn stiffness(&self) -> &DMatrix<f64> {
         self.dense_pair().0
     }
 
-    /// Mass matrix M (dense; built and kept on first use for a banded system).
+    /// Mass matrix M (dense; built and kept on first use for a banded or sparse system).
     pub fn mass(&self) -> &DMatrix<f64> {
         self.dense_pair().1
     }
 
-    /// Largest |Kᵢⱼ| and largest |Mᵢⱼ|, without densifying a banded system.
+    /// Largest |Kᵢⱼ| and largest |Mᵢⱼ|, without densifying a banded or sparse system.
     pub fn amax(&self) -> (f64, f64) {
         match &self.storage {
             Storage::Dense { stiffness, mass } => (stiffness.amax(), mass.amax()),
             Storage::Banded { stiffness, mass, .. } => (stiffness.amax(), mass.amax()),
+            Storage::Sparse { stiffness, mass, .. } => (stiffness.amax(), mass.amax()),
         }
     }
 
@@ -148,6 +192,9 @@ impl System {
         match self.storage {
             Storage::Dense { stiffness, mass } => (stiffness, mass),
             Storage::Banded { stiffness, mass, dense } => {
+                dense.into_inner().unwrap_or_else(|| (stiffness.to_dense(), mass.to_dense()))
+            }
+            Storage::Sparse { stiffness, mass, dense } => {
                 dense.into_inner().unwrap_or_else(|| (stiffness.to_dense(), mass.to_dense()))
             }
         }

@@ -72,9 +72,11 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             fix: Vec::new(),
             write_model: None,
         };
-        let d =
-            testdata::read(&conf.measured, &rotor, &options).map_err(|e| input(format!("{name}: {e}")))?;
-        let updatable = testdata::updatable(&rotor, &conf.model.display().to_string())?;
+        let d = testdata::read(&conf.measured, Some(&rotor), &options)
+            .map_err(|e| input(format!("{name}: {e}")))?;
+        let updatable = eigenfit_rotor::UpdatableRotor::new(rotor)
+            .map(testdata::Updatable::Rotor)
+            .map_err(|e| input(format!("{}: {e}", conf.model.display())))?;
         rotors.push((updatable, options));
         data.push(d);
         names.push(name);

@@ -74,7 +74,8 @@ pub const MAX_RUNS: usize = 1_000_000;
 
 /// Runs `compare`.
 pub fn run(args: &CompareArgs) -> Result<(), CliError> {
-    let (rotor, label) = args.model.load()?;
+    let (model, label) = args.model.load_any()?;
+    let rotor = &model;
     let solver = args.model.solver()?;
     let np = rotor.parameters().len();
     let targets = points("--targets", &args.targets, np)?;

@@ -1,12 +1,13 @@
 //! `eigenfit discover`: find where model and measurement disagree, name the missing effect, add it.
 
+use crate::any_model::AnyModel;
 use crate::error::{input, CliError};
 use crate::output::write_atomically;
 use crate::plot::discovery::DiscoveryPlot;
 use crate::source::ModelArgs;
 use crate::{measured, plot, progress};
 use clap::Args;
-use eigenfit_core::discovery::{Alternative, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
+use eigenfit_core::discovery::{discover, Alternative, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
 use eigenfit_core::StructuralModel;
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde_json::{json, Value};
@@ -39,7 +40,8 @@ pub struct DiscoverArgs {
 
 /// Runs `discover`.
 pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
-    let (rotor, label) = args.model.load()?;
+    let (model, label) = args.model.load_any()?;
+    let rotor = &model;
     let solver = args.model.solver()?;
     let data = measured::read(&args.measured)?;
     if !(args.assumed_std.is_finite() && args.assumed_std > 0.0) {
@@ -47,14 +49,23 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
     }
     let options = DiscoveryOptions { assumed_relative_std: args.assumed_std, ..Default::default() };
     let pb = progress::spinner("discovering: calibrate, detect, screen and refit candidates", args.quiet);
-    let found = discover_rotor(&rotor, &solver.as_ref(), &data, &rotor.nominal_stiffnesses(), &options);
+    let found = match &model {
+        AnyModel::Rotor(r) => discover_rotor(r, &solver.as_ref(), &data, &r.nominal_stiffnesses(), &options),
+        // A matrices model has no mesh to refine: the generic workflow over its [[candidate]]s.
+        AnyModel::Matrices(m) => {
+            discover(m, &solver.as_ref(), &data, &m.candidates(), &m.parameters().nominal_values(), &options)
+                .map(|report| RotorDiscovery { effects: report.effects.clone(), report, mesh_factor: 1 })
+        }
+    };
     pb.finish_and_clear();
     let found = found.map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
     let report = &found.report;
     let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
     let mut written = Vec::new();
     if let Some(path) = &args.write_model {
-        let augmented = found.augmented_model(&rotor).map_err(|e| CliError::Failure(e.to_string()))?;
+        let augmented = found
+            .augmented_model(model.rotor("--write-model")?)
+            .map_err(|e| CliError::Failure(e.to_string()))?;
         let text = augmented.to_toml_string().map_err(|e| CliError::Failure(e.to_string()))?;
         write_atomically(path, text.as_bytes())?;
         written.push(path.display().to_string());

@@ -1,5 +1,6 @@
 //! `eigenfit estimate`: update the bearing stiffnesses to match measured frequencies.
 
+use crate::any_model::AnyModel;
 use crate::error::{input, CliError, EXIT_NOT_CONVERGED};
 use crate::plot::convergence::{Convergence, Run};
 use crate::source::{parameter_vector, ModelArgs};
@@ -68,9 +69,14 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     if let Some(path) = crate::rotordynamics::ross_model(args.model.model.as_deref()) {
         return crate::rotordynamics::estimate(path, &args.measured, args.max_iterations, args.json);
     }
-    let (rotor, label) = args.model.load()?;
+    let (model, label) = args.model.load_any()?;
+    let rotor = &model;
     let solver = args.model.solver()?;
-    let data = testdata::read(&args.measured, &rotor, &args.test_data)?;
+    let layout: Option<&dyn eigenfit_core::testdata::sensors::NodeLayout> = match &model {
+        AnyModel::Rotor(r) => Some(r),
+        AnyModel::Matrices(_) => None,
+    };
+    let data = testdata::read(&args.measured, layout, &args.test_data)?;
     let measurement = data.measurement.clone();
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
         input(format!(
@@ -92,7 +98,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     if args.budget == 0 {
         return Err(input("--budget 0: at least one model evaluation is needed"));
     }
-    let updatable = testdata::updatable(&rotor, &label)?;
+    let updatable = testdata::updatable(rotor, &label)?;
     let initial = parameter_vector(&updatable, "--initial", args.initial.as_deref(), &[])?;
     let model = testdata::fixed(&updatable, &args.test_data.fix)?;
     let initial = model.reduce(&initial);

@@ -1,5 +1,6 @@
 //! `eigenfit simulate`: natural frequencies of a model, at one point or over a stiffness sweep.
 
+use crate::any_model::AnyModel;
 use crate::error::{input, CliError};
 use crate::plot::critical_speed::CriticalSpeedMap;
 use crate::plot::mode_shapes::ModeShapes;
@@ -67,7 +68,13 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if args.speed.is_some() {
         return Err(input("--speed applies to two-plane rotors (files saved by ROSS); this model is planar"));
     }
-    let (mut rotor, label) = args.model.load()?;
+    let (model, label) = args.model.load_any()?;
+    let mut rotor = match model {
+        AnyModel::Rotor(rotor) => rotor,
+        AnyModel::Matrices(m) => {
+            return crate::any_model::simulate(args, &m, &label, args.model.solver()?.as_ref())
+        }
+    };
     for text in &args.effects {
         let effect = EffectSpec::parse(text).map_err(|e| input(format!("--effect {e}")))?;
         rotor = rotor.with_effect(effect).map_err(|e| input(format!("--effect `{text}`: {e}")))?;

@@ -1,5 +1,6 @@
 //! Candidate effects: physics a model may lack, as extra matrix contributions with a value.
 
+use crate::csc::CscSymmetric;
 use crate::model::{ModelError, StructuralModel};
 use crate::parameters::{Parameter, ParameterSet};
 use crate::sparse::SparseSymmetric;
@@ -160,12 +161,31 @@ impl<M: StructuralModel + ?Sized> StructuralModel for Augmented<'_, M> {
     fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
         self.params.check(p)?;
         let nb = self.base.parameters().len();
-        let (mut k, mut m) = self.base.assemble(&p[..nb])?.into_parts();
-        for (c, (value, _)) in self.candidates.iter().zip(self.values(p)) {
-            let (fk, fm) = match c.parameter {
+        let base = self.base.assemble(&p[..nb])?;
+        let factors: Vec<(f64, f64)> = self
+            .candidates
+            .iter()
+            .zip(self.values(p))
+            .map(|(c, (value, _))| match c.parameter {
                 Some(_) => c.law.factors(value),
                 None => (1.0, 1.0),
+            })
+            .collect();
+        if let Some((k, m)) = base.sparse_pair() {
+            // A sparse base stays sparse: a dense copy of 10⁵ DOFs would take 80 GB.
+            let add = |a: CscSymmetric, s: &SparseSymmetric, f: f64| {
+                let delta = CscSymmetric::from_triplets(a.dim(), s.entries().iter().copied());
+                CscSymmetric::combination(1.0, &a, f, &delta)
             };
+            let (mut k, mut m) = (k.clone(), m.clone());
+            for (c, &(fk, fm)) in self.candidates.iter().zip(&factors) {
+                k = add(k, &c.stiffness, fk);
+                m = add(m, &c.mass, fm);
+            }
+            return Ok(System::sparse(k, m)?);
+        }
+        let (mut k, mut m) = base.into_parts();
+        for (c, &(fk, fm)) in self.candidates.iter().zip(&factors) {
             add_scaled(&mut k, &c.stiffness, fk);
             add_scaled(&mut m, &c.mass, fm);
         }
