@@ -54,7 +54,7 @@ pub struct TestDataArgs {
 /// matrices model as it is (its parameters are already declared in its file).
 pub enum Updatable<'a> {
     /// A planar rotor.
-    Rotor(UpdatableRotor),
+    Rotor(Box<UpdatableRotor>),
     /// K(p) = K₀ + Σ pᵢKᵢ, M(p) = M₀ + Σ pᵢMᵢ.
     Matrices(&'a MatricesModel),
 }
@@ -187,7 +187,7 @@ pub struct TestData {
 pub fn updatable<'a>(model: &'a AnyModel, label: &str) -> Result<Updatable<'a>, CliError> {
     match model {
         AnyModel::Rotor(rotor) => UpdatableRotor::new(rotor.clone())
-            .map(Updatable::Rotor)
+            .map(|r| Updatable::Rotor(Box::new(r)))
             .map_err(|e| input(format!("{label}: {e}"))),
         AnyModel::Matrices(m) => Ok(Updatable::Matrices(m)),
     }

@@ -75,7 +75,7 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         let d = testdata::read(&conf.measured, Some(&rotor), &options)
             .map_err(|e| input(format!("{name}: {e}")))?;
         let updatable = eigenfit_rotor::UpdatableRotor::new(rotor)
-            .map(testdata::Updatable::Rotor)
+            .map(|r| testdata::Updatable::Rotor(Box::new(r)))
             .map_err(|e| input(format!("{}: {e}", conf.model.display())))?;
         rotors.push((updatable, options));
         data.push(d);
