@@ -119,18 +119,8 @@ pub fn simulate(
     if args.json {
         let params: serde_json::Map<_, _> = names.iter().cloned().zip(p.iter().map(|&v| json!(v))).collect();
         let mut out = json!({"model": label, "solver": solver.name(), "dofs": model.dofs(), "parameters": params, "frequencies_hz": f});
-        match &sens {
-            Ok(df) => {
-                let by_param: serde_json::Map<_, _> = names
-                    .iter()
-                    .enumerate()
-                    .map(|(i, n)| (n.clone(), json!(df.column(i).iter().copied().collect::<Vec<f64>>())))
-                    .collect();
-                out["sensitivities_hz"] = json!(by_param);
-            }
-            Err(why) => out["sensitivities_unavailable"] = json!(why),
-        }
-        println!("{out}");
+        crate::commands::simulate::add_sensitivities_json(&mut out, &names, &sens);
+        crate::output::emit_json(out);
     } else {
         println!("{label} ({} DOF, {} stored entries, {} solver)", model.dofs(), model.nnz(), solver.name());
         for (n, (v, q)) in names.iter().zip(p.iter().zip(model.parameters().iter())) {

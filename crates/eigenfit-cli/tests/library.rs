@@ -6,6 +6,7 @@ use serde_json::Value;
 use std::process::Command;
 
 const MEASURED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_no_effect.csv");
+const PLATE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../eigenfit-matrices/tests/data/plate/model.toml");
 const HIDDEN: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_hidden_effect.csv");
 
 fn args(list: &[&str]) -> Vec<String> {
@@ -27,8 +28,10 @@ fn library(list: &[&str]) -> (String, u8) {
 
 #[test]
 fn library_and_binary_give_the_same_json_and_exit_code() {
-    let cases: [&[&str]; 5] = [
+    let cases: [&[&str]; 6] = [
         &["simulate", "--preset", "paper-rotor", "--stiffness", "1e5,1e5", "--modes", "2"],
+        // A matrices model takes its own simulate path: its JSON must reach the library too.
+        &["simulate", "--model", PLATE, "--modes", "3"],
         &["simulate", "--preset", "paper-rotor", "--sweep", "1e3:1e7:3", "--modes", "2"],
         &["estimate", "--preset", "paper-rotor", "--measured", MEASURED],
         // Not converged: exit code 3 with the result.

@@ -96,36 +96,14 @@ impl System {
 
     /// A system stored by band (symmetric by construction): checks size and finiteness, O(n·b).
     pub fn banded(stiffness: BandedSymmetric, mass: BandedSymmetric) -> Result<Self, SystemError> {
-        let n = stiffness.dim();
-        if mass.dim() != n {
-            return Err(SystemError::Shape { k_rows: n, k_cols: n, m_rows: mass.dim(), m_cols: mass.dim() });
-        }
-        if n == 0 {
-            return Err(SystemError::Empty);
-        }
-        for (name, a) in [("K", &stiffness), ("M", &mass)] {
-            if let Some((row, col, value)) = a.first_non_finite() {
-                return Err(SystemError::NonFinite { matrix: name, row, col, value });
-            }
-        }
+        check_pair((stiffness.dim(), stiffness.first_non_finite()), (mass.dim(), mass.first_non_finite()))?;
         Ok(Self { storage: Storage::Banded { stiffness, mass, dense: OnceLock::new() } })
     }
 
     /// A system stored as general sparse matrices (symmetric by construction): checks size and
     /// finiteness, O(nnz).
     pub fn sparse(stiffness: CscSymmetric, mass: CscSymmetric) -> Result<Self, SystemError> {
-        let n = stiffness.dim();
-        if mass.dim() != n {
-            return Err(SystemError::Shape { k_rows: n, k_cols: n, m_rows: mass.dim(), m_cols: mass.dim() });
-        }
-        if n == 0 {
-            return Err(SystemError::Empty);
-        }
-        for (name, a) in [("K", &stiffness), ("M", &mass)] {
-            if let Some((row, col, value)) = a.first_non_finite() {
-                return Err(SystemError::NonFinite { matrix: name, row, col, value });
-            }
-        }
+        check_pair((stiffness.dim(), stiffness.first_non_finite()), (mass.dim(), mass.first_non_finite()))?;
         Ok(Self { storage: Storage::Sparse { stiffness, mass, dense: OnceLock::new() } })
     }
 
@@ -199,6 +177,26 @@ impl System {
             }
         }
     }
+}
+
+/// Size and finiteness of a stored K, M pair, each given as (dimension, first non-finite entry):
+/// the checks the band and sparse constructors share (their storage is symmetric by construction).
+fn check_pair(
+    (n, k_bad): (usize, Option<(usize, usize, f64)>),
+    (m_dim, m_bad): (usize, Option<(usize, usize, f64)>),
+) -> Result<(), SystemError> {
+    if m_dim != n {
+        return Err(SystemError::Shape { k_rows: n, k_cols: n, m_rows: m_dim, m_cols: m_dim });
+    }
+    if n == 0 {
+        return Err(SystemError::Empty);
+    }
+    for (matrix, bad) in [("K", k_bad), ("M", m_bad)] {
+        if let Some((row, col, value)) = bad {
+            return Err(SystemError::NonFinite { matrix, row, col, value });
+        }
+    }
+    Ok(())
 }
 
 fn check_matrix(name: &'static str, a: &DMatrix<f64>) -> Result<(), SystemError> {

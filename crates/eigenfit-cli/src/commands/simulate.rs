@@ -157,18 +157,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         let params: serde_json::Map<_, _> = names.iter().cloned().zip(p.iter().map(|&v| json!(v))).collect();
         let mut out =
             json!({"model": label, "solver": solver.name(), "parameters": params, "frequencies_hz": f});
-        match &sens {
-            // df_k/dp_i in Hz per parameter unit, one array (over modes) per parameter.
-            Ok(df) => {
-                let by_param: serde_json::Map<_, _> = names
-                    .iter()
-                    .enumerate()
-                    .map(|(i, n)| (n.clone(), json!(df.column(i).iter().copied().collect::<Vec<f64>>())))
-                    .collect();
-                out["sensitivities_hz"] = json!(by_param);
-            }
-            Err(why) => out["sensitivities_unavailable"] = json!(why),
-        }
+        add_sensitivities_json(&mut out, &names, &sens);
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
@@ -186,6 +175,26 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         args.uff.iter().for_each(|w| println!("wrote {}", w.display()));
     }
     Ok(())
+}
+
+/// `sensitivities_hz` (df_k/dp_i in Hz per parameter unit, one array over modes per parameter),
+/// or `sensitivities_unavailable` saying why there are none.
+pub fn add_sensitivities_json(
+    out: &mut serde_json::Value,
+    names: &[String],
+    sens: &Result<nalgebra::DMatrix<f64>, String>,
+) {
+    match sens {
+        Ok(df) => {
+            let by_param: serde_json::Map<_, _> = names
+                .iter()
+                .enumerate()
+                .map(|(i, n)| (n.clone(), json!(df.column(i).iter().copied().collect::<Vec<f64>>())))
+                .collect();
+            out["sensitivities_hz"] = json!(by_param);
+        }
+        Err(why) => out["sensitivities_unavailable"] = json!(why),
+    }
 }
 
 /// Whether `rotor` is the paper's rotor (whatever its current support stiffnesses).
