@@ -93,7 +93,7 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
     let id = identify(&rotor, &params, &points, &initial, max_iterations).map_err(to_cli)?;
     // Report each stiffness in N/m at the lowest measured speed (constant bearings: their value).
     let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
-    let nominal: Vec<f64> = params.iter().map(|p| rotor.bearings[p.bearing].k[p.entry].at(w0)).collect();
+    let nominal: Vec<f64> = params.iter().map(|p| p.nominal(&rotor, w0)).collect();
     let value: Vec<f64> = nominal.iter().zip(&id.scales).map(|(k, s)| k * s).collect();
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
     let obj = |values: Vec<Value>| -> Map<String, Value> { names.iter().cloned().zip(values).collect() };
