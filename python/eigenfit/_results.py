@@ -292,9 +292,41 @@ class CompareResult(Result):
         return np.asarray([r["estimate"] for r in self._data["runs"]], dtype=float)
 
 
+class CampbellResult(Result):
+    """``eigenfit campbell``: damped whirl frequencies of a two-plane rotor over speed."""
+
+    command = "campbell"
+
+    @property
+    def speeds_rpm(self) -> np.ndarray:
+        """The rotor speeds (rpm)."""
+        return np.asarray(self._data["speeds_rpm"], dtype=float)
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """Damped natural frequencies (Hz), shape (speeds, modes), ascending at each speed."""
+        return np.asarray(self._data["frequencies_hz"], dtype=float)
+
+    @property
+    def whirl(self) -> List[List[str]]:
+        """Whirl of each mode at each speed: ``forward``, ``backward`` or ``mixed``."""
+        return copy.deepcopy(self._data["whirl"])
+
+    @property
+    def log_dec(self) -> np.ndarray:
+        """Logarithmic decrements, shape (speeds, modes)."""
+        return np.asarray(self._data["log_dec"], dtype=float)
+
+    @property
+    def critical_speeds_rpm(self) -> np.ndarray:
+        """Speeds (rpm) where a followed mode crosses the 1× line, ascending."""
+        return np.asarray(self._data["critical_speeds_rpm"], dtype=float)
+
+
 #: Result class by name, for unpickling (the name, not the class, travels in the pickle).
 RESULT_CLASSES = {
-    c.__name__: c for c in (SimulateResult, EstimateResult, DiscoverResult, CompareResult, Result)
+    c.__name__: c
+    for c in (SimulateResult, EstimateResult, DiscoverResult, CompareResult, CampbellResult, Result)
 }
 
 

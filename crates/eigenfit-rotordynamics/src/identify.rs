@@ -296,6 +296,8 @@ pub struct Identification {
     pub model_hz: Vec<f64>,
     /// Model whirl at the estimate.
     pub model_whirl: Vec<Whirl>,
+    /// d f_i / d ln s_j at the estimate (Hz), unweighted.
+    pub jacobian: DMatrix<f64>,
     /// Σ r² (weighted by std_hz, or relative residuals without).
     pub cost: f64,
     /// Iterations taken.
@@ -486,6 +488,7 @@ pub fn identify(
         ln_std,
         model_hz: eval.frequencies_hz.clone(),
         model_whirl: eval.whirl.clone(),
+        jacobian: eval.jacobian.clone(),
         cost,
         iterations,
         evaluations,
