@@ -5,7 +5,7 @@ use crate::error::{input, CliError, EXIT_NOT_CONVERGED, EXIT_OK};
 use eigenfit_core::residual::Linearisation;
 use eigenfit_core::verdict::{judge, FitQuality, FitVerdict};
 use eigenfit_rotordynamics::identify::{
-    bearing_parameters, identify_staged, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
+    bearing_parameters, identify, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
 };
 use eigenfit_rotordynamics::{ross_file, rpm_to_rad, Rotor, RotorDynError};
 use nalgebra::{DMatrix, DVector};
@@ -134,7 +134,7 @@ pub fn estimate(
         return Err(input(format!("{}: the rotor has no bearings to estimate", path.display())));
     }
     let initial = vec![1.0; params.len()];
-    let id = identify_staged(&rotor, &params, &points, &initial, max_iterations).map_err(to_cli)?;
+    let id = identify(&rotor, &params, &points, &initial, max_iterations).map_err(to_cli)?;
     // Report each coefficient at the lowest measured speed (constant bearings: their value).
     let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
     let nominal: Vec<f64> = params.iter().map(|p| p.nominal(&rotor, w0)).collect();

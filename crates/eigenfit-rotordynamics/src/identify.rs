@@ -313,50 +313,12 @@ pub struct Identification {
     pub reason: String,
 }
 
-/// Levenberg–Marquardt in stages when the selection holds more than the direct stiffnesses:
-/// first kxx and kyy alone (the rest held at `initial`), then everything from there. The direct
-/// stiffnesses move the frequencies most; fitted together from a nominal start the weak cross-
-/// coupled and damping directions (singular values 10⁴–10⁵ below) pull the iteration into other
-/// minima (a 12-parameter ROSS run-up from factors 0.8–1.25 away: stalled; staged: recovered).
-pub fn identify_staged(
-    rotor: &Rotor,
-    params: &[Parameter],
-    points: &[RunupPoint],
-    initial: &[f64],
-    max_iterations: usize,
-) -> Result<Identification, RotorDynError> {
-    let direct: Vec<usize> = (0..params.len()).filter(|&i| matches!(params[i].coefficient, 0 | 3)).collect();
-    if direct.is_empty() || direct.len() == params.len() {
-        return identify(rotor, params, points, initial, max_iterations);
-    }
-    let sub: Vec<Parameter> = direct.iter().map(|&i| params[i].clone()).collect();
-    let sub_start: Vec<f64> = direct.iter().map(|&i| initial[i]).collect();
-    let held = scaled_rotor(
-        rotor,
-        &params
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| !direct.contains(i))
-            .map(|(_, p)| p.clone())
-            .collect::<Vec<_>>(),
-        &(0..params.len()).filter(|i| !direct.contains(i)).map(|i| initial[i]).collect::<Vec<_>>(),
-    );
-    let first = identify(&held, &sub, points, &sub_start, max_iterations)?;
-    let mut start = initial.to_vec();
-    for (k, &i) in direct.iter().enumerate() {
-        start[i] = first.scales[k];
-    }
-    let mut out = identify(rotor, params, points, &start, max_iterations)?;
-    out.iterations += first.iterations;
-    out.evaluations += first.evaluations;
-    Ok(out)
-}
-
-/// Largest change of any ln s in one step (a trust region): whirl frequencies are sorted at each
-/// speed, so modes that trade places kink the residual, and long steps jump into other basins.
-const MAX_LN_STEP: f64 = 0.2;
-
-/// Levenberg–Marquardt in ln s from `initial` scales.
+/// Levenberg–Marquardt in ln s from `initial` scales, in stages when the selection holds more
+/// than the direct stiffnesses: first kxx and kyy alone (the rest held at `initial`), then
+/// everything from there. The direct stiffnesses move the frequencies most; fitted together from
+/// a nominal start the weak cross-coupled and damping directions (singular values 10⁴–10⁵
+/// below) pull the iteration into other minima (a 12-parameter ROSS run-up from factors 0.8–1.25
+/// away: stalled; staged: recovered).
 pub fn identify(
     rotor: &Rotor,
     params: &[Parameter],
@@ -364,6 +326,43 @@ pub fn identify(
     initial: &[f64],
     max_iterations: usize,
 ) -> Result<Identification, RotorDynError> {
+    let whole = Fit { rotor, params, points, max_iterations };
+    let direct: Vec<usize> = (0..params.len()).filter(|&i| matches!(params[i].coefficient, 0 | 3)).collect();
+    if direct.is_empty() || direct.len() == params.len() {
+        return levenberg_marquardt(&whole, initial);
+    }
+    let (held, held_scales): (Vec<Parameter>, Vec<f64>) =
+        (0..params.len()).filter(|i| !direct.contains(i)).map(|i| (params[i].clone(), initial[i])).unzip();
+    let held_rotor = scaled_rotor(rotor, &held, &held_scales);
+    let sub: Vec<Parameter> = direct.iter().map(|&i| params[i].clone()).collect();
+    let sub_start: Vec<f64> = direct.iter().map(|&i| initial[i]).collect();
+    let first = levenberg_marquardt(&Fit { rotor: &held_rotor, params: &sub, ..whole }, &sub_start)?;
+    let mut start = initial.to_vec();
+    for (k, &i) in direct.iter().enumerate() {
+        start[i] = first.scales[k];
+    }
+    let mut out = levenberg_marquardt(&whole, &start)?;
+    out.iterations += first.iterations;
+    out.evaluations += first.evaluations;
+    Ok(out)
+}
+
+/// One least-squares problem: a rotor, the parameters on it, the run-up, the iteration limit.
+#[derive(Clone, Copy)]
+struct Fit<'a> {
+    rotor: &'a Rotor,
+    params: &'a [Parameter],
+    points: &'a [RunupPoint],
+    max_iterations: usize,
+}
+
+/// Largest change of any ln s in one step (a trust region): whirl frequencies are sorted at each
+/// speed, so modes that trade places kink the residual, and long steps jump into other basins.
+const MAX_LN_STEP: f64 = 0.2;
+
+/// Levenberg–Marquardt in ln s from `initial` scales.
+fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, RotorDynError> {
+    let Fit { rotor, params, points, max_iterations } = *fit;
     let m = points.len();
     let np = params.len();
     if m < np {

@@ -2,7 +2,7 @@
 //! computed with known stiffnesses, and the reported intervals covering them.
 
 use eigenfit_rotordynamics::identify::{
-    bearing_parameters, evaluate, identify, identify_staged, parse_runup, stiffness_parameters, RunupPoint,
+    bearing_parameters, evaluate, identify, parse_runup, stiffness_parameters, RunupPoint,
 };
 use eigenfit_rotordynamics::ross_file;
 use std::path::PathBuf;
@@ -101,7 +101,7 @@ fn runup_csv_errors_name_the_line() {
 /// A run-up computed by ROSS (independent code, `scripts/ross_runup_reference.py`) on a rotor
 /// whose two bearings' kxx, kyy, kxy, kyx, cxx and cyy were multiplied by known factors; eigenfit
 /// starts from the nominal rotor file and recovers all twelve factors (in stages: kxx and kyy
-/// first, see `identify_staged`).
+/// first, see `identify`).
 #[test]
 fn recovers_cross_coupled_and_damping_coefficients_from_a_ross_runup() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data");
@@ -111,7 +111,7 @@ fn recovers_cross_coupled_and_damping_coefficients_from_a_ross_runup() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("runup_truth.json")).unwrap()).unwrap();
     let params = bearing_parameters(&r, &["kxx", "kyy", "kxy", "kyx", "cxx", "cyy"]).unwrap();
     assert_eq!(params.len(), 12);
-    let id = identify_staged(&r, &params, &points, &vec![1.0; params.len()], 200).unwrap();
+    let id = identify(&r, &params, &points, &vec![1.0; params.len()], 200).unwrap();
     assert!(id.converged, "{}", id.reason);
     assert!(id.identifiable);
     let mut worst = 0.0f64;
