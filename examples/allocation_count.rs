@@ -4,11 +4,12 @@
 //!
 //! `cargo run --release --example allocation_count`
 
-use eigenfit::rotor::presets::paper_rotor;
-use eigenfit::{
-    BandedSolver, Damped, DenseSolver, Driver, EigenSolver, Measurement, Problem, Sensitivities,
-    StructuralModel,
+use eigenfit::core::{
+    eigen::BandedSolver, eigen::DenseSolver, eigen::EigenSolver, measurement::Measurement,
+    model::StructuralModel, problem::Problem, sensitivity::Sensitivities, update::Driver,
+    update::LevenbergMarquardt,
 };
+use eigenfit::rotor::presets::paper_rotor;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -63,7 +64,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("  one linearisation                  {:>5}", count(|| problem.linearise(&[1e3, 2e4])));
     println!("  one cost evaluation                {:>5}", count(|| problem.cost(&[1e3, 2e4])));
     let run = |restarts: bool| {
-        let mut damped = if restarts { Damped::default() } else { Damped::default().with_max_restarts(0) };
+        let mut damped = if restarts {
+            LevenbergMarquardt::default()
+        } else {
+            LevenbergMarquardt::default().with_max_restarts(0)
+        };
         Driver::default().run(&problem, &mut damped, &[1e2, 1e2], &mut [])
     };
     let estimate = run(true)?;

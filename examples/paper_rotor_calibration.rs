@@ -9,13 +9,14 @@
 //! search over which node carries what (see docs/paper-rotor.md); this program fits the continuous
 //! part and prints the side-by-side table.
 
-use eigenfit::multi::Stacked;
-use eigenfit::rotor::{presets, Rotor};
-use eigenfit::update::Evaluate;
-use eigenfit::{
-    Damped, DenseSolver, Driver, EigenSolver, MeasuredMode, Measurement, ModelError, Parameter, ParameterSet,
-    Problem, Scale, StructuralModel, System,
+use eigenfit::core::problem::multi::Stacked;
+use eigenfit::core::problem::LeastSquaresObjective;
+use eigenfit::core::{
+    eigen::DenseSolver, eigen::EigenSolver, matrix::System, measurement::MeasuredMode,
+    measurement::Measurement, model::ModelError, model::Parameter, model::ParameterSet, model::Scale,
+    model::StructuralModel, problem::Problem, update::Driver, update::LevenbergMarquardt,
 };
+use eigenfit::rotor::{presets, Rotor};
 
 use presets::PAPER_TABLE_1 as TABLE_1;
 
@@ -72,10 +73,10 @@ fn main() {
                 Problem::new(model, DenseSolver, Measurement::new(modes).expect("Table 1 is valid"))
             })
             .collect();
-        let stacked =
-            Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect()).expect("same parameters");
+        let stacked = Stacked::new(problems.iter().map(|p| p as &dyn LeastSquaresObjective).collect())
+            .expect("same parameters");
         let e = Driver::default()
-            .run(&stacked, &mut Damped::default(), &start, &mut [])
+            .run(&stacked, &mut LevenbergMarquardt::default(), &start, &mut [])
             .expect("calibration runs");
         let rel: Vec<f64> =
             e.last.frequencies_hz.iter().zip(&e.last.measured_hz).map(|(a, b)| (a / b - 1.0).abs()).collect();

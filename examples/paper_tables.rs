@@ -3,9 +3,12 @@
 //!
 //! Run: `cargo run --release --example paper_tables`
 
-use eigenfit::compare::{reference_measurement, run_case, CompareRun, CompareSettings, SharedData};
+use eigenfit::core::{
+    analysis::compare::reference_measurement, analysis::compare::run_case, analysis::compare::CompareRun,
+    analysis::compare::CompareSettings, analysis::compare::SharedData,
+};
+use eigenfit::core::{eigen::DenseSolver, problem::Problem, update::StrategyKind};
 use eigenfit::rotor::presets;
-use eigenfit::{DenseSolver, Problem, StrategyKind};
 
 /// One case of a paper table: the initial guess and what the paper reports.
 struct Case {

@@ -28,8 +28,9 @@
 use crate::element;
 use crate::error::RotorError;
 use crate::model::{Bearing, Rotor, ShaftElement};
-use eigenfit_core::discovery::{Candidate, ValueLaw};
-use eigenfit_core::{Parameter, SparseSymmetric};
+use eigenfit_core::matrix::SparseSymmetric;
+use eigenfit_core::model::Parameter;
+use eigenfit_core::model::{Candidate, ValueLaw};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
