@@ -3,19 +3,20 @@
 //! LAPACK backend); figures and ratios are in docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use eigenfit::core::{
-    analysis::compare::log_space, analysis::compare::run_grid, analysis::compare::run_grid_serial,
-    analysis::compare::tensor_grid, analysis::compare::CompareSettings,
+use eigenfit::core::analysis::{
+    compare::log_space, compare::run_grid, compare::run_grid_serial, compare::tensor_grid,
+    compare::CompareSettings,
 };
-use eigenfit::core::{analysis::monte_carlo, analysis::monte_carlo::StudySettings};
-use eigenfit::core::{discovery::discover, discovery::DiscoveryOptions};
-use eigenfit::core::{
-    eigen::BandedSolver, eigen::DenseSolver, eigen::EigenSolver, matrix::BandedSymmetric, matrix::System,
-    measurement::MeasuredMode, measurement::Measurement, model::StructuralModel, problem::Problem,
-    sensitivity::Sensitivities, update::Driver, update::LevenbergMarquardt, update::StrategyKind,
-};
-use eigenfit::rotor::Rotor;
-use eigenfit::rotor::{presets::paper_rotor, presets::uniform_rotor};
+use eigenfit::core::analysis::{monte_carlo, monte_carlo::StudySettings};
+use eigenfit::core::discovery::{discover, DiscoveryOptions};
+use eigenfit::core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit::core::matrix::{BandedSymmetric, System};
+use eigenfit::core::measurement::{MeasuredMode, Measurement};
+use eigenfit::core::model::StructuralModel;
+use eigenfit::core::problem::Problem;
+use eigenfit::core::sensitivity::Sensitivities;
+use eigenfit::core::update::{Driver, LevenbergMarquardt, StrategyKind};
+use eigenfit::rotor::{presets::paper_rotor, presets::uniform_rotor, Rotor};
 use std::hint::black_box;
 use std::time::Duration;
 

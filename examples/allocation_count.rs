@@ -4,11 +4,17 @@
 //!
 //! `cargo run --release --example allocation_count`
 
-use eigenfit::core::{
-    eigen::BandedSolver, eigen::DenseSolver, eigen::EigenSolver, measurement::Measurement,
-    model::StructuralModel, problem::Problem, sensitivity::Sensitivities, update::Driver,
-    update::LevenbergMarquardt,
-};
+use eigenfit::core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+
+use eigenfit::core::measurement::Measurement;
+
+use eigenfit::core::model::StructuralModel;
+
+use eigenfit::core::problem::Problem;
+
+use eigenfit::core::sensitivity::Sensitivities;
+
+use eigenfit::core::update::{Driver, LevenbergMarquardt};
 use eigenfit::rotor::presets::paper_rotor;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};

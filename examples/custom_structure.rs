@@ -16,23 +16,19 @@
 //! its interval.
 
 use eigenfit::core::analysis::uncertainty;
+use eigenfit::core::discovery::{discover_configurations, DiscoveryReport};
+use eigenfit::core::eigen::{DenseSolver, EigenSolver};
+use eigenfit::core::measurement::{MeasuredMode, Measurement};
+use eigenfit::core::model::StructuralModel;
 use eigenfit::core::problem::multi::Stacked;
-use eigenfit::core::problem::LeastSquaresObjective;
-use eigenfit::core::{discovery::discover_configurations, discovery::DiscoveryReport};
-use eigenfit::core::{
-    eigen::DenseSolver, eigen::EigenSolver, measurement::MeasuredMode, measurement::Measurement,
-    model::StructuralModel, problem::Problem, update::Driver, update::Estimate, update::Newton,
-    update::PStep, update::StrategyKind, update::UpdateStrategy,
-};
+use eigenfit::core::problem::{LeastSquaresObjective, Problem};
+use eigenfit::core::update::{Driver, Estimate, Newton, PStep, StrategyKind, UpdateStrategy};
 use model::ShearBuilding;
 
 // --- model: begin
 pub mod model {
-    use eigenfit::core::model::Candidate;
-    use eigenfit::core::{
-        matrix::SparseSymmetric, matrix::System, matrix::SystemDerivative, model::ModelError,
-        model::Parameter, model::ParameterSet, model::Scale, model::StructuralModel,
-    };
+    use eigenfit::core::matrix::{SparseSymmetric, System, SystemDerivative};
+    use eigenfit::core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
     use nalgebra::{DMatrix, DVector};
 
     /// A shear building: rigid floors on massless storey springs. DOF i is the sway of floor i

@@ -9,13 +9,13 @@
 //! search over which node carries what (see docs/paper-rotor.md); this program fits the continuous
 //! part and prints the side-by-side table.
 
+use eigenfit::core::eigen::{DenseSolver, EigenSolver};
+use eigenfit::core::matrix::System;
+use eigenfit::core::measurement::{MeasuredMode, Measurement};
+use eigenfit::core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use eigenfit::core::problem::multi::Stacked;
-use eigenfit::core::problem::LeastSquaresObjective;
-use eigenfit::core::{
-    eigen::DenseSolver, eigen::EigenSolver, matrix::System, measurement::MeasuredMode,
-    measurement::Measurement, model::ModelError, model::Parameter, model::ParameterSet, model::Scale,
-    model::StructuralModel, problem::Problem, update::Driver, update::LevenbergMarquardt,
-};
+use eigenfit::core::problem::{LeastSquaresObjective, Problem};
+use eigenfit::core::update::{Driver, LevenbergMarquardt};
 use eigenfit::rotor::{presets, Rotor};
 
 use presets::PAPER_TABLE_1 as TABLE_1;

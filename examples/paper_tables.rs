@@ -3,11 +3,13 @@
 //!
 //! Run: `cargo run --release --example paper_tables`
 
-use eigenfit::core::{
-    analysis::compare::reference_measurement, analysis::compare::run_case, analysis::compare::CompareRun,
-    analysis::compare::CompareSettings, analysis::compare::SharedData,
+use eigenfit::core::analysis::{
+    compare::reference_measurement, compare::run_case, compare::CompareRun, compare::CompareSettings,
+    compare::SharedData,
 };
-use eigenfit::core::{eigen::DenseSolver, problem::Problem, update::StrategyKind};
+use eigenfit::core::eigen::DenseSolver;
+use eigenfit::core::problem::Problem;
+use eigenfit::core::update::StrategyKind;
 use eigenfit::rotor::presets;
 
 /// One case of a paper table: the initial guess and what the paper reports.

@@ -7,9 +7,9 @@
 #[allow(dead_code)]
 mod example;
 
-use eigenfit::core::{
-    model::finite_difference_derivative, model::ModelError, model::StructuralModel, update::StrategyKind,
-};
+use eigenfit::core::model::{finite_difference_derivative, ModelError, StructuralModel};
+
+use eigenfit::core::update::StrategyKind;
 use example::model::ShearBuilding;
 use example::{
     building, chi2_95, discover_storey_mass, measurements, problems, update_all, Noise, Run, DESIGN,

@@ -1,10 +1,10 @@
 //! Missing-effect discovery on data in which an effect is hidden (issue: discovery).
 
-use eigenfit::core::{
-    discovery::discover, discovery::DiscoveryOptions, discovery::DiscoveryReport, model::Augmented,
-};
-use eigenfit::core::{eigen::DenseSolver, measurement::Measurement, model::StructuralModel};
-use eigenfit::core::{measurement::synthetic::synthesise, measurement::synthetic::NoiseRng};
+use eigenfit::core::discovery::{discover, DiscoveryOptions, DiscoveryReport};
+
+use eigenfit::core::eigen::DenseSolver;
+use eigenfit::core::measurement::{synthetic::synthesise, synthetic::NoiseRng, Measurement};
+use eigenfit::core::model::{Augmented, StructuralModel};
 use eigenfit::rotor::{presets, EffectSpec, Rotor};
 
 /// `modes` measured frequencies of `truth` at `stiffness`, with relative noise `rel`.

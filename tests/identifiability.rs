@@ -1,10 +1,10 @@
 //! A support in the shaft-dependent zone is flagged as not identifiable, with a correct bound.
 
-use eigenfit::core::analysis::uncertainty;
-use eigenfit::core::{
-    analysis::Identifiability, eigen::DenseSolver, measurement::MeasuredMode, measurement::Measurement,
-    problem::Problem, update::Driver, update::LevenbergMarquardt,
-};
+use eigenfit::core::analysis::{uncertainty, Identifiability};
+use eigenfit::core::eigen::DenseSolver;
+use eigenfit::core::measurement::{MeasuredMode, Measurement};
+use eigenfit::core::problem::Problem;
+use eigenfit::core::update::{Driver, LevenbergMarquardt};
 use eigenfit::rotor::presets;
 
 /// χ² with parameter `i` held at `value` and the others refitted.

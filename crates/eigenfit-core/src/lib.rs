@@ -15,8 +15,8 @@
 //! mass-normalised (ΦᵀMΦ = I) with the sign rule of [`apply_sign_rule`](eigen::apply_sign_rule).
 //!
 //! ```
-//! use eigenfit_core::{DenseSolver, EigenSolver, System};
-//! use nalgebra::DMatrix;
+//! use eigenfit_core::nalgebra::DMatrix;
+//! use eigenfit_core::prelude::*;
 //!
 //! // Two masses on springs: K = [[2,-1],[-1,2]], M = I  →  λ = 1, 3.
 //! let k = DMatrix::from_row_slice(2, 2, &[2.0, -1.0, -1.0, 2.0]);

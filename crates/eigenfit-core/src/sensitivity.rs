@@ -9,8 +9,7 @@
 //! Every result is refused for a repeated or nearly repeated eigenvalue: there the derivative of
 //! an individual mode is not defined, and any number returned would be silently wrong.
 
-use crate::eigen::Modes;
-use crate::eigen::{EigenSolver, SolveError};
+use crate::eigen::{EigenSolver, Modes, SolveError};
 use crate::matrix::{System, SystemDerivative};
 use crate::model::{ModelError, StructuralModel};
 use nalgebra::{DMatrix, DVector};

@@ -7,8 +7,9 @@
 use eigenfit_core::eigen::{DenseSolver, EigenSolver, SolveError};
 use eigenfit_core::matrix::{SparseSymmetric, System, SystemDerivative};
 use eigenfit_core::model::{ModelError, Parameter, ParameterSet, StructuralModel};
-use eigenfit_core::sensitivity::{eigenvector_derivative_modal, eigenvector_derivative_nelson};
-use eigenfit_core::sensitivity::{Sensitivities, SensitivityError};
+use eigenfit_core::sensitivity::{
+    eigenvector_derivative_modal, eigenvector_derivative_nelson, Sensitivities, SensitivityError,
+};
 use nalgebra::{DMatrix, DVector};
 
 /// A free-free chain of `n` masses 1 + 0.05·i joined by springs s·(1 + 0.1·i), s = p[0].
@@ -125,7 +126,7 @@ impl StructuralModel for LinearDiag {
 /// that only matters near λ = 0 (e.g. relative to λ₁ or to the first elastic eigenvalue, or a
 /// per-solver round-off estimate) would keep the rigid-body protection.
 #[test]
-fn noise_floor_does_not_refuse_well_separated_low_modes() {
+fn rigid_body_tolerance_does_not_refuse_well_separated_low_modes() {
     let k = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 1.001, 1e8]));
     let sys = System::new(k, DMatrix::identity(3, 3)).unwrap();
     let modes = DenseSolver.lowest(&sys, 3).unwrap();

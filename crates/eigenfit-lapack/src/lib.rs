@@ -51,8 +51,7 @@ extern crate openblas_src;
 
 mod driver;
 
-use eigenfit_core::eigen::{apply_sign_rule, EigenSolver, Modes, SolveError};
-use eigenfit_core::eigen::{check_count, shifted_twice};
+use eigenfit_core::eigen::{apply_sign_rule, check_count, shifted_twice, EigenSolver, Modes, SolveError};
 use eigenfit_core::matrix::System;
 use nalgebra::{DMatrix, DVector};
 

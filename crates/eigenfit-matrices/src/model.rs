@@ -4,8 +4,7 @@
 use crate::error::MatricesError;
 use crate::market::read_symmetric;
 use eigenfit_core::matrix::{CscSymmetric, System, SystemDerivative};
-use eigenfit_core::model::Candidate;
-use eigenfit_core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
+use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 

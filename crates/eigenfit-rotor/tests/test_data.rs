@@ -1,11 +1,9 @@
 //! Real test data on the planar rotor: UFF round trip, a pyuff-written export of an independent
 //! finite-element model, and the mirror ambiguity of a symmetric rotor resolved by shapes.
 
-use eigenfit_core::analysis::uncertainty;
-use eigenfit_core::analysis::ShapeFit;
+use eigenfit_core::analysis::{uncertainty, ShapeFit};
 use eigenfit_core::eigen::{DenseSolver, EigenSolver};
-use eigenfit_core::measurement::Measurement;
-use eigenfit_core::measurement::{sensors, uff};
+use eigenfit_core::measurement::{sensors, uff, Measurement};
 use eigenfit_core::problem::{LeastSquaresObjective, Pairing, Problem};
 use eigenfit_core::update::{Driver, LevenbergMarquardt, UpdateStrategy};
 use eigenfit_rotor::Rotor;

@@ -20,7 +20,7 @@ pub struct CampaignArgs {
     /// `name`, `shapes`, `sensor_map`.
     #[arg(value_name = "CAMPAIGN.toml")]
     pub campaign: PathBuf,
-    /// Update strategy: newton, p-step or damped.
+    /// Update strategy: newton, p-step or damped (Levenberg–Marquardt; `levenberg-marquardt` is accepted too).
     #[arg(long, default_value = "damped")]
     pub strategy: String,
     /// Eigen-solver backend: banded (default) or dense.
@@ -55,7 +55,10 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         other => return Err(input(format!("unknown solver `{other}`; available: banded, dense"))),
     };
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
-        input(format!("unknown strategy `{}`; available: newton, p-step, damped", args.strategy))
+        input(format!(
+            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
+            args.strategy
+        ))
     })?;
     let mut rotors = Vec::new();
     let mut data = Vec::new();

@@ -111,7 +111,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         .map(|s| {
             StrategyKind::from_name(s.trim()).ok_or_else(|| {
                 input(format!(
-                    "--strategies: unknown strategy `{}`; available: newton, p-step, damped",
+                    "--strategies: unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
                     s.trim()
                 ))
             })

@@ -6,15 +6,13 @@ use crate::plot::convergence::{Convergence, Run};
 use crate::source::{parameter_vector, ModelArgs};
 use crate::{measured, plot, progress, testdata};
 use clap::Args;
-use eigenfit_core::analysis::Identifiability;
-use eigenfit_core::analysis::{alternative_solutions_within, mirror_solutions};
+use eigenfit_core::analysis::{alternative_solutions_within, mirror_solutions, Identifiability};
 use eigenfit_core::analysis::{
     verdict::at_limits, verdict::judge, verdict::unreachable_modes, verdict::FitVerdict,
 };
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::{LeastSquaresObjective, Problem, ResidualKind};
-use eigenfit_core::update::DEFAULT_EVALUATIONS;
-use eigenfit_core::update::{Budget, Driver, StrategyKind};
+use eigenfit_core::update::{Budget, Driver, StrategyKind, DEFAULT_EVALUATIONS};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
 
@@ -30,7 +28,7 @@ pub struct EstimateArgs {
     pub measured: PathBuf,
     #[command(flatten)]
     pub test_data: testdata::TestDataArgs,
-    /// Update strategy: newton, p-step or damped.
+    /// Update strategy: newton, p-step or damped (Levenberg–Marquardt; `levenberg-marquardt` is accepted too).
     #[arg(long, default_value = "damped")]
     pub strategy: String,
     /// Initial bearing stiffnesses K1,K2,… in N/m (default: the model's values).
@@ -83,7 +81,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let measurement = data.measurement.clone();
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
         input(format!(
-            "unknown strategy `{}`; available: newton, p-step, damped",
+            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
             measured::shown(&args.strategy)
         ))
     })?;

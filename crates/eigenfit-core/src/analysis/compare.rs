@@ -5,11 +5,8 @@ use crate::analysis::{alternatives_among, local_solutions, uncertainty, Identifi
 use crate::eigen::EigenSolver;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
-use crate::problem::LeastSquaresObjective;
-use crate::problem::Linearisation;
-use crate::problem::Problem;
-use crate::update::{Driver, StrategyKind};
-use crate::update::{LevenbergMarquardt, UpdateStrategy};
+use crate::problem::{LeastSquaresObjective, Linearisation, Problem};
+use crate::update::{Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;

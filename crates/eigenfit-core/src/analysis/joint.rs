@@ -6,8 +6,7 @@
 use crate::analysis::{uncertainty, Uncertainty};
 use crate::model::{Parameter, ParameterSet};
 use crate::problem::multi::stack;
-use crate::problem::LeastSquaresObjective;
-use crate::problem::{Linearisation, ResidualError};
+use crate::problem::{LeastSquaresObjective, Linearisation, ResidualError};
 use nalgebra::DMatrix;
 
 /// Several configurations' objectives over the union of their parameters.

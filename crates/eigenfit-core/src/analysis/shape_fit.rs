@@ -8,10 +8,8 @@
 //! d(s/‖s‖)/dp = (I − uuᵀ) P dφₖ/dp / ‖s‖.
 
 use crate::eigen::EigenSolver;
-use crate::model::ParameterSet;
-use crate::model::StructuralModel;
-use crate::problem::LeastSquaresObjective;
-use crate::problem::{Linearisation, Pairing, Problem, ResidualError};
+use crate::model::{ParameterSet, StructuralModel};
+use crate::problem::{LeastSquaresObjective, Linearisation, Pairing, Problem, ResidualError};
 use crate::sensitivity::{eigenvector_derivative_nelson, SensitivityError};
 use nalgebra::{DMatrix, DVector};
 

@@ -1,8 +1,7 @@
 //! What the data say about the estimate: covariance, 95% intervals, singular values, and which
 //! parameters the data cannot determine (with the one-sided bound they do support).
 
-use crate::problem::LeastSquaresObjective;
-use crate::problem::Linearisation;
+use crate::problem::{LeastSquaresObjective, Linearisation};
 use crate::update::{Budget, Driver, LevenbergMarquardt};
 use nalgebra::DMatrix;
 

@@ -3,8 +3,7 @@
 
 use crate::analysis::chi2_upper_tail;
 use crate::model::ParameterSet;
-use crate::problem::LeastSquaresObjective;
-use crate::problem::Linearisation;
+use crate::problem::{LeastSquaresObjective, Linearisation};
 use crate::update::Budget;
 
 /// p-value below which a fit is rejected as poor: strong evidence that no parameter value of this

@@ -5,8 +5,7 @@
 //! parameter and can take minutes per candidate. A candidate's interval only decides whether its
 //! value is clear of zero and plausible, for which the linearised covariance suffices.
 
-use crate::problem::LeastSquaresObjective;
-use crate::problem::Linearisation;
+use crate::problem::{LeastSquaresObjective, Linearisation};
 
 /// 1.96: the two-sided 95 % quantile of the normal distribution.
 const Z_95: f64 = 1.959_963_984_540_054;

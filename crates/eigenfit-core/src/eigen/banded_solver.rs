@@ -4,11 +4,10 @@
 
 use crate::eigen::lanczos::{self, pseudo_random, LanczosWork};
 use crate::eigen::small_eigen::symmetric_eigen;
-use crate::eigen::DenseSolver;
-use crate::eigen::{apply_sign_rule, Modes};
-use crate::eigen::{check_count, shifted_twice, EigenSolver, SolveError};
-use crate::matrix::System;
-use crate::matrix::{BandCholesky, BandedSymmetric};
+use crate::eigen::{
+    apply_sign_rule, check_count, shifted_twice, DenseSolver, EigenSolver, Modes, SolveError,
+};
+use crate::matrix::{BandCholesky, BandedSymmetric, System};
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 

@@ -1,7 +1,6 @@
 //! The default, pure-nalgebra eigen-solver: Cholesky reduction to a standard symmetric problem.
 
-use crate::eigen::{apply_sign_rule, Modes};
-use crate::eigen::{check_count, shifted_twice, EigenSolver, SolveError};
+use crate::eigen::{apply_sign_rule, check_count, shifted_twice, EigenSolver, Modes, SolveError};
 use crate::matrix::System;
 use nalgebra::{Cholesky, DMatrix, DVector, SymmetricEigen};
 

@@ -10,8 +10,7 @@
 //! check catches that and falls back to block subspace iteration.
 
 use crate::eigen::{small_eigen::tridiagonal_eigen, small_eigen::tridiagonal_top};
-use crate::matrix::CscSymmetric;
-use crate::matrix::{BandCholesky, BandedSymmetric};
+use crate::matrix::{BandCholesky, BandedSymmetric, CscSymmetric};
 
 /// A factor of K + σM: solves (K + σM) x = b in place.
 pub(crate) trait ShiftInvert {

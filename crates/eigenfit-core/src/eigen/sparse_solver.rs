@@ -4,12 +4,11 @@
 //! inertia of the sparse LDLᵀ of K − σ′M) proving that no mode below the highest one returned
 //! was missed.
 
-use crate::eigen::DenseSolver;
-use crate::eigen::{apply_sign_rule, Modes};
-use crate::eigen::{check_count, shifted_twice, EigenSolver, SolveError};
-use crate::eigen::{lanczos, lanczos::LanczosWork, lanczos::Locked, lanczos::ShiftInvert};
-use crate::matrix::CscSymmetric;
-use crate::matrix::System;
+use crate::eigen::{
+    apply_sign_rule, check_count, lanczos, lanczos::LanczosWork, lanczos::Locked, lanczos::ShiftInvert,
+    shifted_twice, DenseSolver, EigenSolver, Modes, SolveError,
+};
+use crate::matrix::{CscSymmetric, System};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;

@@ -5,8 +5,7 @@
 //! Only the upper triangle (row ≤ column) is kept, rows sorted and unique within each column —
 //! the layout faer's sparse Cholesky reads with `Side::Upper`, so a factorisation needs no copy.
 
-use crate::matrix::BandedSymmetric;
-use crate::matrix::SparseSymmetric;
+use crate::matrix::{BandedSymmetric, SparseSymmetric};
 use nalgebra::DMatrix;
 
 /// Symmetric n×n matrix, upper triangle in compressed-column storage (CSC).

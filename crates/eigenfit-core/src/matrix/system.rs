@@ -1,8 +1,6 @@
 //! Assembled matrices K, M of a structure at one parameter vector, and their parameter derivatives.
 
-use crate::matrix::BandedSymmetric;
-use crate::matrix::CscSymmetric;
-use crate::matrix::SparseSymmetric;
+use crate::matrix::{BandedSymmetric, CscSymmetric, SparseSymmetric};
 use nalgebra::DMatrix;
 use std::sync::OnceLock;
 use thiserror::Error;

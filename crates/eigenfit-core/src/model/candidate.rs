@@ -1,10 +1,7 @@
 //! Candidate effects: physics a model may lack, as extra matrix contributions with a value.
 
-use crate::matrix::CscSymmetric;
-use crate::matrix::SparseSymmetric;
-use crate::matrix::{System, SystemDerivative};
-use crate::model::{ModelError, StructuralModel};
-use crate::model::{Parameter, ParameterSet};
+use crate::matrix::{CscSymmetric, SparseSymmetric, System, SystemDerivative};
+use crate::model::{ModelError, Parameter, ParameterSet, StructuralModel};
 
 /// How a candidate's value enters K and M.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -3,8 +3,7 @@
 //! because to them it is just a model with fewer parameters.
 
 use crate::matrix::{System, SystemDerivative};
-use crate::model::{ModelError, StructuralModel};
-use crate::model::{ParameterError, ParameterSet};
+use crate::model::{ModelError, ParameterError, ParameterSet, StructuralModel};
 
 /// `inner` with some parameters held at fixed values.
 #[derive(Debug, Clone)]

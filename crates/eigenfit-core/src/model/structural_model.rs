@@ -1,7 +1,6 @@
 //! The [`StructuralModel`] trait: a structure's K and M at a parameter vector, and their derivatives.
 
-use crate::matrix::SparseSymmetric;
-use crate::matrix::{System, SystemDerivative, SystemError};
+use crate::matrix::{SparseSymmetric, System, SystemDerivative, SystemError};
 use crate::model::{ParameterError, ParameterSet};
 use thiserror::Error;
 

@@ -2,8 +2,7 @@
 //! of each configuration are stacked into one least-squares problem.
 
 use crate::model::ParameterSet;
-use crate::problem::LeastSquaresObjective;
-use crate::problem::{Linearisation, ResidualError};
+use crate::problem::{LeastSquaresObjective, Linearisation, ResidualError};
 use nalgebra::{DMatrix, DVector};
 
 /// Stacks problems that share one parameter set (e.g. one rotor measured at several support

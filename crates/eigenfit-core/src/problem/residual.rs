@@ -3,8 +3,7 @@
 use crate::eigen::EigenSolver;
 use crate::measurement::mac::mac;
 use crate::measurement::{MeasuredMode, Measurement};
-use crate::model::ParameterSet;
-use crate::model::StructuralModel;
+use crate::model::{ParameterSet, StructuralModel};
 use crate::sensitivity::{check_wanted_distinct, rigid_body_tolerance, Sensitivities, SensitivityError};
 use crate::units::{eigenvalue_to_hz, hz_to_eigenvalue};
 use nalgebra::{DMatrix, DVector};

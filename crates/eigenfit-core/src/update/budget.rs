@@ -2,8 +2,7 @@
 //! input — a typing slip, data no stiffness can produce — can make eigenfit run for hours.
 
 use crate::model::ParameterSet;
-use crate::problem::LeastSquaresObjective;
-use crate::problem::{Linearisation, ResidualError};
+use crate::problem::{LeastSquaresObjective, Linearisation, ResidualError};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// Evaluations a task may spend when the user sets no budget: a few seconds on the largest

@@ -1,8 +1,7 @@
 //! The iteration loop: termination reasons, observers, history.
 
 use super::{Budget, StepStatus, UpdateError, UpdateStrategy};
-use crate::problem::LeastSquaresObjective;
-use crate::problem::Linearisation;
+use crate::problem::{LeastSquaresObjective, Linearisation};
 
 /// Why a run ended.
 #[derive(Debug, Clone, PartialEq)]

@@ -2,8 +2,7 @@
 
 use super::{Step, StepStatus, UpdateError, UpdateStrategy};
 use crate::model::ParameterSet;
-use crate::problem::LeastSquaresObjective;
-use crate::problem::Linearisation;
+use crate::problem::{LeastSquaresObjective, Linearisation};
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 

@@ -18,8 +18,7 @@ pub use levenberg_marquardt::LevenbergMarquardt;
 pub use newton::Newton;
 pub use pstep::PStep;
 
-use crate::problem::LeastSquaresObjective;
-use crate::problem::{Linearisation, ResidualError};
+use crate::problem::{LeastSquaresObjective, Linearisation, ResidualError};
 use thiserror::Error;
 
 /// Why an update step could not be taken.

@@ -3,8 +3,7 @@
 use super::{
     evaluate_or_diverge, newton_point, square_max_diff_hz, Step, StepStatus, UpdateError, UpdateStrategy,
 };
-use crate::problem::LeastSquaresObjective;
-use crate::problem::Linearisation;
+use crate::problem::{LeastSquaresObjective, Linearisation};
 use crate::units::eigenvalue_to_hz;
 use nalgebra::DVector;
 
