@@ -21,7 +21,7 @@ use eigenfit::core::eigen::{DenseSolver, EigenSolver};
 use eigenfit::core::measurement::{MeasuredMode, Measurement};
 use eigenfit::core::model::StructuralModel;
 use eigenfit::core::problem::multi::Stacked;
-use eigenfit::core::problem::{LeastSquaresObjective, Problem};
+use eigenfit::core::problem::{Objective, Problem};
 use eigenfit::core::update::{Driver, Estimate, Newton, PStep, StrategyKind, UpdateStrategy};
 use model::ShearBuilding;
 
@@ -182,12 +182,11 @@ pub struct Run {
 /// Every strategy from the design stiffnesses. Newton and p-step solve the paper's square system
 /// (as many modes as parameters: the first test); damped fits all tests at once.
 pub fn update_all(problems: &[Problem<ShearBuilding, DenseSolver>]) -> Vec<Run> {
-    let all = Stacked::new(problems.iter().map(|p| p as &dyn LeastSquaresObjective).collect())
-        .expect("same parameters");
+    let all = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect()).expect("same parameters");
     StrategyKind::ALL
         .into_iter()
         .map(|strategy| {
-            let data: &dyn LeastSquaresObjective =
+            let data: &dyn Objective =
                 if strategy == StrategyKind::LevenbergMarquardt { &all } else { &problems[0] };
             let mut s: Box<dyn UpdateStrategy> = match strategy {
                 // The paper's 0.01 Hz suits a 40–200 Hz rotor; a 2–14 Hz building needs finer.

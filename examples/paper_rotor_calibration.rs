@@ -14,7 +14,7 @@ use eigenfit::core::matrix::System;
 use eigenfit::core::measurement::{MeasuredMode, Measurement};
 use eigenfit::core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use eigenfit::core::problem::multi::Stacked;
-use eigenfit::core::problem::{LeastSquaresObjective, Problem};
+use eigenfit::core::problem::{Objective, Problem};
 use eigenfit::core::update::{Driver, LevenbergMarquardt};
 use eigenfit::rotor::{presets, Rotor};
 
@@ -73,8 +73,8 @@ fn main() {
                 Problem::new(model, DenseSolver, Measurement::new(modes).expect("Table 1 is valid"))
             })
             .collect();
-        let stacked = Stacked::new(problems.iter().map(|p| p as &dyn LeastSquaresObjective).collect())
-            .expect("same parameters");
+        let stacked =
+            Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect()).expect("same parameters");
         let e = Driver::default()
             .run(&stacked, &mut LevenbergMarquardt::default(), &start, &mut [])
             .expect("calibration runs");

@@ -12,7 +12,7 @@ use eigenfit_core::matrix::{System, SystemDerivative};
 use eigenfit_core::measurement::sensors::NodeLayout;
 use eigenfit_core::measurement::{mac::MacReport, sensors, sensors::SensorSet, uff, Measurement};
 use eigenfit_core::model::{Fixed, ModelError, ParameterSet, StructuralModel};
-use eigenfit_core::problem::{LeastSquaresObjective, Linearisation, Pairing, Problem, ResidualError};
+use eigenfit_core::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
 use eigenfit_core::update::Estimate;
 use eigenfit_matrices::MatricesModel;
 use eigenfit_rotor::{Rotor, UpdatableRotor};
@@ -356,7 +356,7 @@ impl<'a> Fit<'a> {
     }
 }
 
-impl LeastSquaresObjective for Fit<'_> {
+impl Objective for Fit<'_> {
     fn parameters(&self) -> &ParameterSet {
         match self {
             Fit::Frequencies(p) => p.parameters(),
@@ -371,8 +371,8 @@ impl LeastSquaresObjective for Fit<'_> {
     }
     fn cost(&self, p: &[f64]) -> Option<f64> {
         match self {
-            Fit::Frequencies(q) => LeastSquaresObjective::cost(q, p),
-            Fit::Shapes(s) => LeastSquaresObjective::cost(s, p),
+            Fit::Frequencies(q) => Objective::cost(q, p),
+            Fit::Shapes(s) => Objective::cost(s, p),
         }
     }
 }

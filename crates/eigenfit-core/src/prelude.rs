@@ -7,7 +7,7 @@ pub use crate::eigen::{BandedSolver, DenseSolver, EigenSolver, Modes, SolveError
 pub use crate::matrix::{SparseSymmetric, System, SystemDerivative};
 pub use crate::measurement::{MeasuredMode, Measurement};
 pub use crate::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
-pub use crate::problem::{LeastSquaresObjective, Linearisation, Pairing, Problem};
+pub use crate::problem::{Linearisation, Objective, Pairing, Problem};
 pub use crate::units::{eigenvalue_to_hz, hz_to_eigenvalue};
 pub use crate::update::{
     Driver, Estimate, LevenbergMarquardt, Newton, PStep, StrategyKind, Termination, UpdateStrategy,

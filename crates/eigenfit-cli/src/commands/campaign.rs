@@ -6,7 +6,7 @@ use crate::testdata::{self, Fit, TestDataArgs};
 use clap::Args;
 use eigenfit_core::analysis::Joint;
 use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
-use eigenfit_core::problem::{LeastSquaresObjective, Problem, ResidualKind};
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
 use eigenfit_core::update::{Driver, StrategyKind};
 use eigenfit_rotor::campaign::Campaign;
 use eigenfit_rotor::Rotor;
@@ -95,7 +95,7 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             Fit::new(problem, d, options)
         })
         .collect();
-    let mut joint = Joint::new(fits.iter().map(|f| f as &dyn LeastSquaresObjective).collect())
+    let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Objective).collect())
         .map_err(|e| input(format!("{}: {e}", args.campaign.display())))?;
     let has_std = data.iter().all(|d| d.measurement.has_std() && d.sensors.is_none());
     let initial = joint.parameters().nominal_values();

@@ -11,7 +11,7 @@ use eigenfit_core::analysis::{
     verdict::at_limits, verdict::judge, verdict::unreachable_modes, verdict::FitVerdict,
 };
 use eigenfit_core::model::StructuralModel;
-use eigenfit_core::problem::{LeastSquaresObjective, Problem, ResidualKind};
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
 use eigenfit_core::update::{Budget, Driver, StrategyKind, DEFAULT_EVALUATIONS};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;

@@ -5,7 +5,7 @@ use crate::analysis::{alternatives_among, local_solutions, uncertainty, Identifi
 use crate::eigen::EigenSolver;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
-use crate::problem::{LeastSquaresObjective, Linearisation, Problem};
+use crate::problem::{Linearisation, Objective, Problem};
 use crate::update::{Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -94,7 +94,7 @@ pub struct SharedData {
 
 impl SharedData {
     /// Ranks the seeds and finds the local solutions of `problem`'s data.
-    pub fn new(problem: &dyn LeastSquaresObjective) -> Self {
+    pub fn new(problem: &dyn Objective) -> Self {
         Self {
             seeds: LevenbergMarquardt::rank_seeds(problem),
             solutions: local_solutions(problem, ALTERNATIVE_STARTS),
@@ -103,7 +103,7 @@ impl SharedData {
 
     /// What runs of `strategies` on `problem` share: the seeds and local solutions when one of
     /// them is damped, nothing otherwise.
-    pub fn for_runs(problem: &dyn LeastSquaresObjective, strategies: &[StrategyKind]) -> Self {
+    pub fn for_runs(problem: &dyn Objective, strategies: &[StrategyKind]) -> Self {
         if strategies.contains(&StrategyKind::LevenbergMarquardt) {
             Self::new(problem)
         } else {

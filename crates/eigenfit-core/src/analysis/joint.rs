@@ -6,12 +6,12 @@
 use crate::analysis::{uncertainty, Uncertainty};
 use crate::model::{Parameter, ParameterSet};
 use crate::problem::multi::stack;
-use crate::problem::{LeastSquaresObjective, Linearisation, ResidualError};
+use crate::problem::{Linearisation, Objective, ResidualError};
 use nalgebra::DMatrix;
 
 /// Several configurations' objectives over the union of their parameters.
 pub struct Joint<'a> {
-    parts: Vec<&'a dyn LeastSquaresObjective>,
+    parts: Vec<&'a dyn Objective>,
     /// For each part, the joint index of each of its parameters.
     maps: Vec<Vec<usize>>,
     parameters: ParameterSet,
@@ -22,7 +22,7 @@ pub struct Joint<'a> {
 impl<'a> Joint<'a> {
     /// Joins `parts`; a shared name must have the same unit, bounds and scale everywhere (its
     /// nominal value is the first configuration's).
-    pub fn new(parts: Vec<&'a dyn LeastSquaresObjective>) -> Result<Self, String> {
+    pub fn new(parts: Vec<&'a dyn Objective>) -> Result<Self, String> {
         let mut all: Vec<Parameter> = Vec::new();
         let mut maps = Vec::with_capacity(parts.len());
         for (k, part) in parts.iter().enumerate() {
@@ -96,7 +96,7 @@ impl<'a> Joint<'a> {
     }
 }
 
-impl LeastSquaresObjective for Joint<'_> {
+impl Objective for Joint<'_> {
     fn parameters(&self) -> &ParameterSet {
         &self.parameters
     }

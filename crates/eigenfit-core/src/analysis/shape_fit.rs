@@ -9,7 +9,7 @@
 
 use crate::eigen::EigenSolver;
 use crate::model::{ParameterSet, StructuralModel};
-use crate::problem::{LeastSquaresObjective, Linearisation, Pairing, Problem, ResidualError};
+use crate::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
 use crate::sensitivity::{eigenvector_derivative_nelson, SensitivityError};
 use nalgebra::{DMatrix, DVector};
 
@@ -19,7 +19,7 @@ pub const DEFAULT_SHAPE_STD: f64 = 0.05;
 /// are fitted too: it sets how frequencies weigh against shapes (10:1 with the shape default).
 pub const DEFAULT_FREQUENCY_STD_REL: f64 = 0.005;
 
-/// Frequencies and shapes together: an [`LeastSquaresObjective`] for the update strategies and the
+/// Frequencies and shapes together: an [`Objective`] for the update strategies and the
 /// statistics. The frequency rows are the wrapped [`Problem`]'s (MAC pairing) times
 /// `frequency_weight`; the shape rows follow them; every row is divided by `scale`.
 pub struct ShapeFit<M, S> {
@@ -87,7 +87,7 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     }
 }
 
-impl<M: StructuralModel, S: EigenSolver> LeastSquaresObjective for ShapeFit<M, S> {
+impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
     fn parameters(&self) -> &ParameterSet {
         self.problem.parameters()
     }

@@ -1,7 +1,7 @@
 //! What the data say about the estimate: covariance, 95% intervals, singular values, and which
 //! parameters the data cannot determine (with the one-sided bound they do support).
 
-use crate::problem::{LeastSquaresObjective, Linearisation};
+use crate::problem::{Linearisation, Objective};
 use crate::update::{Budget, Driver, LevenbergMarquardt};
 use nalgebra::DMatrix;
 
@@ -65,18 +65,14 @@ pub const UNCERTAINTY_EVALUATIONS: usize = 2_000;
 /// Uncertainty at the estimate `at` (a converged linearisation whose residual is weighted by
 /// the measurement standard deviations). Returns `None` when the data carry no std. Profile
 /// refits spend at most [`UNCERTAINTY_EVALUATIONS`]; see [`uncertainty_within`] to set the budget.
-pub fn uncertainty(
-    problem: &dyn LeastSquaresObjective,
-    at: &Linearisation,
-    has_std: bool,
-) -> Option<Uncertainty> {
+pub fn uncertainty(problem: &dyn Objective, at: &Linearisation, has_std: bool) -> Option<Uncertainty> {
     uncertainty_within(problem, at, has_std, &Budget::new(UNCERTAINTY_EVALUATIONS))
 }
 
 /// [`uncertainty`] charging every profile refit to `budget` (shared with the fit, so one limit
 /// bounds the whole task).
 pub fn uncertainty_within(
-    problem: &dyn LeastSquaresObjective,
+    problem: &dyn Objective,
     at: &Linearisation,
     has_std: bool,
     budget: &Budget,
@@ -152,7 +148,7 @@ const PROFILE_WIDTH_TOLERANCE: f64 = 1e-3;
 
 /// The profile likelihood of one parameter: Δχ² after refitting the others with it held fixed.
 struct Profile<'a> {
-    problem: &'a dyn LeastSquaresObjective,
+    problem: &'a dyn Objective,
     at: &'a Linearisation,
     i: usize,
     budget: &'a Budget,
@@ -278,17 +274,13 @@ impl Profile<'_> {
 /// parameters the map from stiffnesses to frequencies need not be one-to-one, and then the data
 /// alone cannot choose. Local fits from the best points of the coarse restart grid that reach
 /// an acceptable fit more than 1% (scaled) away from `at` are returned, distinct, best first.
-pub fn alternative_solutions(
-    problem: &dyn LeastSquaresObjective,
-    at: &Linearisation,
-    starts: usize,
-) -> Vec<Vec<f64>> {
+pub fn alternative_solutions(problem: &dyn Objective, at: &Linearisation, starts: usize) -> Vec<Vec<f64>> {
     alternatives_among(problem, at, &local_solutions(problem, starts))
 }
 
 /// The converged local fits (no restarts) from the `starts` best points of the coarse grid: a
 /// property of the data alone, computed once when several estimates share the data.
-pub fn local_solutions(problem: &dyn LeastSquaresObjective, starts: usize) -> Vec<Linearisation> {
+pub fn local_solutions(problem: &dyn Objective, starts: usize) -> Vec<Linearisation> {
     crate::update::levenberg_marquardt::ranked_seeds(problem, &problem.parameters().nominal_values(), &[])
         .into_iter()
         .take(starts)
@@ -303,7 +295,7 @@ pub fn local_solutions(problem: &dyn LeastSquaresObjective, starts: usize) -> Ve
 /// Those of `solutions` that fit as well as `at` (an exact fit, or within the 95% χ² threshold)
 /// more than 1% (scaled) away from it and from each other.
 pub fn alternatives_among(
-    problem: &dyn LeastSquaresObjective,
+    problem: &dyn Objective,
     at: &Linearisation,
     solutions: &[Linearisation],
 ) -> Vec<Vec<f64>> {
@@ -322,7 +314,7 @@ pub fn alternatives_among(
 /// [`alternative_solutions`] with every evaluation charged to `budget`; a spent budget ends the
 /// search with what was found.
 pub fn alternative_solutions_within(
-    problem: &dyn LeastSquaresObjective,
+    problem: &dyn Objective,
     at: &Linearisation,
     starts: usize,
     budget: &Budget,
@@ -335,7 +327,7 @@ pub fn alternative_solutions_within(
 /// (unit, scale and limits) whose exchange fits the data as well as `at`, the exchanged vector.
 /// Costs one evaluation per pair, charged to `budget`.
 pub fn mirror_solutions(
-    problem: &dyn LeastSquaresObjective,
+    problem: &dyn Objective,
     at: &Linearisation,
     budget: &Budget,
 ) -> Vec<(usize, usize, Vec<f64>)> {
@@ -367,7 +359,7 @@ pub fn mirror_solutions(
 const MIRROR_DISTANCE: f64 = 0.1;
 
 /// Largest scaled difference between two parameter vectors.
-fn scaled_distance(problem: &dyn LeastSquaresObjective, a: &[f64], b: &[f64]) -> f64 {
+fn scaled_distance(problem: &dyn Objective, a: &[f64], b: &[f64]) -> f64 {
     let params = problem.parameters();
     params
         .iter()

@@ -3,7 +3,7 @@
 
 use crate::analysis::chi2_upper_tail;
 use crate::model::ParameterSet;
-use crate::problem::{LeastSquaresObjective, Linearisation};
+use crate::problem::{Linearisation, Objective};
 use crate::update::Budget;
 
 /// p-value below which a fit is rejected as poor: strong evidence that no parameter value of this
@@ -138,11 +138,7 @@ pub struct Unreachable {
 /// no parameter value can fit (a typing slip, a wrong unit). Up to four parameters every corner
 /// is tried, beyond only the all-lower and all-upper ones; corners the model cannot be evaluated
 /// at (e.g. a rigid-body mode at a vanishing support) are skipped. Charged to `budget`.
-pub fn unreachable_modes(
-    problem: &dyn LeastSquaresObjective,
-    margin: f64,
-    budget: &Budget,
-) -> Vec<Unreachable> {
+pub fn unreachable_modes(problem: &dyn Objective, margin: f64, budget: &Budget) -> Vec<Unreachable> {
     let params = problem.parameters().as_slice();
     let np = params.len();
     let corner = |mask: usize| -> Vec<f64> {

@@ -17,7 +17,7 @@ use crate::eigen::EigenSolver;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::{Augmented, Candidate, StructuralModel};
 use crate::problem::multi::Stacked;
-use crate::problem::{LeastSquaresObjective, Linearisation, Problem};
+use crate::problem::{Linearisation, Objective, Problem};
 use crate::update::{Driver, LevenbergMarquardt};
 use nalgebra::DVector;
 use thiserror::Error;
@@ -321,7 +321,7 @@ where
     }
     let problems: Vec<Problem<&M, &S>> =
         models.iter().zip(&measured).map(|(&m, d)| Problem::new(m, solver, d.clone())).collect();
-    let base = Stacked::new(problems.iter().map(|p| p as &dyn LeastSquaresObjective).collect())
+    let base = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect())
         .ok_or_else(|| DiscoveryError::Data("the configurations' parameters differ".into()))?;
     // (a) calibrate
     let est = Driver::default()
@@ -523,7 +523,7 @@ struct Projector {
 }
 
 impl Projector {
-    fn new(base: &dyn LeastSquaresObjective, lin: &Linearisation) -> Self {
+    fn new(base: &dyn Objective, lin: &Linearisation) -> Self {
         let js = lin.scaled_jacobian(base.parameters());
         // Orthonormal basis of the column space (thin SVD, dropping null directions).
         let svd = js.svd(true, false);
@@ -550,7 +550,7 @@ fn with_augmented<M, S, T>(
     solver: &S,
     measured: &[Measurement],
     set: &[&Candidate],
-    f: impl FnOnce(&dyn LeastSquaresObjective) -> Option<T>,
+    f: impl FnOnce(&dyn Objective) -> Option<T>,
 ) -> Option<T>
 where
     M: StructuralModel,
@@ -560,7 +560,7 @@ where
         models.iter().map(|&m| Augmented::with_all(m, set)).collect::<Result<_, _>>().ok()?;
     let problems: Vec<Problem<&Augmented<'_, M>, &S>> =
         augmented.iter().zip(measured).map(|(a, d)| Problem::new(a, solver, d.clone())).collect();
-    let stacked = Stacked::new(problems.iter().map(|p| p as &dyn LeastSquaresObjective).collect())?;
+    let stacked = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect())?;
     f(&stacked)
 }
 

@@ -1,6 +1,6 @@
 //! Problem layer: a model, a solver and a measurement make a [`Problem`]; its residual, mode
 //! [`Pairing`] and [`Linearisation`] (residual and Jacobian at a point); the
-//! [`LeastSquaresObjective`] every update strategy works on; and [`multi`] for several
+//! [`Objective`] every update strategy works on; and [`multi`] for several
 //! configurations stacked into one objective.
 //!
 //! Depends on [`measurement`](crate::measurement), [`sensitivity`](crate::sensitivity) and below.
@@ -9,5 +9,5 @@ pub mod multi;
 pub(crate) mod objective;
 pub(crate) mod residual;
 
-pub use objective::LeastSquaresObjective;
+pub use objective::Objective;
 pub use residual::{Linearisation, Pairing, Problem, ResidualError, ResidualKind};

@@ -2,24 +2,24 @@
 //! of each configuration are stacked into one least-squares problem.
 
 use crate::model::ParameterSet;
-use crate::problem::{LeastSquaresObjective, Linearisation, ResidualError};
+use crate::problem::{Linearisation, Objective, ResidualError};
 use nalgebra::{DMatrix, DVector};
 
 /// Stacks problems that share one parameter set (e.g. one rotor measured at several support
 /// settings, each with its own [`Problem`](crate::problem::Problem)).
 pub struct Stacked<'a> {
-    parts: Vec<&'a dyn LeastSquaresObjective>,
+    parts: Vec<&'a dyn Objective>,
 }
 
 impl<'a> Stacked<'a> {
     /// Stacks `parts`; `None` when empty or when the parts' parameter sets differ.
-    pub fn new(parts: Vec<&'a dyn LeastSquaresObjective>) -> Option<Self> {
+    pub fn new(parts: Vec<&'a dyn Objective>) -> Option<Self> {
         let first = parts.first()?.parameters();
         parts.iter().all(|p| p.parameters() == first).then_some(Self { parts })
     }
 }
 
-impl LeastSquaresObjective for Stacked<'_> {
+impl Objective for Stacked<'_> {
     fn parameters(&self) -> &ParameterSet {
         self.parts[0].parameters()
     }

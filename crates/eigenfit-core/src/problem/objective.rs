@@ -7,8 +7,9 @@ use crate::eigen::EigenSolver;
 use crate::model::{ParameterSet, StructuralModel};
 use crate::problem::{Linearisation, Problem, ResidualError};
 
-/// What a strategy sees of the problem: the parameters and the linearisation at any point.
-pub trait LeastSquaresObjective {
+/// The least-squares objective ½‖r(p)‖² a strategy minimises, as a strategy sees it: the
+/// parameters, and the residual and Jacobian at any point.
+pub trait Objective {
     /// The model's parameters.
     fn parameters(&self) -> &ParameterSet;
     /// Residual and Jacobian at `p`.
@@ -21,7 +22,7 @@ pub trait LeastSquaresObjective {
     }
 }
 
-impl<M: StructuralModel, S: EigenSolver> LeastSquaresObjective for Problem<M, S> {
+impl<M: StructuralModel, S: EigenSolver> Objective for Problem<M, S> {
     fn parameters(&self) -> &ParameterSet {
         Problem::parameters(self)
     }

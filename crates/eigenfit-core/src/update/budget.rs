@@ -2,7 +2,7 @@
 //! input — a typing slip, data no stiffness can produce — can make eigenfit run for hours.
 
 use crate::model::ParameterSet;
-use crate::problem::{LeastSquaresObjective, Linearisation, ResidualError};
+use crate::problem::{Linearisation, Objective, ResidualError};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// Evaluations a task may spend when the user sets no budget: a few seconds on the largest
@@ -60,19 +60,19 @@ impl Budget {
     }
 
     /// `problem` with every evaluation charged to this budget.
-    pub fn wrap<'a>(&'a self, problem: &'a dyn LeastSquaresObjective) -> Budgeted<'a> {
+    pub fn wrap<'a>(&'a self, problem: &'a dyn Objective) -> Budgeted<'a> {
         Budgeted { inner: problem, budget: self }
     }
 }
 
-/// An [`LeastSquaresObjective`] that charges each evaluation to a [`Budget`] and fails with
+/// An [`Objective`] that charges each evaluation to a [`Budget`] and fails with
 /// [`ResidualError::BudgetExhausted`] once it is spent.
 pub struct Budgeted<'a> {
-    inner: &'a dyn LeastSquaresObjective,
+    inner: &'a dyn Objective,
     budget: &'a Budget,
 }
 
-impl LeastSquaresObjective for Budgeted<'_> {
+impl Objective for Budgeted<'_> {
     fn parameters(&self) -> &ParameterSet {
         self.inner.parameters()
     }

@@ -2,7 +2,7 @@
 
 use super::{Step, StepStatus, UpdateError, UpdateStrategy};
 use crate::model::ParameterSet;
-use crate::problem::{LeastSquaresObjective, Linearisation};
+use crate::problem::{Linearisation, Objective};
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 
@@ -101,13 +101,13 @@ impl LevenbergMarquardt {
     }
 
     /// The coarse log grid of restart seeds for `problem`, ranked by residual (lowest first).
-    pub fn rank_seeds(problem: &dyn LeastSquaresObjective) -> Arc<Vec<Vec<f64>>> {
+    pub fn rank_seeds(problem: &dyn Objective) -> Arc<Vec<Vec<f64>>> {
         let around = problem.parameters().nominal_values();
         Arc::new(ranked_seeds(problem, &around, &[]))
     }
 
     /// This run's seeds (ranked on first use, or copied from shared ones) and the evaluations spent.
-    fn seeds(&mut self, problem: &dyn LeastSquaresObjective, around: &[f64]) -> (&mut Vec<Vec<f64>>, usize) {
+    fn seeds(&mut self, problem: &dyn Objective, around: &[f64]) -> (&mut Vec<Vec<f64>>, usize) {
         let mut spent = 0;
         if self.seeds.is_none() {
             let fixed = self.fixed.iter().any(|&f| f);
@@ -150,11 +150,7 @@ impl LevenbergMarquardt {
 
     /// The point reached does not fit: restart from the best untried seed, or end with the best
     /// point found.
-    fn restart(
-        &mut self,
-        problem: &dyn LeastSquaresObjective,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError> {
+    fn restart(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
         self.remember(current);
         let (_, mut evaluations) = self.seeds(problem, &current.parameters);
         while self.restarts < self.max_restarts {
@@ -177,11 +173,7 @@ impl LevenbergMarquardt {
 }
 
 /// Coarse log grid over each free parameter's search range, ranked by residual (lowest first).
-pub(crate) fn ranked_seeds(
-    problem: &dyn LeastSquaresObjective,
-    around: &[f64],
-    fixed: &[bool],
-) -> Vec<Vec<f64>> {
+pub(crate) fn ranked_seeds(problem: &dyn Objective, around: &[f64], fixed: &[bool]) -> Vec<Vec<f64>> {
     let params = problem.parameters();
     let per_axis =
         seeds_per_axis((0..params.len()).filter(|&i| !fixed.get(i).copied().unwrap_or(false)).count());
@@ -231,11 +223,7 @@ impl UpdateStrategy for LevenbergMarquardt {
         "damped"
     }
 
-    fn start(
-        &mut self,
-        problem: &dyn LeastSquaresObjective,
-        initial: &Linearisation,
-    ) -> Result<(), UpdateError> {
+    fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
         let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
         if initial.residual.len() < free {
             return Err(UpdateError::Setup(format!(
@@ -260,11 +248,7 @@ impl UpdateStrategy for LevenbergMarquardt {
         lin.max_rel_diff() <= self.residual_tolerance && lin.residual.len() == lin.frequencies_hz.len()
     }
 
-    fn step(
-        &mut self,
-        problem: &dyn LeastSquaresObjective,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError> {
+    fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
         let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
         // Far from the data at the start (a frequency off by more than FAR_START): begin from
         // the best point of the coarse grid instead, when it fits better.
@@ -319,7 +303,7 @@ impl LevenbergMarquardt {
     /// One Levenberg–Marquardt iteration: `Ok(None)` when the current point is stationary.
     fn lm_step(
         &mut self,
-        problem: &dyn LeastSquaresObjective,
+        problem: &dyn Objective,
         current: &Linearisation,
     ) -> Result<Option<Step>, UpdateError> {
         let params = problem.parameters();

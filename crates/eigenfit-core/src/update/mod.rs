@@ -18,7 +18,7 @@ pub use levenberg_marquardt::LevenbergMarquardt;
 pub use newton::Newton;
 pub use pstep::PStep;
 
-use crate::problem::{LeastSquaresObjective, Linearisation, ResidualError};
+use crate::problem::{Linearisation, Objective, ResidualError};
 use thiserror::Error;
 
 /// Why an update step could not be taken.
@@ -64,19 +64,11 @@ pub trait UpdateStrategy {
     /// Name for reports, e.g. `newton`.
     fn name(&self) -> &'static str;
     /// Resets internal state before a run starting at `initial`.
-    fn start(
-        &mut self,
-        problem: &dyn LeastSquaresObjective,
-        initial: &Linearisation,
-    ) -> Result<(), UpdateError>;
+    fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError>;
     /// Whether `lin` already satisfies the convergence test (checked at the start).
     fn converged(&self, lin: &Linearisation) -> bool;
     /// Takes one step.
-    fn step(
-        &mut self,
-        problem: &dyn LeastSquaresObjective,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError>;
+    fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError>;
 }
 
 /// Solves the paper's eq. 28, S Δk = Δλ, on the first N modes (N = number of parameters, as in
@@ -113,10 +105,7 @@ pub(crate) fn square_max_diff_hz(lin: &Linearisation) -> f64 {
 }
 
 /// Linearises at `p`, turning a point outside the bounds or a failed model into `Diverged`.
-pub(crate) fn evaluate_or_diverge(
-    problem: &dyn LeastSquaresObjective,
-    p: &[f64],
-) -> Result<Linearisation, UpdateError> {
+pub(crate) fn evaluate_or_diverge(problem: &dyn Objective, p: &[f64]) -> Result<Linearisation, UpdateError> {
     problem.parameters().check(p).map_err(|e| UpdateError::Diverged(e.to_string()))?;
     problem.linearise(p).map_err(|e| UpdateError::Diverged(e.to_string()))
 }

@@ -3,7 +3,7 @@
 use super::{
     evaluate_or_diverge, newton_point, square_max_diff_hz, Step, StepStatus, UpdateError, UpdateStrategy,
 };
-use crate::problem::{LeastSquaresObjective, Linearisation};
+use crate::problem::{Linearisation, Objective};
 use crate::units::eigenvalue_to_hz;
 use nalgebra::DVector;
 
@@ -63,7 +63,7 @@ impl UpdateStrategy for PStep {
         "p-step"
     }
 
-    fn start(&mut self, _: &dyn LeastSquaresObjective, initial: &Linearisation) -> Result<(), UpdateError> {
+    fn start(&mut self, _: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
         newton_point(initial, &initial.measured_eigenvalues)?;
         self.start_eigenvalues = initial.model_eigenvalues.clone();
         self.stages = if square_max_diff_hz(initial) > self.split_above_hz { self.parts } else { 1 };
@@ -75,11 +75,7 @@ impl UpdateStrategy for PStep {
         square_max_diff_hz(lin) < self.tolerance_hz
     }
 
-    fn step(
-        &mut self,
-        problem: &dyn LeastSquaresObjective,
-        current: &Linearisation,
-    ) -> Result<Step, UpdateError> {
+    fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
         let p = newton_point(current, &self.target(current))?;
         let next = evaluate_or_diverge(problem, &p)?;
         // Advance through every stage whose target the new point already meets.
