@@ -2,8 +2,8 @@
 //! `campbell`: the hooks in those commands route here when the model file is a ROSS rotor.
 
 use crate::error::{input, CliError, EXIT_NOT_CONVERGED, EXIT_OK};
-use eigenfit_core::residual::Linearisation;
-use eigenfit_core::verdict::{judge, FitQuality, FitVerdict};
+use eigenfit_core::analysis::verdict::{judge, FitQuality, FitVerdict};
+use eigenfit_core::problem::Linearisation;
 use eigenfit_rotordynamics::identify::{
     bearing_parameters, identify, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
 };
