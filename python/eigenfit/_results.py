@@ -292,35 +292,29 @@ class CompareResult(Result):
         return np.asarray([r["estimate"] for r in self._data["runs"]], dtype=float)
 
 
+def _float_array(key: str, doc: str) -> Any:
+    """A read-only property: the JSON field ``key`` as a float array."""
+    return property(lambda self: np.asarray(self._data[key], dtype=float), doc=doc)
+
+
 class CampbellResult(Result):
     """``eigenfit campbell``: damped whirl frequencies of a two-plane rotor over speed."""
 
     command = "campbell"
 
-    @property
-    def speeds_rpm(self) -> np.ndarray:
-        """The rotor speeds (rpm)."""
-        return np.asarray(self._data["speeds_rpm"], dtype=float)
-
-    @property
-    def frequencies_hz(self) -> np.ndarray:
-        """Damped natural frequencies (Hz), shape (speeds, modes), ascending at each speed."""
-        return np.asarray(self._data["frequencies_hz"], dtype=float)
+    speeds_rpm = _float_array("speeds_rpm", "The rotor speeds (rpm).")
+    frequencies_hz = _float_array(
+        "frequencies_hz", "Damped natural frequencies (Hz), shape (speeds, modes), ascending at each speed."
+    )
+    log_dec = _float_array("log_dec", "Logarithmic decrements, shape (speeds, modes).")
+    critical_speeds_rpm = _float_array(
+        "critical_speeds_rpm", "Speeds (rpm) where a followed mode crosses the 1× line, ascending."
+    )
 
     @property
     def whirl(self) -> List[List[str]]:
         """Whirl of each mode at each speed: ``forward``, ``backward`` or ``mixed``."""
         return copy.deepcopy(self._data["whirl"])
-
-    @property
-    def log_dec(self) -> np.ndarray:
-        """Logarithmic decrements, shape (speeds, modes)."""
-        return np.asarray(self._data["log_dec"], dtype=float)
-
-    @property
-    def critical_speeds_rpm(self) -> np.ndarray:
-        """Speeds (rpm) where a followed mode crosses the 1× line, ascending."""
-        return np.asarray(self._data["critical_speeds_rpm"], dtype=float)
 
 
 #: Result class by name, for unpickling (the name, not the class, travels in the pickle).
