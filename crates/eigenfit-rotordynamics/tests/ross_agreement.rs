@@ -23,8 +23,9 @@ struct Worst {
 }
 
 /// Compares one rotor file against ROSS's numbers: the worst relative frequency error, the worst
-/// log-decrement error (absolute, relative above 1) and the whirl comparison. With `ross_coefficients` every bearing takes, at each speed, the coefficient
-/// values ROSS used there (its smoothing-spline fit of the tables, recorded by the script).
+/// log-decrement error (absolute, relative above 1) and the whirl comparison. With
+/// `ross_coefficients` every bearing takes, at each speed, the coefficient values ROSS used there
+/// (its smoothing-spline fit of the tables, recorded by the script).
 fn compare_with(file: &str, name: &str, ross_coefficients: bool) -> Worst {
     let mut rotor = ross_file::read(&data(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
     let r = reference();
