@@ -29,7 +29,9 @@ thread_local! {
 /// Prints a command's JSON result on stdout, or hands it to [`crate::run_json`] when that is the
 /// caller. Every `--json` result goes through here, so the library's result and the binary's
 /// output are the same value by construction.
-pub fn emit_json(value: serde_json::Value) {
+pub fn emit_json<T: serde::Serialize + ?Sized>(report: &T) {
+    // Through a `Value`, so keys come out sorted whatever the report's field order.
+    let value = serde_json::to_value(report).expect("reports serialise: every map key is a string");
     let value = CAPTURED.with(|c| match c.borrow_mut().as_mut() {
         Some(slot) => {
             *slot = Some(value);

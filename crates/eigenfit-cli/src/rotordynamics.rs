@@ -1,181 +1,72 @@
-//! Two-plane rotors (files written by ROSS `Rotor.save`) in `simulate`, `estimate` and
-//! `campbell`: the hooks in those commands route here when the model file is a ROSS rotor.
+//! Two-plane rotors (files written by ROSS `Rotor.save`) in `simulate` and `estimate`: the
+//! tables of the rotordynamics workflow's reports.
 
-use crate::error::{input, CliError, EXIT_NOT_CONVERGED, EXIT_OK};
-use eigenfit_rotordynamics::identify::{identify, read_runup, stiffness_parameters};
-use eigenfit_rotordynamics::{ross_file, rpm_to_rad, Rotor, RotorDynError};
-use serde_json::{json, Map, Value};
-use std::path::Path;
+use eigenfit_workflow::rotordynamics::{RunupEstimateReport, SpeedReport};
 
-/// The model file if it is a ROSS rotor (judged by its content: tables `ShaftElement_…`).
-pub fn ross_model(path: Option<&Path>) -> Option<&Path> {
-    let path = path?;
-    let text = std::fs::read_to_string(path).ok()?;
-    ross_file::looks_like_ross(&text).then_some(path)
-}
-
-fn to_cli(e: RotorDynError) -> CliError {
-    match e {
-        RotorDynError::Solver(m) => CliError::Failure(m),
-        other => input(other.to_string()),
+/// `simulate --model ROSS-FILE`: damped modes at one speed.
+pub fn print_speed(r: &SpeedReport) {
+    println!("{}: {} DOF two-plane rotor at {} rpm", r.model, r.dofs, r.speed_rpm);
+    println!(
+        "{:>6}{:>16}{:>16}{:>12}{:>12}{:>10}",
+        "mode", "damped [Hz]", "natural [Hz]", "ζ", "log dec", "whirl"
+    );
+    for i in 0..r.frequencies_hz.len() {
+        println!(
+            "{:>6}{:>16.6}{:>16.6}{:>12.5}{:>12.5}{:>10}",
+            i + 1,
+            r.frequencies_hz[i],
+            r.natural_frequencies_hz[i],
+            r.damping_ratio[i],
+            r.log_dec[i],
+            r.whirl[i]
+        );
     }
 }
 
-/// Loads a ROSS rotor, errors naming the file.
-pub fn load(path: &Path) -> Result<Rotor, CliError> {
-    ross_file::read(path).map_err(to_cli)
-}
-
-fn check_speed(flag: &str, rpm: f64) -> Result<(), CliError> {
-    if !rpm.is_finite() || rpm < 0.0 {
-        return Err(input(format!("{flag} {rpm}: speed must be a finite number of rpm ≥ 0")));
-    }
-    Ok(())
-}
-
-/// `simulate --model ROSS-FILE [--speed RPM] --modes N`: damped modes at one speed.
-pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize, json_out: bool) -> Result<(), CliError> {
-    let rotor = load(path)?;
-    let rpm = speed_rpm.unwrap_or(0.0);
-    check_speed("--speed", rpm)?;
-    if modes == 0 || modes > rotor.dofs() {
-        return Err(input(format!("--modes {modes}: must be between 1 and {} for this rotor", rotor.dofs())));
-    }
-    let all = rotor.lowest_modes(rpm_to_rad(rpm), modes).map_err(to_cli)?;
-    if modes > all.len() {
-        return Err(input(format!(
-            "--modes {modes}: must be between 1 and {} (the oscillating modes of this rotor at {rpm} rpm)",
-            all.len()
-        )));
-    }
-    let shown = &all[..modes];
-    if json_out {
-        let out = json!({
-            "model": path.display().to_string(),
-            "speed_rpm": rpm,
-            "frequencies_hz": shown.iter().map(|m| m.frequency_hz()).collect::<Vec<_>>(),
-            "natural_frequencies_hz": shown.iter().map(|m| m.natural_frequency_hz()).collect::<Vec<_>>(),
-            "whirl": shown.iter().map(|m| m.whirl.name()).collect::<Vec<_>>(),
-            "damping_ratio": shown.iter().map(|m| m.damping_ratio()).collect::<Vec<_>>(),
-            "log_dec": shown.iter().map(|m| m.log_dec()).collect::<Vec<_>>(),
+/// `estimate --model ROSS-FILE --measured RUNUP.csv`: the bearing stiffnesses and the points.
+pub fn print_estimate(r: &RunupEstimateReport) {
+    println!(
+        "{}: {} bearing stiffnesses from {} run-up frequencies: {} after {} iterations",
+        r.model,
+        r.parameters.0.len(),
+        r.points.len(),
+        if r.converged { "converged" } else { "NOT converged" },
+        r.iterations
+    );
+    println!(
+        "{:<28}{:>16}{:>16}{:>32}",
+        "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]"
+    );
+    for (i, ((name, initial), (_, value))) in r.initial.iter().zip(r.parameters.iter()).enumerate() {
+        let none = if r.identifiable { "(no std_hz given)" } else { "(not identifiable)" };
+        let iv = r.intervals.as_ref().map_or(none.to_string(), |iv| {
+            let iv = iv.0[i].1;
+            format!("[{:.4e}, {:.4e}]", iv[0], iv[1])
         });
-        crate::output::emit_json(out);
-    } else {
-        println!("{}: {} DOF two-plane rotor at {rpm} rpm", path.display(), rotor.dofs());
-        println!(
-            "{:>6}{:>16}{:>16}{:>12}{:>12}{:>10}",
-            "mode", "damped [Hz]", "natural [Hz]", "ζ", "log dec", "whirl"
-        );
-        for (i, m) in shown.iter().enumerate() {
-            println!(
-                "{:>6}{:>16.6}{:>16.6}{:>12.5}{:>12.5}{:>10}",
-                i + 1,
-                m.frequency_hz(),
-                m.natural_frequency_hz(),
-                m.damping_ratio(),
-                m.log_dec(),
-                m.whirl.name()
-            );
-        }
+        println!("{name:<28}{initial:>16.4e}{value:>16.6e}{iv:>32}");
     }
-    Ok(())
-}
-
-/// `estimate --model ROSS-FILE --measured RUNUP.csv`: kxx and kyy of every bearing.
-pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: bool) -> Result<u8, CliError> {
-    let rotor = load(path)?;
-    let points = read_runup(measured).map_err(to_cli)?;
-    let params = stiffness_parameters(&rotor);
-    if params.is_empty() {
-        return Err(input(format!("{}: the rotor has no bearings to estimate", path.display())));
+    println!(
+        "{:>10}{:>6}{:>16}{:>16}{:>12}{:>10}",
+        "rpm", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]", "whirl"
+    );
+    for p in &r.points {
+        println!(
+            "{:>10.1}{:>6}{:>16.6}{:>16.6}{:>12.2e}{:>10}",
+            p.speed_rpm,
+            p.mode,
+            p.measured_hz,
+            p.model_hz,
+            p.model_hz - p.measured_hz,
+            p.model_whirl
+        );
     }
-    let initial = vec![1.0; params.len()];
-    let id = identify(&rotor, &params, &points, &initial, max_iterations).map_err(to_cli)?;
-    // Report each stiffness in N/m at the lowest measured speed (constant bearings: their value).
-    let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
-    let nominal: Vec<f64> = params.iter().map(|p| rotor.bearings[p.bearing].k[p.entry].at(w0)).collect();
-    let value: Vec<f64> = nominal.iter().zip(&id.scales).map(|(k, s)| k * s).collect();
-    let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
-    let obj = |values: Vec<Value>| -> Map<String, Value> { names.iter().cloned().zip(values).collect() };
-    // 95 % intervals, log-normal (the estimate is linearised in ln k).
-    let intervals: Option<Vec<[f64; 2]>> = id
-        .ln_std
-        .as_ref()
-        .map(|sd| value.iter().zip(sd).map(|(v, s)| [v * (-1.96 * s).exp(), v * (1.96 * s).exp()]).collect());
-    let dof = points.len().saturating_sub(params.len());
-    if json_out {
-        let mut out = json!({
-            "model": path.display().to_string(),
-            "converged": id.converged,
-            "termination": id.reason,
-            "iterations": id.iterations,
-            "evaluations": id.evaluations,
-            "reference_speed_rpm": w0 * 30.0 / std::f64::consts::PI,
-            "initial": obj(nominal.iter().map(|&v| json!(v)).collect()),
-            "parameters": obj(value.iter().map(|&v| json!(v)).collect()),
-            "scales": obj(id.scales.iter().map(|&v| json!(v)).collect()),
-            "cost": id.cost,
-            "identifiable": id.identifiable,
-            "points": points.iter().enumerate().map(|(i, p)| json!({
-                "speed_rpm": p.speed_rpm,
-                "mode": p.mode,
-                "measured_hz": p.frequency_hz,
-                "model_hz": id.model_hz[i],
-                "model_whirl": id.model_whirl[i].name(),
-                "measured_whirl": p.whirl.map(|w| w.name()),
-            })).collect::<Vec<_>>(),
-        });
-        if let (Some(iv), Some(sd)) = (&intervals, &id.ln_std) {
-            out["intervals"] = Value::Object(obj(iv.iter().map(|i| json!(i)).collect()));
-            out["standard_deviations_ln"] = Value::Object(obj(sd.iter().map(|&s| json!(s)).collect()));
-            out["chi2"] = json!(id.cost);
-            out["dof"] = json!(dof);
-        }
-        crate::output::emit_json(out);
-    } else {
-        println!(
-            "{}: {} bearing stiffnesses from {} run-up frequencies: {} after {} iterations",
-            path.display(),
-            params.len(),
-            points.len(),
-            if id.converged { "converged" } else { "NOT converged" },
-            id.iterations
-        );
-        println!(
-            "{:<28}{:>16}{:>16}{:>32}",
-            "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]"
-        );
-        for i in 0..params.len() {
-            let none = if id.identifiable { "(no std_hz given)" } else { "(not identifiable)" };
-            let iv = intervals
-                .as_ref()
-                .map_or(none.to_string(), |iv| format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]));
-            println!("{:<28}{:>16.4e}{:>16.6e}{iv:>32}", names[i], nominal[i], value[i]);
-        }
-        println!(
-            "{:>10}{:>6}{:>16}{:>16}{:>12}{:>10}",
-            "rpm", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]", "whirl"
-        );
-        for (i, p) in points.iter().enumerate() {
-            println!(
-                "{:>10.1}{:>6}{:>16.6}{:>16.6}{:>12.2e}{:>10}",
-                p.speed_rpm,
-                p.mode,
-                p.frequency_hz,
-                id.model_hz[i],
-                id.model_hz[i] - p.frequency_hz,
-                id.model_whirl[i].name()
-            );
-        }
-        if id.ln_std.is_some() {
-            println!("chi² = {:.4} with {dof} degrees of freedom", id.cost);
-        }
-        if !id.identifiable {
-            println!(
-                "not identifiable: the frequencies do not determine every parameter separately \
-                 (an isotropic rotor's kxx and kyy act alike); no intervals"
-            );
-        }
+    if let (Some(chi2), Some(dof)) = (r.chi2, r.dof) {
+        println!("chi² = {chi2:.4} with {dof} degrees of freedom");
     }
-    Ok(if id.converged { EXIT_OK } else { EXIT_NOT_CONVERGED })
+    if !r.identifiable {
+        println!(
+            "not identifiable: the frequencies do not determine every parameter separately \
+             (an isotropic rotor's kxx and kyy act alike); no intervals"
+        );
+    }
 }

@@ -2,6 +2,8 @@
 
 use thiserror::Error;
 
+pub mod measured_csv;
+
 /// One measured mode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasuredMode {

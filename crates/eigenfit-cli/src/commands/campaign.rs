@@ -2,7 +2,6 @@
 
 use crate::error::{input, CliError, EXIT_NOT_CONVERGED};
 use crate::progress;
-use crate::testdata::{self, Fit, TestDataArgs};
 use clap::Args;
 use eigenfit_core::testdata::Joint;
 use eigenfit_core::{
@@ -10,6 +9,9 @@ use eigenfit_core::{
 };
 use eigenfit_rotor::campaign::Campaign;
 use eigenfit_rotor::Rotor;
+use eigenfit_workflow::overrides::fixed;
+use eigenfit_workflow::test_data::{self, Fit, TestDataOptions};
+use eigenfit_workflow::Updatable;
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
@@ -63,25 +65,25 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
     for conf in &campaign.configurations {
         let name = conf.name.clone().unwrap_or_default();
         let rotor = Rotor::from_toml_file(&conf.model).map_err(|e| input(format!("{name}: {e}")))?;
-        let options = TestDataArgs {
+        let options = TestDataOptions {
             shapes: conf.shapes.clone(),
             sensor_map: conf.sensor_map.clone(),
             node_tolerance: args.node_tolerance,
             shape_std: args.shape_std,
             mac_threshold: args.mac_threshold,
             fix: Vec::new(),
-            write_model: None,
         };
-        let d = testdata::read(&conf.measured, Some(&rotor), &options)
+        let d = test_data::read(&conf.measured, Some(&rotor), &options)
             .map_err(|e| input(format!("{name}: {e}")))?;
+        crate::commands::simulate::print_notes(&d.file_notes);
         let updatable = eigenfit_rotor::UpdatableRotor::new(rotor)
-            .map(|r| testdata::Updatable::Rotor(Box::new(r)))
+            .map(|r| Updatable::Rotor(Box::new(r)))
             .map_err(|e| input(format!("{}: {e}", conf.model.display())))?;
         rotors.push((updatable, options));
         data.push(d);
         names.push(name);
     }
-    let fixed: Vec<_> = rotors.iter().map(|(r, _)| testdata::fixed(r, &[])).collect::<Result<_, _>>()?;
+    let fixed: Vec<_> = rotors.iter().map(|(r, _)| fixed(r, &[])).collect::<Result<_, _>>()?;
     let fits: Vec<Fit> = fixed
         .iter()
         .zip(&data)
@@ -89,7 +91,7 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         .map(|((m, d), (_, options))| {
             let problem =
                 Problem::new(m, solver.as_ref(), d.measurement.clone()).with_kind(ResidualKind::Relative);
-            Fit::new(problem, d, options)
+            Fit::new(problem, d, options.shape_std)
         })
         .collect();
     let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Evaluate).collect())
@@ -174,7 +176,7 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
                 c
             })
             .collect::<Vec<_>>());
-        crate::output::emit_json(out);
+        crate::output::emit_json(&out);
     } else {
         println!(
             "{}: {} configurations, {} strategy, {} after {} iterations",

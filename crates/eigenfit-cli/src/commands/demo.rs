@@ -7,10 +7,11 @@ use crate::error::{input, CliError};
 use crate::plot::convergence::{Convergence, Run};
 use crate::plot::critical_speed::PAPER_TABLE_1;
 use crate::plot::discovery::DiscoveryPlot;
-use crate::{measured, plot, progress};
+use crate::{plot, progress};
 use clap::Args;
 use eigenfit_core::compare::{log_space, reference_measurement, run_grid, tensor_grid, CompareSettings};
 use eigenfit_core::discovery::{discover, DiscoveryOptions};
+use eigenfit_core::measurement::measured_csv;
 use eigenfit_core::{DenseSolver, Driver, EigenSolver, Problem, StrategyKind, StructuralModel};
 use eigenfit_rotor::presets;
 use serde_json::{json, Value};
@@ -147,18 +148,16 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
     pb.finish_and_clear();
     let grid = grid.map_err(CliError::Failure)?;
     say(format!("3. From a {n}×{n} grid of initial guesses (1e1–1e9 N/m), same data:", n = args.grid));
-    let mut basin = Vec::new();
-    for &s in &strategies {
-        let group: Vec<_> = grid.iter().filter(|r| r.strategy == s).collect();
-        let converged = group.iter().filter(|r| r.converged).count();
-        let at_target =
-            group.iter().filter(|r| r.converged && r.relative_error <= plot::compare_map::AT_TARGET).count();
+    let basin = eigenfit_workflow::compare::basins(&grid, &strategies);
+    for b in &basin {
         say(format!(
-            "   {:<8} converged from {converged:>3}/{} starts, {at_target:>3} of them to the target (within 10 %)",
-            s.name(),
-            group.len()
+            "   {:<8} converged from {:>3}/{} starts, {:>3} of them to the target (within {:.0} %)",
+            b.strategy,
+            b.converged,
+            b.runs,
+            b.at_target,
+            eigenfit_workflow::compare::AT_TARGET * 100.0
         ));
-        basin.push(json!({"strategy": s.name(), "runs": group.len(), "converged": converged, "at_target": at_target}));
     }
     say("   (runs that converged elsewhere found the second exact solution two frequencies allow for".into());
     say("   two stiffnesses: see compare-convergence.png; a third measured mode removes it)".into());
@@ -166,7 +165,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
     plots.extend(compare::write_maps(out, label, &names, &grid, &targets, &strategies)?);
 
     // 4. Discovery of a hidden effect.
-    let data = measured::parse(HIDDEN_EFFECT_CSV)
+    let data = measured_csv::parse(HIDDEN_EFFECT_CSV)
         .map_err(|e| CliError::Failure(format!("built-in dataset: line {e}")))?;
     let pb = progress::spinner("discovering the hidden effect", args.quiet);
     let options = DiscoveryOptions::default();
@@ -203,7 +202,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
 
     let seconds = started.elapsed().as_secs_f64();
     if args.json {
-        crate::output::emit_json(json!({
+        crate::output::emit_json(&json!({
             "model": label,
             "table_1": table,
             "table_3_case_1": {"target": TARGET, "initial": INITIAL, "reference_hz": reference,

@@ -1,17 +1,20 @@
 //! `eigenfit estimate`: update the bearing stiffnesses to match measured frequencies.
 
-use crate::any_model::AnyModel;
 use crate::error::{input, CliError, EXIT_NOT_CONVERGED};
 use crate::plot::convergence::{Convergence, Run};
-use crate::source::{parameter_vector, ModelArgs};
-use crate::{measured, plot, progress, testdata};
+use crate::source::ModelArgs;
+use crate::{plot, progress, testdata};
 use clap::Args;
+use eigenfit_core::measurement::measured_csv;
 use eigenfit_core::statistics::{alternative_solutions_within, mirror_solutions};
 use eigenfit_core::update::DEFAULT_EVALUATIONS;
 use eigenfit_core::verdict::{at_limits, judge, unreachable_modes, FitVerdict};
 use eigenfit_core::{
     Budget, Driver, Evaluate, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel,
 };
+use eigenfit_workflow::overrides::{fixed, parameter_vector};
+use eigenfit_workflow::simulate::check_roundoff;
+use eigenfit_workflow::test_data::{self, updated_model_toml, Fit, ShapeReport};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
 
@@ -66,22 +69,27 @@ const UNREACHABLE_MARGIN: f64 = 0.1;
 /// parameter sits on a limit or the budget ran out).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
-    if let Some(path) = crate::rotordynamics::ross_model(args.model.model.as_deref()) {
-        return crate::rotordynamics::estimate(path, &args.measured, args.max_iterations, args.json);
+    if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
+        let report = eigenfit_workflow::rotordynamics::estimate(path, &args.measured, args.max_iterations)?;
+        let code = if report.converged { crate::error::EXIT_OK } else { EXIT_NOT_CONVERGED };
+        if args.json {
+            crate::output::emit_json(&report);
+        } else {
+            crate::rotordynamics::print_estimate(&report);
+        }
+        return Ok(code);
     }
     let (model, label) = args.model.load_any()?;
     let rotor = &model;
     let solver = args.model.solver()?;
-    let layout: Option<&dyn eigenfit_core::testdata::sensors::NodeLayout> = match &model {
-        AnyModel::Rotor(r) => Some(r),
-        AnyModel::Matrices(_) => None,
-    };
-    let data = testdata::read(&args.measured, layout, &args.test_data)?;
+    let options = args.test_data.options();
+    let data = test_data::read(&args.measured, model.layout(), &options)?;
+    crate::commands::simulate::print_notes(&data.file_notes);
     let measurement = data.measurement.clone();
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
         input(format!(
             "unknown strategy `{}`; available: newton, p-step, damped",
-            measured::shown(&args.strategy)
+            measured_csv::shown(&args.strategy)
         ))
     })?;
     let kind = match args.residual.as_str() {
@@ -91,16 +99,16 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         other => {
             return Err(input(format!(
                 "unknown residual `{}`; available: relative, hz, eigenvalue",
-                measured::shown(other)
+                measured_csv::shown(other)
             )))
         }
     };
     if args.budget == 0 {
         return Err(input("--budget 0: at least one model evaluation is needed"));
     }
-    let updatable = testdata::updatable(rotor, &label)?;
+    let updatable = model.updatable(&label)?;
     let initial = parameter_vector(&updatable, "--initial", args.initial.as_deref(), &[])?;
-    let model = testdata::fixed(&updatable, &args.test_data.fix)?;
+    let model = fixed(&updatable, &options.fix)?;
     let initial = model.reduce(&initial);
     let np = model.parameters().len();
     // With shapes every mode gives a row per sensor too: fewer modes than parameters may do.
@@ -132,7 +140,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let mode_numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
     let sigma_max = measurement.modes().iter().filter_map(|m| m.std_hz).reduce(f64::max);
     let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
-    let mut fit = testdata::Fit::new(problem, &data, &args.test_data);
+    let mut fit = Fit::new(problem, &data, options.shape_std);
     let budget = Budget::new(args.budget);
     // Data no parameter value can produce is refused before any fitting.
     let unreachable = unreachable_modes(&fit, UNREACHABLE_MARGIN, &budget);
@@ -143,7 +151,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 format!(
                     "mode {} at {} Hz (the model reaches {:.4}–{:.4} Hz)",
                     mode_numbers[u.index],
-                    measured::shown_number(u.measured_hz),
+                    measured_csv::shown_number(u.measured_hz),
                     u.reachable_hz[0],
                     u.reachable_hz[1]
                 )
@@ -190,17 +198,14 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
     let system = model.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
     if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
-        crate::commands::simulate::refuse_roundoff(&system, &modes)?;
+        crate::commands::simulate::print_notes(check_roundoff(&system, &modes)?.as_slice());
     }
     let converged = estimate.termination.is_converged();
     let quality = judge(&estimate.last, np);
     let limits = at_limits(model.parameters(), &estimate.parameters);
     let pb = progress::spinner("intervals and other solutions", args.quiet || !converged);
-    let (unc, scatter) = if converged {
-        testdata::uncertainty(&mut fit, &estimate.last, has_std, &budget)
-    } else {
-        (None, None)
-    };
+    let (unc, scatter) =
+        if converged { fit.uncertainty_within(&estimate.last, has_std, &budget) } else { (None, None) };
     let mac = fit.mac(&estimate.parameters, args.test_data.mac_threshold);
     let mut alternatives: Vec<Alternative> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {
@@ -334,9 +339,16 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         if args.plot.is_some() {
             out["plots"] = json!(plot::names(&plots));
         }
-        testdata::add_json(&mut out, &fit, &data, &estimate, mac.as_ref(), scatter);
-        testdata::add_fixed_json(&mut out, &model);
-        crate::output::emit_json(out);
+        let shapes = ShapeReport::new(&fit, &data, &estimate, mac.as_ref(), scatter);
+        let shapes = serde_json::to_value(&shapes).expect("reports serialise: every map key is a string");
+        if let (Value::Object(out), Value::Object(shapes)) = (&mut out, shapes) {
+            out.extend(shapes);
+        }
+        let held = model.held();
+        if !held.is_empty() {
+            out["fixed"] = Value::Object(held.into_iter().map(|(n, v)| (n, json!(v))).collect());
+        }
+        crate::output::emit_json(&out);
     } else {
         println!(
             "{label}: {} strategy, {} after {} iterations ({} model evaluations)",
@@ -412,7 +424,8 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     }
     if let Some(path) = &args.test_data.write_model {
-        testdata::write_model(path, &args.measured, &model, &estimate, unc.as_ref())?;
+        let text = updated_model_toml(&args.measured, &model, &estimate, unc.as_ref())?;
+        crate::output::write_atomically(path, text.as_bytes())?;
         if !args.json {
             println!("wrote {}", path.display());
         }

@@ -5,6 +5,7 @@ use super::style::{self, log_bounds, log_tick, mode_colour, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
 use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_workflow::simulate::{sweep, SweepCheck};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -38,7 +39,8 @@ pub struct CriticalSpeedMap {
 }
 
 impl CriticalSpeedMap {
-    /// Sweeps `count` log-spaced stiffnesses over `range` (N/m), every bearing equal, `modes` modes.
+    /// Sweeps `count` log-spaced stiffnesses over `range` (N/m), every bearing equal, `modes`
+    /// modes (the workflow's sweep, as `simulate --sweep` uses; frequencies taken as solved).
     pub fn sweep(
         title: &str,
         model: &dyn StructuralModel,
@@ -46,19 +48,11 @@ impl CriticalSpeedMap {
         range: (f64, f64),
         count: usize,
         modes: usize,
-        on_point: impl Fn(),
+        progress: &mut dyn eigenfit_workflow::Progress,
     ) -> Result<Self, CliError> {
-        let np = model.parameters().len();
-        let count = count.max(2);
-        let mut stiffness = Vec::with_capacity(count);
-        let mut frequencies = Vec::with_capacity(count);
-        for k in eigenfit_core::compare::log_space(range.0, range.1, count) {
-            let system = model.assemble(&vec![k; np]).map_err(|e| CliError::Failure(e.to_string()))?;
-            let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
-            stiffness.push(k);
-            frequencies.push(m.frequencies_hz());
-            on_point();
-        }
+        let stiffness = eigenfit_core::compare::log_space(range.0, range.1, count.max(2));
+        let frequencies =
+            sweep(model, solver, &stiffness, modes, SweepCheck::None, &mut Vec::new(), progress)?;
         Ok(Self {
             title: title.to_string(),
             stiffness,

@@ -1,0 +1,27 @@
+//! eigenfit's workflows: what the `eigenfit` commands do, as library calls.
+//!
+//! Each job takes a request and returns a report whose `Serialize` form is the command's
+//! `--json` output (the CLI only parses arguments, prints tables and plots, and picks the exit
+//! code). Loading any supported model file ([`source`]: planar rotor TOML, `kind = "matrices"`,
+//! ROSS two-plane rotors) and the solver by name live here too, so a library user (and the
+//! Python package) gets the same models, checks and messages as the command line.
+//!
+//! The crate sits above every plugin crate (rotor, matrices, rotordynamics) and below the CLI.
+
+pub mod compare;
+pub mod discover;
+pub mod error;
+pub mod model;
+pub mod named;
+pub mod overrides;
+pub mod progress;
+pub mod rotordynamics;
+pub mod simulate;
+pub mod source;
+pub mod test_data;
+
+pub use error::WorkflowError;
+pub use model::{AnyModel, Updatable};
+pub use named::Named;
+pub use progress::{NoProgress, Progress};
+pub use source::ModelSource;
