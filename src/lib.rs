@@ -9,3 +9,5 @@ pub use eigenfit_core::*;
 #[cfg(feature = "lapack")]
 pub use eigenfit_lapack as lapack;
 pub use eigenfit_rotor as rotor;
+/// Whole jobs (simulate, estimate, compare, discover, campbell, campaign) with serde reports.
+pub use eigenfit_workflow as workflow;

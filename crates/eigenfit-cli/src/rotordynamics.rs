@@ -39,8 +39,8 @@ pub fn print_estimate(r: &RunupEstimateReport) {
     );
     for (i, ((name, initial), (_, value))) in r.initial.iter().zip(r.parameters.iter()).enumerate() {
         let none = if r.identifiable { "(no std_hz given)" } else { "(not identifiable)" };
-        let iv = r.intervals.as_ref().map_or(none.to_string(), |iv| {
-            let iv = iv.0[i].1;
+        let iv = r.with_std.as_ref().map_or(none.to_string(), |w| {
+            let iv = w.intervals.0[i].1;
             format!("[{:.4e}, {:.4e}]", iv[0], iv[1])
         });
         println!("{name:<28}{initial:>16.4e}{value:>16.6e}{iv:>32}");
@@ -60,8 +60,8 @@ pub fn print_estimate(r: &RunupEstimateReport) {
             p.model_whirl
         );
     }
-    if let (Some(chi2), Some(dof)) = (r.chi2, r.dof) {
-        println!("chi² = {chi2:.4} with {dof} degrees of freedom");
+    if let Some(w) = &r.with_std {
+        println!("chi² = {:.4} with {} degrees of freedom", w.chi2, w.dof);
     }
     if !r.identifiable {
         println!(

@@ -4,7 +4,7 @@
 
 use clap::Args;
 use eigenfit_core::testdata::MacReport;
-use eigenfit_workflow::test_data::{Fit, TestData, TestDataOptions};
+use eigenfit_workflow::test_data::{TestData, TestDataOptions};
 use std::path::PathBuf;
 
 /// Options for measured shapes (universal files or `--shapes`).
@@ -18,6 +18,21 @@ pub struct TestDataArgs {
     /// (`node,model_node,direction[,sign]`) instead of by node coordinates.
     #[arg(long, value_name = "FILE.csv")]
     pub sensor_map: Option<PathBuf>,
+    /// Node matching, shape weight and MAC threshold.
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    /// Hold a parameter at a value instead of estimating it, NAME=VALUE (repeatable).
+    #[arg(long = "fix", value_name = "NAME=VALUE")]
+    pub fix: Vec<String>,
+    /// Write the updated model (the estimated values as the model's nominal ones, with a header
+    /// naming the data file, the date, χ² and the intervals) as TOML.
+    #[arg(long, value_name = "OUT.toml")]
+    pub write_model: Option<PathBuf>,
+}
+
+/// How measured shapes are tied to the model and weighted (`estimate` and `campaign`).
+#[derive(Debug, Args)]
+pub struct ShapeArgs {
     /// Distance in metres within which a measured node matches a model node.
     #[arg(long, default_value_t = 1e-3, value_name = "M")]
     pub node_tolerance: f64,
@@ -28,13 +43,6 @@ pub struct TestDataArgs {
     /// unpaired and the run is not acceptable (exit code 3).
     #[arg(long, default_value_t = 0.6, value_name = "MAC")]
     pub mac_threshold: f64,
-    /// Hold a parameter at a value instead of estimating it, NAME=VALUE (repeatable).
-    #[arg(long = "fix", value_name = "NAME=VALUE")]
-    pub fix: Vec<String>,
-    /// Write the updated model (the estimated values as the model's nominal ones, with a header
-    /// naming the data file, the date, χ² and the intervals) as TOML.
-    #[arg(long, value_name = "OUT.toml")]
-    pub write_model: Option<PathBuf>,
 }
 
 impl TestDataArgs {
@@ -43,16 +51,16 @@ impl TestDataArgs {
         TestDataOptions {
             shapes: self.shapes.clone(),
             sensor_map: self.sensor_map.clone(),
-            node_tolerance: self.node_tolerance,
-            shape_std: self.shape_std,
-            mac_threshold: self.mac_threshold,
+            node_tolerance: self.shape.node_tolerance,
+            shape_std: self.shape.shape_std,
+            mac_threshold: self.shape.mac_threshold,
             fix: self.fix.clone(),
         }
     }
 }
 
 /// The shape part of the text report.
-pub fn print(data: &TestData, mac: Option<&MacReport>, scatter: Option<f64>, fit: &Fit) {
+pub fn print(data: &TestData, mac: Option<&MacReport>, scatter: Option<f64>, has_std: bool) {
     for n in &data.notes {
         eprintln!("note: {n}");
     }
@@ -82,7 +90,7 @@ pub fn print(data: &TestData, mac: Option<&MacReport>, scatter: Option<f64>, fit
         let list: Vec<String> = r.missing.iter().map(usize::to_string).collect();
         println!("model modes not measured (or not seen by the sensors): {}", list.join(", "));
     }
-    if let Some(s) = scatter.filter(|_| !fit.measured().has_std()) {
+    if let Some(s) = scatter.filter(|_| !has_std) {
         println!("intervals from the residual scatter (no std in the data): sigma_hat = {s:.3e}");
     }
 }

@@ -169,27 +169,14 @@ impl From<&Identifiability> for RunIdentifiability {
     }
 }
 
-/// One run of a comparison.
+/// One run of a comparison: the run's own fields and, on request, its time and statistics.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunReport {
     /// Strategy name.
     pub strategy: &'static str,
-    /// Target parameters.
-    pub target: Vec<f64>,
-    /// Initial guess.
-    pub initial: Vec<f64>,
-    /// Whether the run converged.
-    pub converged: bool,
-    /// Why it stopped.
-    pub termination: String,
-    /// Iterations.
-    pub iterations: usize,
-    /// Model evaluations.
-    pub evaluations: usize,
-    /// The estimate.
-    pub estimate: Vec<f64>,
-    /// max |estimate/target − 1|.
-    pub relative_error: f64,
+    /// Target, initial guess, outcome, iterations, evaluations, estimate, relative error.
+    #[serde(flatten)]
+    pub run: CompareRun,
     /// Wall-clock time, when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub seconds: Option<f64>,
@@ -206,14 +193,7 @@ impl RunReport {
     pub fn new(r: &CompareRun, timing: bool) -> Self {
         Self {
             strategy: r.strategy.name(),
-            target: r.target.clone(),
-            initial: r.initial.clone(),
-            converged: r.converged,
-            termination: r.termination.clone(),
-            iterations: r.iterations,
-            evaluations: r.evaluations,
-            estimate: r.estimate.clone(),
-            relative_error: r.relative_error,
+            run: r.clone(),
             seconds: timing.then_some(r.seconds),
             alternative_solutions: (r.strategy == StrategyKind::Damped && r.converged)
                 .then(|| r.alternatives.clone()),

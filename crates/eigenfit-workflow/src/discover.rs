@@ -11,17 +11,44 @@ use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde::Serialize;
 use std::path::Path;
 
-/// A refitted candidate in a report.
+/// What and where an effect is: the part every effect in a report has.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FitReport {
+pub struct Place {
     /// Effect kind.
     pub kind: String,
     /// Where (node or element), when the kind has a place.
     pub location: Option<usize>,
+    /// The unit of its value.
+    pub unit: String,
+    /// Position along the shaft (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position_m: Option<f64>,
+    /// Elements covered.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elements: Option<[usize; 2]>,
+}
+
+/// The place of an effect from its fields (the core's discovery types each carry them).
+macro_rules! place {
+    ($e:expr) => {
+        Place {
+            kind: $e.kind.clone(),
+            location: $e.location,
+            unit: $e.unit.clone(),
+            position_m: $e.position_m,
+            elements: $e.elements,
+        }
+    };
+}
+
+/// A refitted candidate in a report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitReport {
+    /// What and where.
+    #[serde(flatten)]
+    pub place: Place,
     /// Fitted value.
     pub value: Option<f64>,
-    /// Its unit.
-    pub unit: String,
     /// 95 % interval of the value.
     pub interval: Option<[f64; 2]>,
     /// χ² after the refit.
@@ -30,27 +57,17 @@ pub struct FitReport {
     pub aicc: f64,
     /// Whether the value is physically plausible.
     pub plausible: bool,
-    /// Position along the shaft (m).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub position_m: Option<f64>,
-    /// Elements covered.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub elements: Option<[usize; 2]>,
 }
 
 impl From<&Fit> for FitReport {
     fn from(f: &Fit) -> Self {
         Self {
-            kind: f.kind.clone(),
-            location: f.location,
+            place: place!(f),
             value: f.value,
-            unit: f.unit.clone(),
             interval: f.interval,
             chi2: f.chi2,
             aicc: f.aicc,
             plausible: f.plausible,
-            position_m: f.position_m,
-            elements: f.elements,
         }
     }
 }
@@ -58,75 +75,45 @@ impl From<&Fit> for FitReport {
 /// An effect the data cannot tell apart from the named one.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AlternativeReport {
-    /// Effect kind.
-    pub kind: String,
-    /// Where.
-    pub location: Option<usize>,
+    /// What and where.
+    #[serde(flatten)]
+    pub place: Place,
     /// Fitted value.
     pub value: Option<f64>,
-    /// Its unit.
-    pub unit: String,
     /// AICc against the named effect.
     pub delta_aicc: f64,
-    /// Position along the shaft (m).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub position_m: Option<f64>,
-    /// Elements covered.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub elements: Option<[usize; 2]>,
 }
 
 impl From<&Alternative> for AlternativeReport {
     fn from(a: &Alternative) -> Self {
-        Self {
-            kind: a.kind.clone(),
-            location: a.location,
-            value: a.value,
-            unit: a.unit.clone(),
-            delta_aicc: a.delta_aicc,
-            position_m: a.position_m,
-            elements: a.elements,
-        }
+        Self { place: place!(a), value: a.value, delta_aicc: a.delta_aicc }
     }
 }
 
 /// A named missing effect.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EffectReport {
-    /// Effect kind.
-    pub kind: String,
-    /// Where.
-    pub location: Option<usize>,
+    /// What and where.
+    #[serde(flatten)]
+    pub place: Place,
     /// Fitted value (1 for an on/off effect).
     pub value: f64,
-    /// Its unit.
-    pub unit: String,
     /// 95 % interval of the value.
     pub interval: Option<[f64; 2]>,
     /// AICc gain.
     pub delta_aicc: f64,
     /// Effects the data cannot tell apart from this one.
     pub ambiguous_with: Vec<AlternativeReport>,
-    /// Position along the shaft (m).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub position_m: Option<f64>,
-    /// Elements covered.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub elements: Option<[usize; 2]>,
 }
 
 impl From<&NamedEffect> for EffectReport {
     fn from(e: &NamedEffect) -> Self {
         Self {
-            kind: e.kind.clone(),
-            location: e.location,
+            place: place!(e),
             value: e.value.unwrap_or(1.0),
-            unit: e.unit.clone(),
             interval: e.interval,
             delta_aicc: e.delta_aicc,
             ambiguous_with: e.ambiguous_with.iter().map(Into::into).collect(),
-            position_m: e.position_m,
-            elements: e.elements,
         }
     }
 }

@@ -8,9 +8,11 @@
 //!
 //! The crate sits above every plugin crate (rotor, matrices, rotordynamics) and below the CLI.
 
+pub mod campaign;
 pub mod compare;
 pub mod discover;
 pub mod error;
+pub mod estimate;
 pub mod model;
 pub mod named;
 pub mod overrides;

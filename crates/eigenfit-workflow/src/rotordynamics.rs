@@ -128,18 +128,22 @@ pub struct RunupEstimateReport {
     pub identifiable: bool,
     /// The run-up points at the estimate.
     pub points: Vec<RunupPointReport>,
-    /// 95 % intervals (log-normal), with std only.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub intervals: Option<Named<[f64; 2]>>,
-    /// Standard deviations of ln k, with std only.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub standard_deviations_ln: Option<Named<f64>>,
-    /// χ² (the cost), with std only.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub chi2: Option<f64>,
-    /// Degrees of freedom, with std only.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub dof: Option<usize>,
+    /// Intervals and χ², with std only.
+    #[serde(flatten)]
+    pub with_std: Option<RunupIntervals>,
+}
+
+/// The part of a run-up estimate that needs standard deviations.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunupIntervals {
+    /// 95 % intervals (log-normal).
+    pub intervals: Named<[f64; 2]>,
+    /// Standard deviations of ln k.
+    pub standard_deviations_ln: Named<f64>,
+    /// χ² (the cost).
+    pub chi2: f64,
+    /// Degrees of freedom.
+    pub dof: usize,
 }
 
 /// `estimate --model ROSS-FILE --measured RUNUP.csv`: kxx and kyy of every bearing.
@@ -162,12 +166,15 @@ pub fn estimate(
     let value: Vec<f64> = nominal.iter().zip(&id.scales).map(|(k, s)| k * s).collect();
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
     // 95 % intervals, log-normal (the estimate is linearised in ln k).
-    let intervals: Option<Vec<[f64; 2]>> = id
-        .ln_std
-        .as_ref()
-        .map(|sd| value.iter().zip(sd).map(|(v, s)| [v * (-1.96 * s).exp(), v * (1.96 * s).exp()]).collect());
-    let dof = points.len().saturating_sub(params.len());
-    let with_std = id.ln_std.is_some();
+    let with_std = id.ln_std.as_ref().map(|sd| RunupIntervals {
+        intervals: Named::new(
+            &names,
+            value.iter().zip(sd).map(|(v, s)| [v * (-1.96 * s).exp(), v * (1.96 * s).exp()]),
+        ),
+        standard_deviations_ln: Named::new(&names, sd.iter().copied()),
+        chi2: id.cost,
+        dof: points.len().saturating_sub(params.len()),
+    });
     Ok(RunupEstimateReport {
         model: path.display().to_string(),
         converged: id.converged,
@@ -192,10 +199,7 @@ pub fn estimate(
                 measured_whirl: p.whirl.map(|w| w.name()),
             })
             .collect(),
-        intervals: intervals.map(|iv| Named::new(&names, iv)),
-        standard_deviations_ln: id.ln_std.as_ref().map(|sd| Named::new(&names, sd.iter().copied())),
-        chi2: with_std.then_some(id.cost),
-        dof: with_std.then_some(dof),
+        with_std,
     })
 }
 

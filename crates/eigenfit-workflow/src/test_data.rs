@@ -289,8 +289,7 @@ pub struct SensorReport {
     pub sign: f64,
 }
 
-/// The test-data part of the estimate report: `pairing`, `notes`, and with shapes `mac`,
-/// `mac_full`, `mac_threshold`, `unpaired`, `swapped`, `missing`, `sensors`, `interval_basis`.
+/// The test-data part of the estimate report: `pairing`, `notes`, and with shapes the MAC part.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct ShapeReport {
     /// Measured mode number → model mode number, both from 1.
@@ -298,27 +297,29 @@ pub struct ShapeReport {
     /// What the user should know about the data.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
-    /// MAC of each measured mode with its paired model mode's neighbours.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub mac: Option<Vec<Vec<f64>>>,
+    /// MAC, pairing verdicts and sensors (shapes only).
+    #[serde(flatten)]
+    pub shapes: Option<MacPart>,
+}
+
+/// The MAC part of a report: `mac`, `mac_full`, `mac_threshold`, `unpaired`, `swapped`,
+/// `missing`, `sensors`, `interval_basis`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MacPart {
+    /// MAC of each measured mode with the paired model modes.
+    pub mac: Vec<Vec<f64>>,
     /// MAC against every model mode computed.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub mac_full: Option<Vec<Vec<f64>>>,
+    pub mac_full: Vec<Vec<f64>>,
     /// The pairing threshold.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub mac_threshold: Option<f64>,
+    pub mac_threshold: f64,
     /// Measured modes below the threshold.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub unpaired: Option<Vec<usize>>,
+    pub unpaired: Vec<usize>,
     /// Measured mode pairs paired in the opposite order.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub swapped: Option<Vec<(usize, usize)>>,
+    pub swapped: Vec<(usize, usize)>,
     /// Model modes not measured.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub missing: Option<Vec<usize>>,
+    pub missing: Vec<usize>,
     /// The sensors.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sensors: Option<Vec<SensorReport>>,
+    pub sensors: Vec<SensorReport>,
     /// What the intervals were scaled by.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub interval_basis: Option<String>,
@@ -334,26 +335,25 @@ impl ShapeReport {
         mac: Option<&MacReport>,
         scatter: Option<f64>,
     ) -> Self {
-        let mut out = ShapeReport {
-            pairing: pairing(fit.measured(), &estimate.last.paired_modes),
-            notes: data.notes.clone(),
-            ..Default::default()
-        };
-        let (Some(r), Some(set)) = (mac, &data.sensors) else { return out };
-        out.mac = Some(r.matrix.clone());
-        out.mac_full = Some(r.full.clone());
-        out.mac_threshold = Some(r.threshold);
-        out.unpaired = Some(r.unpaired.clone());
-        out.swapped = Some(r.swapped.clone());
-        out.missing = Some(r.missing.clone());
-        out.sensors = Some(
-            set.sensors
+        let shapes = mac.zip(data.sensors.as_ref()).map(|(r, set)| MacPart {
+            mac: r.matrix.clone(),
+            mac_full: r.full.clone(),
+            mac_threshold: r.threshold,
+            unpaired: r.unpaired.clone(),
+            swapped: r.swapped.clone(),
+            missing: r.missing.clone(),
+            sensors: set
+                .sensors
                 .iter()
                 .map(|s| SensorReport { name: s.name(), model_node: s.model_node, dof: s.dof, sign: s.sign })
                 .collect(),
-        );
-        out.interval_basis = scatter.map(|s| interval_basis(s, s == 1.0 && fit.measured().has_std()));
-        out
+            interval_basis: scatter.map(|s| interval_basis(s, s == 1.0 && fit.measured().has_std())),
+        });
+        ShapeReport {
+            pairing: pairing(fit.measured(), &estimate.last.paired_modes),
+            notes: data.notes.clone(),
+            shapes,
+        }
     }
 }
 

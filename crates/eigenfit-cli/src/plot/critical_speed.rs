@@ -105,12 +105,7 @@ impl Figure for CriticalSpeedMap {
             .y_label_area_size(90)
             .build_cartesian_2d(x_range.log_scale(), y_range.log_scale())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("support stiffness k [N/m]")
-            .y_desc("natural frequency f [Hz]")
-            .axis_desc_style(style::font(style::AXIS))
-            .label_style(style::font(style::TICK))
+        style::axes(&mut chart.configure_mesh(), "support stiffness k [N/m]", "natural frequency f [Hz]")
             .x_label_formatter(&log_tick)
             .y_label_formatter(&log_tick)
             .light_line_style(style::LIGHT.mix(0.5))
@@ -140,15 +135,7 @@ impl Figure for CriticalSpeedMap {
                 .label(self.reference_label.clone())
                 .legend(|(x, y)| Circle::new((x + 12, y), 6, INK.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .label_font(style::font(style::LEGEND))
-            .background_style(WHITE.mix(0.9))
-            .border_style(style::GUIDE)
-            .margin(12)
-            .draw()
-            .map_err(err)?;
+        style::legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         Ok(())
     }
 }

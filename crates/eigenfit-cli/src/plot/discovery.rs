@@ -93,13 +93,7 @@ impl Figure for DiscoveryPlot {
         chart
             .draw_series([Rectangle::new([(0.5, -2.0), (n as f64 + 0.5, 2.0)], BAND.filled())])
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_desc("mode")
-            .y_desc("(model − measured) / σ   [σ, symmetric log scale]")
-            .axis_desc_style(style::font(style::AXIS))
-            .label_style(style::font(style::TICK))
+        style::axes(chart.configure_mesh().disable_x_mesh(), "mode", "(model − measured) / σ   [σ, symmetric log scale]")
             .x_labels(n.min(20))
             .x_label_formatter(&|v| {
                 if (v - v.round()).abs() < 1e-9 && *v >= 1.0 {

@@ -128,12 +128,7 @@ impl Figure for ModeShapes {
             .y_label_area_size(80)
             .build_cartesian_2d(x0 - pad..x1 + pad, -1.75..2.15)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("position along the shaft x [m]")
-            .y_desc("displacement (normalised to the largest) [–]")
-            .axis_desc_style(style::font(style::AXIS))
-            .label_style(style::font(style::TICK))
+        style::axes(&mut chart.configure_mesh(), "position along the shaft x [m]", "displacement (normalised to the largest) [–]")
             .y_labels(17)
             .y_label_formatter(&|v: &f64| {
                 if v.abs() > 1.01 || (v * 2.0 - (v * 2.0).round()).abs() > 1e-9 {
@@ -190,15 +185,7 @@ impl Figure for ModeShapes {
                 .label(format!("mode {}: {} Hz", k + 1, format_hz(s.frequency_hz)))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperMiddle)
-            .label_font(style::font(style::LEGEND))
-            .background_style(WHITE.mix(0.9))
-            .border_style(style::GUIDE)
-            .margin(12)
-            .draw()
-            .map_err(err)?;
+        style::legend(&mut chart, SeriesLabelPosition::UpperMiddle)?;
         Ok(())
     }
 }
