@@ -1,6 +1,7 @@
 //! Writing result files so that a crash or a full disk never leaves half a file behind.
 
 use crate::error::{input, CliError};
+use clap::Args;
 use std::io::Write;
 use std::path::Path;
 
@@ -16,6 +17,26 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
         let _ = std::fs::remove_file(&tmp);
         fail(e)
     })
+}
+
+/// `--quiet` and `--json`, shared by every command that reports and may take a while.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// No progress bars or spinners.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Print one JSON object instead of the text report.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The report as one JSON object with `--json` (see [`emit_json`]), else as the command's text.
+pub fn report<R: serde::Serialize>(json: bool, report: &R, text: impl FnOnce(&R)) {
+    if json {
+        emit_json(report);
+    } else {
+        text(report);
+    }
 }
 
 thread_local! {

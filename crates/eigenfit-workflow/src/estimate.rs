@@ -258,7 +258,8 @@ pub fn run(
 ) -> Result<EstimateOutcome, WorkflowError> {
     // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
     if let Some(path) = rotordynamics::ross_model(request.source.model.as_deref()) {
-        return rotordynamics::estimate(path, &request.measured, request.max_iterations).map(EstimateOutcome::Runup);
+        return rotordynamics::estimate(path, &request.measured, request.max_iterations)
+            .map(EstimateOutcome::Runup);
     }
     let (any, label) = request.source.load_any()?;
     let solver = request.source.solver()?;
@@ -274,7 +275,10 @@ pub fn run(
         "hz" => ResidualKind::FrequencyHz,
         "eigenvalue" => ResidualKind::Eigenvalue,
         other => {
-            return Err(input(format!("unknown residual `{}`; available: relative, hz, eigenvalue", shown(other))))
+            return Err(input(format!(
+                "unknown residual `{}`; available: relative, hz, eigenvalue",
+                shown(other)
+            )))
         }
     };
     if request.budget == 0 {
@@ -357,7 +361,9 @@ pub fn run(
         .map_err(|e| input(e.to_string()));
     progress.end();
     let estimate = match estimate {
-        Err(_) if budget.exhausted() => return Ok(EstimateOutcome::BudgetExhaustedBeforeFit { limit: budget.limit() }),
+        Err(_) if budget.exhausted() => {
+            return Ok(EstimateOutcome::BudgetExhaustedBeforeFit { limit: budget.limit() })
+        }
         other => other?,
     };
     // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
@@ -419,8 +425,12 @@ pub fn run(
     let status = |i: usize| -> String {
         let bound = unc.as_ref().map(|u| &u.identifiability[i]);
         match (limits[i], bound) {
-            (_, Some(Identifiability::LowerBoundOnly { lower })) => format!("not identifiable: ≥ {lower:.4e}"),
-            (_, Some(Identifiability::UpperBoundOnly { upper })) => format!("not identifiable: ≤ {upper:.4e}"),
+            (_, Some(Identifiability::LowerBoundOnly { lower })) => {
+                format!("not identifiable: ≥ {lower:.4e}")
+            }
+            (_, Some(Identifiability::UpperBoundOnly { upper })) => {
+                format!("not identifiable: ≤ {upper:.4e}")
+            }
             (0, Some(Identifiability::Determined)) => {
                 let u = unc.as_ref().map_or([0.0; 2], |u| u.intervals[i]);
                 format!("[{:.4e}, {:.4e}]", u[0], u[1])

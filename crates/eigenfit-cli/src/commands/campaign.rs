@@ -25,12 +25,9 @@ pub struct CampaignArgs {
     /// Node matching, shape weight and MAC threshold.
     #[command(flatten)]
     pub shape: crate::testdata::ShapeArgs,
-    /// No progress indicator.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Print one JSON object instead of a report.
-    #[arg(long)]
-    pub json: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
 }
 
 /// Runs `campaign`; returns the exit code (3 when not converged or a mode is unpaired).
@@ -44,11 +41,9 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         shape_std: args.shape.shape_std,
         mac_threshold: args.shape.mac_threshold,
     };
-    let report = campaign::run(&request, &mut Bars::new(args.quiet))?;
+    let report = campaign::run(&request, &mut Bars::new(args.report.quiet))?;
     crate::commands::simulate::print_notes(&report.file_notes);
-    if args.json {
-        crate::output::emit_json(&report);
-    } else {
+    crate::output::report(args.report.json, &report, |report| {
         println!(
             "{}: {} configurations, {} strategy, {} after {} iterations",
             report.campaign,
@@ -58,7 +53,8 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             report.iterations
         );
         println!("{:<24}{:>16}{:>16}{:>34}", "parameter", "initial", "estimate", "95% interval");
-        for (i, ((n, initial), (_, value))) in report.initial.iter().zip(report.parameters.iter()).enumerate() {
+        for (i, ((n, initial), (_, value))) in report.initial.iter().zip(report.parameters.iter()).enumerate()
+        {
             let iv = report.intervals.as_ref().map_or("-".to_string(), |u| {
                 let iv = u.0[i].1;
                 format!("[{:.4e}, {:.4e}]", iv[0], iv[1])
@@ -68,16 +64,20 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         for c in &report.configurations {
             println!("{}:", c.name);
             for (k, (m, f)) in c.measured_hz.iter().zip(&c.frequencies_hz).enumerate() {
-                let mac_text = c.mac_pairing.as_ref().map_or(String::new(), |p| {
-                    format!("  MAC {:.4} with model mode {}", p[k].2, p[k].1)
-                });
-                println!("  mode {:>2}: measured {m:>12.6} Hz, model {f:>12.6} Hz{mac_text}", c.mode_numbers[k]);
+                let mac_text = c
+                    .mac_pairing
+                    .as_ref()
+                    .map_or(String::new(), |p| format!("  MAC {:.4} with model mode {}", p[k].2, p[k].1));
+                println!(
+                    "  mode {:>2}: measured {m:>12.6} Hz, model {f:>12.6} Hz{mac_text}",
+                    c.mode_numbers[k]
+                );
             }
             c.notes.iter().for_each(|n| eprintln!("note: {}: {n}", c.name));
         }
         if let Some(s) = report.scatter.filter(|_| !report.has_std) {
             println!("intervals from the residual scatter (no std in the data): sigma_hat = {s:.3e}");
         }
-    }
+    });
     Ok(if report.converged { 0 } else { EXIT_NOT_CONVERGED })
 }

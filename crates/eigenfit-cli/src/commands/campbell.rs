@@ -39,9 +39,7 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
-    if args.json {
-        crate::output::emit_json(&report);
-    } else {
+    crate::output::report(args.json, &report, |report| {
         println!(
             "{}: Campbell diagram, {} modes at {} speeds",
             report.model,
@@ -65,6 +63,6 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
             println!("critical speed {:.1} rpm ({} whirl, log dec {:.4})", k.rpm, k.whirl, k.log_dec);
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
-    }
+    });
     Ok(())
 }

@@ -52,9 +52,9 @@ pub struct CompareArgs {
     /// compare-iterations.svg/.png) into this folder (two parameters, a grid of initial guesses).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
-    /// No progress bar.
-    #[arg(long)]
-    pub quiet: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
     /// Also append each finished run to this file as one JSON line, flushed at once, so that a
     /// long batch loses nothing already computed if it is interrupted.
     #[arg(long, value_name = "FILE.jsonl")]
@@ -63,9 +63,6 @@ pub struct CompareArgs {
     /// same input gives byte-for-byte the same output.
     #[arg(long)]
     pub timing: bool,
-    /// Print one JSON object (`runs` array and `summary`) instead of tables.
-    #[arg(long)]
-    pub json: bool,
 }
 
 /// The request these arguments make.
@@ -90,7 +87,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     let solver = args.model.solver()?;
     let np = model.parameters().len();
     let plan = compare::plan(&request(args), np)?;
-    let pb = progress::bar(plan.runs() as u64, "compare runs", args.quiet);
+    let pb = progress::bar(plan.runs() as u64, "compare runs", args.report.quiet);
     // Opened after every argument is checked; the reference data are checked before the first
     // run, and the file is appended to, so a run refused there loses nothing written before.
     let mut stream = args.stream.as_deref().map(Stream::open).transpose()?;
@@ -109,9 +106,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
-    if args.json {
-        crate::output::emit_json(&report);
-    } else {
+    crate::output::report(args.report.json, &report, |report| {
         println!(
             "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",
             report.runs.len(),
@@ -151,7 +146,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             print_maps(&report.raw, &plan.targets, &plan.strategies);
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
-    }
+    });
     // A write failure ends the command non-zero after the results are printed.
     stream.map_or(Ok(()), |w| w.finish(report.runs.len()))
 }

@@ -36,12 +36,9 @@ pub struct DemoArgs {
     /// Points per axis of the grid of initial guesses of the convergence map (1e1–1e9 N/m).
     #[arg(long, default_value_t = 15, value_name = "N")]
     pub grid: usize,
-    /// No progress bars.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Print one JSON object instead of the report.
-    #[arg(long)]
-    pub json: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
 }
 
 /// Runs `demo`.
@@ -95,7 +92,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
         &rotor,
         &solver,
         &TARGET,
-        simulate::MapOptions { range: (1e2, 1e9), plain: true, quiet: args.quiet },
+        simulate::MapOptions { range: (1e2, 1e9), plain: true, quiet: args.report.quiet },
     )?);
 
     // 2. Table 3 case 1 with all three strategies.
@@ -143,7 +140,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
     let initials = tensor_grid(&log_space(1e1, 1e9, args.grid), 2);
     let targets = vec![TARGET.to_vec()];
     let strategies = StrategyKind::ALL.to_vec();
-    let pb = progress::bar((initials.len() * strategies.len()) as u64, "convergence map", args.quiet);
+    let pb = progress::bar((initials.len() * strategies.len()) as u64, "convergence map", args.report.quiet);
     let grid = run_grid(&rotor, &solver, &targets, &initials, &strategies, &settings, |_| pb.inc(1));
     pb.finish_and_clear();
     let grid = grid.map_err(CliError::Failure)?;
@@ -167,7 +164,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
     // 4. Discovery of a hidden effect.
     let data = measured_csv::parse(HIDDEN_EFFECT_CSV)
         .map_err(|e| CliError::Failure(format!("built-in dataset: line {e}")))?;
-    let pb = progress::spinner("discovering the hidden effect", args.quiet);
+    let pb = progress::spinner("discovering the hidden effect", args.report.quiet);
     let options = DiscoveryOptions::default();
     let found = discover(&rotor, &solver, &data, &rotor.candidates(), &rotor.nominal_stiffnesses(), &options);
     pb.finish_and_clear();
@@ -201,7 +198,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
     plots.extend(plot::write(&DiscoveryPlot::from_report(label, &found), out, "discovery")?);
 
     let seconds = started.elapsed().as_secs_f64();
-    if args.json {
+    if args.report.json {
         crate::output::emit_json(&json!({
             "model": label,
             "table_1": table,

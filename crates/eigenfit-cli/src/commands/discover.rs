@@ -30,12 +30,9 @@ pub struct DiscoverArgs {
     /// Write the before/after residual plot (discovery.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
-    /// No progress indicator.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Print one JSON object instead of a report.
-    #[arg(long)]
-    pub json: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
 }
 
 /// Runs `discover`.
@@ -50,7 +47,7 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
         &args.measured,
         args.assumed_std,
         &mut notes,
-        &mut Bars::new(args.quiet),
+        &mut Bars::new(args.report.quiet),
     );
     crate::commands::simulate::print_notes(&notes);
     let Discovery { found, mut report } = found?;
@@ -63,16 +60,14 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
         let figure = DiscoveryPlot::from_report(&label, &found.report);
         report.written.extend(plot::names(&plot::write(&figure, dir, "discovery")?));
     }
-    if args.json {
-        crate::output::emit_json(&report);
-    } else {
+    crate::output::report(args.report.json, &report, |report| {
         let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
         let units: Vec<String> = model.parameters().iter().map(|p| p.unit.clone()).collect();
         print_report(&found, &names, &units, &label);
         for w in &report.written {
             println!("wrote {w}");
         }
-    }
+    });
     Ok(())
 }
 

@@ -43,12 +43,9 @@ pub struct EstimateArgs {
     /// Write the convergence history (convergence.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
-    /// No progress indicator.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Print one JSON object instead of a report.
-    #[arg(long)]
-    pub json: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
 }
 
 /// The request these arguments make.
@@ -70,16 +67,12 @@ fn request(args: &EstimateArgs) -> EstimateRequest {
 /// parameter sits on a limit or the budget ran out).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let mut notes = Vec::new();
-    let outcome = estimate::run(&request(args), &mut notes, &mut Bars::new(args.quiet));
+    let outcome = estimate::run(&request(args), &mut notes, &mut Bars::new(args.report.quiet));
     print_notes(&notes);
     let mut est = match outcome? {
         EstimateOutcome::Runup(report) => {
             let code = if report.converged { EXIT_OK } else { EXIT_NOT_CONVERGED };
-            if args.json {
-                crate::output::emit_json(&report);
-            } else {
-                crate::rotordynamics::print_estimate(&report);
-            }
+            crate::output::report(args.report.json, &report, crate::rotordynamics::print_estimate);
             return Ok(code);
         }
         EstimateOutcome::BudgetExhaustedBeforeFit { limit } => {
@@ -113,17 +106,15 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     };
     let code = if est.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
     crate::error::set_exit_on_closed_pipe(code);
-    if args.json {
-        est.report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
-        crate::output::emit_json(&est.report);
-    } else {
+    est.report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
+    crate::output::report(args.report.json, &est.report, |_| {
         print_report(&est);
         testdata::print(&est.data, est.mac.as_ref(), est.scatter, est.has_std);
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
-    }
+    });
     if let (Some(path), Some(text)) = (&args.test_data.write_model, est.updated_model.take()) {
         crate::output::write_atomically(path, text?.as_bytes())?;
-        if !args.json {
+        if !args.report.json {
             println!("wrote {}", path.display());
         }
     }
@@ -155,7 +146,11 @@ fn print_report(est: &Estimation) {
         ),
         (v, Some(chi2)) => println!(
             "fit quality: {} (χ² = {}, {} dof, p = {}){}",
-            if v == FitVerdict::Poor { "POOR, no stiffness within noise explains the data" } else { "acceptable" },
+            if v == FitVerdict::Poor {
+                "POOR, no stiffness within noise explains the data"
+            } else {
+                "acceptable"
+            },
             significant(chi2),
             r.dof,
             r.p_value.map_or("n/a (no dof)".to_string(), significant),

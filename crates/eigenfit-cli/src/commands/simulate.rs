@@ -1,7 +1,6 @@
 //! `eigenfit simulate`: natural frequencies of a model, at one point or over a stiffness sweep.
 
 use crate::error::{input, CliError};
-use crate::output::emit_json;
 use crate::plot;
 use crate::plot::critical_speed::CriticalSpeedMap;
 use crate::plot::mode_shapes::ModeShapes;
@@ -57,12 +56,9 @@ pub struct SimulateArgs {
     /// docs/test-data.md).
     #[arg(long, value_name = "FILE.unv", conflicts_with = "sweep")]
     pub uff: Option<PathBuf>,
-    /// No progress bar.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Print one JSON object instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
 }
 
 /// Runs `simulate`.
@@ -70,11 +66,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
         let report = eigenfit_workflow::rotordynamics::simulate(path, args.speed, args.modes)?;
-        if args.json {
-            emit_json(&report);
-        } else {
-            crate::rotordynamics::print_speed(&report);
-        }
+        crate::output::report(args.report.json, &report, |report| {
+            crate::rotordynamics::print_speed(report);
+        });
         return Ok(());
     }
     if args.speed.is_some() {
@@ -98,7 +92,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             Some(dir) => {
                 // Mode shapes at the model's (or the given) stiffnesses.
                 let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
-                let options = MapOptions { range, plain: args.effects.is_empty(), quiet: args.quiet };
+                let options = MapOptions { range, plain: args.effects.is_empty(), quiet: args.report.quiet };
                 write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
             }
             None => Vec::new(),
@@ -111,7 +105,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             args.modes,
             SweepCheck::RefuseRoundoff,
             &mut notes,
-            &mut Bars::new(args.quiet),
+            &mut Bars::new(args.report.quiet),
         );
         print_notes(&notes);
         let report = SweepReport {
@@ -125,9 +119,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             plots: args.plot.as_ref().map(|_| plot::names(&plots)),
             notes,
         };
-        if args.json {
-            emit_json(&report);
-        } else {
+        crate::output::report(args.report.json, &report, |report| {
             println!("{label}: natural frequencies against support stiffness (all bearings equal)");
             print!("{:>14}", "k [N/m]");
             (1..=args.modes).for_each(|m| print!("{:>14}", format!("f{m} [Hz]")));
@@ -138,7 +130,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 println!();
             }
             plots.iter().for_each(|w| println!("wrote {}", w.display()));
-        }
+        });
         return Ok(());
     }
     let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
@@ -150,20 +142,19 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     print_notes(&report.notes);
     let plots = match &args.plot {
         Some(dir) => {
-            let options = MapOptions { range: (1e2, 1e9), plain: args.effects.is_empty(), quiet: args.quiet };
+            let options =
+                MapOptions { range: (1e2, 1e9), plain: args.effects.is_empty(), quiet: args.report.quiet };
             write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
         }
         None => Vec::new(),
     };
     report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
-    if args.json {
-        emit_json(&report);
-    } else {
+    crate::output::report(args.report.json, &report, |report| {
         println!("{label} ({} DOF, {} solver)", rotor.dofs(), solver.name());
-        print_point(&report, &vec!["N/m".to_string(); p.len()]);
+        print_point(report, &vec!["N/m".to_string(); p.len()]);
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
         args.uff.iter().for_each(|w| println!("wrote {}", w.display()));
-    }
+    });
     Ok(())
 }
 
@@ -191,16 +182,14 @@ fn simulate_matrices(
     let p = parameter_vector(model, "--set", None, &args.sets)?;
     let mut report = at_point(label, model, solver, &p, args.modes, SweepCheck::None)?;
     report.dofs = Some(model.dofs());
-    if args.json {
-        emit_json(&report);
-    } else {
+    crate::output::report(args.report.json, &report, |report| {
         println!("{label} ({} DOF, {} stored entries, {} solver)", model.dofs(), model.nnz(), solver.name());
         let units: Vec<String> = model.parameters().iter().map(|q| q.unit.clone()).collect();
-        print_point(&report, &units);
+        print_point(report, &units);
         if let Some(why) = &report.sensitivities_unavailable {
             println!("(no sensitivities: {why})");
         }
-    }
+    });
     Ok(())
 }
 

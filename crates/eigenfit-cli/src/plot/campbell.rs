@@ -41,11 +41,12 @@ impl Figure for CampbellPlot<'_> {
             .y_label_area_size(90)
             .build_cartesian_2d(s0..s1, 0.0..f_max.max(1.0))
             .map_err(err)?;
-        style::axes(&mut chart.configure_mesh(), "rotor speed [rpm]", "damped natural frequency [Hz]")
-            .light_line_style(style::LIGHT.mix(0.5))
-            .bold_line_style(style::LIGHT)
-            .draw()
-            .map_err(err)?;
+        style::grid(
+            style::axes(&mut chart.configure_mesh(), "rotor speed [rpm]", "damped natural frequency [Hz]"),
+            0.5,
+        )
+        .draw()
+        .map_err(err)?;
         for curve in &c.curves {
             for k in 1..c.speeds_rpm.len() {
                 let (Some(i0), Some(i1)) = (curve[k - 1], curve[k]) else { continue };

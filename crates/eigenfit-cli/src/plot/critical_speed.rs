@@ -105,13 +105,14 @@ impl Figure for CriticalSpeedMap {
             .y_label_area_size(90)
             .build_cartesian_2d(x_range.log_scale(), y_range.log_scale())
             .map_err(err)?;
-        style::axes(&mut chart.configure_mesh(), "support stiffness k [N/m]", "natural frequency f [Hz]")
-            .x_label_formatter(&log_tick)
-            .y_label_formatter(&log_tick)
-            .light_line_style(style::LIGHT.mix(0.5))
-            .bold_line_style(style::LIGHT)
-            .draw()
-            .map_err(err)?;
+        style::grid(
+            style::axes(&mut chart.configure_mesh(), "support stiffness k [N/m]", "natural frequency f [Hz]"),
+            0.5,
+        )
+        .x_label_formatter(&log_tick)
+        .y_label_formatter(&log_tick)
+        .draw()
+        .map_err(err)?;
         for m in 0..modes {
             let c = mode_colour(m);
             chart

@@ -128,7 +128,9 @@ impl Figure for ModeShapes {
             .y_label_area_size(80)
             .build_cartesian_2d(x0 - pad..x1 + pad, -1.75..2.15)
             .map_err(err)?;
-        style::axes(&mut chart.configure_mesh(), "position along the shaft x [m]", "displacement (normalised to the largest) [–]")
+        let mut mesh = chart.configure_mesh();
+        let x = "position along the shaft x [m]";
+        style::grid(style::axes(&mut mesh, x, "displacement (normalised to the largest) [–]"), 0.4)
             .y_labels(17)
             .y_label_formatter(&|v: &f64| {
                 if v.abs() > 1.01 || (v * 2.0 - (v * 2.0).round()).abs() > 1e-9 {
@@ -137,10 +139,9 @@ impl Figure for ModeShapes {
                     style::trim(*v, 1)
                 }
             })
-            .light_line_style(style::LIGHT.mix(0.4))
-            .bold_line_style(style::LIGHT)
             .draw()
             .map_err(err)?;
+        drop(mesh);
         // The shaft axis and the nodes.
         chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], INK.stroke_width(2))).map_err(err)?;
         chart.draw_series(self.nodes.iter().map(|&x| Circle::new((x, 0.0), 3, INK.filled()))).map_err(err)?;

@@ -324,6 +324,14 @@ pub fn axes<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
     mesh.x_desc(x).y_desc(y).axis_desc_style(font(AXIS)).label_style(font(TICK))
 }
 
+/// Minor grid lines in the light grey at `minor_alpha`, major ones in the light grey.
+pub fn grid<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
+    mesh: &'m mut MeshStyle<'a, 'b, X, Y, DB>,
+    minor_alpha: f64,
+) -> &'m mut MeshStyle<'a, 'b, X, Y, DB> {
+    mesh.light_line_style(LIGHT.mix(minor_alpha)).bold_line_style(LIGHT)
+}
+
 /// Draws the series legend at `position` in the shared look (legend font, a light box).
 pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
     chart: &mut ChartContext<'a, DB, CT>,
