@@ -5,118 +5,11 @@ use crate::error::{failure, input, WorkflowError};
 use crate::model::AnyModel;
 use crate::named::Named;
 use crate::progress::Progress;
-use eigenfit_core::discovery::{discover, Alternative, DiscoveryOptions, Fit, NamedEffect};
+use eigenfit_core::discovery::{discover, DiscoveryOptions, Fit, NamedEffect};
 use eigenfit_core::{EigenSolver, StructuralModel};
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde::Serialize;
 use std::path::Path;
-
-/// What and where an effect is: the part every effect in a report has.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Place {
-    /// Effect kind.
-    pub kind: String,
-    /// Where (node or element), when the kind has a place.
-    pub location: Option<usize>,
-    /// The unit of its value.
-    pub unit: String,
-    /// Position along the shaft (m).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub position_m: Option<f64>,
-    /// Elements covered.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub elements: Option<[usize; 2]>,
-}
-
-/// The place of an effect from its fields (the core's discovery types each carry them).
-macro_rules! place {
-    ($e:expr) => {
-        Place {
-            kind: $e.kind.clone(),
-            location: $e.location,
-            unit: $e.unit.clone(),
-            position_m: $e.position_m,
-            elements: $e.elements,
-        }
-    };
-}
-
-/// A refitted candidate in a report.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FitReport {
-    /// What and where.
-    #[serde(flatten)]
-    pub place: Place,
-    /// Fitted value.
-    pub value: Option<f64>,
-    /// 95 % interval of the value.
-    pub interval: Option<[f64; 2]>,
-    /// χ² after the refit.
-    pub chi2: f64,
-    /// AICc after the refit.
-    pub aicc: f64,
-    /// Whether the value is physically plausible.
-    pub plausible: bool,
-}
-
-impl From<&Fit> for FitReport {
-    fn from(f: &Fit) -> Self {
-        Self {
-            place: place!(f),
-            value: f.value,
-            interval: f.interval,
-            chi2: f.chi2,
-            aicc: f.aicc,
-            plausible: f.plausible,
-        }
-    }
-}
-
-/// An effect the data cannot tell apart from the named one.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AlternativeReport {
-    /// What and where.
-    #[serde(flatten)]
-    pub place: Place,
-    /// Fitted value.
-    pub value: Option<f64>,
-    /// AICc against the named effect.
-    pub delta_aicc: f64,
-}
-
-impl From<&Alternative> for AlternativeReport {
-    fn from(a: &Alternative) -> Self {
-        Self { place: place!(a), value: a.value, delta_aicc: a.delta_aicc }
-    }
-}
-
-/// A named missing effect.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct EffectReport {
-    /// What and where.
-    #[serde(flatten)]
-    pub place: Place,
-    /// Fitted value (1 for an on/off effect).
-    pub value: f64,
-    /// 95 % interval of the value.
-    pub interval: Option<[f64; 2]>,
-    /// AICc gain.
-    pub delta_aicc: f64,
-    /// Effects the data cannot tell apart from this one.
-    pub ambiguous_with: Vec<AlternativeReport>,
-}
-
-impl From<&NamedEffect> for EffectReport {
-    fn from(e: &NamedEffect) -> Self {
-        Self {
-            place: place!(e),
-            value: e.value.unwrap_or(1.0),
-            interval: e.interval,
-            delta_aicc: e.delta_aicc,
-            ambiguous_with: e.ambiguous_with.iter().map(Into::into).collect(),
-        }
-    }
-}
 
 /// One measured mode before and after.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -141,9 +34,9 @@ pub struct DiscoverReport {
     /// Whether the misfit is beyond the noise.
     pub disagreement_significant: bool,
     /// The strongest named effect.
-    pub missing_effect: Option<EffectReport>,
+    pub missing_effect: Option<NamedEffect>,
     /// Every named effect, strongest first.
-    pub missing_effects: Vec<EffectReport>,
+    pub missing_effects: Vec<NamedEffect>,
     /// Mesh refinement factor settled on (1: the user's mesh).
     pub mesh_refinement: usize,
     /// RMS residual before (Hz).
@@ -159,9 +52,9 @@ pub struct DiscoverReport {
     /// The nominal parameters calibrated.
     pub calibrated_parameters: Named<f64>,
     /// The best candidate after the first.
-    pub runner_up: Option<FitReport>,
+    pub runner_up: Option<Fit>,
     /// Every candidate refitted.
-    pub candidates_refitted: Vec<FitReport>,
+    pub candidates_refitted: Vec<Fit>,
     /// Each measured mode before and after.
     pub modes: Vec<ModeReport>,
     /// Files written (the augmented model, plots).
@@ -209,8 +102,8 @@ pub fn run(
     let report = DiscoverReport {
         model: label.to_string(),
         disagreement_significant: r.disagreement_significant,
-        missing_effect: found.effects.first().map(Into::into),
-        missing_effects: found.effects.iter().map(Into::into).collect(),
+        missing_effect: found.effects.first().cloned(),
+        missing_effects: found.effects.clone(),
         mesh_refinement: found.mesh_factor,
         rms_residual_before_hz: r.rms_before_hz,
         rms_residual_after_hz: r.rms_after_hz,
@@ -218,8 +111,8 @@ pub fn run(
         dof_before: r.dof_before,
         p_value: r.p_value,
         calibrated_parameters: Named::new(&names, r.base_parameters.iter().copied()),
-        runner_up: r.runner_up.as_ref().map(Into::into),
-        candidates_refitted: r.fits.iter().map(Into::into).collect(),
+        runner_up: r.runner_up.clone(),
+        candidates_refitted: r.fits.clone(),
         modes: r
             .modes
             .iter()
