@@ -10,6 +10,7 @@
 
 pub mod campaign;
 pub mod compare;
+pub mod demo;
 pub mod discover;
 pub mod error;
 pub mod estimate;

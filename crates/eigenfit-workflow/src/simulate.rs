@@ -50,6 +50,18 @@ pub fn frequencies(
     Ok(m.frequencies_hz())
 }
 
+/// The lowest `count` modes of `model` at `p` (for plots of mode shapes); a model that cannot
+/// be assembled or solved there is a failure.
+pub fn modes_at(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    count: usize,
+) -> Result<Modes, WorkflowError> {
+    let system = model.assemble(p).map_err(failure)?;
+    solver.lowest(&system, count).map_err(failure)
+}
+
 /// How a sweep treats round-off: the table refuses lost frequencies, the plot draws what it gets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SweepCheck {

@@ -3,7 +3,7 @@
 use super::style::{self, mode_colour, short_sci, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
-use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_core::EigenSolver;
 use eigenfit_rotor::Rotor;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -54,8 +54,7 @@ impl ModeShapes {
         p: &[f64],
         modes: usize,
     ) -> Result<Self, CliError> {
-        let system = rotor.assemble(p).map_err(|e| CliError::Failure(e.to_string()))?;
-        let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
+        let m = eigenfit_workflow::simulate::modes_at(rotor, solver, p, modes)?;
         let nodes = rotor.nodes().to_vec();
         let shapes = (0..m.count())
             .map(|k| Shape { frequency_hz: m.frequencies_hz()[k], curve: interpolate(&nodes, m.shape(k)) })
