@@ -30,8 +30,8 @@ pub fn print_estimate(r: &RunupEstimateReport) {
         r.model,
         r.parameters.0.len(),
         r.points.len(),
-        if r.converged { "converged" } else { "NOT converged" },
-        r.iterations
+        if r.outcome.converged { "converged" } else { "NOT converged" },
+        r.outcome.iterations
     );
     println!(
         "{:<28}{:>16}{:>16}{:>32}",

@@ -4,7 +4,7 @@
 
 use clap::Args;
 use eigenfit_core::testdata::MacReport;
-use eigenfit_workflow::test_data::{TestData, TestDataOptions};
+use eigenfit_workflow::test_data::{ShapeOptions, TestData, TestDataOptions};
 use std::path::PathBuf;
 
 /// Options for measured shapes (universal files or `--shapes`).
@@ -45,15 +45,24 @@ pub struct ShapeArgs {
     pub mac_threshold: f64,
 }
 
+impl ShapeArgs {
+    /// The options these arguments give.
+    pub fn options(&self) -> ShapeOptions {
+        ShapeOptions {
+            node_tolerance: self.node_tolerance,
+            shape_std: self.shape_std,
+            mac_threshold: self.mac_threshold,
+        }
+    }
+}
+
 impl TestDataArgs {
     /// The options these arguments give.
     pub fn options(&self) -> TestDataOptions {
         TestDataOptions {
             shapes: self.shapes.clone(),
             sensor_map: self.sensor_map.clone(),
-            node_tolerance: self.shape.node_tolerance,
-            shape_std: self.shape.shape_std,
-            mac_threshold: self.shape.mac_threshold,
+            shape: self.shape.options(),
             fix: self.fix.clone(),
         }
     }

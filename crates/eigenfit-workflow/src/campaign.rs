@@ -4,9 +4,10 @@
 use crate::error::{failure, input, WorkflowError};
 use crate::model::Updatable;
 use crate::named::Named;
+use crate::outcome::Outcome;
 use crate::overrides::fixed;
 use crate::progress::Progress;
-use crate::test_data::{self, interval_basis, pairing, Fit, TestDataOptions};
+use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDataOptions};
 use eigenfit_core::testdata::Joint;
 use eigenfit_core::{
     BandedSolver, DenseSolver, Driver, EigenSolver, Evaluate, Problem, ResidualKind, StrategyKind,
@@ -27,12 +28,8 @@ pub struct CampaignRequest {
     pub solver: String,
     /// Iteration limit.
     pub max_iterations: usize,
-    /// Distance in metres within which a measured node matches a model node.
-    pub node_tolerance: f64,
-    /// Standard deviation of the entries of a unit-length measured shape.
-    pub shape_std: f64,
-    /// Lowest MAC at which a measured mode counts as paired.
-    pub mac_threshold: f64,
+    /// Node matching, shape weight and MAC threshold for every configuration.
+    pub shape: ShapeOptions,
 }
 
 /// One configuration at the joint estimate.
@@ -70,14 +67,9 @@ pub struct CampaignReport {
     pub campaign: String,
     /// Strategy name.
     pub strategy: &'static str,
-    /// Converged with every mode paired.
-    pub converged: bool,
-    /// Why the iteration stopped.
-    pub termination: String,
-    /// Iterations.
-    pub iterations: usize,
-    /// Model evaluations.
-    pub evaluations: usize,
+    /// Converged (with every mode paired), why it stopped, iterations, evaluations.
+    #[serde(flatten)]
+    pub outcome: Outcome,
     /// Initial values.
     pub initial: Named<f64>,
     /// Estimated values.
@@ -126,9 +118,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         let options = TestDataOptions {
             shapes: conf.shapes.clone(),
             sensor_map: conf.sensor_map.clone(),
-            node_tolerance: request.node_tolerance,
-            shape_std: request.shape_std,
-            mac_threshold: request.mac_threshold,
+            shape: request.shape,
             fix: Vec::new(),
         };
         let d = test_data::read(&conf.measured, Some(&rotor), &options)
@@ -148,7 +138,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         .map(|(m, d)| {
             let problem =
                 Problem::new(m, solver.as_ref(), d.measurement.clone()).with_kind(ResidualKind::Relative);
-            Fit::new(problem, d, request.shape_std)
+            Fit::new(problem, d, request.shape.shape_std)
         })
         .collect();
     let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Evaluate).collect())
@@ -173,7 +163,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     for (k, fit) in fits.iter().enumerate() {
         let sub = joint.part_values(k, &p);
         let lin = joint.part_linearise(k, &p).map_err(|e| failure(format!("{}: {e}", names[k])))?;
-        let mac = fit.mac(&sub, request.mac_threshold);
+        let mac = fit.mac(&sub, request.shape.mac_threshold);
         unpaired |= mac.as_ref().is_some_and(|r| !r.unpaired.is_empty());
         configurations.push(ConfigurationReport {
             name: names[k].clone(),
@@ -190,10 +180,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     Ok(CampaignReport {
         campaign: request.campaign.display().to_string(),
         strategy: estimate.strategy,
-        converged: estimate.termination.is_converged() && !unpaired,
-        termination: estimate.termination.to_string(),
-        iterations: estimate.iterations,
-        evaluations: estimate.evaluations,
+        outcome: Outcome::of(&estimate, estimate.termination.is_converged() && !unpaired),
         initial: Named::new(&pnames, initial.iter().copied()),
         parameters: Named::new(&pnames, p.iter().copied()),
         chi2: estimate.last.chi2(),

@@ -31,6 +31,12 @@ pub struct ModeReport {
 pub struct DiscoverReport {
     /// The model's label.
     pub model: String,
+    /// χ² before.
+    pub chi2_before: f64,
+    /// Degrees of freedom before.
+    pub dof_before: usize,
+    /// P(χ² this large from noise alone).
+    pub p_value: f64,
     /// Whether the misfit is beyond the noise.
     pub disagreement_significant: bool,
     /// The strongest named effect.
@@ -43,12 +49,6 @@ pub struct DiscoverReport {
     pub rms_residual_before_hz: f64,
     /// RMS residual after (Hz).
     pub rms_residual_after_hz: f64,
-    /// χ² before.
-    pub chi2_before: f64,
-    /// Degrees of freedom before.
-    pub dof_before: usize,
-    /// P(χ² this large from noise alone).
-    pub p_value: f64,
     /// The nominal parameters calibrated.
     pub calibrated_parameters: Named<f64>,
     /// The best candidate after the first.

@@ -3,6 +3,7 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
+use crate::outcome::Outcome;
 use crate::overrides::{fixed, parameter_vector};
 use crate::progress::Progress;
 use crate::rotordynamics::{self, RunupEstimateReport};
@@ -148,8 +149,9 @@ pub struct EstimateReport {
     pub model: String,
     /// Strategy name.
     pub strategy: &'static str,
-    /// Whether the iteration converged.
-    pub converged: bool,
+    /// Converged, why it stopped, iterations, model evaluations of the fit.
+    #[serde(flatten)]
+    pub outcome: Outcome,
     /// Converged, fit not poor, no parameter on a limit, budget not spent, every mode paired.
     pub acceptable: bool,
     /// The verdict in words.
@@ -166,12 +168,6 @@ pub struct EstimateReport {
     pub relative_rms_residual: f64,
     /// Measured mode numbers that disagree by more than 3σ.
     pub disagreeing_modes: Vec<usize>,
-    /// Why the iteration stopped.
-    pub termination: String,
-    /// Iterations.
-    pub iterations: usize,
-    /// Model evaluations of the fit.
-    pub evaluations: usize,
     /// The evaluation budget.
     pub budget: BudgetReport,
     /// Initial values.
@@ -182,6 +178,9 @@ pub struct EstimateReport {
     pub parameter_status: Named<String>,
     /// Parameters on a limit.
     pub at_limit: Vec<String>,
+    /// Intervals and what the data determine (a converged run with std or scatter).
+    #[serde(flatten)]
+    pub uncertainty: Option<IntervalsReport>,
     /// Other equally good solutions.
     pub alternative_solutions: Vec<AlternativeSolution>,
     /// Model frequencies at the estimate (Hz).
@@ -190,9 +189,6 @@ pub struct EstimateReport {
     pub measured_hz: Vec<f64>,
     /// The iterations.
     pub history: Vec<HistoryRecord>,
-    /// Intervals and what the data determine (a converged run with std or scatter).
-    #[serde(flatten)]
-    pub uncertainty: Option<IntervalsReport>,
     /// Plot files written.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plots: Option<Vec<String>>,
@@ -317,7 +313,7 @@ pub fn run(
     let mode_numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
     let sigma_max = measurement.modes().iter().filter_map(|m| m.std_hz).reduce(f64::max);
     let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
-    let mut fit = Fit::new(problem, &data, options.shape_std);
+    let mut fit = Fit::new(problem, &data, options.shape.shape_std);
     let budget = Budget::new(request.budget);
     // Data no parameter value can produce is refused before any fitting.
     let unreachable = unreachable_modes(&fit, UNREACHABLE_MARGIN, &budget);
@@ -379,7 +375,7 @@ pub fn run(
     }
     let (unc, scatter) =
         if converged { fit.uncertainty_within(&estimate.last, has_std, &budget) } else { (None, None) };
-    let mac = fit.mac(&estimate.parameters, options.mac_threshold);
+    let mac = fit.mac(&estimate.parameters, options.shape.mac_threshold);
     let mut alternatives: Vec<(Vec<f64>, Option<(usize, usize)>)> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {
         for (i, j, p) in mirror_solutions(&fit, &estimate.last, &budget) {
@@ -447,7 +443,7 @@ pub fn run(
     let report = EstimateReport {
         model: label,
         strategy: estimate.strategy,
-        converged,
+        outcome: Outcome::of(&estimate, converged),
         acceptable,
         verdict: verdict.to_string(),
         fit_quality: quality.verdict.label(),
@@ -456,9 +452,6 @@ pub fn run(
         p_value: quality.p_value,
         relative_rms_residual: quality.relative_rms,
         disagreeing_modes: quality.disagreeing.iter().map(|&k| mode_numbers[k]).collect(),
-        termination: estimate.termination.to_string(),
-        iterations: estimate.iterations,
-        evaluations: estimate.evaluations,
         budget: BudgetReport { limit: budget.limit(), used: budget.used(), exhausted: budget_spent },
         initial: Named::new(&names, initial.iter().copied()),
         parameters: Named::new(&names, estimate.parameters.iter().copied()),

@@ -3,6 +3,7 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
+use crate::outcome::Outcome;
 use eigenfit_rotordynamics::identify::{identify, read_runup, stiffness_parameters};
 use eigenfit_rotordynamics::{campbell, ross_file, rpm_to_rad, Campbell, Rotor, RotorDynError};
 use serde::Serialize;
@@ -106,14 +107,9 @@ pub struct RunupPointReport {
 pub struct RunupEstimateReport {
     /// The model file.
     pub model: String,
-    /// Whether the iteration met its tolerance.
-    pub converged: bool,
-    /// Why the iteration stopped.
-    pub termination: String,
-    /// Iterations taken.
-    pub iterations: usize,
-    /// Eigen-solve rounds.
-    pub evaluations: usize,
+    /// Converged, why it stopped, iterations, eigen-solve rounds.
+    #[serde(flatten)]
+    pub outcome: Outcome,
     /// The speed the stiffnesses are reported at (the lowest measured, rpm).
     pub reference_speed_rpm: f64,
     /// Nominal stiffnesses (N/m).
@@ -177,10 +173,12 @@ pub fn estimate(
     });
     Ok(RunupEstimateReport {
         model: path.display().to_string(),
-        converged: id.converged,
-        termination: id.reason.clone(),
-        iterations: id.iterations,
-        evaluations: id.evaluations,
+        outcome: Outcome {
+            converged: id.converged,
+            termination: id.reason.clone(),
+            iterations: id.iterations,
+            evaluations: id.evaluations,
+        },
         reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
         initial: Named::new(&names, nominal.iter().copied()),
         parameters: Named::new(&names, value.iter().copied()),

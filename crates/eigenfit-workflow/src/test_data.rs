@@ -19,35 +19,39 @@ use eigenfit_rotor::Rotor;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-/// Options for measured shapes (universal files or a shape CSV).
-#[derive(Debug, Clone, PartialEq)]
-pub struct TestDataOptions {
-    /// Measured mode shapes beside a CSV of frequencies: `mode,node,direction,value`.
-    pub shapes: Option<PathBuf>,
-    /// For a universal file: a CSV map `node,model_node,direction[,sign]` tying sensors to model
-    /// DOFs instead of node coordinates.
-    pub sensor_map: Option<PathBuf>,
+/// How measured shapes are tied to the model and weighted (one set per estimate or campaign).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeOptions {
     /// Distance in metres within which a measured node matches a model node.
     pub node_tolerance: f64,
     /// Standard deviation of the entries of a unit-length measured shape.
     pub shape_std: f64,
     /// Lowest MAC at which a measured mode counts as paired.
     pub mac_threshold: f64,
-    /// Parameters held at a value, `NAME=VALUE`.
-    pub fix: Vec<String>,
 }
 
-impl Default for TestDataOptions {
+impl Default for ShapeOptions {
     fn default() -> Self {
         Self {
-            shapes: None,
-            sensor_map: None,
             node_tolerance: 1e-3,
             shape_std: eigenfit_core::testdata::shapes::DEFAULT_SHAPE_STD,
             mac_threshold: 0.6,
-            fix: Vec::new(),
         }
     }
+}
+
+/// Options for measured shapes (universal files or a shape CSV) and held parameters.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TestDataOptions {
+    /// Measured mode shapes beside a CSV of frequencies: `mode,node,direction,value`.
+    pub shapes: Option<PathBuf>,
+    /// For a universal file: a CSV map `node,model_node,direction[,sign]` tying sensors to model
+    /// DOFs instead of node coordinates.
+    pub sensor_map: Option<PathBuf>,
+    /// Node matching, shape weight, MAC threshold.
+    pub shape: ShapeOptions,
+    /// Parameters held at a value, `NAME=VALUE`.
+    pub fix: Vec<String>,
 }
 
 /// Measured data and, with shapes, the sensors they were measured at.
@@ -101,17 +105,15 @@ pub fn read(
             input("measured shapes (a universal file or --shapes) need a rotor model; a matrices model takes frequencies only")
         })
     };
-    if !(options.node_tolerance.is_finite() && options.node_tolerance >= 0.0) {
-        return Err(input(format!(
-            "--node-tolerance {}: must be a finite distance ≥ 0 m",
-            options.node_tolerance
-        )));
+    let ShapeOptions { node_tolerance, shape_std, mac_threshold } = options.shape;
+    if !(node_tolerance.is_finite() && node_tolerance >= 0.0) {
+        return Err(input(format!("--node-tolerance {node_tolerance}: must be a finite distance ≥ 0 m")));
     }
-    if !(options.shape_std.is_finite() && options.shape_std > 0.0) {
-        return Err(input(format!("--shape-std {}: must be a positive finite number", options.shape_std)));
+    if !(shape_std.is_finite() && shape_std > 0.0) {
+        return Err(input(format!("--shape-std {shape_std}: must be a positive finite number")));
     }
-    if !(0.0..=1.0).contains(&options.mac_threshold) {
-        return Err(input(format!("--mac-threshold {}: must lie in [0, 1]", options.mac_threshold)));
+    if !(0.0..=1.0).contains(&mac_threshold) {
+        return Err(input(format!("--mac-threshold {mac_threshold}: must lie in [0, 1]")));
     }
     if !is_universal_file(path) {
         if options.sensor_map.is_some() {
@@ -136,14 +138,14 @@ pub fn read(
         Some(map) => sensors::map_explicit(&file, rotor()?, &read_text(map)?)
             .map_err(|e| input(format!("{}: {e}", map.display())))?,
         None => {
-            match sensors::map_by_coordinates(&file, rotor()?, options.node_tolerance) {
+            match sensors::map_by_coordinates(&file, rotor()?, node_tolerance) {
                 Ok(set) => set,
                 // Test systems often export millimetres without saying so (no dataset 164):
                 // accept that reading when it ties every node, and say so.
                 Err(e) if file.length_factor.is_none() => {
                     let mut mm = file.clone();
                     mm.nodes.iter_mut().for_each(|n| n.coordinates.iter_mut().for_each(|c| *c /= 1000.0));
-                    let set = sensors::map_by_coordinates(&mm, rotor()?, options.node_tolerance)
+                    let set = sensors::map_by_coordinates(&mm, rotor()?, node_tolerance)
                         .map_err(|_| at(e.to_string()))?;
                     file.warnings.push(
                         "no units dataset (164) and the node coordinates match the model only as millimetres: \

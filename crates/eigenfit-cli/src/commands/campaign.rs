@@ -37,9 +37,7 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         strategy: args.strategy.clone(),
         solver: args.solver.clone(),
         max_iterations: args.max_iterations,
-        node_tolerance: args.shape.node_tolerance,
-        shape_std: args.shape.shape_std,
-        mac_threshold: args.shape.mac_threshold,
+        shape: args.shape.options(),
     };
     let report = campaign::run(&request, &mut Bars::new(args.report.quiet))?;
     crate::commands::simulate::print_notes(&report.file_notes);
@@ -49,8 +47,8 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             report.campaign,
             report.configurations.len(),
             report.strategy,
-            report.termination,
-            report.iterations
+            report.outcome.termination,
+            report.outcome.iterations
         );
         println!("{:<24}{:>16}{:>16}{:>34}", "parameter", "initial", "estimate", "95% interval");
         for (i, ((n, initial), (_, value))) in report.initial.iter().zip(report.parameters.iter()).enumerate()
@@ -79,5 +77,5 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             println!("intervals from the residual scatter (no std in the data): sigma_hat = {s:.3e}");
         }
     });
-    Ok(if report.converged { 0 } else { EXIT_NOT_CONVERGED })
+    Ok(if report.outcome.converged { 0 } else { EXIT_NOT_CONVERGED })
 }

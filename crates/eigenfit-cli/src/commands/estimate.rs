@@ -71,7 +71,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     print_notes(&notes);
     let mut est = match outcome? {
         EstimateOutcome::Runup(report) => {
-            let code = if report.converged { EXIT_OK } else { EXIT_NOT_CONVERGED };
+            let code = if report.outcome.converged { EXIT_OK } else { EXIT_NOT_CONVERGED };
             crate::output::report(args.report.json, &report, crate::rotordynamics::print_estimate);
             return Ok(code);
         }
@@ -127,7 +127,7 @@ fn print_report(est: &Estimation) {
     let names: Vec<&str> = r.parameters.iter().map(|(n, _)| n.as_str()).collect();
     println!(
         "{}: {} strategy, {} after {} iterations ({} model evaluations)",
-        r.model, r.strategy, r.termination, r.iterations, r.budget.used
+        r.model, r.strategy, r.outcome.termination, r.outcome.iterations, r.budget.used
     );
     println!("{:<20}{:>16}{:>16}   95% interval [N/m]", "parameter", "initial [N/m]", "estimate [N/m]");
     for (i, n) in names.iter().enumerate() {
