@@ -8,7 +8,7 @@ use crate::progress::Progress;
 use eigenfit_core::compare::{
     log_space, reference_measurement, run_grid, tensor_grid, CompareRun, CompareSettings,
 };
-use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport};
+use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit};
 use eigenfit_core::measurement::measured_csv;
 use eigenfit_core::{DenseSolver, Driver, EigenSolver, Estimate, Problem, StrategyKind, StructuralModel};
 use eigenfit_rotor::presets::{self, PAPER_TABLE_1};
@@ -78,25 +78,18 @@ pub struct ConvergenceMap {
     pub strategies: Vec<Basin>,
 }
 
-/// The effect discovery named in the built-in dataset, with the evidence.
+/// The effect discovery named in the built-in dataset (its refit: kind, location, value,
+/// interval, χ², AICc, plausibility) with the evidence before and after.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct HiddenEffect {
-    /// `kind@location`, for the text report.
-    #[serde(skip)]
-    pub label: String,
-    /// Effect kind and location.
-    pub kind: String,
-    /// Node or element.
-    pub location: Option<usize>,
-    /// Fitted value, unit.
-    pub value: Option<f64>,
-    /// The value's unit.
-    pub unit: String,
-    /// χ² with the stiffnesses alone, and with the effect.
+    /// The named effect's refit.
+    #[serde(flatten)]
+    pub fit: Fit,
+    /// χ² with the stiffnesses alone.
     pub chi2_before: f64,
     /// χ² with the effect added.
     pub chi2_after: f64,
-    /// RMS residual before and after (Hz).
+    /// RMS residual before (Hz).
     pub rms_residual_before_hz: f64,
     /// RMS residual after (Hz).
     pub rms_residual_after_hz: f64,
@@ -195,11 +188,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
     progress.end();
     let found = found.map_err(failure)?;
     let discovery = found.selected.as_ref().map(|s| HiddenEffect {
-        label: s.label.clone(),
-        kind: s.kind.clone(),
-        location: s.location,
-        value: s.value,
-        unit: s.unit.clone(),
+        fit: s.clone(),
         chi2_before: found.chi2_before,
         chi2_after: s.chi2,
         rms_residual_before_hz: found.rms_before_hz,

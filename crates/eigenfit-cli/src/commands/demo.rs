@@ -144,10 +144,10 @@ fn text(found: &Demo, dofs: usize, grid: usize) -> Vec<String> {
     ));
     match &r.discovery {
         Some(s) => {
-            let value = s.value.map_or("on".to_string(), |v| format!("{v:.4e} {}", s.unit));
+            let value = s.fit.value.map_or("on".to_string(), |v| format!("{v:.4e} {}", s.fit.unit));
             say.push(format!(
                 "   missing effect: {} = {value} (hidden: disk-rotary-inertia@0 = 1e-3 kg·m²)",
-                s.label
+                s.fit.label
             ));
             say.push(format!(
                 "   χ² {:.0} → {:.2}, RMS residual {:.3} → {:.4} Hz",
