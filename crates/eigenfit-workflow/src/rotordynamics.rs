@@ -222,44 +222,20 @@ pub fn parse_speeds(text: &str) -> Result<Vec<f64>, WorkflowError> {
         .collect())
 }
 
-/// One critical speed in a report.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct CriticalSpeedReport {
-    /// Speed (rpm).
-    pub rpm: f64,
-    /// The followed curve that crosses the 1× line.
-    pub curve: usize,
-    /// `forward` or `backward`.
-    pub whirl: &'static str,
-    /// Logarithmic decrement there.
-    pub log_dec: f64,
-}
-
-/// The Campbell diagram of a two-plane rotor.
+/// The Campbell diagram of a two-plane rotor: the diagram's own keys (`speeds_rpm`,
+/// `frequencies_hz`, `whirl`, `log_dec`, `curves`, `critical_speeds`) and these.
 #[derive(Debug, Clone, Serialize)]
 pub struct CampbellReport {
     /// The model file.
     pub model: String,
-    /// Speeds (rpm).
-    pub speeds_rpm: Vec<f64>,
-    /// Damped frequencies (Hz), one row per speed.
-    pub frequencies_hz: Vec<Vec<f64>>,
-    /// Whirl per speed and mode.
-    pub whirl: Vec<Vec<&'static str>>,
-    /// Log decrements per speed and mode.
-    pub log_dec: Vec<Vec<f64>>,
+    /// The diagram.
+    #[serde(flatten)]
+    pub campbell: Campbell,
     /// The critical speeds (rpm).
     pub critical_speeds_rpm: Vec<f64>,
-    /// The critical speeds with their curve, whirl and log decrement.
-    pub critical_speeds: Vec<CriticalSpeedReport>,
-    /// Followed curves: per speed, the mode index each curve has there.
-    pub curves: Vec<Vec<Option<usize>>>,
     /// Plot files written.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plots: Option<Vec<String>>,
-    /// The diagram itself (for plots).
-    #[serde(skip)]
-    pub campbell: Campbell,
 }
 
 /// `campbell`: damped frequencies, whirl and log decrement of a ROSS rotor against speed.
@@ -272,24 +248,9 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
     let c = campbell(&rotor, &speeds, modes).map_err(|e| input(format!("{}: {e}", path.display())))?;
     Ok(CampbellReport {
         model: path.display().to_string(),
-        speeds_rpm: c.speeds_rpm.clone(),
-        frequencies_hz: c.frequencies_hz.clone(),
-        whirl: c.whirl.iter().map(|v| v.iter().map(|w| w.name()).collect()).collect(),
-        log_dec: c.log_dec.clone(),
         critical_speeds_rpm: c.critical_speeds.iter().map(|k| k.rpm).collect(),
-        critical_speeds: c
-            .critical_speeds
-            .iter()
-            .map(|k| CriticalSpeedReport {
-                rpm: k.rpm,
-                curve: k.curve,
-                whirl: k.whirl.name(),
-                log_dec: k.log_dec,
-            })
-            .collect(),
-        curves: c.curves.clone(),
-        plots: None,
         campbell: c,
+        plots: None,
     })
 }
 

@@ -44,23 +44,23 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
             "{}: Campbell diagram, {} modes at {} speeds",
             report.model,
             args.modes,
-            report.speeds_rpm.len()
+            report.campbell.speeds_rpm.len()
         );
         print!("{:>10}", "rpm");
         (1..=args.modes).for_each(|m| print!("{:>22}", format!("f{m} [Hz] whirl")));
         println!();
-        for (k, rpm) in report.speeds_rpm.iter().enumerate() {
+        for (k, rpm) in report.campbell.speeds_rpm.iter().enumerate() {
             print!("{rpm:>10.1}");
-            for (f, w) in report.frequencies_hz[k].iter().zip(&report.whirl[k]) {
-                print!("{:>22}", format!("{f:.4} {}", &w[..1]));
+            for (f, w) in report.campbell.frequencies_hz[k].iter().zip(&report.campbell.whirl[k]) {
+                print!("{:>22}", format!("{f:.4} {}", &w.name()[..1]));
             }
             println!();
         }
-        if report.critical_speeds.is_empty() {
+        if report.campbell.critical_speeds.is_empty() {
             println!("no critical speed in range (no followed mode crosses the 1× line)");
         }
-        for k in &report.critical_speeds {
-            println!("critical speed {:.1} rpm ({} whirl, log dec {:.4})", k.rpm, k.whirl, k.log_dec);
+        for k in &report.campbell.critical_speeds {
+            println!("critical speed {:.1} rpm ({} whirl, log dec {:.4})", k.rpm, k.whirl.name(), k.log_dec);
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     });
