@@ -3,7 +3,7 @@
 
 use crate::error::CliError;
 use clap::Args;
-use eigenfit_core::EigenSolver;
+use eigenfit_core::eigen::EigenSolver;
 use eigenfit_workflow::{AnyModel, ModelSource};
 use std::path::PathBuf;
 

@@ -3,7 +3,7 @@
 //! in `eigenfit_workflow::test_data`.
 
 use clap::Args;
-use eigenfit_core::testdata::MacReport;
+use eigenfit_core::measurement::mac::MacReport;
 use eigenfit_workflow::test_data::{ShapeOptions, TestData, TestDataOptions};
 use std::path::PathBuf;
 
@@ -37,7 +37,7 @@ pub struct ShapeArgs {
     #[arg(long, default_value_t = 1e-3, value_name = "M")]
     pub node_tolerance: f64,
     /// Standard deviation of the entries of a unit-length measured shape (shape residual weight).
-    #[arg(long, default_value_t = eigenfit_core::testdata::shapes::DEFAULT_SHAPE_STD, value_name = "S")]
+    #[arg(long, default_value_t = eigenfit_core::analysis::DEFAULT_SHAPE_STD, value_name = "S")]
     pub shape_std: f64,
     /// Lowest MAC at which a measured mode counts as paired; below it the mode is named
     /// unpaired and the run is not acceptable (exit code 3).

@@ -8,10 +8,10 @@ use crate::outcome::Outcome;
 use crate::overrides::fixed;
 use crate::progress::Progress;
 use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDataOptions};
-use eigenfit_core::testdata::Joint;
-use eigenfit_core::{
-    BandedSolver, DenseSolver, Driver, EigenSolver, Evaluate, Problem, ResidualKind, StrategyKind,
-};
+use eigenfit_core::analysis::Joint;
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
+use eigenfit_core::update::{Driver, StrategyKind};
 use eigenfit_rotor::campaign::Campaign;
 use eigenfit_rotor::{Rotor, UpdatableRotor};
 use serde::Serialize;
@@ -106,7 +106,10 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         other => return Err(input(format!("unknown solver `{other}`; available: banded, dense"))),
     };
     let strategy_kind = StrategyKind::from_name(&request.strategy).ok_or_else(|| {
-        input(format!("unknown strategy `{}`; available: newton, p-step, damped", request.strategy))
+        input(format!(
+            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
+            request.strategy
+        ))
     })?;
     let mut models = Vec::new();
     let mut data = Vec::new();
@@ -141,7 +144,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
             Fit::new(problem, d, request.shape.shape_std)
         })
         .collect();
-    let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Evaluate).collect())
+    let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Objective).collect())
         .map_err(|e| input(format!("{}: {e}", request.campaign.display())))?;
     let has_std = data.iter().all(|d| d.measurement.has_std() && d.sensors.is_none());
     let initial = joint.parameters().nominal_values();
@@ -184,7 +187,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         initial: Named::new(&pnames, initial.iter().copied()),
         parameters: Named::new(&pnames, p.iter().copied()),
         chi2: estimate.last.chi2(),
-        dof: estimate.last.dof(),
+        dof: estimate.last.degrees_of_freedom(),
         intervals: unc.as_ref().map(|u| Named::new(&pnames, u.intervals.iter().copied())),
         interval_basis: scatter.map(|s| interval_basis(s, has_std)),
         configurations,

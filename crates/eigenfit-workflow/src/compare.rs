@@ -8,8 +8,11 @@
 
 use crate::error::{input, WorkflowError};
 use crate::overrides::{parse_list, points};
-use eigenfit_core::compare::{log_space, run_grid, tensor_grid, CompareRun, CompareSettings};
-use eigenfit_core::{EigenSolver, Identifiability, StrategyKind, StructuralModel};
+use eigenfit_core::analysis::compare::{log_space, run_grid, tensor_grid, CompareRun, CompareSettings};
+use eigenfit_core::analysis::Identifiability;
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::update::StrategyKind;
 use serde::Serialize;
 
 /// Relative error within which a converged run counts in the summary's `converged_within_1e-6`.
@@ -105,7 +108,7 @@ pub fn plan(request: &CompareRequest, np: usize) -> Result<ComparePlan, Workflow
         .map(|s| {
             StrategyKind::from_name(s.trim()).ok_or_else(|| {
                 input(format!(
-                    "--strategies: unknown strategy `{}`; available: newton, p-step, damped",
+                    "--strategies: unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
                     s.trim()
                 ))
             })
@@ -195,7 +198,7 @@ impl RunReport {
             strategy: r.strategy.name(),
             run: r.clone(),
             seconds: timing.then_some(r.seconds),
-            alternative_solutions: (r.strategy == StrategyKind::Damped && r.converged)
+            alternative_solutions: (r.strategy == StrategyKind::LevenbergMarquardt && r.converged)
                 .then(|| r.alternatives.clone()),
             identifiable: r.identifiability.as_ref().map(|ids| ids.iter().map(Into::into).collect()),
         }
@@ -242,7 +245,7 @@ pub fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[Strate
                 converged: conv.len(),
                 converged_within_1e6: conv.iter().filter(|r| r.relative_error <= WITHIN_1E6).count(),
                 // Only damped runs are checked for other solutions: a 0 elsewhere would mean nothing.
-                ambiguous: (s == StrategyKind::Damped)
+                ambiguous: (s == StrategyKind::LevenbergMarquardt)
                     .then(|| conv.iter().filter(|r| !r.alternatives.is_empty()).count()),
                 median_iterations: (!iters.is_empty()).then(|| iters[iters.len() / 2]),
                 max_iterations: iters.last().copied(),

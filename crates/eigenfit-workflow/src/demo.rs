@@ -5,12 +5,15 @@
 use crate::compare::{basins, Basin};
 use crate::error::{failure, WorkflowError};
 use crate::progress::Progress;
-use eigenfit_core::compare::{
+use eigenfit_core::analysis::compare::{
     log_space, reference_measurement, run_grid, tensor_grid, CompareRun, CompareSettings,
 };
 use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 use eigenfit_core::measurement::measured_csv;
-use eigenfit_core::{DenseSolver, Driver, EigenSolver, Estimate, Problem, StrategyKind, StructuralModel};
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::problem::Problem;
+use eigenfit_core::update::{Driver, Estimate, StrategyKind};
 use eigenfit_rotor::presets::{self, PAPER_TABLE_1};
 use serde::Serialize;
 

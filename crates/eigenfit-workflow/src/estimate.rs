@@ -10,14 +10,13 @@ use crate::rotordynamics::{self, RunupEstimateReport};
 use crate::simulate::check_roundoff;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
+use eigenfit_core::analysis::verdict::{at_limits, judge, unreachable_modes, FitQuality, FitVerdict};
+use eigenfit_core::analysis::{alternative_solutions_within, mirror_solutions, Identifiability, Uncertainty};
+use eigenfit_core::measurement::mac::MacReport;
 use eigenfit_core::measurement::measured_csv::{shown, shown_number};
-use eigenfit_core::statistics::{alternative_solutions_within, mirror_solutions};
-use eigenfit_core::testdata::MacReport;
-use eigenfit_core::verdict::{at_limits, judge, unreachable_modes, FitQuality, FitVerdict};
-use eigenfit_core::{
-    Budget, Damped, Driver, Estimate, Evaluate, Identifiability, Problem, ResidualKind, StrategyKind,
-    StructuralModel, Uncertainty,
-};
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
+use eigenfit_core::update::{Budget, Driver, Estimate, LevenbergMarquardt, StrategyKind};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -264,7 +263,10 @@ pub fn run(
     notes.extend(data.file_notes.iter().cloned());
     let measurement = data.measurement.clone();
     let strategy_kind = StrategyKind::from_name(&request.strategy).ok_or_else(|| {
-        input(format!("unknown strategy `{}`; available: newton, p-step, damped", shown(&request.strategy)))
+        input(format!(
+            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
+            shown(&request.strategy)
+        ))
     })?;
     let kind = match request.residual.as_str() {
         "relative" => ResidualKind::Relative,
@@ -339,10 +341,10 @@ pub fn run(
     // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
     // the best point of its coarse grid instead, and says so.
     let mut start = initial.clone();
-    if strategy_kind == StrategyKind::Damped {
+    if strategy_kind == StrategyKind::LevenbergMarquardt {
         let budgeted = budget.wrap(&fit);
         if let Err(e) = budgeted.linearise(&initial) {
-            if let Some(seed) = Damped::rank_seeds(&budgeted).first() {
+            if let Some(seed) = LevenbergMarquardt::rank_seeds(&budgeted).first() {
                 notes.push(format!(
                     "the model cannot be evaluated at --initial ({e}); starting from the best point of the coarse grid"
                 ));

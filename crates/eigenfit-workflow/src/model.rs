@@ -4,8 +4,8 @@
 //! plots, writing a rotor file) say so for a matrices model.
 
 use crate::error::{input, WorkflowError};
-use eigenfit_core::discovery::Candidate;
-use eigenfit_core::{ModelError, ParameterSet, StructuralModel, System, SystemDerivative};
+use eigenfit_core::matrix::{System, SystemDerivative};
+use eigenfit_core::model::{Candidate, ModelError, ParameterSet, StructuralModel};
 use eigenfit_matrices::MatricesModel;
 use eigenfit_rotor::{Rotor, UpdatableRotor};
 use std::path::Path;
@@ -81,7 +81,7 @@ impl AnyModel {
     }
 
     /// The rotor as the node layout measured shapes are tied to (a matrices model has none).
-    pub fn layout(&self) -> Option<&dyn eigenfit_core::testdata::sensors::NodeLayout> {
+    pub fn layout(&self) -> Option<&dyn eigenfit_core::measurement::sensors::NodeLayout> {
         match self {
             AnyModel::Rotor(r) => Some(r),
             AnyModel::Matrices(_) => None,

@@ -18,7 +18,7 @@ pub struct Outcome {
 
 impl Outcome {
     /// The outcome of a driver run; `converged` as given (the caller may require more).
-    pub fn of(estimate: &eigenfit_core::Estimate, converged: bool) -> Self {
+    pub fn of(estimate: &eigenfit_core::update::Estimate, converged: bool) -> Self {
         Self {
             converged,
             termination: estimate.termination.to_string(),

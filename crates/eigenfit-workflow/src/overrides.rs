@@ -2,8 +2,7 @@
 //! parameters (`--fix`). Every error names the option and the item.
 
 use crate::error::{input, WorkflowError};
-use eigenfit_core::fixed::Fixed;
-use eigenfit_core::StructuralModel;
+use eigenfit_core::model::{Fixed, StructuralModel};
 
 /// Parses `K1,K2,…` into finite numbers, naming the bad item (errors start with `flag`).
 pub fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>, WorkflowError> {

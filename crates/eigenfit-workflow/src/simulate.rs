@@ -4,8 +4,11 @@
 use crate::error::{failure, input, WorkflowError};
 use crate::named::Named;
 use crate::progress::Progress;
-use eigenfit_core::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF};
-use eigenfit_core::{EigenSolver, Modes, Sensitivities, StructuralModel, System};
+use eigenfit_core::eigen::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF};
+use eigenfit_core::eigen::{EigenSolver, Modes};
+use eigenfit_core::matrix::System;
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::sensitivity::Sensitivities;
 use eigenfit_rotor::{presets, Rotor};
 use serde::Serialize;
 
@@ -127,7 +130,7 @@ pub fn sweep_points(text: &str) -> Result<Vec<f64>, WorkflowError> {
             "--sweep `{text}`: {count} points, more than the {MAX_SWEEP_POINTS} a sweep accepts"
         )));
     }
-    Ok(eigenfit_core::compare::log_space(a, b, count))
+    Ok(eigenfit_core::analysis::compare::log_space(a, b, count))
 }
 
 /// Whether `rotor` is the paper's rotor (whatever its current support stiffnesses).

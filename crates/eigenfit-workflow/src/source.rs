@@ -3,8 +3,8 @@
 
 use crate::error::{input, WorkflowError};
 use crate::model::{self, AnyModel};
-use eigenfit_core::dense::DENSE_MAX_DOFS;
-use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, SparseSolver, StructuralModel};
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver, SparseSolver, DENSE_MAX_DOFS};
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{presets, Rotor, RotorError};
 use std::path::PathBuf;
 

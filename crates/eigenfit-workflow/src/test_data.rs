@@ -7,14 +7,14 @@
 use crate::error::{failure, input, WorkflowError};
 use crate::model::Updatable;
 use crate::named::Named;
-use eigenfit_core::fixed::Fixed;
-use eigenfit_core::measurement::measured_csv;
-use eigenfit_core::testdata::sensors::NodeLayout;
-use eigenfit_core::testdata::{sensors, uff, MacReport, SensorSet, ShapeFit};
-use eigenfit_core::{
-    Budget, EigenSolver, Estimate, Evaluate, Linearisation, Measurement, Pairing, ParameterSet, Problem,
-    ResidualError, StructuralModel, Uncertainty,
-};
+use eigenfit_core::analysis::{ShapeFit, Uncertainty};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::measurement::mac::MacReport;
+use eigenfit_core::measurement::sensors::{self, NodeLayout, SensorSet};
+use eigenfit_core::measurement::{measured_csv, uff, Measurement};
+use eigenfit_core::model::{Fixed, ParameterSet, StructuralModel};
+use eigenfit_core::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
+use eigenfit_core::update::{Budget, Estimate};
 use eigenfit_rotor::Rotor;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -34,7 +34,7 @@ impl Default for ShapeOptions {
     fn default() -> Self {
         Self {
             node_tolerance: 1e-3,
-            shape_std: eigenfit_core::testdata::shapes::DEFAULT_SHAPE_STD,
+            shape_std: eigenfit_core::analysis::DEFAULT_SHAPE_STD,
             mac_threshold: 0.6,
         }
     }
@@ -204,7 +204,7 @@ impl<'a> Fit<'a> {
     /// (1 when the data carry standard deviations).
     pub fn uncertainty(&mut self, at: &Linearisation, has_std: bool) -> Option<(Uncertainty, f64)> {
         match self {
-            Fit::Frequencies(p) => eigenfit_core::statistics::uncertainty(p, at, has_std).map(|u| (u, 1.0)),
+            Fit::Frequencies(p) => eigenfit_core::analysis::uncertainty(p, at, has_std).map(|u| (u, 1.0)),
             Fit::Shapes(s) => s.uncertainty(at),
         }
     }
@@ -220,7 +220,7 @@ impl<'a> Fit<'a> {
     ) -> (Option<Uncertainty>, Option<f64>) {
         match self {
             Fit::Frequencies(p) => {
-                (eigenfit_core::statistics::uncertainty_within(p, at, has_std, budget), None)
+                (eigenfit_core::analysis::uncertainty_within(p, at, has_std, budget), None)
             }
             Fit::Shapes(s) => s.uncertainty(at).map_or((None, None), |(u, sc)| (Some(u), Some(sc))),
         }
@@ -241,7 +241,7 @@ impl<'a> Fit<'a> {
     }
 }
 
-impl Evaluate for Fit<'_> {
+impl Objective for Fit<'_> {
     fn parameters(&self) -> &ParameterSet {
         match self {
             Fit::Frequencies(p) => p.parameters(),
@@ -256,8 +256,8 @@ impl Evaluate for Fit<'_> {
     }
     fn cost(&self, p: &[f64]) -> Option<f64> {
         match self {
-            Fit::Frequencies(q) => Evaluate::cost(q, p),
-            Fit::Shapes(s) => Evaluate::cost(s, p),
+            Fit::Frequencies(q) => Objective::cost(q, p),
+            Fit::Shapes(s) => Objective::cost(s, p),
         }
     }
 }
@@ -383,7 +383,7 @@ pub fn updated_model_toml(
         utc_date(),
         data_file.display(),
         estimate.last.chi2(),
-        estimate.last.dof()
+        estimate.last.degrees_of_freedom()
     );
     for (i, p) in model.parameters().iter().enumerate() {
         let interval = unc.map_or("no interval".to_string(), |u| {

@@ -1,7 +1,7 @@
 //! The workflows as a library user calls them: a model by name, a report whose numbers check
 //! against finite differences, and the checks that refuse bad requests before any work.
 
-use eigenfit_core::dense::DENSE_MAX_DOFS;
+use eigenfit_core::eigen::DENSE_MAX_DOFS;
 use eigenfit_workflow::compare::{self, CompareRequest, MAX_RUNS};
 use eigenfit_workflow::simulate::{at_point, SweepCheck};
 use eigenfit_workflow::{ModelSource, WorkflowError};

@@ -13,7 +13,7 @@ pub struct CampaignArgs {
     /// `name`, `shapes`, `sensor_map`.
     #[arg(value_name = "CAMPAIGN.toml")]
     pub campaign: PathBuf,
-    /// Update strategy: newton, p-step or damped.
+    /// Update strategy: newton, p-step or damped (Levenberg–Marquardt; `levenberg-marquardt` is accepted too).
     #[arg(long, default_value = "damped")]
     pub strategy: String,
     /// Eigen-solver backend: banded (default) or dense.

@@ -6,8 +6,9 @@ use crate::plot::compare_map::{CompareMaps, MapKind};
 use crate::source::ModelArgs;
 use crate::{plot, progress};
 use clap::Args;
-use eigenfit_core::compare::CompareRun;
-use eigenfit_core::{StrategyKind, StructuralModel};
+use eigenfit_core::analysis::compare::CompareRun;
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::update::StrategyKind;
 use eigenfit_workflow::compare::{self, CompareRequest, WITHIN_1E6};
 use std::path::{Path, PathBuf};
 

@@ -10,7 +10,7 @@ use crate::plot::convergence::{Convergence, Run};
 use crate::plot::discovery::DiscoveryPlot;
 use crate::progress::Bars;
 use clap::Args;
-use eigenfit_core::StructuralModel;
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::presets;
 use eigenfit_workflow::compare::AT_TARGET;
 use eigenfit_workflow::demo::{self, Demo, DemoReport, LABEL, PAPER_CASE_1, TARGET};
@@ -44,7 +44,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
         out,
         LABEL,
         &rotor,
-        &eigenfit_core::DenseSolver,
+        &eigenfit_core::eigen::DenseSolver,
         &TARGET,
         simulate::MapOptions { range: (1e2, 1e9), plain: true, quiet: args.report.quiet },
     )?;

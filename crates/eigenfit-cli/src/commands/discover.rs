@@ -8,7 +8,7 @@ use crate::progress::Bars;
 use crate::source::ModelArgs;
 use clap::Args;
 use eigenfit_core::discovery::DiscoveryReport;
-use eigenfit_core::StructuralModel;
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::discovery::RotorDiscovery;
 use eigenfit_workflow::discover::{self, Discovery};
 use std::path::PathBuf;

@@ -7,8 +7,8 @@ use crate::progress::Bars;
 use crate::source::ModelArgs;
 use crate::{plot, testdata};
 use clap::Args;
+use eigenfit_core::analysis::verdict::FitVerdict;
 use eigenfit_core::update::DEFAULT_EVALUATIONS;
-use eigenfit_core::verdict::FitVerdict;
 use eigenfit_workflow::estimate::{self, EstimateOutcome, EstimateRequest, Estimation};
 use std::path::PathBuf;
 
@@ -24,7 +24,7 @@ pub struct EstimateArgs {
     pub measured: PathBuf,
     #[command(flatten)]
     pub test_data: testdata::TestDataArgs,
-    /// Update strategy: newton, p-step or damped.
+    /// Update strategy: newton, p-step or damped (Levenberg–Marquardt; `levenberg-marquardt` is accepted too).
     #[arg(long, default_value = "damped")]
     pub strategy: String,
     /// Initial bearing stiffnesses K1,K2,… in N/m (default: the model's values).

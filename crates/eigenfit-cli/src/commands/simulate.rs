@@ -7,7 +7,8 @@ use crate::plot::mode_shapes::ModeShapes;
 use crate::progress::Bars;
 use crate::source::ModelArgs;
 use clap::Args;
-use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{EffectSpec, Rotor};
 use eigenfit_workflow::overrides::parameter_vector;
 use eigenfit_workflow::simulate::{

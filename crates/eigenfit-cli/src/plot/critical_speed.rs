@@ -4,7 +4,8 @@
 use super::style::{self, log_bounds, log_tick, mode_colour, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
-use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::model::StructuralModel;
 use eigenfit_workflow::simulate::{sweep, SweepCheck};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -50,7 +51,7 @@ impl CriticalSpeedMap {
         modes: usize,
         progress: &mut dyn eigenfit_workflow::Progress,
     ) -> Result<Self, CliError> {
-        let stiffness = eigenfit_core::compare::log_space(range.0, range.1, count.max(2));
+        let stiffness = eigenfit_core::analysis::compare::log_space(range.0, range.1, count.max(2));
         let frequencies =
             sweep(model, solver, &stiffness, modes, SweepCheck::None, &mut Vec::new(), progress)?;
         Ok(Self {

@@ -3,7 +3,7 @@
 use super::style::{self, mode_colour, short_sci, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
-use eigenfit_core::EigenSolver;
+use eigenfit_core::eigen::EigenSolver;
 use eigenfit_rotor::Rotor;
 use plotters::coord::Shift;
 use plotters::prelude::*;
