@@ -7,6 +7,19 @@
 //! Python package) gets the same models, checks and messages as the command line.
 //!
 //! The crate sits above every plugin crate (rotor, matrices, rotordynamics) and below the CLI.
+//!
+//! ```no_run
+//! use eigenfit_workflow::simulate::{at_point, SweepCheck};
+//! use eigenfit_workflow::ModelSource;
+//!
+//! // `eigenfit simulate --preset paper-rotor --stiffness 1e5,1e5 --modes 3 --json`, as a call.
+//! let source = ModelSource::preset("paper-rotor");
+//! let (model, label) = source.load_any()?;
+//! let solver = source.solver()?;
+//! let report = at_point(&label, &model, solver.as_ref(), &[1e5, 1e5], 3, SweepCheck::RefuseRoundoff)?;
+//! println!("{}", serde_json::to_string(&report)?);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod campaign;
 pub mod compare;
