@@ -20,6 +20,9 @@ use eigenfit_core::update::{Budget, Driver, Estimate, LevenbergMarquardt, Strate
 use serde::Serialize;
 use std::path::PathBuf;
 
+/// Another equally good parameter vector, with the exchanged pair when it is a mirror solution.
+type Alternative = (Vec<f64>, Option<(usize, usize)>);
+
 /// Restart-grid points refitted locally when searching for other equally good solutions.
 const ALTERNATIVE_STARTS: usize = 6;
 /// A measured mode this far (relative) outside every frequency the model reaches is refused.
@@ -234,7 +237,7 @@ pub struct Estimation {
 /// What an estimation ended with.
 pub enum EstimateOutcome {
     /// A two-plane (ROSS) rotor's bearing stiffnesses from run-up data.
-    Runup(RunupEstimateReport),
+    Runup(Box<RunupEstimateReport>),
     /// The budget ran out before the fit could start; nothing to report.
     BudgetExhaustedBeforeFit {
         /// The budget.
@@ -254,7 +257,7 @@ pub fn run(
     // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
     if let Some(path) = rotordynamics::ross_model(request.source.model.as_deref()) {
         return rotordynamics::estimate(path, &request.measured, request.max_iterations)
-            .map(EstimateOutcome::Runup);
+            .map(|r| EstimateOutcome::Runup(Box::new(r)));
     }
     let (any, label) = request.source.load_any()?;
     let solver = request.source.solver()?;
@@ -378,7 +381,7 @@ pub fn run(
     let (unc, scatter) =
         if converged { fit.uncertainty_within(&estimate.last, has_std, &budget) } else { (None, None) };
     let mac = fit.mac(&estimate.parameters, options.shape.mac_threshold);
-    let mut alternatives: Vec<(Vec<f64>, Option<(usize, usize)>)> = Vec::new();
+    let mut alternatives: Vec<Alternative> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {
         for (i, j, p) in mirror_solutions(&fit, &estimate.last, &budget) {
             alternatives.push((p, Some((i, j))));
@@ -481,7 +484,7 @@ pub fn run(
         uncertainty: unc.as_ref().map(|u| IntervalsReport::new(&names, u)),
         plots: None,
         test_data: ShapeReport::new(&fit, &data, &estimate, mac.as_ref(), scatter),
-        fixed: (!held.is_empty()).then(|| Named(held)),
+        fixed: (!held.is_empty()).then_some(Named(held)),
     };
     let updated_model =
         request.write_model.then(|| updated_model_toml(&request.measured, &model, &estimate, unc.as_ref()));

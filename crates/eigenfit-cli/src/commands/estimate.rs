@@ -72,7 +72,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let mut est = match outcome? {
         EstimateOutcome::Runup(report) => {
             let code = if report.outcome.converged { EXIT_OK } else { EXIT_NOT_CONVERGED };
-            crate::output::report(args.report.json, &report, crate::rotordynamics::print_estimate);
+            crate::output::report(args.report.json, &*report, crate::rotordynamics::print_estimate);
             return Ok(code);
         }
         EstimateOutcome::BudgetExhaustedBeforeFit { limit } => {
