@@ -99,10 +99,12 @@ impl ModeComparison {
     }
 }
 
-/// A refitted candidate.
-#[derive(Debug, Clone, PartialEq)]
+/// A refitted candidate. Serialises as a `discover` report's candidate (what, where, value,
+/// interval, χ², AICc, plausibility).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Fit {
     /// The candidate's label, `kind@location`.
+    #[serde(skip)]
     pub label: String,
     /// Kind.
     pub kind: String,
@@ -115,12 +117,16 @@ pub struct Fit {
     /// 95% interval of the value.
     pub interval: Option<[f64; 2]>,
     /// Position along the structure (m), for an effect placed by coordinate.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub position_m: Option<f64>,
     /// First and last element, for an effect over a run of elements.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
     /// All fitted parameters: the base's, then the values of every effect in the fit.
+    #[serde(skip)]
     pub parameters: Vec<f64>,
     /// 95% (covariance) intervals of all fitted parameters, where they could be computed.
+    #[serde(skip)]
     pub intervals: Vec<Option<[f64; 2]>>,
     /// χ² of the fit.
     pub chi2: f64,
@@ -129,6 +135,7 @@ pub struct Fit {
     /// Is the value physically plausible (and, for a value, its interval clear of zero)?
     pub plausible: bool,
     /// Model frequencies of the measured modes, Hz.
+    #[serde(skip)]
     pub frequencies_hz: Vec<f64>,
 }
 
@@ -155,17 +162,20 @@ impl Fit {
 }
 
 /// An alternative that explains the data about as well as a named effect.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Alternative {
     /// `kind@location`.
+    #[serde(skip)]
     pub label: String,
     /// Kind.
     pub kind: String,
     /// Location.
     pub location: Option<usize>,
     /// Position along the structure (m), if placed by coordinate.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub position_m: Option<f64>,
     /// Element run, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
     /// Its fitted value.
     pub value: Option<f64>,
@@ -191,19 +201,23 @@ impl Alternative {
 }
 
 /// One effect named by forward selection, with its value from the final joint fit.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct NamedEffect {
     /// `kind@location`.
+    #[serde(skip)]
     pub label: String,
     /// Kind.
     pub kind: String,
     /// Location.
     pub location: Option<usize>,
     /// Position along the structure (m), if placed by coordinate.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub position_m: Option<f64>,
     /// Element run, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
-    /// Fitted value in the final joint fit (`None` for a switch).
+    /// Fitted value in the final joint fit (`None` for a switch, reported as 1: on).
+    #[serde(serialize_with = "value_or_on")]
     pub value: Option<f64>,
     /// Its 95% interval.
     pub interval: Option<[f64; 2]>,
@@ -213,6 +227,11 @@ pub struct NamedEffect {
     pub delta_aicc: f64,
     /// Alternatives within [`DiscoveryOptions::ambiguity_aicc`] when it was chosen.
     pub ambiguous_with: Vec<Alternative>,
+}
+
+/// A switched effect has no value; reports give it as 1 ("on").
+fn value_or_on<S: serde::Serializer>(value: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(value.unwrap_or(1.0))
 }
 
 impl NamedEffect {
