@@ -96,11 +96,7 @@ pub fn shown(field: &str) -> String {
 /// A number as shown in a message: plain when moderate, in exponent form when it would print
 /// hundreds of digits (1e300).
 pub fn shown_number(v: f64) -> String {
-    if v.is_finite() && v != 0.0 && !(1e-4..1e9).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        format!("{v}")
-    }
+    eigenfit_core::verdict::shown_number(v)
 }
 
 /// [`parse`] with the notes for the user (ignored columns), each starting with `LINE: `.

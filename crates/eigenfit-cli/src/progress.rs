@@ -38,3 +38,17 @@ pub fn spinner(message: &str, quiet: bool) -> ProgressBar {
     pb.enable_steady_tick(Duration::from_millis(100));
     pb
 }
+
+/// Shows a multi-run task's steps (the interval phase's profile bounds) on a bar: the driver's
+/// observer mechanism, so the library reports progress without knowing about terminals.
+pub struct StepsBar(pub ProgressBar);
+
+impl eigenfit_core::Observer for StepsBar {
+    fn observe(&mut self, _record: &eigenfit_core::IterationRecord) {
+        self.0.tick();
+    }
+    fn steps_done(&mut self, done: usize, total: usize) {
+        self.0.set_length(total as u64);
+        self.0.set_position(done as u64);
+    }
+}

@@ -379,15 +379,18 @@ impl Evaluate for Fit<'_> {
 }
 
 /// Intervals and the residual scatter they were scaled by: the frequency fit's as the statistics
-/// module gives them (within `budget`), the shape fit's from [`ShapeFit::uncertainty`].
+/// module gives them (within `budget`, bounds done reported to `observers`), the shape fit's from [`ShapeFit::uncertainty`].
 pub fn uncertainty(
     fit: &mut Fit,
     at: &Linearisation,
     has_std: bool,
     budget: &eigenfit_core::Budget,
+    observers: &mut [&mut dyn eigenfit_core::Observer],
 ) -> (Option<Uncertainty>, Option<f64>) {
     match fit {
-        Fit::Frequencies(p) => (eigenfit_core::statistics::uncertainty_within(p, at, has_std, budget), None),
+        Fit::Frequencies(p) => {
+            (eigenfit_core::statistics::uncertainty_observed(p, at, has_std, budget, observers), None)
+        }
         Fit::Shapes(s) => s.uncertainty(at).map_or((None, None), |(u, sc)| (Some(u), Some(sc))),
     }
 }

@@ -1,6 +1,7 @@
 //! [`RotorBuilder`]: collect a rotor description unchecked, validate it once in
 //! [`build`](RotorBuilder::build).
 
+use crate::element;
 use crate::error::RotorError;
 use crate::file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section};
 use crate::model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
@@ -445,12 +446,48 @@ fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>
             .and_then(|s| section_material[s])
             .or(default_material)
             .ok_or_else(|| at(entry, None)(RotorError::MissingMaterial { element: e }))?;
-        elements.push(ShaftElement {
-            length: nodes[e + 1] - nodes[e],
-            outer_diameter: outer,
-            inner_diameter: inner,
-            material,
-        });
+        let element = ShaftElement { length: nodes[e + 1] - nodes[e], outer_diameter: outer, inner_diameter: inner, material };
+        let diameter_site = if section.is_some_and(|s| s.diameter.is_some()) { entry } else { Entry::Shaft };
+        check_representable(e, &element, &spec.materials[material], diameter_site)?;
+        elements.push(element);
     }
     Ok(elements)
+}
+
+/// Values that each pass validation can still overflow (or vanish) in floating point once
+/// combined, e.g. a diameter of 1e300 m has D⁴ = ∞; assembly would then fail with `K[0, 0] is
+/// inf`, naming no field. Checked here, where the field behind it is known.
+fn check_representable(
+    e: usize,
+    el: &ShaftElement,
+    mat: &Material,
+    diameter_site: Entry,
+) -> Result<(), SitedError> {
+    let ok = |v: f64| v.is_finite() && v > 0.0;
+    let second_moment = element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
+    let area = element::area(el.outer_diameter, el.inner_diameter);
+    let geometry = [("second moment of area [m⁴]", second_moment), ("cross-section area [m²]", area)];
+    for (quantity, value) in geometry {
+        if !ok(value) {
+            let error =
+                RotorError::NotRepresentable { element: e, cause: "diameter", given: el.outer_diameter, quantity, value };
+            return Err(at(diameter_site, Some("diameter"))(error));
+        }
+    }
+    // The largest entries of the element matrices: 12·EI/L³ and 4·EI/L, 156·ρAL/420.
+    let ei = mat.youngs_modulus * second_moment;
+    let stiffness = [12.0 * ei / el.length.powi(3), 4.0 * ei / el.length];
+    let mass = [156.0 * mat.density * area * el.length / 420.0];
+    let material_site = |key| at(Entry::Material(el.material), Some(key));
+    if let Some(&value) = stiffness.iter().find(|&&v| !ok(v)) {
+        let (cause, given) = ("youngs_modulus", mat.youngs_modulus);
+        let error = RotorError::NotRepresentable { element: e, cause, given, quantity: "stiffness matrix entry", value };
+        return Err(material_site(cause)(error));
+    }
+    if let Some(&value) = mass.iter().find(|&&v| !ok(v)) {
+        let (cause, given) = ("density", mat.density);
+        let error = RotorError::NotRepresentable { element: e, cause, given, quantity: "mass matrix entry", value };
+        return Err(material_site(cause)(error));
+    }
+    Ok(())
 }

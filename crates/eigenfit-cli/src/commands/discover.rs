@@ -8,7 +8,9 @@ use crate::source::ModelArgs;
 use crate::{measured, plot, progress};
 use clap::Args;
 use eigenfit_core::discovery::{discover, Alternative, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
-use eigenfit_core::StructuralModel;
+use eigenfit_core::update::DEFAULT_EVALUATIONS;
+use eigenfit_core::verdict::check_reachable;
+use eigenfit_core::{Budget, Problem, StructuralModel};
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -47,6 +49,11 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
     if !(args.assumed_std.is_finite() && args.assumed_std > 0.0) {
         return Err(input(format!("--assumed-std {}: must be a positive number", args.assumed_std)));
     }
+    // Estimate's sanity check, so a typing slip ends here as it does there (exit 2, mode named).
+    let mode_numbers: Vec<usize> = data.modes().iter().map(|m| m.mode + 1).collect();
+    let problem = Problem::new(&model, solver.as_ref(), data.clone());
+    check_reachable(&problem, &mode_numbers, &Budget::new(DEFAULT_EVALUATIONS))
+        .map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
     let options = DiscoveryOptions { assumed_relative_std: args.assumed_std, ..Default::default() };
     let pb = progress::spinner("discovering: calibrate, detect, screen and refit candidates", args.quiet);
     let found = match &model {
@@ -135,12 +142,23 @@ fn report_json(found: &RotorDiscovery, names: &[String], label: &str, written: &
         "dof_before": r.dof_before,
         "p_value": r.p_value,
         "calibrated_parameters": base,
+        "refitted_parameters": refitted(r, names).map(|rows| rows.into_iter()
+            .map(|(n, v, iv)| (n.to_string(), json!({"value": v, "interval": iv})))
+            .collect::<serde_json::Map<String, Value>>()),
         "runner_up": r.runner_up.as_ref().map(fit_json),
         "candidates_refitted": r.fits.iter().map(fit_json).collect::<Vec<_>>(),
         "modes": r.modes.iter().map(|m| json!({"mode": m.mode + 1, "measured_hz": m.measured_hz, "std_hz": m.std_hz,
             "before_hz": m.before_hz, "after_hz": m.after_hz})).collect::<Vec<_>>(),
         "written": written,
     })
+}
+
+/// The model's own parameters as refitted together with the selected effect(s): the values a
+/// user should take, not the calibration without the effect.
+fn refitted<'a>(r: &DiscoveryReport, names: &'a [String]) -> Option<Vec<(&'a str, f64, Option<[f64; 2]>)>> {
+    let fit = r.selected.as_ref()?;
+    let rows = names.iter().enumerate().map(|(i, n)| (n.as_str(), fit.parameters[i], fit.intervals.get(i).copied().flatten()));
+    (fit.parameters.len() >= names.len()).then(|| rows.collect())
 }
 
 fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], label: &str) {
@@ -206,6 +224,13 @@ fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], labe
                 "  evidence: χ² {:.2} → {:.2}, AICc {:.2} → {:.2}, RMS residual {:.4} → {:.4} Hz",
                 r.chi2_before, chi2, r.aicc_before, aicc, r.rms_before_hz, r.rms_after_hz
             );
+            if let Some(rows) = refitted(r, names) {
+                println!("  the model's parameters refitted with the effect:");
+                for ((n, v, iv), u) in rows.into_iter().zip(units) {
+                    let interval = iv.map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
+                    println!("    {n} = {v:.6e} {u}{interval}");
+                }
+            }
             if let Some(u) = &r.runner_up {
                 println!("  runner-up to the first effect: {} (AICc {:.2} on its own)", u.label, u.aicc);
             }

@@ -8,7 +8,7 @@ use crate::{measured, plot, progress, testdata};
 use clap::Args;
 use eigenfit_core::statistics::{alternative_solutions_within, mirror_solutions};
 use eigenfit_core::update::DEFAULT_EVALUATIONS;
-use eigenfit_core::verdict::{at_limits, judge, unreachable_modes, FitVerdict};
+use eigenfit_core::verdict::{at_limits, check_reachable, judge, FitVerdict};
 use eigenfit_core::{
     Budget, Driver, Evaluate, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel,
 };
@@ -59,8 +59,6 @@ type Alternative = (Vec<f64>, Option<(usize, usize)>);
 
 /// Restart-grid points refitted locally when searching for other equally good solutions.
 const ALTERNATIVE_STARTS: usize = 6;
-/// A measured mode this far (relative) outside every frequency the model reaches is refused.
-const UNREACHABLE_MARGIN: f64 = 0.1;
 
 /// Runs `estimate`; returns the exit code (3 when the run did not converge, the fit is poor, a
 /// parameter sits on a limit or the budget ran out).
@@ -135,26 +133,8 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let mut fit = testdata::Fit::new(problem, &data, &args.test_data);
     let budget = Budget::new(args.budget);
     // Data no parameter value can produce is refused before any fitting.
-    let unreachable = unreachable_modes(&fit, UNREACHABLE_MARGIN, &budget);
-    if !unreachable.is_empty() {
-        let list: Vec<String> = unreachable
-            .iter()
-            .map(|u| {
-                format!(
-                    "mode {} at {} Hz (the model reaches {:.4}–{:.4} Hz)",
-                    mode_numbers[u.index],
-                    measured::shown_number(u.measured_hz),
-                    u.reachable_hz[0],
-                    u.reachable_hz[1]
-                )
-            })
-            .collect();
-        return Err(input(format!(
-            "{}: no stiffness within the limits can produce {}: a typing slip or a wrong unit?",
-            args.measured.display(),
-            list.join("; ")
-        )));
-    }
+    check_reachable(&fit, &mode_numbers, &budget)
+        .map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
     // A start inside the bounds where the model cannot be evaluated (a support so soft its mode
     // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
     // the best point of its coarse grid instead, and says so.
@@ -195,12 +175,15 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let converged = estimate.termination.is_converged();
     let quality = judge(&estimate.last, np);
     let limits = at_limits(model.parameters(), &estimate.parameters);
-    let pb = progress::spinner("intervals and other solutions", args.quiet || !converged);
+    // Profile bounds done / total on a bar, then other solutions.
+    let mut bounds = progress::StepsBar(progress::bar(0, "interval bounds", args.quiet || !converged));
     let (unc, scatter) = if converged {
-        testdata::uncertainty(&mut fit, &estimate.last, has_std, &budget)
+        testdata::uncertainty(&mut fit, &estimate.last, has_std, &budget, &mut [&mut bounds])
     } else {
         (None, None)
     };
+    bounds.0.finish_and_clear();
+    let pb = progress::spinner("searching for other solutions", args.quiet || !converged);
     let mac = fit.mac(&estimate.parameters, args.test_data.mac_threshold);
     let mut alternatives: Vec<Alternative> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {
