@@ -88,6 +88,12 @@ const CASES: &[Case] = &[
         exit: 2,
         says: &["mode 1 cannot be trusted: round-off in the matrices"],
     },
+    // Finer still, the solver itself fails (a missed mode): the same refusal, exit 2, not 1.
+    Case {
+        args: &["simulate", "--preset", "uniform-rotor", "--elements", "20000"],
+        exit: 2,
+        says: &["mode 1 cannot be trusted: round-off in the matrices (≈ "],
+    },
     Case {
         args: &["simulate", "--preset", "paper-rotor", "--effect", "point-mass@0=1e50"],
         exit: 2,

@@ -6,6 +6,7 @@ use crate::error::RotorError;
 use crate::file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section};
 use crate::model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
 use eigenfit_core::{Parameter, ParameterSet, Scale};
+use std::collections::HashMap;
 
 /// The entry of a description an error is about, in file order (0-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -220,6 +221,8 @@ impl RotorBuilder {
                 .map_err(at(entry, Some("diametral_inertia")))?;
         }
         let mut bearings: Vec<Bearing> = Vec::with_capacity(spec.bearings.len());
+        // Names seen so far (10⁵ bearings must not take a quadratic scan).
+        let mut bearing_index: HashMap<String, usize> = HashMap::with_capacity(spec.bearings.len());
         for (i, b) in spec.bearings.iter_mut().enumerate() {
             let entry = Entry::Bearing(i);
             node_check("bearing", i, b.node).map_err(at(entry, Some("node")))?;
@@ -230,9 +233,10 @@ impl RotorBuilder {
                     location: format!("bearing {i}"),
                 }));
             }
-            if let Some(first) = bearings.iter().position(|q| q.name == name) {
+            if let Some(&first) = bearing_index.get(&name) {
                 return Err(at(entry, Some("name"))(RotorError::DuplicateBearing { name, first, second: i }));
             }
+            bearing_index.insert(name.clone(), i);
             if !(b.stiffness.is_finite() && (STIFFNESS_LOWER..=STIFFNESS_UPPER).contains(&b.stiffness)) {
                 return Err(at(entry, Some("stiffness"))(RotorError::InvalidValue {
                     location: here(),
@@ -290,15 +294,18 @@ fn non_negative(at: impl FnOnce() -> String, quantity: &'static str, v: f64) -> 
 }
 
 fn check_materials(materials: &[Material]) -> Result<(), SitedError> {
+    let mut seen: HashMap<&str, usize> = HashMap::with_capacity(materials.len());
     for (i, m) in materials.iter().enumerate() {
         let entry = Entry::Material(i);
         if m.name.trim().is_empty() {
             return Err(at(entry, Some("name"))(RotorError::EmptyName { location: format!("material {i}") }));
         }
-        if let Some(first) = materials[..i].iter().position(|q| q.name == m.name) {
+        // A map of the names seen: 10⁵ materials must not take a quadratic scan.
+        if let Some(&first) = seen.get(m.name.as_str()) {
             let error = RotorError::DuplicateMaterial { name: m.name.clone(), first, second: i };
             return Err(at(entry, Some("name"))(error));
         }
+        seen.insert(&m.name, i);
         let here = || format!("material `{}`", m.name);
         positive(here, "youngs_modulus", m.youngs_modulus).map_err(at(entry, Some("youngs_modulus")))?;
         positive(here, "density", m.density).map_err(at(entry, Some("density")))?;

@@ -245,9 +245,26 @@ fn frequencies(
     modes: usize,
 ) -> Result<Vec<f64>, CliError> {
     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-    let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
+    let m = solver.lowest(&system, modes).map_err(|e| solver_failure(&system, e))?;
     refuse_roundoff(&system, &m)?;
     Ok(m.frequencies_hz())
+}
+
+/// A solver failure on matrices whose lowest mode is lost to round-off whatever the solver (a
+/// mesh so fine that the iteration misses modes) is bad input, said as such; otherwise internal.
+pub(crate) fn solver_failure(system: &eigenfit_core::System, e: eigenfit_core::SolveError) -> CliError {
+    use eigenfit_core::roundoff::{trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF};
+    let level = trial_vector_roundoff(system);
+    if level.is_nan() || level > MAX_RELATIVE_ROUNDOFF {
+        input(format!(
+            "mode 1 cannot be trusted: round-off in the matrices (≈ {level:.1e} of its eigenvalue at a rigid-translation \
+             trial vector, more than \
+             {MAX_RELATIVE_ROUNDOFF:e}) made the solver fail ({e}); the mesh is too fine or a value too extreme for \
+             double precision (use fewer elements, or values closer to the rest of the model)"
+        ))
+    } else {
+        CliError::Failure(e.to_string())
+    }
 }
 
 /// Never a frequency lost to round-off with exit 0 (issue 13): a fine mesh or an extreme value
