@@ -4,9 +4,10 @@
 //! MAX_RELATIVE_ROUNDOFF) the estimate bounds the actual eigenvalue error, so an accepted
 //! answer is never noise; run with `--nocapture` for the table quoted in docs/user-guide.md.
 
-use eigenfit::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF};
+use eigenfit::core::eigen::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF};
+use eigenfit::core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit::core::model::StructuralModel;
 use eigenfit::rotor::{mesh, presets};
-use eigenfit::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
 
 fn lowest(model: &dyn StructuralModel, solver: &dyn EigenSolver) -> Option<(f64, f64)> {
     let system = model.assemble(&model.parameters().nominal_values()).ok()?;

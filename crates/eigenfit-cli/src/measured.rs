@@ -5,7 +5,7 @@
 //! increase with mode number, and a mode listed twice.
 
 use crate::error::{input, CliError};
-use eigenfit_core::{MeasuredMode, Measurement};
+use eigenfit_core::measurement::{MeasuredMode, Measurement};
 use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
@@ -96,7 +96,7 @@ pub fn shown(field: &str) -> String {
 /// A number as shown in a message: plain when moderate, in exponent form when it would print
 /// hundreds of digits (1e300).
 pub fn shown_number(v: f64) -> String {
-    eigenfit_core::verdict::shown_number(v)
+    eigenfit_core::analysis::verdict::shown_number(v)
 }
 
 /// [`parse`] with the notes for the user (ignored columns), each starting with `LINE: `.

@@ -43,8 +43,8 @@ pub fn spinner(message: &str, quiet: bool) -> ProgressBar {
 /// observer mechanism, so the library reports progress without knowing about terminals.
 pub struct StepsBar(pub ProgressBar);
 
-impl eigenfit_core::Observer for StepsBar {
-    fn observe(&mut self, _record: &eigenfit_core::IterationRecord) {
+impl eigenfit_core::update::Observer for StepsBar {
+    fn observe(&mut self, _record: &eigenfit_core::update::IterationRecord) {
         self.0.tick();
     }
     fn steps_done(&mut self, done: usize, total: usize) {

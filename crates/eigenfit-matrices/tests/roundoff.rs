@@ -2,8 +2,9 @@
 //! plate from Matrix Market files, against scipy's ARPACK frequencies (an independent solver).
 //! The estimate must bound the actual error and stay far below the refusal threshold.
 
-use eigenfit_core::roundoff::{relative_roundoff, trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF};
-use eigenfit_core::{EigenSolver, SparseSolver, StructuralModel};
+use eigenfit_core::eigen::roundoff::{relative_roundoff, trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF};
+use eigenfit_core::eigen::{EigenSolver, SparseSolver};
+use eigenfit_core::model::StructuralModel;
 use eigenfit_matrices::MatricesModel;
 use serde_json::Value;
 use std::path::PathBuf;
