@@ -77,11 +77,13 @@ fn the_interval_phase_reports_bounds_done_to_its_observers() {
     let data = [(59.029, 0.06), (203.444, 0.2), (670.711, 0.6)];
     let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
     let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est = Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut []).unwrap();
+    let est =
+        Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut []).unwrap();
     let mut steps = Steps::default();
     let budget = eigenfit::core::update::Budget::new(eigenfit::core::analysis::UNCERTAINTY_EVALUATIONS);
     let observed =
-        eigenfit::core::analysis::uncertainty_observed(&problem, &est.last, true, &budget, &mut [&mut steps]).unwrap();
+        eigenfit::core::analysis::uncertainty_observed(&problem, &est.last, true, &budget, &mut [&mut steps])
+            .unwrap();
     // Same answer as without an observer, and one report per profiled bound: 0, 1, …, total.
     assert_eq!(observed.identifiability, uncertainty(&problem, &est.last, true).unwrap().identifiability);
     let total = steps.0.first().expect("K2 is profiled, so progress is reported").1;

@@ -454,7 +454,12 @@ fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>
             .and_then(|s| section_material[s])
             .or(default_material)
             .ok_or_else(|| at(entry, None)(RotorError::MissingMaterial { element: e }))?;
-        let element = ShaftElement { length: nodes[e + 1] - nodes[e], outer_diameter: outer, inner_diameter: inner, material };
+        let element = ShaftElement {
+            length: nodes[e + 1] - nodes[e],
+            outer_diameter: outer,
+            inner_diameter: inner,
+            material,
+        };
         let diameter_site = if section.is_some_and(|s| s.diameter.is_some()) { entry } else { Entry::Shaft };
         check_representable(e, &element, &spec.materials[material], diameter_site)?;
         elements.push(element);
@@ -477,8 +482,13 @@ fn check_representable(
     let geometry = [("second moment of area [m⁴]", second_moment), ("cross-section area [m²]", area)];
     for (quantity, value) in geometry {
         if !ok(value) {
-            let error =
-                RotorError::NotRepresentable { element: e, cause: "diameter", given: el.outer_diameter, quantity, value };
+            let error = RotorError::NotRepresentable {
+                element: e,
+                cause: "diameter",
+                given: el.outer_diameter,
+                quantity,
+                value,
+            };
             return Err(at(diameter_site, Some("diameter"))(error));
         }
     }
@@ -489,12 +499,19 @@ fn check_representable(
     let material_site = |key| at(Entry::Material(el.material), Some(key));
     if let Some(&value) = stiffness.iter().find(|&&v| !ok(v)) {
         let (cause, given) = ("youngs_modulus", mat.youngs_modulus);
-        let error = RotorError::NotRepresentable { element: e, cause, given, quantity: "stiffness matrix entry", value };
+        let error = RotorError::NotRepresentable {
+            element: e,
+            cause,
+            given,
+            quantity: "stiffness matrix entry",
+            value,
+        };
         return Err(material_site(cause)(error));
     }
     if let Some(&value) = mass.iter().find(|&&v| !ok(v)) {
         let (cause, given) = ("density", mat.density);
-        let error = RotorError::NotRepresentable { element: e, cause, given, quantity: "mass matrix entry", value };
+        let error =
+            RotorError::NotRepresentable { element: e, cause, given, quantity: "mass matrix entry", value };
         return Err(material_site(cause)(error));
     }
     Ok(())

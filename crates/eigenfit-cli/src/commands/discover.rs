@@ -7,8 +7,8 @@ use crate::plot::discovery::DiscoveryPlot;
 use crate::source::ModelArgs;
 use crate::{measured, plot, progress};
 use clap::Args;
-use eigenfit_core::discovery::{discover, Alternative, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
 use eigenfit_core::analysis::verdict::check_reachable;
+use eigenfit_core::discovery::{discover, Alternative, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::Problem;
 use eigenfit_core::update::{Budget, DEFAULT_EVALUATIONS};
@@ -158,7 +158,10 @@ fn report_json(found: &RotorDiscovery, names: &[String], label: &str, written: &
 /// user should take, not the calibration without the effect.
 fn refitted<'a>(r: &DiscoveryReport, names: &'a [String]) -> Option<Vec<(&'a str, f64, Option<[f64; 2]>)>> {
     let fit = r.selected.as_ref()?;
-    let rows = names.iter().enumerate().map(|(i, n)| (n.as_str(), fit.parameters[i], fit.intervals.get(i).copied().flatten()));
+    let rows = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.as_str(), fit.parameters[i], fit.intervals.get(i).copied().flatten()));
     (fit.parameters.len() >= names.len()).then(|| rows.collect())
 }
 
@@ -228,7 +231,8 @@ fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], labe
             if let Some(rows) = refitted(r, names) {
                 println!("  the model's parameters refitted with the effect:");
                 for ((n, v, iv), u) in rows.into_iter().zip(units) {
-                    let interval = iv.map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
+                    let interval =
+                        iv.map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
                     println!("    {n} = {v:.6e} {u}{interval}");
                 }
             }

@@ -254,7 +254,10 @@ fn frequencies(
 
 /// A solver failure on matrices whose lowest mode is lost to round-off whatever the solver (a
 /// mesh so fine that the iteration misses modes) is bad input, said as such; otherwise internal.
-pub(crate) fn solver_failure(system: &eigenfit_core::matrix::System, e: eigenfit_core::eigen::SolveError) -> CliError {
+pub(crate) fn solver_failure(
+    system: &eigenfit_core::matrix::System,
+    e: eigenfit_core::eigen::SolveError,
+) -> CliError {
     use eigenfit_core::eigen::roundoff::{trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF};
     let level = trial_vector_roundoff(system);
     if level.is_nan() || level > MAX_RELATIVE_ROUNDOFF {

@@ -231,7 +231,8 @@ pub fn check_reachable(
     if unreachable.is_empty() {
         return Ok(());
     }
-    let modes = unreachable.into_iter().map(|u| (mode_numbers.get(u.index).copied().unwrap_or(u.index + 1), u));
+    let modes =
+        unreachable.into_iter().map(|u| (mode_numbers.get(u.index).copied().unwrap_or(u.index + 1), u));
     Err(UnreachableData { modes: modes.collect() })
 }
 
