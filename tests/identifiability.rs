@@ -60,3 +60,34 @@ fn soft_supports_are_determined_with_tight_intervals() {
         assert!(iv[1] / iv[0] < 1.5, "interval {iv:?} too wide for 0.1% data at 1e5 N/m");
     }
 }
+
+/// Records the interval phase's progress as an observer sees it.
+#[derive(Default)]
+struct Steps(Vec<(usize, usize)>);
+
+impl eigenfit::core::update::Observer for Steps {
+    fn observe(&mut self, _record: &eigenfit::core::update::IterationRecord) {}
+    fn steps_done(&mut self, done: usize, total: usize) {
+        self.0.push((done, total));
+    }
+}
+
+#[test]
+fn the_interval_phase_reports_bounds_done_to_its_observers() {
+    let data = [(59.029, 0.06), (203.444, 0.2), (670.711, 0.6)];
+    let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
+    let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
+    let est =
+        Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut []).unwrap();
+    let mut steps = Steps::default();
+    let budget = eigenfit::core::update::Budget::new(eigenfit::core::analysis::UNCERTAINTY_EVALUATIONS);
+    let observed =
+        eigenfit::core::analysis::uncertainty_observed(&problem, &est.last, true, &budget, &mut [&mut steps])
+            .unwrap();
+    // Same answer as without an observer, and one report per profiled bound: 0, 1, …, total.
+    assert_eq!(observed.identifiability, uncertainty(&problem, &est.last, true).unwrap().identifiability);
+    let total = steps.0.first().expect("K2 is profiled, so progress is reported").1;
+    assert!(total >= 2 && total % 2 == 0, "{:?}", steps.0);
+    let expected: Vec<(usize, usize)> = (0..=total).map(|d| (d, total)).collect();
+    assert_eq!(steps.0, expected);
+}

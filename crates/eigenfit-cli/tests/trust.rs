@@ -88,6 +88,12 @@ const CASES: &[Case] = &[
         exit: 2,
         says: &["mode 1 cannot be trusted: round-off in the matrices"],
     },
+    // Finer still, the solver itself fails (a missed mode): the same refusal, exit 2, not 1.
+    Case {
+        args: &["simulate", "--preset", "uniform-rotor", "--elements", "20000"],
+        exit: 2,
+        says: &["mode 1 cannot be trusted: round-off in the matrices (≈ "],
+    },
     Case {
         args: &["simulate", "--preset", "paper-rotor", "--effect", "point-mass@0=1e50"],
         exit: 2,
@@ -103,6 +109,18 @@ const CASES: &[Case] = &[
         args: &["estimate", "--preset", "paper-rotor", "--measured", "decimal_slip.csv"],
         exit: 2,
         says: &["decimal_slip.csv: no stiffness within the limits can produce mode 8 at 38889.557 Hz"],
+    },
+    // discover runs estimate's sanity check (the same library function).
+    Case {
+        args: &["discover", "--preset", "paper-rotor", "--measured", "decimal_slip.csv"],
+        exit: 2,
+        says: &["decimal_slip.csv: no stiffness within the limits can produce mode 8 at 38889.557 Hz"],
+    },
+    // A value that overflows in assembly is blamed on its file field.
+    Case {
+        args: &["simulate", "--model", "huge_diameter.toml"],
+        exit: 2,
+        says: &["huge_diameter.toml: line 12: element 0: diameter = 1e300 gives a second moment of area"],
     },
     Case {
         args: &["estimate", "--preset", "ross-example", "--measured", "decreasing.csv"],
@@ -267,6 +285,30 @@ fn the_stiff_rotor_reports_chi2_and_stays_within_its_budget() {
         alternatives.iter().any(|a| a["mirror_of"] == serde_json::json!(["k_DE", "k_NDE"])),
         "{alternatives:?}"
     );
+}
+
+#[test]
+fn discover_reports_the_stiffnesses_refitted_with_the_effect() {
+    let measured = "../../../../examples/measured_hidden_effect.csv";
+    let out = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", measured, "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    // The refitted values lie inside their intervals and away from the calibration without the
+    // effect (the hidden effect pulled that one off; the data were made with 2e5 and 5e4 N/m).
+    for name in ["k_K1", "k_K2"] {
+        let refitted = &v["refitted_parameters"][name];
+        let value = refitted["value"].as_f64().unwrap();
+        let [lo, hi] = [0, 1].map(|k| refitted["interval"][k].as_f64().unwrap());
+        assert!(lo < value && value < hi, "{name}: {refitted}");
+        // Calibrated without the effect, the stiffness is elsewhere (outside the refitted interval).
+        let calibrated = v["calibrated_parameters"][name].as_f64().unwrap();
+        assert!(calibrated < lo || calibrated > hi, "{name}: {calibrated} in [{lo}, {hi}]");
+    }
+    let out = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", measured]);
+    let report = text(&out.stdout);
+    assert!(report.contains("the model's parameters refitted with the effect:"), "{report}");
+    let k1 = v["refitted_parameters"]["k_K1"]["value"].as_f64().unwrap();
+    assert!(report.contains(&format!("k_K1 = {k1:.6e} N/m, 95% [")), "{report}");
 }
 
 #[test]

@@ -2,11 +2,13 @@
 //! [`build`](RotorBuilder::build).
 
 use crate::effects;
+use crate::element;
 use crate::error::RotorError;
 use crate::model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
 use crate::spec::{BearingSpec, Disk, EffectSpec, Material, PointMass, RotorSpec, Section};
 use eigenfit_core::matrix::{BandedSymmetric, SparseSymmetric};
 use eigenfit_core::model::{Parameter, ParameterSet, Scale};
+use std::collections::HashMap;
 
 /// The entry of a description an error is about, in file order (0-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -222,6 +224,8 @@ impl RotorBuilder {
                 .map_err(at(entry, Some("diametral_inertia")))?;
         }
         let mut bearings: Vec<Bearing> = Vec::with_capacity(spec.bearings.len());
+        // Names seen so far (10⁵ bearings must not take a quadratic scan).
+        let mut bearing_index: HashMap<String, usize> = HashMap::with_capacity(spec.bearings.len());
         for (i, b) in spec.bearings.iter_mut().enumerate() {
             let entry = Entry::Bearing(i);
             node_check("bearing", i, b.node).map_err(at(entry, Some("node")))?;
@@ -232,9 +236,10 @@ impl RotorBuilder {
                     location: format!("bearing {i}"),
                 }));
             }
-            if let Some(first) = bearings.iter().position(|q| q.name == name) {
+            if let Some(&first) = bearing_index.get(&name) {
                 return Err(at(entry, Some("name"))(RotorError::DuplicateBearing { name, first, second: i }));
             }
+            bearing_index.insert(name.clone(), i);
             if !(b.stiffness.is_finite() && (STIFFNESS_LOWER..=STIFFNESS_UPPER).contains(&b.stiffness)) {
                 return Err(at(entry, Some("stiffness"))(RotorError::InvalidValue {
                     location: here(),
@@ -292,15 +297,18 @@ fn non_negative(at: impl FnOnce() -> String, quantity: &'static str, v: f64) -> 
 }
 
 fn check_materials(materials: &[Material]) -> Result<(), SitedError> {
+    let mut seen: HashMap<&str, usize> = HashMap::with_capacity(materials.len());
     for (i, m) in materials.iter().enumerate() {
         let entry = Entry::Material(i);
         if m.name.trim().is_empty() {
             return Err(at(entry, Some("name"))(RotorError::EmptyName { location: format!("material {i}") }));
         }
-        if let Some(first) = materials[..i].iter().position(|q| q.name == m.name) {
+        // A map of the names seen: 10⁵ materials must not take a quadratic scan.
+        if let Some(&first) = seen.get(m.name.as_str()) {
             let error = RotorError::DuplicateMaterial { name: m.name.clone(), first, second: i };
             return Err(at(entry, Some("name"))(error));
         }
+        seen.insert(&m.name, i);
         let here = || format!("material `{}`", m.name);
         positive(here, "youngs_modulus", m.youngs_modulus).map_err(at(entry, Some("youngs_modulus")))?;
         positive(here, "density", m.density).map_err(at(entry, Some("density")))?;
@@ -448,14 +456,67 @@ fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>
             .and_then(|s| section_material[s])
             .or(default_material)
             .ok_or_else(|| at(entry, None)(RotorError::MissingMaterial { element: e }))?;
-        elements.push(ShaftElement {
+        let element = ShaftElement {
             length: nodes[e + 1] - nodes[e],
             outer_diameter: outer,
             inner_diameter: inner,
             material,
-        });
+        };
+        let diameter_site = if section.is_some_and(|s| s.diameter.is_some()) { entry } else { Entry::Shaft };
+        check_representable(e, &element, &spec.materials[material], diameter_site)?;
+        elements.push(element);
     }
     Ok(elements)
+}
+
+/// Values that each pass validation can still overflow (or vanish) in floating point once
+/// combined, e.g. a diameter of 1e300 m has D⁴ = ∞; assembly would then fail with `K[0, 0] is
+/// inf`, naming no field. Checked here, where the field behind it is known.
+fn check_representable(
+    e: usize,
+    el: &ShaftElement,
+    mat: &Material,
+    diameter_site: Entry,
+) -> Result<(), SitedError> {
+    let ok = |v: f64| v.is_finite() && v > 0.0;
+    let second_moment = element::second_moment_of_area(el.outer_diameter, el.inner_diameter);
+    let area = element::area(el.outer_diameter, el.inner_diameter);
+    let geometry = [("second moment of area [m⁴]", second_moment), ("cross-section area [m²]", area)];
+    for (quantity, value) in geometry {
+        if !ok(value) {
+            let error = RotorError::NotRepresentable {
+                element: e,
+                cause: "diameter",
+                given: el.outer_diameter,
+                quantity,
+                value,
+            };
+            return Err(at(diameter_site, Some("diameter"))(error));
+        }
+    }
+    // The largest entries of the element matrices: 12·EI/L³ and 4·EI/L, 156·ρAL/420.
+    let ei = mat.youngs_modulus * second_moment;
+    let stiffness = [12.0 * ei / el.length.powi(3), 4.0 * ei / el.length];
+    let mass = [156.0 * mat.density * area * el.length / 420.0];
+    let material_site = |key| at(Entry::Material(el.material), Some(key));
+    if let Some(&value) = stiffness.iter().find(|&&v| !ok(v)) {
+        let (cause, given) = ("youngs_modulus", mat.youngs_modulus);
+        let error = RotorError::NotRepresentable {
+            element: e,
+            cause,
+            given,
+            quantity: "stiffness matrix entry",
+            value,
+        };
+        return Err(material_site(cause)(error));
+    }
+    if let Some(&value) = mass.iter().find(|&&v| !ok(v)) {
+        let (cause, given) = ("density", mat.density);
+        let error =
+            RotorError::NotRepresentable { element: e, cause, given, quantity: "mass matrix entry", value };
+        return Err(material_site(cause)(error));
+    }
+    Ok(())
 }
 
 // Construction's last step and the rebuilding constructors live here, beside the builder they

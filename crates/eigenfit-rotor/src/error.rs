@@ -113,6 +113,24 @@ pub enum RotorError {
         /// Outer diameter (m).
         outer: f64,
     },
+    /// Valid values whose combination overflows or vanishes in floating point (a diameter of
+    /// 1e300 m: D⁴ = ∞), so the element's matrices cannot be formed.
+    #[error(
+        "element {element}: {cause} = {} gives a {quantity} of {}, which floating point cannot hold: \
+         use values in a physical range", Num(*.given), Num(*.value)
+    )]
+    NotRepresentable {
+        /// The element.
+        element: usize,
+        /// The field behind it: `diameter`, `youngs_modulus` or `density`.
+        cause: &'static str,
+        /// That field's value.
+        given: f64,
+        /// What overflowed, e.g. `second moment of area [m⁴]`.
+        quantity: &'static str,
+        /// Its value (∞ or 0).
+        value: f64,
+    },
     /// An element has no outer diameter (no shaft default and no section gives one).
     #[error("element {element} has no diameter: set `shaft.diameter` or a `[[shaft.section]]` covering it")]
     MissingDiameter {

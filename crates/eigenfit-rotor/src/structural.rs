@@ -34,7 +34,8 @@ impl StructuralModel for Rotor {
             .bearings
             .get(i)
             .ok_or(ModelError::ParameterIndex { index: i, count: self.bearings.len() })?;
-        self.parameters.check(p)?;
+        // Only kᵢ enters this derivative (checking all np values per derivative is quadratic).
+        self.parameters.check_entry(p, i)?;
         let mut d = SystemDerivative::zeros(self.dofs());
         let j = Self::displacement_dof(b.node);
         d.stiffness.add(j, j, 1.0);

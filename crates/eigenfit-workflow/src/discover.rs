@@ -5,9 +5,12 @@ use crate::error::{failure, input, WorkflowError};
 use crate::model::AnyModel;
 use crate::named::Named;
 use crate::progress::Progress;
-use eigenfit_core::discovery::{discover, DiscoveryOptions, Fit, NamedEffect};
+use eigenfit_core::analysis::verdict::check_reachable;
+use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
+use eigenfit_core::problem::Problem;
+use eigenfit_core::update::{Budget, DEFAULT_EVALUATIONS};
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde::Serialize;
 use std::path::Path;
@@ -52,6 +55,9 @@ pub struct DiscoverReport {
     pub rms_residual_after_hz: f64,
     /// The nominal parameters calibrated.
     pub calibrated_parameters: Named<f64>,
+    /// The model's own parameters refitted together with the selected effect(s): the values a
+    /// user should take, not the calibration without the effect (`None` when nothing was named).
+    pub refitted_parameters: Option<Named<Refitted>>,
     /// The best candidate after the first.
     pub runner_up: Option<Fit>,
     /// Every candidate refitted.
@@ -60,6 +66,29 @@ pub struct DiscoverReport {
     pub modes: Vec<ModeReport>,
     /// Files written (the augmented model, plots).
     pub written: Vec<String>,
+}
+
+/// A parameter refitted with the named effect(s).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Refitted {
+    /// The value.
+    pub value: f64,
+    /// Its 95 % interval, when one could be computed.
+    pub interval: Option<[f64; 2]>,
+}
+
+/// The model's own parameters as refitted together with the selected effect(s).
+fn refitted(r: &DiscoveryReport, names: &[String]) -> Option<Named<Refitted>> {
+    let fit = r.selected.as_ref()?;
+    (fit.parameters.len() >= names.len()).then(|| {
+        Named::new(
+            names,
+            (0..names.len()).map(|i| Refitted {
+                value: fit.parameters[i],
+                interval: fit.intervals.get(i).copied().flatten(),
+            }),
+        )
+    })
 }
 
 /// A discovery and its report.
@@ -86,6 +115,11 @@ pub fn run(
     if !(assumed_std.is_finite() && assumed_std > 0.0) {
         return Err(input(format!("--assumed-std {assumed_std}: must be a positive number")));
     }
+    // Estimate's sanity check, so a typing slip ends here as it does there (exit 2, mode named).
+    let mode_numbers: Vec<usize> = data.modes().iter().map(|m| m.mode + 1).collect();
+    let problem = Problem::new(model, solver, data.clone());
+    check_reachable(&problem, &mode_numbers, &Budget::new(DEFAULT_EVALUATIONS))
+        .map_err(|e| input(format!("{}: {e}", measured.display())))?;
     let options = DiscoveryOptions { assumed_relative_std: assumed_std, ..Default::default() };
     progress.begin("discovering: calibrate, detect, screen and refit candidates", None);
     let found = match model {
@@ -112,6 +146,7 @@ pub fn run(
         dof_before: r.dof_before,
         p_value: r.p_value,
         calibrated_parameters: Named::new(&names, r.base_parameters.iter().copied()),
+        refitted_parameters: refitted(r, &names),
         runner_up: r.runner_up.clone(),
         candidates_refitted: r.fits.clone(),
         modes: r

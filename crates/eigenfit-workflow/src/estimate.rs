@@ -5,15 +5,15 @@ use crate::error::{input, WorkflowError};
 use crate::named::Named;
 use crate::outcome::Outcome;
 use crate::overrides::{fixed, parameter_vector};
-use crate::progress::Progress;
+use crate::progress::{Progress, StepsObserver};
 use crate::rotordynamics::{self, RunupEstimateReport};
 use crate::simulate::check_roundoff;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
-use eigenfit_core::analysis::verdict::{at_limits, judge, unreachable_modes, FitQuality, FitVerdict};
+use eigenfit_core::analysis::verdict::{at_limits, check_reachable, judge, FitQuality, FitVerdict};
 use eigenfit_core::analysis::{alternative_solutions_within, mirror_solutions, Identifiability, Uncertainty};
 use eigenfit_core::measurement::mac::MacReport;
-use eigenfit_core::measurement::measured_csv::{shown, shown_number};
+use eigenfit_core::measurement::measured_csv::shown;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
 use eigenfit_core::update::{Budget, Driver, Estimate, LevenbergMarquardt, StrategyKind};
@@ -25,8 +25,6 @@ type Alternative = (Vec<f64>, Option<(usize, usize)>);
 
 /// Restart-grid points refitted locally when searching for other equally good solutions.
 const ALTERNATIVE_STARTS: usize = 6;
-/// A measured mode this far (relative) outside every frequency the model reaches is refused.
-const UNREACHABLE_MARGIN: f64 = 0.1;
 
 /// What to estimate, as the command line gives it.
 #[derive(Debug, Clone, PartialEq)]
@@ -335,25 +333,7 @@ pub fn run(
     let mut fit = Fit::new(problem, &data, options.shape.shape_std);
     let budget = Budget::new(request.budget);
     // Data no parameter value can produce is refused before any fitting.
-    let unreachable = unreachable_modes(&fit, UNREACHABLE_MARGIN, &budget);
-    if !unreachable.is_empty() {
-        let list: Vec<String> = unreachable
-            .iter()
-            .map(|u| {
-                format!(
-                    "mode {} at {} Hz (the model reaches {:.4}–{:.4} Hz)",
-                    mode_numbers[u.index],
-                    shown_number(u.measured_hz),
-                    u.reachable_hz[0],
-                    u.reachable_hz[1]
-                )
-            })
-            .collect();
-        return Err(input(format!(
-            "{measured_name}: no stiffness within the limits can produce {}: a typing slip or a wrong unit?",
-            list.join("; ")
-        )));
-    }
+    check_reachable(&fit, &mode_numbers, &budget).map_err(|e| input(format!("{measured_name}: {e}")))?;
     // A start inside the bounds where the model cannot be evaluated (a support so soft its mode
     // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
     // the best point of its coarse grid instead, and says so.
@@ -389,11 +369,18 @@ pub fn run(
     let converged = estimate.termination.is_converged();
     let quality = judge(&estimate.last, np);
     let limits = at_limits(model.parameters(), &estimate.parameters);
+    // Profile bounds done / total through the driver's observer mechanism, then other solutions.
+    let (unc, scatter) = if converged {
+        let mut bounds = StepsObserver::new(progress, "interval bounds");
+        let unc = fit.uncertainty_within(&estimate.last, has_std, &budget, &mut [&mut bounds]);
+        bounds.finish();
+        unc
+    } else {
+        (None, None)
+    };
     if converged {
-        progress.begin("intervals and other solutions", None);
+        progress.begin("searching for other solutions", None);
     }
-    let (unc, scatter) =
-        if converged { fit.uncertainty_within(&estimate.last, has_std, &budget) } else { (None, None) };
     let mac = fit.mac(&estimate.parameters, options.shape.mac_threshold);
     let mut alternatives: Vec<Alternative> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {

@@ -4,8 +4,10 @@
 use crate::error::{failure, input, WorkflowError};
 use crate::named::Named;
 use crate::progress::Progress;
-use eigenfit_core::eigen::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF};
-use eigenfit_core::eigen::{EigenSolver, Modes};
+use eigenfit_core::eigen::roundoff::{
+    relative_roundoff, trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF,
+};
+use eigenfit_core::eigen::{EigenSolver, Modes, SolveError};
 use eigenfit_core::matrix::System;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::sensitivity::Sensitivities;
@@ -48,9 +50,24 @@ pub fn frequencies(
     notes: &mut Vec<String>,
 ) -> Result<Vec<f64>, WorkflowError> {
     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-    let m = solver.lowest(&system, modes).map_err(failure)?;
+    let m = solver.lowest(&system, modes).map_err(|e| solver_failure(&system, e))?;
     notes.extend(check_roundoff(&system, &m)?);
     Ok(m.frequencies_hz())
+}
+
+/// A solver failure on matrices whose lowest mode is lost to round-off whatever the solver (a
+/// mesh so fine that the iteration misses modes) is bad input, said as such; otherwise internal.
+pub fn solver_failure(system: &System, e: SolveError) -> WorkflowError {
+    let level = trial_vector_roundoff(system);
+    if level.is_nan() || level > MAX_RELATIVE_ROUNDOFF {
+        input(format!(
+            "mode 1 cannot be trusted: round-off in the matrices (≈ {level:.1e} of its eigenvalue at a rigid-translation \
+             trial vector, more than {MAX_RELATIVE_ROUNDOFF:e}) made the solver fail ({e}); the mesh is too fine or a \
+             value too extreme for double precision (use fewer elements, or values closer to the rest of the model)"
+        ))
+    } else {
+        failure(e)
+    }
 }
 
 /// The lowest `count` modes of `model` at `p` (for plots of mode shapes); a model that cannot

@@ -14,7 +14,7 @@ use eigenfit_core::measurement::sensors::{self, NodeLayout, SensorSet};
 use eigenfit_core::measurement::{measured_csv, uff, Measurement};
 use eigenfit_core::model::{Fixed, ParameterSet, StructuralModel};
 use eigenfit_core::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
-use eigenfit_core::update::{Budget, Estimate};
+use eigenfit_core::update::{Budget, Estimate, Observer};
 use eigenfit_rotor::Rotor;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -210,17 +210,18 @@ impl<'a> Fit<'a> {
     }
 
     /// Intervals and the residual scatter they were scaled by: the frequency fit's as the
-    /// statistics module gives them (within `budget`), the shape fit's from
-    /// [`ShapeFit::uncertainty`].
+    /// statistics module gives them (within `budget`, bounds done reported to `observers`), the
+    /// shape fit's from [`ShapeFit::uncertainty`].
     pub fn uncertainty_within(
         &mut self,
         at: &Linearisation,
         has_std: bool,
         budget: &Budget,
+        observers: &mut [&mut dyn Observer],
     ) -> (Option<Uncertainty>, Option<f64>) {
         match self {
             Fit::Frequencies(p) => {
-                (eigenfit_core::analysis::uncertainty_within(p, at, has_std, budget), None)
+                (eigenfit_core::analysis::uncertainty_observed(p, at, has_std, budget, observers), None)
             }
             Fit::Shapes(s) => s.uncertainty(at).map_or((None, None), |(u, sc)| (Some(u), Some(sc))),
         }

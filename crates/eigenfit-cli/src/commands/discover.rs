@@ -10,7 +10,8 @@ use clap::Args;
 use eigenfit_core::discovery::DiscoveryReport;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::discovery::RotorDiscovery;
-use eigenfit_workflow::discover::{self, Discovery};
+use eigenfit_workflow::discover::{self, Discovery, Refitted};
+use eigenfit_workflow::Named;
 use std::path::PathBuf;
 
 /// Arguments of `discover`.
@@ -63,7 +64,7 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
     crate::output::report(args.report.json, &report, |report| {
         let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
         let units: Vec<String> = model.parameters().iter().map(|p| p.unit.clone()).collect();
-        print_report(&found, &names, &units, &label);
+        print_report(&found, report.refitted_parameters.as_ref(), &names, &units, &label);
         for w in &report.written {
             println!("wrote {w}");
         }
@@ -71,7 +72,13 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], label: &str) {
+fn print_report(
+    found: &RotorDiscovery,
+    refitted: Option<&Named<Refitted>>,
+    names: &[String],
+    units: &[String],
+    label: &str,
+) {
     let r: &DiscoveryReport = &found.report;
     println!("{label}: calibrated the nominal parameters:");
     for ((n, v), u) in names.iter().zip(&r.base_parameters).zip(units) {
@@ -134,6 +141,15 @@ fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], labe
                 "  evidence: χ² {:.2} → {:.2}, AICc {:.2} → {:.2}, RMS residual {:.4} → {:.4} Hz",
                 r.chi2_before, chi2, r.aicc_before, aicc, r.rms_before_hz, r.rms_after_hz
             );
+            if let Some(rows) = refitted {
+                println!("  the model's parameters refitted with the effect:");
+                for ((n, v), u) in rows.iter().zip(units) {
+                    let interval = v
+                        .interval
+                        .map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
+                    println!("    {n} = {:.6e} {u}{interval}", v.value);
+                }
+            }
             if let Some(u) = &r.runner_up {
                 println!("  runner-up to the first effect: {} (AICc {:.2} on its own)", u.label, u.aicc);
             }

@@ -2,7 +2,7 @@
 //! parameters the data cannot determine (with the one-sided bound they do support).
 
 use crate::problem::{Linearisation, Objective};
-use crate::update::{Budget, Driver, LevenbergMarquardt};
+use crate::update::{Budget, Driver, LevenbergMarquardt, Observer};
 use nalgebra::DMatrix;
 
 /// χ² quantile of one degree of freedom at 95%: the profile-likelihood threshold.
@@ -77,6 +77,18 @@ pub fn uncertainty_within(
     has_std: bool,
     budget: &Budget,
 ) -> Option<Uncertainty> {
+    uncertainty_observed(problem, at, has_std, budget, &mut [])
+}
+
+/// [`uncertainty_within`] telling `observers` how many of the profile-likelihood bounds are done
+/// ([`Observer::steps_done`]): the interval phase's progress.
+pub fn uncertainty_observed(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    has_std: bool,
+    budget: &Budget,
+    observers: &mut [&mut dyn Observer],
+) -> Option<Uncertainty> {
     if !has_std {
         return None;
     }
@@ -100,17 +112,31 @@ pub fn uncertainty_within(
     let mut intervals = Vec::with_capacity(np);
     let mut identifiability = Vec::with_capacity(np);
     let mut budget_exhausted = false;
+    let profiled = |i: usize| {
+        let sigma = scaled_cov[(i, i)].sqrt();
+        !(sigma.is_finite() && sigma <= PROFILE_TRIGGER)
+    };
+    // Two bounds per profiled parameter.
+    let (total, mut done) = (2 * (0..np).filter(|&i| profiled(i)).count(), 0);
+    let mut report = |done: usize| observers.iter_mut().for_each(|o| o.steps_done(done, total));
+    if total > 0 {
+        report(0);
+    }
     for (i, par) in params.iter().enumerate() {
         let s = par.to_scaled(at.parameters[i]);
         let sigma = scaled_cov[(i, i)].sqrt();
-        if sigma.is_finite() && sigma <= PROFILE_TRIGGER {
+        if !profiled(i) {
             intervals.push([par.from_scaled(s - Z_95 * sigma), par.from_scaled(s + Z_95 * sigma)]);
             identifiability.push(Identifiability::Determined);
             continue;
         }
         let profile = Profile { problem, at, i, budget, sigma };
         let lower = profile.bound(-1.0);
+        done += 1;
+        report(done);
         let upper = profile.bound(1.0);
+        done += 1;
+        report(done);
         budget_exhausted |= budget.exhausted();
         let (lower, upper) = match (lower, upper) {
             (Ok(l), Ok(u)) => (l, u),

@@ -2,9 +2,11 @@
 //! the data cannot say, and the relative RMS residual is all that is reported.
 
 use crate::analysis::chi2_upper_tail;
+use crate::measurement::measured_csv::shown_number;
 use crate::model::ParameterSet;
 use crate::problem::{Linearisation, Objective};
 use crate::update::Budget;
+use thiserror::Error;
 
 /// p-value below which a fit is rejected as poor: strong evidence that no parameter value of this
 /// model explains the data within their standard deviations.
@@ -188,6 +190,51 @@ pub fn unreachable_modes(problem: &dyn Objective, margin: f64, budget: &Budget) 
         .filter(|&k| measured[k] > hi[k] * (1.0 + margin) || measured[k] < lo[k] * (1.0 - margin))
         .map(|k| Unreachable { index: k, measured_hz: measured[k], reachable_hz: [lo[k], hi[k]] })
         .collect()
+}
+
+/// A measured mode this far (relative) outside every frequency the model reaches is refused.
+pub const UNREACHABLE_MARGIN: f64 = 0.1;
+
+/// Measured data no parameter value within the limits can produce: the reason a fit or a
+/// discovery is refused before it starts.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("no stiffness within the limits can produce {}: a typing slip or a wrong unit?", listed(.modes))]
+pub struct UnreachableData {
+    /// The measured mode number (from 1) and why it cannot be reached, per refused mode.
+    pub modes: Vec<(usize, Unreachable)>,
+}
+
+fn listed(modes: &[(usize, Unreachable)]) -> String {
+    let parts: Vec<String> = modes
+        .iter()
+        .map(|(mode, u)| {
+            format!(
+                "mode {mode} at {} Hz (the model reaches {:.4}–{:.4} Hz)",
+                shown_number(u.measured_hz),
+                u.reachable_hz[0],
+                u.reachable_hz[1]
+            )
+        })
+        .collect();
+    parts.join("; ")
+}
+
+/// The one sanity check every command runs on measured data before fitting (estimate,
+/// discover): refuses modes more than [`UNREACHABLE_MARGIN`] outside what the model reaches
+/// (see [`unreachable_modes`]). `mode_numbers` are the measured modes' numbers (from 1) in the
+/// order the problem lists them. Charged to `budget`.
+pub fn check_reachable(
+    problem: &dyn Objective,
+    mode_numbers: &[usize],
+    budget: &Budget,
+) -> Result<(), UnreachableData> {
+    let unreachable = unreachable_modes(problem, UNREACHABLE_MARGIN, budget);
+    if unreachable.is_empty() {
+        return Ok(());
+    }
+    let modes =
+        unreachable.into_iter().map(|u| (mode_numbers.get(u.index).copied().unwrap_or(u.index + 1), u));
+    Err(UnreachableData { modes: modes.collect() })
 }
 
 #[cfg(test)]

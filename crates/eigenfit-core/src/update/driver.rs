@@ -88,6 +88,10 @@ impl IterationRecord {
 pub trait Observer {
     /// Called with the starting point and after each iteration.
     fn observe(&mut self, record: &IterationRecord);
+
+    /// Called by a task made of many runs when `done` of its `total` steps are finished (the
+    /// interval phase: one step per profile-likelihood bound). The default ignores it.
+    fn steps_done(&mut self, _done: usize, _total: usize) {}
 }
 
 /// The outcome of a run. Always carries the last good point and the history, whatever the ending.
