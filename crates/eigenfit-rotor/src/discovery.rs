@@ -37,7 +37,16 @@ impl RotorDiscovery {
         let fitted =
             self.report.selected.as_ref().map_or(&self.report.base_parameters[..], |s| &s.parameters[..nb]);
         let mut out = rotor.with_stiffnesses(fitted)?;
-        for e in self.effects.iter().filter(|e| e.kind != "mesh-refinement") {
+        for (entry, e) in self.effects.iter().enumerate().filter(|(_, e)| e.kind != "mesh-refinement") {
+            if e.kind == crate::pedestal::KIND {
+                // The model file has no pedestal DOF yet: refuse rather than write a different model.
+                return Err(RotorError::Effect {
+                    entry,
+                    kind: e.kind.clone(),
+                    why: "a pedestal adds a degree of freedom, which a rotor model file cannot describe yet"
+                        .into(),
+                });
+            }
             let mut spec = EffectSpec::new(e.kind.clone(), e.location, e.value.unwrap_or(1.0));
             spec.elements = e.elements.filter(|[a, b]| a != b);
             if e.kind == "point-mass" {
@@ -171,6 +180,7 @@ fn mesh_effect(gain: f64, ambiguous_with: Vec<Alternative>) -> NamedEffect {
         unit: "sub-elements per element".into(),
         delta_aicc: gain,
         ambiguous_with,
+        companions: Vec::new(),
     }
 }
 

@@ -404,6 +404,9 @@ pub fn candidates_on(rotor: &Rotor, fine: &Rotor, factor: usize) -> Vec<Candidat
                 law: law(&spec.kind),
                 position_m: spec.position_m,
                 elements: spec.elements,
+                extra_dofs: 0,
+                companions: Vec::new(),
+                rerouted: Vec::new(),
             });
         }
     };
@@ -487,6 +490,7 @@ pub fn candidates_on(rotor: &Rotor, fine: &Rotor, factor: usize) -> Vec<Candidat
         Some(Parameter::new("timoshenko_fraction", "", 0.0).with_bounds(0.0, 5.0)),
         (0.6, 1.4),
     );
+    out.extend(crate::pedestal::candidates(fine, mass));
     out
 }
 

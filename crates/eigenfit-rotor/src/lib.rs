@@ -61,6 +61,7 @@ mod file;
 mod layout;
 pub mod mesh;
 mod model;
+pub mod pedestal;
 pub mod presets;
 pub mod updatable;
 

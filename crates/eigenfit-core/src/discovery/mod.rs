@@ -10,11 +10,13 @@
 //!
 //! Nothing here is rotor-specific: a plugin offers [`Candidate`]s, the engine does the rest.
 
+mod augmented;
 mod candidate;
 mod chi2;
 mod interval;
 
-pub use candidate::{Augmented, Candidate, ValueLaw};
+pub use augmented::Augmented;
+pub use candidate::{Candidate, Companion, ValueLaw};
 
 pub use chi2::chi2_upper_tail;
 
@@ -217,6 +219,21 @@ pub struct NamedEffect {
     pub delta_aicc: f64,
     /// Alternatives within [`DiscoveryOptions::ambiguity_aicc`] when it was chosen.
     pub ambiguous_with: Vec<Alternative>,
+    /// The effect's further fitted values ([`Candidate::companions`]) in the final joint fit.
+    pub companions: Vec<CompanionValue>,
+}
+
+/// A further fitted value of a named effect (a pedestal's stiffness beside its mass).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompanionValue {
+    /// The parameter's name.
+    pub name: String,
+    /// Fitted value.
+    pub value: f64,
+    /// Its 95% interval.
+    pub interval: Option<[f64; 2]>,
+    /// Unit.
+    pub unit: String,
 }
 
 impl NamedEffect {
@@ -232,6 +249,7 @@ impl NamedEffect {
             unit: c.unit().to_string(),
             delta_aicc,
             ambiguous_with,
+            companions: Vec::new(),
         }
     }
 }
@@ -377,7 +395,7 @@ where
                     candidates
                         .iter()
                         .enumerate()
-                        .filter(|&(i, c)| c.parameter.is_some() && open(i))
+                        .filter(|&(i, c)| !c.needs_refit() && open(i))
                         .filter_map(|(i, c)| {
                             screen(&models, solver, &measured, &chosen_refs, c, &lin, &projector)
                                 .map(|s| (i, s))
@@ -408,13 +426,7 @@ where
         }
         let to_refit: Vec<usize> = picks
             .into_iter()
-            .chain(
-                candidates
-                    .iter()
-                    .enumerate()
-                    .filter(|&(i, c)| c.parameter.is_none() && open(i))
-                    .map(|(i, _)| i),
-            )
+            .chain(candidates.iter().enumerate().filter(|&(i, c)| c.needs_refit() && open(i)).map(|(i, _)| i))
             .collect();
         let mut fits: Vec<(usize, Fit)> = to_refit
             .into_iter()
@@ -454,9 +466,19 @@ where
     // Values and intervals of the final joint fit, in the order the effects were added.
     let mut next = nb;
     for (effect, &i) in named.iter_mut().zip(&chosen) {
-        if candidates[i].parameter.is_some() {
+        let c = &candidates[i];
+        if c.parameter.is_some() {
             effect.value = Some(current.parameters[next]);
             effect.interval = current.intervals.get(next).copied().flatten();
+            next += 1;
+        }
+        for comp in &c.companions {
+            effect.companions.push(CompanionValue {
+                name: comp.parameter.name.clone(),
+                value: current.parameters[next],
+                interval: current.intervals.get(next).copied().flatten(),
+                unit: comp.parameter.unit.clone(),
+            });
             next += 1;
         }
     }
@@ -608,7 +630,7 @@ fn refit<M: StructuralModel, S: EigenSolver>(
 ) -> Option<Fit> {
     let candidate = *set.last()?;
     let mut start = current.to_vec();
-    start.extend(candidate.parameter.as_ref().map(|p| p.nominal));
+    start.extend(candidate.parameters().map(|p| p.nominal));
     let n: usize = measured.iter().map(Measurement::len).sum();
     with_augmented(models, solver, measured, set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
@@ -618,20 +640,22 @@ fn refit<M: StructuralModel, S: EigenSolver>(
         let chi2 = 2.0 * est.last.cost();
         let intervals = interval::covariance_intervals(problem, &est.last);
         // Every fitted effect value (not only the new one) must stay plausible.
-        let nb = k - set.iter().filter(|c| c.parameter.is_some()).count();
+        let nb = k - set.iter().map(|c| c.parameter_count()).sum::<usize>();
         let mut index = nb;
         let mut plausible = true;
         let mut value = None;
         let mut interval = None;
         for c in set {
-            if c.parameter.is_none() {
-                continue;
+            for (q, (lo, hi)) in c.plausible_ranges().enumerate() {
+                let (v, iv) = (est.parameters[index], intervals[index]);
+                plausible &= v >= lo && v <= hi;
+                if q == 0 && c.parameter.is_some() {
+                    // The effect's own value must be clear of zero (a companion need not).
+                    plausible &= iv.is_none_or(|iv| iv[0] > 0.0 || iv[1] < 0.0);
+                    (value, interval) = (Some(v), iv);
+                }
+                index += 1;
             }
-            let (v, iv) = (est.parameters[index], intervals[index]);
-            let (lo, hi) = c.plausible;
-            plausible &= v >= lo && v <= hi && iv.is_none_or(|iv| iv[0] > 0.0 || iv[1] < 0.0);
-            (value, interval) = (Some(v), iv);
-            index += 1;
         }
         if candidate.parameter.is_none() {
             (value, interval) = (None, None);
