@@ -66,7 +66,8 @@ impl RotorDiscovery {
 /// When the user's mesh shows a significant misfit that no candidate explains, the workflow is run again on the mesh
 /// refined [`REFINEMENT`]-fold (candidates still located in the user's mesh); the refined
 /// result is kept only if its final AICc beats the user's mesh by `min_aicc_gain`, and then
-/// `mesh-refinement` is named with that gain.
+/// `mesh-refinement` is named with that gain. All runs together spend at most
+/// [`DiscoveryOptions::max_evaluations`] eigen-solves (the report's `evaluations` is the total).
 pub fn discover_rotor<S: EigenSolver>(
     rotor: &Rotor,
     solver: &S,
@@ -75,14 +76,24 @@ pub fn discover_rotor<S: EigenSolver>(
     options: &DiscoveryOptions,
 ) -> Result<RotorDiscovery, DiscoveryError> {
     let coarse = discover(rotor, solver, measured, &effects::candidates(rotor), initial, options)?;
-    let coarse_result = RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
+    let mut coarse_result =
+        RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
     if !coarse_result.report.disagreement_significant {
         return Ok(coarse_result);
     }
     let Ok(fine_rotor) = mesh::refined(rotor, REFINEMENT) else { return Ok(coarse_result) };
+    // The refined-mesh runs share what the first run left of the evaluation budget.
+    let left = |spent: usize| DiscoveryOptions {
+        max_evaluations: options.max_evaluations.saturating_sub(spent),
+        ..options.clone()
+    };
     // First the refined mesh alone (one calibration): if it explains the data, that is the
     // answer — said instead of a physical effect, or beside one that fits about as well.
-    if let Ok(fine_base) = discover(&fine_rotor, solver, measured, &[], initial, options) {
+    let fine_base =
+        discover(&fine_rotor, solver, measured, &[], initial, &left(coarse_result.report.evaluations));
+    if let Ok(mut fine_base) = fine_base {
+        coarse_result.report.evaluations += fine_base.evaluations;
+        fine_base.evaluations = coarse_result.report.evaluations;
         if !fine_base.disagreement_significant {
             let gain = final_aicc(&coarse_result.report) - fine_base.aicc_before;
             if gain > -options.ambiguity_aicc {
@@ -96,9 +107,19 @@ pub fn discover_rotor<S: EigenSolver>(
         return Ok(coarse_result);
     }
     let candidates = effects::candidates_on(rotor, &fine_rotor, REFINEMENT);
-    let Ok(mut fine) = discover(&fine_rotor, solver, measured, &candidates, initial, options) else {
-        return Ok(coarse_result);
-    };
+    let fine = discover(
+        &fine_rotor,
+        solver,
+        measured,
+        &candidates,
+        initial,
+        &left(coarse_result.report.evaluations),
+    );
+    let Ok(mut fine) = fine else { return Ok(coarse_result) };
+    coarse_result.report.evaluations += fine.evaluations;
+    coarse_result.report.budget_exhausted |= fine.budget_exhausted;
+    fine.evaluations = coarse_result.report.evaluations;
+    fine.budget_exhausted = coarse_result.report.budget_exhausted;
     let gain = final_aicc(&coarse_result.report) - final_aicc(&fine);
     // Like any effect, the refinement is named only if what is left is noise.
     let (chi2, k) =

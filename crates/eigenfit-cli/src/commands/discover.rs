@@ -115,6 +115,14 @@ fn effect_json(e: &NamedEffect) -> Value {
         "interval": e.interval, "delta_aicc": e.delta_aicc,
         "ambiguous_with": e.ambiguous_with.iter().map(alternative_json).collect::<Vec<_>>()});
     place(&mut v, e.position_m, e.elements);
+    // Further fitted values of the effect (a pedestal's stiffness beside its mass), by name.
+    if !e.companions.is_empty() {
+        v["companions"] = e
+            .companions
+            .iter()
+            .map(|c| json!({"name": c.name, "value": c.value, "interval": c.interval, "unit": c.unit}))
+            .collect();
+    }
     v
 }
 
@@ -140,6 +148,8 @@ fn report_json(found: &RotorDiscovery, names: &[String], label: &str, written: &
         "modes": r.modes.iter().map(|m| json!({"mode": m.mode + 1, "measured_hz": m.measured_hz, "std_hz": m.std_hz,
             "before_hz": m.before_hz, "after_hz": m.after_hz})).collect::<Vec<_>>(),
         "written": written,
+        "evaluations": r.evaluations,
+        "budget_exhausted": r.budget_exhausted,
     })
 }
 
@@ -190,6 +200,12 @@ fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], labe
                 let interval =
                     e.interval.map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
                 println!("  {} = {value}{interval} (ΔAICc {:.2})", e.label, e.delta_aicc);
+                for c in &e.companions {
+                    let iv = c
+                        .interval
+                        .map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
+                    println!("    with {} = {:.4e} {}{iv}", c.name, c.value, c.unit);
+                }
                 if e.kind == "mesh-refinement" {
                     println!("    the model's mesh is too coarse for this noise: refining it explains part of the gap");
                 }
@@ -210,6 +226,12 @@ fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], labe
                 println!("  runner-up to the first effect: {} (AICc {:.2} on its own)", u.label, u.aicc);
             }
         }
+    }
+    if r.budget_exhausted {
+        println!(
+            "note: the search stopped at its budget of eigen-solves ({} spent): effects it had not reached were not tried",
+            r.evaluations
+        );
     }
     println!(
         "{:>5}{:>14}{:>10}{:>14}{:>9}{:>14}{:>9}",

@@ -23,7 +23,7 @@ pub use chi2::chi2_upper_tail;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::multi::Stacked;
 use crate::residual::{Linearisation, Problem};
-use crate::update::{Damped, Driver, Evaluate};
+use crate::update::{Budget, Damped, Driver, Evaluate, Termination};
 use crate::{EigenSolver, StructuralModel};
 use nalgebra::DVector;
 use thiserror::Error;
@@ -60,7 +60,17 @@ pub struct DiscoveryOptions {
     pub max_effects: usize,
     /// Alternatives within this AICc of a named effect are reported as ambiguous (default 2).
     pub ambiguity_aicc: f64,
+    /// Most model evaluations (eigen-solves) the whole run may spend (default
+    /// [`DEFAULT_EVALUATIONS`]): bounded time whatever the data. When they run out the search
+    /// stops with what it has ([`DiscoveryReport::budget_exhausted`]).
+    pub max_evaluations: usize,
 }
+
+/// Evaluations a discovery run may spend by default: about 1 s of one core on 8 modes of the
+/// paper rotor (~0.1 ms per evaluation of its 22 DOFs, more on the 4-fold refined mesh), several
+/// times what the hardest independent data of the study needed (see docs/discovery.md,
+/// "Bounded time").
+pub const DEFAULT_EVALUATIONS: usize = 10_000;
 
 impl Default for DiscoveryOptions {
     fn default() -> Self {
@@ -73,6 +83,7 @@ impl Default for DiscoveryOptions {
             refits_per_kind: 1,
             max_effects: 3,
             ambiguity_aicc: 2.0,
+            max_evaluations: DEFAULT_EVALUATIONS,
         }
     }
 }
@@ -286,6 +297,10 @@ pub struct DiscoveryReport {
     pub rms_before_hz: f64,
     /// RMS of model − measured after, Hz.
     pub rms_after_hz: f64,
+    /// Model evaluations (eigen-solves) spent.
+    pub evaluations: usize,
+    /// True when [`DiscoveryOptions::max_evaluations`] ran out before the search ended.
+    pub budget_exhausted: bool,
 }
 
 /// Corrected Akaike information criterion with known σ: χ² + 2k + 2k(k+1)/(n − k − 1).
@@ -345,9 +360,10 @@ where
         models.iter().zip(&measured).map(|(&m, d)| Problem::new(m, solver, d.clone())).collect();
     let base = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect())
         .ok_or_else(|| DiscoveryError::Data("the configurations' parameters differ".into()))?;
+    let budget = Budget::new(options.max_evaluations);
     // (a) calibrate
     let est = Driver::default()
-        .run(&base, &mut Damped::default(), initial, &mut [])
+        .run_within(&base, &mut Damped::default(), initial, &mut [], &budget)
         .map_err(|e| DiscoveryError::Calibration(e.to_string()))?;
     let base_lin = est.last;
     let chi2_before = 2.0 * base_lin.cost();
@@ -370,8 +386,11 @@ where
         modes: compare_modes(&measured, &base_lin, &base_lin),
         rms_before_hz: rms_diff(&base_lin),
         rms_after_hz: rms_diff(&base_lin),
+        evaluations: 0,
+        budget_exhausted: false,
     };
     if !disagreement_significant {
+        report.evaluations = budget.used();
         return Ok(report);
     }
     // (b) forward selection: each round screens the candidates not yet chosen against the model
@@ -382,6 +401,9 @@ where
     let mut current = Fit::base(&base_lin, aicc_before);
     let mut named: Vec<NamedEffect> = Vec::new();
     for round in 0..options.max_effects {
+        if budget.exhausted() {
+            break;
+        }
         if round > 0 && chi2_upper_tail(current.chi2, n - current.parameters.len()) >= options.significance {
             break;
         }
@@ -389,7 +411,7 @@ where
         let open = |i: usize| !chosen.iter().any(|&c| same_place(&candidates[c], &candidates[i]));
         let mut scored: Vec<(usize, f64)> =
             with_augmented(&models, solver, &measured, &chosen_refs, |problem| {
-                let lin = problem.linearise(&current.parameters).ok()?;
+                let lin = budget.wrap(problem).linearise(&current.parameters).ok()?;
                 let projector = Projector::new(problem, &lin);
                 Some(
                     candidates
@@ -397,7 +419,7 @@ where
                         .enumerate()
                         .filter(|&(i, c)| !c.needs_refit() && open(i))
                         .filter_map(|(i, c)| {
-                            screen(&models, solver, &measured, &chosen_refs, c, &lin, &projector)
+                            screen(&models, solver, &measured, &chosen_refs, c, &lin, &projector, &budget)
                                 .map(|s| (i, s))
                         })
                         .collect(),
@@ -433,7 +455,7 @@ where
             .filter_map(|i| {
                 let mut set = chosen_refs.clone();
                 set.push(&candidates[i]);
-                refit(&models, solver, &measured, &set, &current.parameters).map(|f| (i, f))
+                refit(&models, solver, &measured, &set, &current.parameters, &budget).map(|f| (i, f))
             })
             .collect();
         fits.sort_by(|a, b| a.1.aicc.total_cmp(&b.1.aicc));
@@ -450,13 +472,16 @@ where
         }
         let ambiguous_with = fits
             .iter()
-            .filter(|(i, f)| *i != best_i && f.plausible && f.aicc - best.aicc < options.ambiguity_aicc)
+            .filter(|(i, _)| !same_place(&candidates[*i], &candidates[best_i]))
+            .filter(|(_, f)| f.plausible && f.aicc - best.aicc < options.ambiguity_aicc)
             .map(|(i, f)| Alternative::new(&candidates[*i], f, best.aicc))
             .collect();
         named.push(NamedEffect::new(&candidates[best_i], current.aicc - best.aicc, ambiguous_with));
         chosen.push(best_i);
         current = best;
     }
+    report.evaluations = budget.used();
+    report.budget_exhausted = budget.exhausted();
     // (c) name the effects only if, with them, the misfit is one the noise can explain.
     let k = current.parameters.len();
     let consistent = n > k && chi2_upper_tail(current.chi2, n - k) >= options.min_after_p_value;
@@ -600,13 +625,15 @@ fn screen<M: StructuralModel, S: EigenSolver>(
     candidate: &Candidate,
     current: &Linearisation,
     projector: &Projector,
+    budget: &Budget,
 ) -> Option<f64> {
     let par = candidate.parameter.as_ref()?;
     let mut p = current.parameters.clone();
     p.push(par.nominal);
     let mut set = chosen.to_vec();
     set.push(candidate);
-    let lin = with_augmented(models, solver, measured, &set, |problem| problem.linearise(&p).ok())?;
+    let lin =
+        with_augmented(models, solver, measured, &set, |problem| budget.wrap(problem).linearise(&p).ok())?;
     let j = projector.apply(&lin.jacobian.column(lin.jacobian.ncols() - 1).into_owned());
     let r = projector.apply(&lin.residual);
     let jj = j.norm_squared();
@@ -627,6 +654,7 @@ fn refit<M: StructuralModel, S: EigenSolver>(
     measured: &[Measurement],
     set: &[&Candidate],
     current: &[f64],
+    budget: &Budget,
 ) -> Option<Fit> {
     let candidate = *set.last()?;
     let mut start = current.to_vec();
@@ -635,7 +663,13 @@ fn refit<M: StructuralModel, S: EigenSolver>(
     with_augmented(models, solver, measured, set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
-        let est = Driver { max_iterations: 60 }.run(problem, &mut Damped::default(), &start, &mut []).ok()?;
+        let est = Driver { max_iterations: 60 }
+            .run_within(problem, &mut Damped::default(), &start, &mut [], budget)
+            .ok()?;
+        // A fit cut short by the budget is not a fit.
+        if matches!(est.termination, Termination::BudgetExhausted { .. }) {
+            return None;
+        }
         let k = problem.parameters().len();
         let chi2 = 2.0 * est.last.cost();
         let intervals = interval::covariance_intervals(problem, &est.last);
