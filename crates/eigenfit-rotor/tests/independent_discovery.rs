@@ -107,7 +107,8 @@ fn candidate_derivatives_match_finite_differences() {
     for kind in
         ["section-change", "point-mass", "shaft-rotary-inertia", "timoshenko-shaft", "shaft-stiffness-loss"]
     {
-        for c in candidates.iter().filter(|c| c.kind == kind).take(3) {
+        // (A switch at the textbook value has no value to differentiate.)
+        for c in candidates.iter().filter(|c| c.kind == kind && c.parameter.is_some()).take(3) {
             let model = Augmented::new(&rotor, c).unwrap();
             let mut p = vec![2e5, 5e4];
             // A value away from 0, where a non-linear law differs from its tangent at 0.
