@@ -75,6 +75,25 @@ pub fn discover_rotor<S: EigenSolver>(
     initial: &[f64],
     options: &DiscoveryOptions,
 ) -> Result<RotorDiscovery, DiscoveryError> {
+    let mut found = search(rotor, solver, measured, initial, options)?;
+    // The mirror image of an effect on a symmetric rotor fits exactly as well: say so.
+    crate::mirror::add_images(rotor, &mut found.effects);
+    for e in &found.effects {
+        for r in found.report.effects.iter_mut().filter(|r| r.label == e.label) {
+            r.ambiguous_with = e.ambiguous_with.clone();
+        }
+    }
+    Ok(found)
+}
+
+/// The search of [`discover_rotor`]: the user's mesh, then the refined mesh when needed.
+fn search<S: EigenSolver>(
+    rotor: &Rotor,
+    solver: &S,
+    measured: &Measurement,
+    initial: &[f64],
+    options: &DiscoveryOptions,
+) -> Result<RotorDiscovery, DiscoveryError> {
     let coarse = discover(rotor, solver, measured, &effects::candidates(rotor), initial, options)?;
     let mut coarse_result =
         RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };

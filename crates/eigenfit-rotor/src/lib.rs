@@ -60,6 +60,7 @@ mod error;
 mod file;
 mod layout;
 pub mod mesh;
+pub mod mirror;
 mod model;
 pub mod pedestal;
 pub mod presets;
