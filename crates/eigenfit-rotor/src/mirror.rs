@@ -141,7 +141,7 @@ mod tests {
     use super::Mirror;
     use crate::{presets, BearingSpec, Disk, EffectSpec, Material, Rotor};
     use eigenfit_core::discovery::NamedEffect;
-    use eigenfit_core::{DenseSolver, EigenSolver};
+    use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 
     fn symmetric() -> Rotor {
         Rotor::builder()

@@ -8,8 +8,8 @@
 //! needs m_p > 0 (else M is singular) and k_p > 0.
 
 use crate::model::Rotor;
-use eigenfit_core::discovery::{Candidate, Companion};
-use eigenfit_core::{Parameter, Scale, SparseSymmetric, StructuralModel};
+use eigenfit_core::matrix::SparseSymmetric;
+use eigenfit_core::model::{Candidate, Companion, Parameter, Scale, StructuralModel};
 
 /// Kind name of the candidate.
 pub const KIND: &str = "pedestal";

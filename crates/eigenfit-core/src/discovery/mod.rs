@@ -10,21 +10,15 @@
 //!
 //! Nothing here is rotor-specific: a plugin offers [`Candidate`]s, the engine does the rest.
 
-mod augmented;
-mod candidate;
-mod chi2;
 mod interval;
 
-pub use augmented::Augmented;
-pub use candidate::{Candidate, Companion, ValueLaw};
-
-pub use chi2::chi2_upper_tail;
-
+use crate::analysis::chi2_upper_tail;
+use crate::eigen::EigenSolver;
 use crate::measurement::{MeasuredMode, Measurement};
-use crate::multi::Stacked;
-use crate::residual::{Linearisation, Problem};
-use crate::update::{Budget, Damped, Driver, Evaluate, Termination};
-use crate::{EigenSolver, StructuralModel};
+use crate::model::{Augmented, Candidate, StructuralModel};
+use crate::problem::multi::Stacked;
+use crate::problem::{Linearisation, Objective, Problem};
+use crate::update::{Budget, Driver, LevenbergMarquardt, Termination};
 use nalgebra::DVector;
 use thiserror::Error;
 
@@ -358,12 +352,12 @@ where
     }
     let problems: Vec<Problem<&M, &S>> =
         models.iter().zip(&measured).map(|(&m, d)| Problem::new(m, solver, d.clone())).collect();
-    let base = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect())
+    let base = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect())
         .ok_or_else(|| DiscoveryError::Data("the configurations' parameters differ".into()))?;
     let budget = Budget::new(options.max_evaluations);
     // (a) calibrate
     let est = Driver::default()
-        .run_within(&base, &mut Damped::default(), initial, &mut [], &budget)
+        .run_within(&base, &mut LevenbergMarquardt::default(), initial, &mut [], &budget)
         .map_err(|e| DiscoveryError::Calibration(e.to_string()))?;
     let base_lin = est.last;
     let chi2_before = 2.0 * base_lin.cost();
@@ -574,8 +568,8 @@ struct Projector {
 }
 
 impl Projector {
-    fn new(base: &dyn Evaluate, lin: &Linearisation) -> Self {
-        let js = crate::update::damped::scaled_jacobian(base.parameters(), lin);
+    fn new(base: &dyn Objective, lin: &Linearisation) -> Self {
+        let js = lin.scaled_jacobian(base.parameters());
         // Orthonormal basis of the column space (thin SVD, dropping null directions).
         let svd = js.svd(true, false);
         let u = svd.u.expect("requested"); // proof: svd(true, _) always computes U
@@ -601,7 +595,7 @@ fn with_augmented<M, S, T>(
     solver: &S,
     measured: &[Measurement],
     set: &[&Candidate],
-    f: impl FnOnce(&dyn Evaluate) -> Option<T>,
+    f: impl FnOnce(&dyn Objective) -> Option<T>,
 ) -> Option<T>
 where
     M: StructuralModel,
@@ -611,7 +605,7 @@ where
         models.iter().map(|&m| Augmented::with_all(m, set)).collect::<Result<_, _>>().ok()?;
     let problems: Vec<Problem<&Augmented<'_, M>, &S>> =
         augmented.iter().zip(measured).map(|(a, d)| Problem::new(a, solver, d.clone())).collect();
-    let stacked = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect())?;
+    let stacked = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect())?;
     f(&stacked)
 }
 
@@ -664,7 +658,7 @@ fn refit<M: StructuralModel, S: EigenSolver>(
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
         let est = Driver { max_iterations: 60 }
-            .run_within(problem, &mut Damped::default(), &start, &mut [], budget)
+            .run_within(problem, &mut LevenbergMarquardt::default(), &start, &mut [], budget)
             .ok()?;
         // A fit cut short by the budget is not a fit.
         if matches!(est.termination, Termination::BudgetExhausted { .. }) {

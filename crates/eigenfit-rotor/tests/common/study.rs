@@ -6,7 +6,9 @@
 #![allow(dead_code)]
 
 use eigenfit_core::discovery::{DiscoveryOptions, NamedEffect};
-use eigenfit_core::{BandedSolver, EigenSolver, MeasuredMode, Measurement, Modes, SolveError, System};
+use eigenfit_core::eigen::{BandedSolver, EigenSolver, Modes, SolveError};
+use eigenfit_core::matrix::System;
+use eigenfit_core::measurement::{MeasuredMode, Measurement};
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use eigenfit_rotor::presets;
 use nalgebra::DVector;
