@@ -41,7 +41,7 @@ fn main() {
                         .iter()
                         .map(|n| {
                             let alts: Vec<&str> = n.ambiguous_with.iter().map(|a| a.label.as_str()).collect();
-                            format!("{}={:?} ~{:?}", n.label, n.value, alts)
+                            format!("{}={:?} (ΔAICc {:.1}) ~{:?}", n.label, n.value, n.delta_aicc, alts)
                         })
                         .collect();
                     eprintln!("{} {noise} {}: {outcome:?} {labels:?}", case.name, draw.draw);

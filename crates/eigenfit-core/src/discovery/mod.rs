@@ -41,7 +41,9 @@ pub struct DiscoveryOptions {
     pub significance: f64,
     /// Candidates refitted after screening (default 8; switches are always refitted).
     pub refits: usize,
-    /// AICc improvement over the base model needed to name an effect (default 4).
+    /// AICc improvement over the base model needed to name an effect (default 6: with ~130
+    /// candidates to choose from, 4 named a noise fit in 2.4 % of 330 clean independent draws,
+    /// 6 in 1.5 %; docs/discovery.md).
     pub min_aicc_gain: f64,
     /// Relative frequency std assumed for modes without one (default 1e-3).
     pub assumed_relative_std: f64,
@@ -71,7 +73,7 @@ impl Default for DiscoveryOptions {
         Self {
             significance: 0.05,
             refits: 8,
-            min_aicc_gain: 4.0,
+            min_aicc_gain: 6.0,
             assumed_relative_std: 1e-3,
             min_after_p_value: 1e-3,
             refits_per_kind: 1,
