@@ -13,9 +13,12 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 use study::CountingSolver;
 
+/// Draws of one case: (frequencies, standard deviations), Hz.
+type Draws = Vec<(Vec<f64>, Vec<f64>)>;
+
 fn main() {
     let fixtures = study::load();
-    let mut cases: Vec<(String, Vec<(Vec<f64>, Vec<f64>)>)> = Vec::new();
+    let mut cases: Vec<(String, Draws)> = Vec::new();
     for case in &fixtures.case {
         let draws: Vec<_> = fixtures
             .draw

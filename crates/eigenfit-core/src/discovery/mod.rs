@@ -415,7 +415,7 @@ where
                         .enumerate()
                         .filter(|&(i, c)| !c.needs_refit() && open(i))
                         .filter_map(|(i, c)| {
-                            screen(&models, solver, &measured, &chosen_refs, c, &lin, &projector, &budget)
+                            screen(&models, solver, &measured, &chosen_refs, c, (&lin, &projector), &budget)
                                 .map(|s| (i, s))
                         })
                         .collect(),
@@ -619,8 +619,7 @@ fn screen<M: StructuralModel, S: EigenSolver>(
     measured: &[Measurement],
     chosen: &[&Candidate],
     candidate: &Candidate,
-    current: &Linearisation,
-    projector: &Projector,
+    (current, projector): (&Linearisation, &Projector),
     budget: &Budget,
 ) -> Option<f64> {
     let par = candidate.parameter.as_ref()?;
