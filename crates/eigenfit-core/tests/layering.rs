@@ -282,6 +282,7 @@ const ROTOR_LAYERS: &[&str] = &[
     "element",
     "spec",
     "model",
+    "pedestal",
     "effects",
     "structural",
     "builder",
@@ -290,6 +291,7 @@ const ROTOR_LAYERS: &[&str] = &[
     "updatable",
     "layout",
     "mesh",
+    "mirror",
     "discovery",
     "campaign",
 ];
