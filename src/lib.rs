@@ -20,6 +20,8 @@ pub use eigenfit_core::nalgebra;
 #[cfg(feature = "lapack")]
 pub use eigenfit_lapack as lapack;
 pub use eigenfit_rotor as rotor;
+/// Whole jobs (simulate, estimate, compare, discover, campbell, campaign) with serde reports.
+pub use eigenfit_workflow as workflow;
 
 /// The items most programs need: the core prelude and the rotor model.
 pub mod prelude {

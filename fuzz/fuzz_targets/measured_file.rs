@@ -1,6 +1,6 @@
-//! Fuzz target `measured_file`: the CLI's measured-data CSV parser on arbitrary text.
+//! Fuzz target `measured_file`: the measured-data CSV parser
+//! (`eigenfit_core::measurement::measured_csv`) on arbitrary text.
 //!
-//! The parser lives in the binary crate, so its source is included here with `#[path]`.
 //! Properties: `parse` returns `Ok` or an error that starts with the 1-based line it is about
 //! (`LINE: …`, a line of the text); an accepted measurement is non-empty, sorted by strictly
 //! increasing mode number, with positive finite frequencies and std all-or-none, positive and
@@ -8,17 +8,11 @@
 
 #![no_main]
 
-#[allow(dead_code)]
-#[path = "../../crates/eigenfit-cli/src/error.rs"]
-mod error;
-#[allow(dead_code)]
-#[path = "../../crates/eigenfit-cli/src/measured.rs"]
-mod measured;
-
+use eigenfit_core::measurement::measured_csv as measured;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    // `measured::read` rejects non-UTF-8 files before parsing (tested in the CLI corpus).
+    // `measured::read_with_notes` rejects non-UTF-8 files before parsing (tested in the CLI corpus).
     let Ok(text) = std::str::from_utf8(data) else { return };
     match measured::parse(text) {
         Err(message) => {

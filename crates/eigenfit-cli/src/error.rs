@@ -32,6 +32,15 @@ impl CliError {
     }
 }
 
+impl From<eigenfit_workflow::WorkflowError> for CliError {
+    fn from(e: eigenfit_workflow::WorkflowError) -> Self {
+        match e {
+            eigenfit_workflow::WorkflowError::Input(m) => CliError::Input(m),
+            eigenfit_workflow::WorkflowError::Failure(m) => CliError::Failure(m),
+        }
+    }
+}
+
 /// Shorthand for an input error.
 pub fn input(msg: impl Into<String>) -> CliError {
     CliError::Input(msg.into())

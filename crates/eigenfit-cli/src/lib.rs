@@ -5,10 +5,8 @@
 //! Exit codes: 0 success, 1 internal failure, 2 bad input (arguments, files, data),
 //! 3 an estimation that did not converge (its results are still printed).
 
-pub mod any_model;
 pub mod commands;
 pub mod error;
-pub mod measured;
 pub mod output;
 pub mod plot;
 pub mod progress;

@@ -1,6 +1,7 @@
 //! Writing result files so that a crash or a full disk never leaves half a file behind.
 
 use crate::error::{input, CliError};
+use clap::Args;
 use std::io::Write;
 use std::path::Path;
 
@@ -18,6 +19,26 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
     })
 }
 
+/// `--quiet` and `--json`, shared by every command that reports and may take a while.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// No progress bars or spinners.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Print one JSON object instead of the text report.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The report as one JSON object with `--json` (see [`emit_json`]), else as the command's text.
+pub fn report<R: serde::Serialize>(json: bool, report: &R, text: impl FnOnce(&R)) {
+    if json {
+        emit_json(report);
+    } else {
+        text(report);
+    }
+}
+
 thread_local! {
     /// Set while [`crate::run_json`] runs a command on this thread: the command's JSON lands here
     /// instead of on stdout. Per thread, so concurrent library calls (Dask workers' threads) never
@@ -29,7 +50,9 @@ thread_local! {
 /// Prints a command's JSON result on stdout, or hands it to [`crate::run_json`] when that is the
 /// caller. Every `--json` result goes through here, so the library's result and the binary's
 /// output are the same value by construction.
-pub fn emit_json(value: serde_json::Value) {
+pub fn emit_json<T: serde::Serialize + ?Sized>(report: &T) {
+    // Through a `Value`, so keys come out sorted whatever the report's field order.
+    let value = serde_json::to_value(report).expect("reports serialise: every map key is a string");
     let value = CAPTURED.with(|c| match c.borrow_mut().as_mut() {
         Some(slot) => {
             *slot = Some(value);

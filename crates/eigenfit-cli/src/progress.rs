@@ -38,3 +38,36 @@ pub fn spinner(message: &str, quiet: bool) -> ProgressBar {
     pb.enable_steady_tick(Duration::from_millis(100));
     pb
 }
+
+/// The workflows' progress drawn as bars (known length) and spinners, one stage at a time.
+pub struct Bars {
+    quiet: bool,
+    current: Option<ProgressBar>,
+}
+
+impl Bars {
+    /// Bars that draw unless `quiet` (or stderr is not a terminal).
+    pub fn new(quiet: bool) -> Self {
+        Self { quiet, current: None }
+    }
+}
+
+impl eigenfit_workflow::Progress for Bars {
+    fn begin(&mut self, stage: &str, steps: Option<u64>) {
+        self.end();
+        self.current = Some(match steps {
+            Some(n) => bar(n, stage, self.quiet),
+            None => spinner(stage, self.quiet),
+        });
+    }
+    fn step(&mut self) {
+        if let Some(pb) = &self.current {
+            pb.inc(1);
+        }
+    }
+    fn end(&mut self) {
+        if let Some(pb) = self.current.take() {
+            pb.finish_and_clear();
+        }
+    }
+}

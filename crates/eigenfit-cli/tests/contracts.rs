@@ -1,5 +1,7 @@
 //! The JSON contracts other tools rely on (issues: foundation, strategies).
 
+mod common;
+
 use serde_json::Value;
 use std::process::Command;
 
@@ -52,18 +54,8 @@ fn ross_example_matches_ross() {
 #[test]
 fn estimate_reports_parameters_frequencies_and_intervals() {
     let csv = temp_file("m.csv", "mode,frequency_hz,std_hz\n1,36.107,0.036\n2,84.066,0.084\n3,305.649,0.3\n");
-    let (code, v) = eigenfit(&[
-        "estimate",
-        "--preset",
-        "paper-rotor",
-        "--measured",
-        csv.to_str().unwrap(),
-        "--strategy",
-        "damped",
-        "--initial",
-        "1e2,1e2",
-        "--json",
-    ]);
+    let (code, v) =
+        eigenfit(&common::paper_estimate(csv.to_str().unwrap(), "damped", "1e2,1e2", &["--json"]));
     assert_eq!(code, 0);
     assert_eq!(v["converged"], true);
     assert!(v["iterations"].as_u64().unwrap() >= 1);
@@ -77,18 +69,8 @@ fn estimate_reports_parameters_frequencies_and_intervals() {
 #[test]
 fn estimate_that_does_not_converge_exits_with_3_and_still_reports() {
     let csv = temp_file("far.csv", "mode,frequency_hz\n1,36.107\n2,84.066\n");
-    let (code, v) = eigenfit(&[
-        "estimate",
-        "--preset",
-        "paper-rotor",
-        "--measured",
-        csv.to_str().unwrap(),
-        "--strategy",
-        "newton",
-        "--initial",
-        "1e8,1e8",
-        "--json",
-    ]);
+    let (code, v) =
+        eigenfit(&common::paper_estimate(csv.to_str().unwrap(), "newton", "1e8,1e8", &["--json"]));
     assert_eq!(code, 3);
     assert_eq!(v["converged"], false);
     assert!(v["parameters"]["k_K2"].is_number());

@@ -1,16 +1,13 @@
 //! The `kind = "matrices"` contract (issue 17): simulate, --set, estimate and compare on the
 //! committed 920-DOF stiffened plate, against scipy's answers committed beside it.
 
+mod common;
+
 use serde_json::Value;
-use std::path::PathBuf;
 use std::process::Command;
 
 fn plate(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../eigenfit-matrices/tests/data/plate")
-        .join(name)
-        .display()
-        .to_string()
+    common::data_file("../eigenfit-matrices/tests/data/plate", name)
 }
 
 fn eigenfit(args: &[&str]) -> (i32, Value, String) {

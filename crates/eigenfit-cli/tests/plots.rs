@@ -2,6 +2,8 @@
 //! expected titles, axes and legend entries, the PNG is a real image; `eigenfit demo` writes every
 //! plot kind; progress bars stay off stderr when it is not a terminal.
 
+mod common;
+
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -132,20 +134,8 @@ fn estimate_plots_its_convergence_history() {
     let dir = temp_dir("estimate");
     let csv = dir.join("m.csv");
     std::fs::write(&csv, "mode,frequency_hz\n1,36.107\n2,84.066\n").unwrap();
-    let out = eigenfit(&[
-        "estimate",
-        "--preset",
-        "paper-rotor",
-        "--measured",
-        csv.to_str().unwrap(),
-        "--strategy",
-        "newton",
-        "--initial",
-        "1e2,1e2",
-        "--plot",
-        dir.to_str().unwrap(),
-        "--json",
-    ]);
+    let more = ["--plot", dir.to_str().unwrap(), "--json"];
+    let out = eigenfit(&common::paper_estimate(csv.to_str().unwrap(), "newton", "1e2,1e2", &more));
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let v = json(&out);
     assert_eq!(v["converged"], true);

@@ -1,8 +1,9 @@
 //! The two-plane (ROSS rotor) contract of `simulate`, `campbell` and `estimate`, through the
 //! binary, on rotor files saved by ROSS (crates/eigenfit-rotordynamics/tests/data).
 
+mod common;
+
 use serde_json::Value;
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn run(args: &[&str]) -> Output {
@@ -10,11 +11,7 @@ fn run(args: &[&str]) -> Output {
 }
 
 fn data(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../eigenfit-rotordynamics/tests/data")
-        .join(name)
-        .display()
-        .to_string()
+    common::data_file("../eigenfit-rotordynamics/tests/data", name)
 }
 
 fn json(out: &Output) -> Value {

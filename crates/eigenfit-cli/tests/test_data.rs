@@ -1,12 +1,14 @@
 //! Real test data through the CLI (issue 14's contract): universal files and shape CSV in,
 //! MAC pairing and shape residuals, the JSON `mac` and `pairing`.
 
+mod common;
+
 use serde_json::Value;
 use std::path::PathBuf;
 use std::process::Command;
 
 fn data(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/uff").join(name).display().to_string()
+    common::data_file("../../tests/data/uff", name)
 }
 
 fn run(args: &[&str]) -> (i32, String, String) {

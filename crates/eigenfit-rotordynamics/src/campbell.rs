@@ -12,8 +12,8 @@ use faer::c64;
 /// can still be found at the next speed.
 const SPARE_MODES: usize = 4;
 
-/// A Campbell diagram.
-#[derive(Debug, Clone)]
+/// A Campbell diagram (serialises as the `campbell` report's diagram).
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct Campbell {
     /// Speeds (rpm).
     pub speeds_rpm: Vec<f64>,
@@ -31,7 +31,7 @@ pub struct Campbell {
 }
 
 /// A crossing of a followed mode with the synchronous line.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct CriticalSpeed {
     /// Speed (rpm).
     pub rpm: f64,

@@ -30,6 +30,13 @@ impl Whirl {
     }
 }
 
+/// Reports give a whirl by its name.
+impl serde::Serialize for Whirl {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
 /// One damped mode at one speed.
 #[derive(Debug, Clone)]
 pub struct Mode {

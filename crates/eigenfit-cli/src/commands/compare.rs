@@ -1,19 +1,15 @@
 //! `eigenfit compare`: strategies × targets × a grid of initial guesses on reference data.
 
-use crate::error::{input, CliError};
+use crate::error::CliError;
 use crate::output::Stream;
 use crate::plot::compare_map::{CompareMaps, MapKind};
-use crate::source::{parse_list, ModelArgs};
+use crate::source::ModelArgs;
 use crate::{plot, progress};
 use clap::Args;
-use eigenfit_core::analysis::Identifiability;
-use eigenfit_core::analysis::{
-    compare::log_space, compare::run_grid, compare::tensor_grid, compare::CompareRun,
-    compare::CompareSettings,
-};
+use eigenfit_core::analysis::compare::CompareRun;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::update::StrategyKind;
-use serde_json::{json, Value};
+use eigenfit_workflow::compare::{self, CompareRequest, WITHIN_1E6};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `compare`.
@@ -57,9 +53,9 @@ pub struct CompareArgs {
     /// compare-iterations.svg/.png) into this folder (two parameters, a grid of initial guesses).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
-    /// No progress bar.
-    #[arg(long)]
-    pub quiet: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
     /// Also append each finished run to this file as one JSON line, flushed at once, so that a
     /// long batch loses nothing already computed if it is interrupted.
     #[arg(long, value_name = "FILE.jsonl")]
@@ -68,117 +64,57 @@ pub struct CompareArgs {
     /// same input gives byte-for-byte the same output.
     #[arg(long)]
     pub timing: bool,
-    /// Print one JSON object (`runs` array and `summary`) instead of tables.
-    #[arg(long)]
-    pub json: bool,
 }
 
-/// Most runs one `compare` accepts: far beyond any study (the paper's maps are 10⁴), checked
-/// before anything is allocated.
-pub const MAX_RUNS: usize = 1_000_000;
+/// The request these arguments make.
+fn request(args: &CompareArgs) -> CompareRequest {
+    CompareRequest {
+        targets: args.targets.clone(),
+        grid: args.grid,
+        range: args.range.clone(),
+        initials: args.initials.clone(),
+        strategies: args.strategies.clone(),
+        decimals: args.decimals,
+        std_hz: args.std_hz,
+        modes: args.modes,
+        max_iterations: args.max_iterations,
+        timing: args.timing,
+    }
+}
 
 /// Runs `compare`.
 pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     let (model, label) = args.model.load_any()?;
-    let rotor = &model;
     let solver = args.model.solver()?;
-    let np = rotor.parameters().len();
-    let targets = points("--targets", &args.targets, np)?;
-    let initials = match (&args.initials, args.grid) {
-        (Some(text), _) => points("--initials", text, np)?,
-        (None, Some(n)) if n >= 2 => {
-            let r = parse_list("--range", &args.range.replace(':', ","))?;
-            if r.len() != 2 || !(r[0] > 0.0 && r[1] > r[0]) {
-                return Err(input(format!("--range `{}`: expected FROM:TO with 0 < FROM < TO", args.range)));
-            }
-            // Counted before the grid is built: 10000^2 points would exhaust memory first.
-            u32::try_from(np)
-                .ok()
-                .and_then(|d| n.checked_pow(d))
-                .filter(|&c| c <= MAX_RUNS)
-                .ok_or_else(|| {
-                    input(format!(
-                        "--grid {n}: {n}^{np} initial guesses, more than the {MAX_RUNS} runs compare accepts; use a smaller --grid"
-                    ))
-                })?;
-            tensor_grid(&log_space(r[0], r[1], n), np)
-        }
-        _ => return Err(input("give --grid N (N ≥ 2) or --initials K1:K2,…")),
-    };
-    let strategies = args
-        .strategies
-        .split(',')
-        .map(|s| {
-            StrategyKind::from_name(s.trim()).ok_or_else(|| {
-                input(format!(
-                    "--strategies: unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
-                    s.trim()
-                ))
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    // Beyond ±15 decimals rounding either changes nothing a double holds or overflows to NaN.
-    if let Some(d) = args.decimals.filter(|d| !(-15..=15).contains(d)) {
-        return Err(input(format!(
-            "--decimals {d}: must be between -15 and 15 (a double holds about 16 digits)"
-        )));
-    }
-    let total_runs = targets.len().saturating_mul(initials.len()).saturating_mul(strategies.len());
-    if total_runs > MAX_RUNS {
-        return Err(input(format!(
-            "{} targets × {} initial guesses × {} strategies = {total_runs} runs, more than the {MAX_RUNS} compare accepts",
-            targets.len(),
-            initials.len(),
-            strategies.len()
-        )));
-    }
-    if let Some(s) = args.std_hz {
-        if !(s.is_finite() && s > 0.0) {
-            return Err(input(format!("--std-hz {s}: must be a positive finite number")));
-        }
-    }
-    let settings = CompareSettings {
-        modes: args.modes.unwrap_or(np).max(np),
-        decimals: args.decimals,
-        std_hz: args.std_hz,
-        max_iterations: args.max_iterations,
-    };
-    let total = (targets.len() * initials.len() * strategies.len()) as u64;
-    let pb = progress::bar(total, "compare runs", args.quiet);
-    // Opened after every argument is checked; run_grid checks the reference data before its
-    // first run, and the file is appended to, so a run refused there loses nothing written before.
+    let np = model.parameters().len();
+    let plan = compare::plan(&request(args), np)?;
+    let pb = progress::bar(plan.runs() as u64, "compare runs", args.report.quiet);
+    // Opened after every argument is checked; the reference data are checked before the first
+    // run, and the file is appended to, so a run refused there loses nothing written before.
     let mut stream = args.stream.as_deref().map(Stream::open).transpose()?;
-    let runs = run_grid(&rotor, &solver.as_ref(), &targets, &initials, &strategies, &settings, |r| {
+    let report = compare::run(&label, &model, solver.as_ref(), &plan, |r| {
         pb.inc(1);
         if let Some(w) = stream.as_mut() {
-            w.append(&run_json(r, args.timing).to_string());
+            let line = serde_json::to_value(r).expect("reports serialise: every map key is a string");
+            w.append(&line.to_string());
         }
     });
     pb.finish_and_clear();
-    let runs = runs.map_err(|e| input(format!("reference data: {e}")))?;
-    let summary = summarise(&runs, &targets, &strategies);
-    let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
+    let mut report = report?;
+    let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
     let plots = match &args.plot {
-        Some(dir) => write_maps(dir, &label, &names, &runs, &targets, &strategies)?,
+        Some(dir) => write_maps(dir, &label, &names, &report.raw, &plan.targets, &plan.strategies)?,
         None => Vec::new(),
     };
-    if args.json {
-        let runs_json: Vec<Value> = runs.iter().map(|r| run_json(r, args.timing)).collect();
-        let summary_json: Vec<Value> = summary.iter().map(Summary::to_json).collect();
-        let mut out = json!({"model": label, "solver": solver.name(), "modes": settings.modes,
-                   "decimals": args.decimals, "std_hz": args.std_hz, "runs": runs_json, "summary": summary_json});
-        if args.plot.is_some() {
-            out["plots"] = json!(plot::names(&plots));
-        }
-        crate::output::emit_json(out);
-    } else {
+    report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
+    crate::output::report(args.report.json, &report, |report| {
         println!(
             "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",
-            runs.len(),
-            targets.len(),
-            initials.len(),
-            strategies.len(),
-            settings.modes
+            report.runs.len(),
+            plan.targets.len(),
+            plan.initials.len(),
+            plan.strategies.len(),
+            report.modes
         );
         println!(
             "{:<16}{:<9}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",
@@ -191,34 +127,29 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             "max rel err",
             "ambiguous"
         );
-        for s in &summary {
+        for s in &report.summary {
             let target: Vec<String> = s.target.iter().map(|v| format!("{v:.0e}")).collect();
             let fmt = |v: Option<usize>| v.map_or("-".to_string(), |v| v.to_string());
             println!(
                 "{:<16}{:<9}{:>11}{:>12}{:>9}{:>9}{:>15.2e}{:>11}",
                 target.join(":"),
-                s.strategy.name(),
+                s.strategy,
                 format!("{}/{}", s.converged, s.runs),
-                s.within_1e6,
+                s.converged_within_1e6,
                 fmt(s.median_iterations),
                 fmt(s.max_iterations),
                 s.max_relative_error,
-                // Only damped runs are checked for other solutions: a 0 elsewhere would mean nothing.
-                if s.strategy == StrategyKind::LevenbergMarquardt {
-                    s.ambiguous.to_string()
-                } else {
-                    "-".to_string()
-                }
+                fmt(s.ambiguous)
             );
         }
         println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged damped runs whose data also fit another solution, - where not checked)");
         if args.maps && np == 2 {
-            print_maps(&runs, &targets, &strategies);
+            print_maps(&report.raw, &plan.targets, &plan.strategies);
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
-    }
+    });
     // A write failure ends the command non-zero after the results are printed.
-    stream.map_or(Ok(()), |w| w.finish(runs.len()))
+    stream.map_or(Ok(()), |w| w.finish(report.runs.len()))
 }
 
 /// Writes the convergence and iteration maps; a note on stderr (and nothing written) unless the
@@ -253,105 +184,6 @@ pub fn write_maps(
     Ok(written)
 }
 
-fn points(flag: &str, text: &str, np: usize) -> Result<Vec<Vec<f64>>, CliError> {
-    text.split(',')
-        .map(|item| {
-            let p = parse_list(flag, &item.replace(':', ","))?;
-            if p.len() != np || p.iter().any(|&v| v <= 0.0) {
-                return Err(input(format!(
-                    "{flag}: `{item}` must be {np} positive stiffnesses joined by `:`"
-                )));
-            }
-            Ok(p)
-        })
-        .collect()
-}
-
-fn run_json(r: &CompareRun, timing: bool) -> Value {
-    let mut v = json!({
-        "strategy": r.strategy.name(),
-        "target": r.target,
-        "initial": r.initial,
-        "converged": r.converged,
-        "termination": r.termination,
-        "iterations": r.iterations,
-        "evaluations": r.evaluations,
-        "estimate": r.estimate,
-        "relative_error": r.relative_error,
-    });
-    if timing {
-        v["seconds"] = json!(r.seconds);
-    }
-    if r.strategy == StrategyKind::LevenbergMarquardt && r.converged {
-        v["alternative_solutions"] = json!(r.alternatives);
-    }
-    if let Some(ids) = &r.identifiability {
-        v["identifiable"] = ids
-            .iter()
-            .map(|i| match i {
-                Identifiability::Determined => json!(true),
-                Identifiability::LowerBoundOnly { lower } => json!({"lower_bound": lower}),
-                Identifiability::UpperBoundOnly { upper } => json!({"upper_bound": upper}),
-                Identifiability::Undetermined => json!(false),
-            })
-            .collect();
-    }
-    v
-}
-
-/// Per target and strategy: how many runs converged, how fast, how accurately.
-struct Summary {
-    target: Vec<f64>,
-    strategy: StrategyKind,
-    runs: usize,
-    converged: usize,
-    within_1e6: usize,
-    ambiguous: usize,
-    median_iterations: Option<usize>,
-    max_iterations: Option<usize>,
-    max_relative_error: f64,
-}
-
-impl Summary {
-    fn to_json(&self) -> Value {
-        json!({
-            "target": self.target,
-            "strategy": self.strategy.name(),
-            "runs": self.runs,
-            "converged": self.converged,
-            "converged_within_1e-6": self.within_1e6,
-            "ambiguous": (self.strategy == StrategyKind::LevenbergMarquardt).then_some(self.ambiguous),
-            "median_iterations": self.median_iterations,
-            "max_iterations": self.max_iterations,
-            "max_relative_error": self.max_relative_error,
-        })
-    }
-}
-
-fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKind]) -> Vec<Summary> {
-    let mut out = Vec::new();
-    for t in targets {
-        for &s in strategies {
-            let group: Vec<&CompareRun> = runs.iter().filter(|r| &r.target == t && r.strategy == s).collect();
-            let conv: Vec<&&CompareRun> = group.iter().filter(|r| r.converged).collect();
-            let mut iters: Vec<usize> = conv.iter().map(|r| r.iterations).collect();
-            iters.sort_unstable();
-            out.push(Summary {
-                target: t.clone(),
-                strategy: s,
-                runs: group.len(),
-                converged: conv.len(),
-                within_1e6: conv.iter().filter(|r| r.relative_error <= 1e-6).count(),
-                ambiguous: conv.iter().filter(|r| !r.alternatives.is_empty()).count(),
-                median_iterations: (!iters.is_empty()).then(|| iters[iters.len() / 2]),
-                max_iterations: iters.last().copied(),
-                max_relative_error: conv.iter().map(|r| r.relative_error).fold(0.0, f64::max),
-            });
-        }
-    }
-    out
-}
-
 /// Convergence maps: one character per initial guess, K1 down the rows, K2 across.
 fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKind]) {
     let mut k1: Vec<f64> = runs.iter().map(|r| r.initial[0]).collect();
@@ -374,7 +206,7 @@ fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyK
                 let row: String = runs
                     .iter()
                     .filter(|r| &r.target == t && r.strategy == s && r.initial[0] == a)
-                    .map(|r| match (r.converged, r.relative_error <= 1e-6) {
+                    .map(|r| match (r.converged, r.relative_error <= WITHIN_1E6) {
                         (true, true) => '●',
                         (true, false) => '○',
                         _ => '·',

@@ -1,16 +1,16 @@
 //! `eigenfit discover`: find where model and measurement disagree, name the missing effect, add it.
 
-use crate::any_model::AnyModel;
-use crate::error::{input, CliError};
+use crate::error::CliError;
 use crate::output::write_atomically;
+use crate::plot;
 use crate::plot::discovery::DiscoveryPlot;
+use crate::progress::Bars;
 use crate::source::ModelArgs;
-use crate::{measured, plot, progress};
 use clap::Args;
-use eigenfit_core::discovery::{discover, Alternative, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
+use eigenfit_core::discovery::DiscoveryReport;
 use eigenfit_core::model::StructuralModel;
-use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
-use serde_json::{json, Value};
+use eigenfit_rotor::discovery::RotorDiscovery;
+use eigenfit_workflow::discover::{self, Discovery};
 use std::path::PathBuf;
 
 /// Arguments of `discover`.
@@ -30,127 +30,45 @@ pub struct DiscoverArgs {
     /// Write the before/after residual plot (discovery.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
-    /// No progress indicator.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Print one JSON object instead of a report.
-    #[arg(long)]
-    pub json: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
 }
 
 /// Runs `discover`.
 pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
     let (model, label) = args.model.load_any()?;
-    let rotor = &model;
     let solver = args.model.solver()?;
-    let data = measured::read(&args.measured)?;
-    if !(args.assumed_std.is_finite() && args.assumed_std > 0.0) {
-        return Err(input(format!("--assumed-std {}: must be a positive number", args.assumed_std)));
-    }
-    let options = DiscoveryOptions { assumed_relative_std: args.assumed_std, ..Default::default() };
-    let pb = progress::spinner("discovering: calibrate, detect, screen and refit candidates", args.quiet);
-    let found = match &model {
-        AnyModel::Rotor(r) => discover_rotor(r, &solver.as_ref(), &data, &r.nominal_stiffnesses(), &options),
-        // A matrices model has no mesh to refine: the generic workflow over its [[candidate]]s.
-        AnyModel::Matrices(m) => {
-            discover(m, &solver.as_ref(), &data, &m.candidates(), &m.parameters().nominal_values(), &options)
-                .map(|report| RotorDiscovery { effects: report.effects.clone(), report, mesh_factor: 1 })
-        }
-    };
-    pb.finish_and_clear();
-    let found = found.map_err(|e| input(format!("{}: {e}", args.measured.display())))?;
-    let report = &found.report;
-    let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
-    let mut written = Vec::new();
+    let mut notes = Vec::new();
+    let found = discover::run(
+        &label,
+        &model,
+        solver.as_ref(),
+        &args.measured,
+        args.assumed_std,
+        &mut notes,
+        &mut Bars::new(args.report.quiet),
+    );
+    crate::commands::simulate::print_notes(&notes);
+    let Discovery { found, mut report } = found?;
     if let Some(path) = &args.write_model {
-        let augmented = found
-            .augmented_model(model.rotor("--write-model")?)
-            .map_err(|e| CliError::Failure(e.to_string()))?;
-        let text = augmented.to_toml_string().map_err(|e| CliError::Failure(e.to_string()))?;
+        let text = discover::augmented_model_toml(&found, &model)?;
         write_atomically(path, text.as_bytes())?;
-        written.push(path.display().to_string());
+        report.written.push(path.display().to_string());
     }
     if let Some(dir) = &args.plot {
-        let figure = DiscoveryPlot::from_report(&label, report);
-        written.extend(plot::names(&plot::write(&figure, dir, "discovery")?));
+        let figure = DiscoveryPlot::from_report(&label, &found.report);
+        report.written.extend(plot::names(&plot::write(&figure, dir, "discovery")?));
     }
-    if args.json {
-        crate::output::emit_json(report_json(&found, &names, &label, &written));
-    } else {
-        let units: Vec<String> = rotor.parameters().iter().map(|p| p.unit.clone()).collect();
+    crate::output::report(args.report.json, &report, |report| {
+        let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
+        let units: Vec<String> = model.parameters().iter().map(|p| p.unit.clone()).collect();
         print_report(&found, &names, &units, &label);
-        for w in written {
+        for w in &report.written {
             println!("wrote {w}");
         }
-    }
+    });
     Ok(())
-}
-
-fn fit_json(f: &Fit) -> Value {
-    let mut v = json!({"kind": f.kind, "location": f.location, "value": f.value, "unit": f.unit, "interval": f.interval,
-           "chi2": f.chi2, "aicc": f.aicc, "plausible": f.plausible});
-    place(&mut v, f.position_m, f.elements);
-    v
-}
-
-/// Adds `position_m` and `elements` where the effect has them.
-fn place(v: &mut Value, position_m: Option<f64>, elements: Option<[usize; 2]>) {
-    if let Some(x) = position_m {
-        v["position_m"] = json!(x);
-    }
-    if let Some(e) = elements {
-        v["elements"] = json!(e);
-    }
-}
-
-fn alternative_json(a: &Alternative) -> Value {
-    let mut v = json!({"kind": a.kind, "location": a.location, "value": a.value, "unit": a.unit,
-                       "delta_aicc": a.delta_aicc});
-    place(&mut v, a.position_m, a.elements);
-    v
-}
-
-fn effect_json(e: &NamedEffect) -> Value {
-    let mut v = json!({"kind": e.kind, "location": e.location, "value": e.value.unwrap_or(1.0), "unit": e.unit,
-        "interval": e.interval, "delta_aicc": e.delta_aicc,
-        "ambiguous_with": e.ambiguous_with.iter().map(alternative_json).collect::<Vec<_>>()});
-    place(&mut v, e.position_m, e.elements);
-    // Further fitted values of the effect (a pedestal's stiffness beside its mass), by name.
-    if !e.companions.is_empty() {
-        v["companions"] = e
-            .companions
-            .iter()
-            .map(|c| json!({"name": c.name, "value": c.value, "interval": c.interval, "unit": c.unit}))
-            .collect();
-    }
-    v
-}
-
-fn report_json(found: &RotorDiscovery, names: &[String], label: &str, written: &[String]) -> Value {
-    let r = &found.report;
-    let missing = found.effects.first().map(effect_json);
-    let base: serde_json::Map<String, Value> =
-        names.iter().cloned().zip(r.base_parameters.iter().map(|&v| json!(v))).collect();
-    json!({
-        "model": label,
-        "disagreement_significant": r.disagreement_significant,
-        "missing_effect": missing,
-        "missing_effects": found.effects.iter().map(effect_json).collect::<Vec<_>>(),
-        "mesh_refinement": found.mesh_factor,
-        "rms_residual_before_hz": r.rms_before_hz,
-        "rms_residual_after_hz": r.rms_after_hz,
-        "chi2_before": r.chi2_before,
-        "dof_before": r.dof_before,
-        "p_value": r.p_value,
-        "calibrated_parameters": base,
-        "runner_up": r.runner_up.as_ref().map(fit_json),
-        "candidates_refitted": r.fits.iter().map(fit_json).collect::<Vec<_>>(),
-        "modes": r.modes.iter().map(|m| json!({"mode": m.mode + 1, "measured_hz": m.measured_hz, "std_hz": m.std_hz,
-            "before_hz": m.before_hz, "after_hz": m.after_hz})).collect::<Vec<_>>(),
-        "written": written,
-        "evaluations": r.evaluations,
-        "budget_exhausted": r.budget_exhausted,
-    })
 }
 
 fn print_report(found: &RotorDiscovery, names: &[String], units: &[String], label: &str) {

@@ -1,17 +1,21 @@
 //! `eigenfit simulate`: natural frequencies of a model, at one point or over a stiffness sweep.
 
-use crate::any_model::AnyModel;
 use crate::error::{input, CliError};
+use crate::plot;
 use crate::plot::critical_speed::CriticalSpeedMap;
 use crate::plot::mode_shapes::ModeShapes;
-use crate::source::{parameter_vector, parse_list, ModelArgs};
-use crate::{plot, progress};
+use crate::progress::Bars;
+use crate::source::ModelArgs;
 use clap::Args;
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
-use eigenfit_core::sensitivity::Sensitivities;
-use eigenfit_rotor::{presets, EffectSpec, Rotor};
-use serde_json::json;
+use eigenfit_rotor::{EffectSpec, Rotor};
+use eigenfit_workflow::overrides::parameter_vector;
+use eigenfit_workflow::simulate::{
+    at_point, check_modes, is_paper_rotor, sweep, sweep_points, PointReport, SweepCheck, SweepPoint,
+    SweepReport,
+};
+use eigenfit_workflow::AnyModel;
 use std::path::{Path, PathBuf};
 
 /// Stiffnesses drawn on the critical speed map (log-spaced).
@@ -53,19 +57,20 @@ pub struct SimulateArgs {
     /// docs/test-data.md).
     #[arg(long, value_name = "FILE.unv", conflicts_with = "sweep")]
     pub uff: Option<PathBuf>,
-    /// No progress bar.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Print one JSON object instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// `--quiet`, `--json`.
+    #[command(flatten)]
+    pub report: crate::output::ReportArgs,
 }
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
-    // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics module.
-    if let Some(path) = crate::rotordynamics::ross_model(args.model.model.as_deref()) {
-        return crate::rotordynamics::simulate(path, args.speed, args.modes, args.json);
+    // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics workflow.
+    if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
+        let report = eigenfit_workflow::rotordynamics::simulate(path, args.speed, args.modes)?;
+        crate::output::report(args.report.json, &report, |report| {
+            crate::rotordynamics::print_speed(report);
+        });
+        return Ok(());
     }
     if args.speed.is_some() {
         return Err(input("--speed applies to two-plane rotors (files saved by ROSS); this model is planar"));
@@ -73,136 +78,138 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let (model, label) = args.model.load_any()?;
     let mut rotor = match model {
         AnyModel::Rotor(rotor) => rotor,
-        AnyModel::Matrices(m) => {
-            return crate::any_model::simulate(args, &m, &label, args.model.solver()?.as_ref())
-        }
+        AnyModel::Matrices(m) => return simulate_matrices(args, &m, &label, args.model.solver()?.as_ref()),
     };
     for text in &args.effects {
         let effect = EffectSpec::parse(text).map_err(|e| input(format!("--effect {e}")))?;
         rotor = rotor.with_effect(effect).map_err(|e| input(format!("--effect `{text}`: {e}")))?;
     }
     let solver = args.model.solver()?;
-    if args.modes == 0 || args.modes > rotor.dofs() {
-        return Err(input(format!(
-            "--modes {}: must be between 1 and {} for this model",
-            args.modes,
-            rotor.dofs()
-        )));
-    }
-    let names: Vec<String> = rotor.parameters().iter().map(|p| p.name.clone()).collect();
-    if let Some(sweep) = &args.sweep {
-        let points = sweep_points(sweep)?;
+    check_modes(args.modes, rotor.dofs())?;
+    if let Some(text) = &args.sweep {
+        let points = sweep_points(text)?;
         let range = (points[0], points[points.len() - 1]);
         let plots = match &args.plot {
             Some(dir) => {
                 // Mode shapes at the model's (or the given) stiffnesses.
                 let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
-                {
-                    let options = MapOptions { range, plain: args.effects.is_empty(), quiet: args.quiet };
-                    write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
-                }
+                let options = MapOptions { range, plain: args.effects.is_empty(), quiet: args.report.quiet };
+                write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
             }
             None => Vec::new(),
         };
-        let pb = progress::bar(points.len() as u64, "sweep", args.quiet);
-        let mut rows = Vec::with_capacity(points.len());
-        for k in points {
-            let p = vec![k; names.len()];
-            rows.push((k, frequencies(&rotor, solver.as_ref(), &p, args.modes)?));
-            pb.inc(1);
-        }
-        pb.finish_and_clear();
-        if args.json {
-            let sweep: Vec<_> =
-                rows.iter().map(|(k, f)| json!({"stiffness": k, "frequencies_hz": f})).collect();
-            let mut out = json!({"model": label, "solver": solver.name(), "sweep": sweep});
-            if args.plot.is_some() {
-                out["plots"] = json!(plot::names(&plots));
-            }
-            crate::output::emit_json(out);
-        } else {
+        let mut notes = Vec::new();
+        let rows = sweep(
+            &rotor,
+            solver.as_ref(),
+            &points,
+            args.modes,
+            SweepCheck::RefuseRoundoff,
+            &mut notes,
+            &mut Bars::new(args.report.quiet),
+        );
+        print_notes(&notes);
+        let report = SweepReport {
+            model: label.clone(),
+            solver: solver.name().to_string(),
+            sweep: points
+                .iter()
+                .zip(rows?)
+                .map(|(&stiffness, frequencies_hz)| SweepPoint { stiffness, frequencies_hz })
+                .collect(),
+            plots: args.plot.as_ref().map(|_| plot::names(&plots)),
+            notes,
+        };
+        crate::output::report(args.report.json, &report, |report| {
             println!("{label}: natural frequencies against support stiffness (all bearings equal)");
             print!("{:>14}", "k [N/m]");
             (1..=args.modes).for_each(|m| print!("{:>14}", format!("f{m} [Hz]")));
             println!();
-            for (k, f) in rows {
-                print!("{k:>14.4e}");
-                f.iter().for_each(|v| print!("{v:>14.4}"));
+            for point in &report.sweep {
+                print!("{:>14.4e}", point.stiffness);
+                point.frequencies_hz.iter().for_each(|v| print!("{v:>14.4}"));
                 println!();
             }
             plots.iter().for_each(|w| println!("wrote {}", w.display()));
-        }
+        });
         return Ok(());
     }
     let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
     if let Some(path) = &args.uff {
-        crate::testdata::write_uff(path, &label, &rotor, solver.as_ref(), &p, args.modes)?;
+        let text = eigenfit_workflow::test_data::uff_text(&label, &rotor, solver.as_ref(), &p, args.modes)?;
+        crate::output::write_atomically(path, text.as_bytes())?;
     }
-    // Frequencies and their sensitivities from one solve; a model whose modes have none
-    // (repeated or rigid-body modes) still gets its frequencies, and says why.
-    let (f, sens) = match Sensitivities::compute(&rotor, solver.as_ref(), &p, args.modes) {
-        Ok(s) => {
-            let system = rotor.assemble(&p).map_err(|e| input(e.to_string()))?;
-            refuse_roundoff(&system, &s.modes)?;
-            (s.modes.frequencies_hz(), Ok(s.frequencies_hz))
-        }
-        Err(e) => (frequencies(&rotor, solver.as_ref(), &p, args.modes)?, Err(e.to_string())),
-    };
+    let mut report = at_point(&label, &rotor, solver.as_ref(), &p, args.modes, SweepCheck::RefuseRoundoff)?;
+    print_notes(&report.notes);
     let plots = match &args.plot {
         Some(dir) => {
-            let options = MapOptions { range: (1e2, 1e9), plain: args.effects.is_empty(), quiet: args.quiet };
+            let options =
+                MapOptions { range: (1e2, 1e9), plain: args.effects.is_empty(), quiet: args.report.quiet };
             write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
         }
         None => Vec::new(),
     };
-    if args.json {
-        let params: serde_json::Map<_, _> = names.iter().cloned().zip(p.iter().map(|&v| json!(v))).collect();
-        let mut out =
-            json!({"model": label, "solver": solver.name(), "parameters": params, "frequencies_hz": f});
-        add_sensitivities_json(&mut out, &names, &sens);
-        if args.plot.is_some() {
-            out["plots"] = json!(plot::names(&plots));
-        }
-        crate::output::emit_json(out);
-    } else {
+    report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
+    crate::output::report(args.report.json, &report, |report| {
         println!("{label} ({} DOF, {} solver)", rotor.dofs(), solver.name());
-        for (n, v) in names.iter().zip(&p) {
-            println!("  {n} = {v:.6e} N/m");
-        }
-        println!("{:>6}{:>18}", "mode", "frequency [Hz]");
-        for (i, v) in f.iter().enumerate() {
-            println!("{:>6}{v:>18.6}", i + 1);
-        }
+        print_point(report, &vec!["N/m".to_string(); p.len()]);
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
         args.uff.iter().for_each(|w| println!("wrote {}", w.display()));
-    }
+    });
     Ok(())
 }
 
-/// `sensitivities_hz` (df_k/dp_i in Hz per parameter unit, one array over modes per parameter),
-/// or `sensitivities_unavailable` saying why there are none.
-pub fn add_sensitivities_json(
-    out: &mut serde_json::Value,
-    names: &[String],
-    sens: &Result<nalgebra::DMatrix<f64>, String>,
-) {
-    match sens {
-        Ok(df) => {
-            let by_param: serde_json::Map<_, _> = names
-                .iter()
-                .enumerate()
-                .map(|(i, n)| (n.clone(), json!(df.column(i).iter().copied().collect::<Vec<f64>>())))
-                .collect();
-            out["sensitivities_hz"] = json!(by_param);
+/// `simulate` on a matrices model: frequencies and their sensitivities at the nominal values
+/// (or `--set`), in the rotor's JSON and table layout.
+fn simulate_matrices(
+    args: &SimulateArgs,
+    model: &eigenfit_matrices::MatricesModel,
+    label: &str,
+    solver: &dyn EigenSolver,
+) -> Result<(), CliError> {
+    for (given, flag) in [
+        (args.stiffness.is_some(), "--stiffness"),
+        (!args.effects.is_empty(), "--effect"),
+        (args.sweep.is_some(), "--sweep"),
+        (args.plot.is_some(), "--plot"),
+    ] {
+        if given {
+            return Err(input(format!(
+                "{flag} applies to rotor models only; use --set NAME=VALUE for a matrices model"
+            )));
         }
-        Err(why) => out["sensitivities_unavailable"] = json!(why),
+    }
+    check_modes(args.modes, model.dofs())?;
+    let p = parameter_vector(model, "--set", None, &args.sets)?;
+    let mut report = at_point(label, model, solver, &p, args.modes, SweepCheck::None)?;
+    report.dofs = Some(model.dofs());
+    crate::output::report(args.report.json, &report, |report| {
+        println!("{label} ({} DOF, {} stored entries, {} solver)", model.dofs(), model.nnz(), solver.name());
+        let units: Vec<String> = model.parameters().iter().map(|q| q.unit.clone()).collect();
+        print_point(report, &units);
+        if let Some(why) = &report.sensitivities_unavailable {
+            println!("(no sensitivities: {why})");
+        }
+    });
+    Ok(())
+}
+
+/// The parameters (with `units`) and the frequencies of a point.
+fn print_point(report: &PointReport, units: &[String]) {
+    for ((n, v), unit) in report.parameters.iter().zip(units) {
+        println!("  {n} = {v:.6e} {unit}");
+    }
+    println!("{:>6}{:>18}", "mode", "frequency [Hz]");
+    for (i, v) in report.frequencies_hz.iter().enumerate() {
+        println!("{:>6}{v:>18.6}", i + 1);
     }
 }
 
-/// Whether `rotor` is the paper's rotor (whatever its current support stiffnesses).
-pub fn is_paper_rotor(rotor: &Rotor) -> bool {
-    let paper = presets::paper_rotor();
-    rotor.with_stiffnesses(&paper.nominal_stiffnesses()).is_ok_and(|r| r == paper)
+/// Notes on stderr, as `eigenfit: note: …`.
+pub(crate) fn print_notes(notes: &[String]) {
+    for n in notes {
+        eprintln!("eigenfit: note: {n}");
+    }
 }
 
 /// How the critical speed map is drawn.
@@ -227,10 +234,8 @@ pub fn write_plots(
     MapOptions { range, plain, quiet }: MapOptions,
 ) -> Result<Vec<PathBuf>, CliError> {
     let modes = PLOT_MODES.min(rotor.dofs());
-    let pb = progress::bar(MAP_POINTS as u64, "critical speed map", quiet);
-    let map = CriticalSpeedMap::sweep(label, rotor, solver, range, MAP_POINTS, modes, || pb.inc(1));
-    pb.finish_and_clear();
-    let mut map = map?;
+    let mut map =
+        CriticalSpeedMap::sweep(label, rotor, solver, range, MAP_POINTS, modes, &mut Bars::new(quiet))?;
     if plain && is_paper_rotor(rotor) {
         map = map.with_paper_table_1();
     }
@@ -238,72 +243,4 @@ pub fn write_plots(
     let shapes = ModeShapes::of_rotor(label, rotor, solver, p, modes)?;
     written.extend(plot::write(&shapes, dir, "mode-shapes")?);
     Ok(written)
-}
-
-fn frequencies(
-    model: &dyn StructuralModel,
-    solver: &dyn EigenSolver,
-    p: &[f64],
-    modes: usize,
-) -> Result<Vec<f64>, CliError> {
-    let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-    let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
-    refuse_roundoff(&system, &m)?;
-    Ok(m.frequencies_hz())
-}
-
-/// Never a frequency lost to round-off with exit 0 (issue 13): a fine mesh or an extreme value
-/// whose lowest eigenvalue the matrices cannot resolve is refused, saying why.
-pub(crate) fn refuse_roundoff(
-    system: &eigenfit_core::matrix::System,
-    modes: &eigenfit_core::eigen::Modes,
-) -> Result<(), CliError> {
-    use eigenfit_core::eigen::{
-        roundoff::relative_roundoff, roundoff::MAX_RELATIVE_ROUNDOFF, roundoff::NOTE_RELATIVE_ROUNDOFF,
-    };
-    let levels = relative_roundoff(system, modes);
-    match levels.iter().position(|&r| r.is_nan() || r > MAX_RELATIVE_ROUNDOFF) {
-        None => {
-            if let Some(j) = levels.iter().position(|&r| r > NOTE_RELATIVE_ROUNDOFF) {
-                eprintln!(
-                    "eigenfit: note: mode {}: round-off may reach {:.1e} of its eigenvalue (a fine mesh or an extreme value); \
-                     the trailing digits are not significant",
-                    j + 1,
-                    levels[j]
-                );
-            }
-            Ok(())
-        }
-        Some(j) => Err(input(format!(
-            "mode {} cannot be trusted: round-off in the matrices (ε·(‖K‖/λ + ‖M‖)·‖φ‖² ≈ {:.1e}) exceeds {MAX_RELATIVE_ROUNDOFF:e} \
-             of its eigenvalue; the mesh is too fine or a value too extreme for double precision (use fewer elements, \
-             or values closer to the rest of the model)",
-            j + 1,
-            levels[j]
-        ))),
-    }
-}
-
-/// Most points of a `--sweep`: a smooth critical speed map needs a few hundred.
-const MAX_SWEEP_POINTS: usize = 100_000;
-
-fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
-    let parts: Vec<&str> = text.split(':').collect();
-    let bad = || input(format!("--sweep `{text}`: expected FROM:TO:COUNT with 0 < FROM < TO and COUNT ≥ 2"));
-    if parts.len() != 3 {
-        return Err(bad());
-    }
-    let ends = parse_list("--sweep", &format!("{},{}", parts[0], parts[1]))?;
-    let count: usize = parts[2].trim().parse().map_err(|_| bad())?;
-    let (a, b) = (ends[0], ends[1]);
-    if !(a > 0.0 && b > a && count >= 2) {
-        return Err(bad());
-    }
-    // Checked before the points are allocated: each is an eigen-solve.
-    if count > MAX_SWEEP_POINTS {
-        return Err(input(format!(
-            "--sweep `{text}`: {count} points, more than the {MAX_SWEEP_POINTS} a sweep accepts"
-        )));
-    }
-    Ok(eigenfit_core::analysis::compare::log_space(a, b, count))
 }

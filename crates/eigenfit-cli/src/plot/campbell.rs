@@ -41,16 +41,12 @@ impl Figure for CampbellPlot<'_> {
             .y_label_area_size(90)
             .build_cartesian_2d(s0..s1, 0.0..f_max.max(1.0))
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("rotor speed [rpm]")
-            .y_desc("damped natural frequency [Hz]")
-            .axis_desc_style(style::font(style::AXIS))
-            .label_style(style::font(style::TICK))
-            .light_line_style(style::LIGHT.mix(0.5))
-            .bold_line_style(style::LIGHT)
-            .draw()
-            .map_err(err)?;
+        style::grid(
+            style::axes(&mut chart.configure_mesh(), "rotor speed [rpm]", "damped natural frequency [Hz]"),
+            0.5,
+        )
+        .draw()
+        .map_err(err)?;
         for curve in &c.curves {
             for k in 1..c.speeds_rpm.len() {
                 let (Some(i0), Some(i1)) = (curve[k - 1], curve[k]) else { continue };
@@ -97,15 +93,7 @@ impl Figure for CampbellPlot<'_> {
             .map_err(err)?
             .label("critical speed")
             .legend(|(x, y)| Circle::new((x + 12, y), 6, INK.stroke_width(2)));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font(style::font(style::LEGEND))
-            .background_style(WHITE.mix(0.9))
-            .border_style(style::GUIDE)
-            .margin(12)
-            .draw()
-            .map_err(err)?;
+        style::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         Ok(())
     }
 }

@@ -11,11 +11,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::RGBColor;
 
-/// Relative error under which a converged run counts as "at the target" on the maps: separates
-/// the basin of the target from the basin of another exact solution (which lies a factor ≥ 2
-/// away on the paper rotor), while the paper strategies' 0.01 Hz stopping test (up to ~6 % off
-/// on stiff supports) still counts as reaching the target.
-pub const AT_TARGET: f64 = 0.1;
+/// Relative error under which a converged run counts as "at the target" on the maps (defined
+/// with the comparison, in the workflow).
+pub use eigenfit_workflow::compare::AT_TARGET;
 
 /// Where a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -88,18 +88,14 @@ impl Figure for Convergence {
             .y_label_area_size(90)
             .build_cartesian_2d(0.0..x_end, p_range.log_scale())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("iteration")
-            .y_desc(format!("parameter [{}]", self.unit))
-            .axis_desc_style(style::font(style::AXIS))
-            .label_style(style::font(style::TICK))
-            .x_label_formatter(&x_fmt)
-            .y_label_formatter(&log_tick)
-            .light_line_style(style::LIGHT.mix(0.4))
-            .bold_line_style(style::LIGHT)
-            .draw()
-            .map_err(err)?;
+        style::grid(
+            style::axes(&mut chart.configure_mesh(), "iteration", format!("parameter [{}]", self.unit)),
+            0.4,
+        )
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&log_tick)
+        .draw()
+        .map_err(err)?;
         let mut entries = Vec::new();
         if let Some(t) = &self.target {
             for &v in t {
@@ -147,16 +143,9 @@ impl Figure for Convergence {
             .y_label_area_size(90)
             .build_cartesian_2d(0.0..x_end, d_range.log_scale())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("iteration")
-            .y_desc("max |f − f_measured| [Hz]")
-            .axis_desc_style(style::font(style::AXIS))
-            .label_style(style::font(style::TICK))
+        style::grid(style::axes(&mut chart.configure_mesh(), "iteration", "max |f − f_measured| [Hz]"), 0.4)
             .x_label_formatter(&x_fmt)
             .y_label_formatter(&log_tick)
-            .light_line_style(style::LIGHT.mix(0.4))
-            .bold_line_style(style::LIGHT)
             .draw()
             .map_err(err)?;
         let mut entries = Vec::new();

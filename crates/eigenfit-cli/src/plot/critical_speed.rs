@@ -6,6 +6,7 @@ use super::{err, DrawResult, Figure};
 use crate::error::CliError;
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
+use eigenfit_workflow::simulate::{sweep, SweepCheck};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -39,7 +40,8 @@ pub struct CriticalSpeedMap {
 }
 
 impl CriticalSpeedMap {
-    /// Sweeps `count` log-spaced stiffnesses over `range` (N/m), every bearing equal, `modes` modes.
+    /// Sweeps `count` log-spaced stiffnesses over `range` (N/m), every bearing equal, `modes`
+    /// modes (the workflow's sweep, as `simulate --sweep` uses; frequencies taken as solved).
     pub fn sweep(
         title: &str,
         model: &dyn StructuralModel,
@@ -47,19 +49,11 @@ impl CriticalSpeedMap {
         range: (f64, f64),
         count: usize,
         modes: usize,
-        on_point: impl Fn(),
+        progress: &mut dyn eigenfit_workflow::Progress,
     ) -> Result<Self, CliError> {
-        let np = model.parameters().len();
-        let count = count.max(2);
-        let mut stiffness = Vec::with_capacity(count);
-        let mut frequencies = Vec::with_capacity(count);
-        for k in eigenfit_core::analysis::compare::log_space(range.0, range.1, count) {
-            let system = model.assemble(&vec![k; np]).map_err(|e| CliError::Failure(e.to_string()))?;
-            let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
-            stiffness.push(k);
-            frequencies.push(m.frequencies_hz());
-            on_point();
-        }
+        let stiffness = eigenfit_core::analysis::compare::log_space(range.0, range.1, count.max(2));
+        let frequencies =
+            sweep(model, solver, &stiffness, modes, SweepCheck::None, &mut Vec::new(), progress)?;
         Ok(Self {
             title: title.to_string(),
             stiffness,
@@ -112,18 +106,14 @@ impl Figure for CriticalSpeedMap {
             .y_label_area_size(90)
             .build_cartesian_2d(x_range.log_scale(), y_range.log_scale())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("support stiffness k [N/m]")
-            .y_desc("natural frequency f [Hz]")
-            .axis_desc_style(style::font(style::AXIS))
-            .label_style(style::font(style::TICK))
-            .x_label_formatter(&log_tick)
-            .y_label_formatter(&log_tick)
-            .light_line_style(style::LIGHT.mix(0.5))
-            .bold_line_style(style::LIGHT)
-            .draw()
-            .map_err(err)?;
+        style::grid(
+            style::axes(&mut chart.configure_mesh(), "support stiffness k [N/m]", "natural frequency f [Hz]"),
+            0.5,
+        )
+        .x_label_formatter(&log_tick)
+        .y_label_formatter(&log_tick)
+        .draw()
+        .map_err(err)?;
         for m in 0..modes {
             let c = mode_colour(m);
             chart
@@ -147,15 +137,7 @@ impl Figure for CriticalSpeedMap {
                 .label(self.reference_label.clone())
                 .legend(|(x, y)| Circle::new((x + 12, y), 6, INK.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .label_font(style::font(style::LEGEND))
-            .background_style(WHITE.mix(0.9))
-            .border_style(style::GUIDE)
-            .margin(12)
-            .draw()
-            .map_err(err)?;
+        style::legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         Ok(())
     }
 }

@@ -4,7 +4,6 @@ use super::style::{self, mode_colour, short_sci, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
 use eigenfit_core::eigen::EigenSolver;
-use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::Rotor;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -55,8 +54,7 @@ impl ModeShapes {
         p: &[f64],
         modes: usize,
     ) -> Result<Self, CliError> {
-        let system = rotor.assemble(p).map_err(|e| CliError::Failure(e.to_string()))?;
-        let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
+        let m = eigenfit_workflow::simulate::modes_at(rotor, solver, p, modes)?;
         let nodes = rotor.nodes().to_vec();
         let shapes = (0..m.count())
             .map(|k| Shape { frequency_hz: m.frequencies_hz()[k], curve: interpolate(&nodes, m.shape(k)) })
@@ -129,12 +127,9 @@ impl Figure for ModeShapes {
             .y_label_area_size(80)
             .build_cartesian_2d(x0 - pad..x1 + pad, -1.75..2.15)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("position along the shaft x [m]")
-            .y_desc("displacement (normalised to the largest) [–]")
-            .axis_desc_style(style::font(style::AXIS))
-            .label_style(style::font(style::TICK))
+        let mut mesh = chart.configure_mesh();
+        let x = "position along the shaft x [m]";
+        style::grid(style::axes(&mut mesh, x, "displacement (normalised to the largest) [–]"), 0.4)
             .y_labels(17)
             .y_label_formatter(&|v: &f64| {
                 if v.abs() > 1.01 || (v * 2.0 - (v * 2.0).round()).abs() > 1e-9 {
@@ -143,10 +138,9 @@ impl Figure for ModeShapes {
                     style::trim(*v, 1)
                 }
             })
-            .light_line_style(style::LIGHT.mix(0.4))
-            .bold_line_style(style::LIGHT)
             .draw()
             .map_err(err)?;
+        drop(mesh);
         // The shaft axis and the nodes.
         chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], INK.stroke_width(2))).map_err(err)?;
         chart.draw_series(self.nodes.iter().map(|&x| Circle::new((x, 0.0), 3, INK.filled()))).map_err(err)?;
@@ -191,15 +185,7 @@ impl Figure for ModeShapes {
                 .label(format!("mode {}: {} Hz", k + 1, format_hz(s.frequency_hz)))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperMiddle)
-            .label_font(style::font(style::LEGEND))
-            .background_style(WHITE.mix(0.9))
-            .border_style(style::GUIDE)
-            .margin(12)
-            .draw()
-            .map_err(err)?;
+        style::legend(&mut chart, SeriesLabelPosition::UpperMiddle)?;
         Ok(())
     }
 }

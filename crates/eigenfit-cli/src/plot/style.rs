@@ -1,6 +1,8 @@
 //! The shared look: the bundled font, sizes, colours, number formats and a symmetric-log axis.
 
+use plotters::chart::{ChartContext, MeshStyle, SeriesLabelPosition};
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::coord::CoordTranslate;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, RGBColor};
@@ -310,4 +312,38 @@ pub fn title<DB: DrawingBackend>(
     ))
     .map_err(super::err)?;
     Ok(rest)
+}
+
+/// The axis titles in the axis font and the tick labels in the tick font: every chart's mesh
+/// starts here, the rest (formatters, grid lines) is the chart's own.
+pub fn axes<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
+    mesh: &'m mut MeshStyle<'a, 'b, X, Y, DB>,
+    x: impl Into<String>,
+    y: impl Into<String>,
+) -> &'m mut MeshStyle<'a, 'b, X, Y, DB> {
+    mesh.x_desc(x).y_desc(y).axis_desc_style(font(AXIS)).label_style(font(TICK))
+}
+
+/// Minor grid lines in the light grey at `minor_alpha`, major ones in the light grey.
+pub fn grid<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
+    mesh: &'m mut MeshStyle<'a, 'b, X, Y, DB>,
+    minor_alpha: f64,
+) -> &'m mut MeshStyle<'a, 'b, X, Y, DB> {
+    mesh.light_line_style(LIGHT.mix(minor_alpha)).bold_line_style(LIGHT)
+}
+
+/// Draws the series legend at `position` in the shared look (legend font, a light box).
+pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> super::DrawResult {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font(font(LEGEND))
+        .background_style(WHITE.mix(0.9))
+        .border_style(GUIDE)
+        .margin(12)
+        .draw()
+        .map_err(super::err)
 }

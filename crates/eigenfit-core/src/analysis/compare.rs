@@ -28,10 +28,12 @@ pub struct CompareSettings {
     pub max_iterations: usize,
 }
 
-/// One run of the comparison.
-#[derive(Debug, Clone, PartialEq)]
+/// One run of the comparison. Serialises as the `compare` report's run (the fields a report
+/// shows as they are; the strategy, time and statistics are reported by name or on request).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct CompareRun {
     /// Strategy.
+    #[serde(skip)]
     pub strategy: StrategyKind,
     /// True parameters.
     pub target: Vec<f64>,
@@ -50,11 +52,14 @@ pub struct CompareRun {
     /// max |estimate / target − 1| over the parameters.
     pub relative_error: f64,
     /// Wall-clock time of the run (s); for reports, never for tests.
+    #[serde(skip)]
     pub seconds: f64,
     /// Per parameter, whether the data determine it (damped runs with `std_hz` only).
+    #[serde(skip)]
     pub identifiability: Option<Vec<Identifiability>>,
     /// Other parameter vectors that fit the data equally well (damped runs only): when not
     /// empty, the data cannot choose between them and the estimate.
+    #[serde(skip)]
     pub alternatives: Vec<Vec<f64>>,
 }
 

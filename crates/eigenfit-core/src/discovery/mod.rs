@@ -112,10 +112,12 @@ impl ModeComparison {
     }
 }
 
-/// A refitted candidate.
-#[derive(Debug, Clone, PartialEq)]
+/// A refitted candidate. Serialises as a `discover` report's candidate (what, where, value,
+/// interval, χ², AICc, plausibility).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Fit {
     /// The candidate's label, `kind@location`.
+    #[serde(skip)]
     pub label: String,
     /// Kind.
     pub kind: String,
@@ -128,12 +130,16 @@ pub struct Fit {
     /// 95% interval of the value.
     pub interval: Option<[f64; 2]>,
     /// Position along the structure (m), for an effect placed by coordinate.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub position_m: Option<f64>,
     /// First and last element, for an effect over a run of elements.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
     /// All fitted parameters: the base's, then the values of every effect in the fit.
+    #[serde(skip)]
     pub parameters: Vec<f64>,
     /// 95% (covariance) intervals of all fitted parameters, where they could be computed.
+    #[serde(skip)]
     pub intervals: Vec<Option<[f64; 2]>>,
     /// χ² of the fit.
     pub chi2: f64,
@@ -142,6 +148,7 @@ pub struct Fit {
     /// Is the value physically plausible (and, for a value, its interval clear of zero)?
     pub plausible: bool,
     /// Model frequencies of the measured modes, Hz.
+    #[serde(skip)]
     pub frequencies_hz: Vec<f64>,
 }
 
@@ -168,17 +175,20 @@ impl Fit {
 }
 
 /// An alternative that explains the data about as well as a named effect.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Alternative {
     /// `kind@location`.
+    #[serde(skip)]
     pub label: String,
     /// Kind.
     pub kind: String,
     /// Location.
     pub location: Option<usize>,
     /// Position along the structure (m), if placed by coordinate.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub position_m: Option<f64>,
     /// Element run, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
     /// Its fitted value.
     pub value: Option<f64>,
@@ -204,19 +214,23 @@ impl Alternative {
 }
 
 /// One effect named by forward selection, with its value from the final joint fit.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct NamedEffect {
     /// `kind@location`.
+    #[serde(skip)]
     pub label: String,
     /// Kind.
     pub kind: String,
     /// Location.
     pub location: Option<usize>,
     /// Position along the structure (m), if placed by coordinate.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub position_m: Option<f64>,
     /// Element run, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
-    /// Fitted value in the final joint fit (`None` for a switch).
+    /// Fitted value in the final joint fit (`None` for a switch, reported as 1: on).
+    #[serde(serialize_with = "value_or_on")]
     pub value: Option<f64>,
     /// Its 95% interval.
     pub interval: Option<[f64; 2]>,
@@ -227,11 +241,12 @@ pub struct NamedEffect {
     /// Alternatives within [`DiscoveryOptions::ambiguity_aicc`] when it was chosen.
     pub ambiguous_with: Vec<Alternative>,
     /// The effect's further fitted values ([`Candidate::companions`]) in the final joint fit.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub companions: Vec<CompanionValue>,
 }
 
 /// A further fitted value of a named effect (a pedestal's stiffness beside its mass).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct CompanionValue {
     /// The parameter's name.
     pub name: String,
@@ -241,6 +256,11 @@ pub struct CompanionValue {
     pub interval: Option<[f64; 2]>,
     /// Unit.
     pub unit: String,
+}
+
+/// A switched effect has no value; reports give it as 1 ("on").
+fn value_or_on<S: serde::Serializer>(value: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(value.unwrap_or(1.0))
 }
 
 impl NamedEffect {

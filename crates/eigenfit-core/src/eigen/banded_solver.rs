@@ -29,7 +29,7 @@ use std::cell::RefCell;
 /// If a mode was missed (a repeated eigenvalue: one start vector sees it once) or Lanczos does
 /// not converge, block subspace iteration (Bathe; Rayleigh–Ritz in the same inverted form, by
 /// Jacobi) takes over; if it too misses a mode, or more than half the modes are requested,
-/// [`DenseSolver`] (up to 4000 DOFs).
+/// [`DenseSolver`] (up to [`DENSE_MAX_DOFS`](super::DENSE_MAX_DOFS) DOFs).
 ///
 /// All work arrays live in a per-thread workspace reused from call to call: repeated solves of
 /// the same size (an update loop) allocate only the returned [`Modes`]. A dense [`System`] is
@@ -224,7 +224,7 @@ enum Method {
 }
 
 /// Largest system the banded solver hands to the dense one when its Sturm check fails.
-const MAX_DENSE_FALLBACK: usize = 4000;
+const MAX_DENSE_FALLBACK: usize = super::DENSE_MAX_DOFS;
 
 fn well_conditioned(c: &BandCholesky) -> bool {
     let (dmin, dmax) = c.pivot_range();

@@ -4,6 +4,11 @@ use crate::eigen::{apply_sign_rule, check_count, shifted_twice, EigenSolver, Mod
 use crate::matrix::System;
 use nalgebra::{Cholesky, DMatrix, DVector, SymmetricEigen};
 
+/// Largest model (DOFs) handed to a dense solver — the CLI's `dense`/`lapack` choice and the
+/// fallbacks of the banded and sparse solvers: its two n×n matrices take 16n² bytes (256 MB
+/// here) and its solve O(n³) time. 4002 admits the 2000-element uniform rotor.
+pub const DENSE_MAX_DOFS: usize = 4002;
+
 /// Dense solver for the lowest modes, accurate to round-off *relative to each eigenvalue*
 /// when at most half the modes are requested.
 ///

@@ -16,7 +16,7 @@ pub(crate) mod solver;
 pub(crate) mod sparse_solver;
 
 pub use banded_solver::{subspace_size, BandedSolver};
-pub use dense_solver::DenseSolver;
+pub use dense_solver::{DenseSolver, DENSE_MAX_DOFS};
 pub use modes::{apply_sign_rule, Modes};
 pub use solver::{check_count, shifted_twice, EigenSolver, SolveError};
 pub use sparse_solver::SparseSolver;

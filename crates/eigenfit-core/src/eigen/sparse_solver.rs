@@ -36,7 +36,7 @@ use std::cell::RefCell;
 /// [`lowest_with_next`](EigenSolver::lowest_with_next) as a lower bound on the next eigenvalue.
 /// One start vector sees a repeated eigenvalue (a square plate's (m, n) and (n, m) modes) once:
 /// when the count shows missed modes, Lanczos is rerun M-orthogonally to the modes found, which
-/// finds the missing copies, and the count is repeated. Systems of up to 4000 DOFs fall back to
+/// finds the missing copies, and the count is repeated. Systems of up to `DENSE_MAX_DOFS` (4002) DOFs fall back to
 /// [`DenseSolver`] when that fails too; larger ones report the failure.
 ///
 /// The symbolic factorisation (ordering, elimination tree) depends only on the pattern of K and
@@ -79,7 +79,7 @@ impl Default for SparseSolver {
 }
 
 /// Largest system handed to the dense solver when the sparse path fails.
-const MAX_DENSE_FALLBACK: usize = 4000;
+const MAX_DENSE_FALLBACK: usize = super::DENSE_MAX_DOFS;
 /// Lanczos reruns (against the modes found) allowed after the Sturm count shows a missed mode.
 const MAX_RERUNS: usize = 4;
 

@@ -11,6 +11,8 @@ pub mod uff;
 
 use thiserror::Error;
 
+pub mod measured_csv;
+
 /// One measured mode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasuredMode {

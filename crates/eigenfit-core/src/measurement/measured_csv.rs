@@ -1,14 +1,31 @@
-//! The measured-data file: CSV with header `mode,frequency_hz[,std_hz]`, modes numbered from 1.
+//! The measured-data file: CSV with header `mode,frequency_hz[,std_hz]`, modes numbered from 1
+//! (docs/test-data.md). A file format, so it lives here where a library user can read it too;
+//! the CLI and the fuzz crate call it.
 //!
 //! Read with the `csv` crate (RFC 4180 quoting), so a quoted field with a comma is one field.
 //! Before any fit the data are checked for what no model can produce: frequencies that do not
 //! increase with mode number, and a mode listed twice.
 
-use crate::error::{input, CliError};
-use eigenfit_core::measurement::{MeasuredMode, Measurement};
+use crate::measurement::{MeasuredMode, Measurement};
 use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
+use thiserror::Error;
+
+/// Why a measured-data file could not be read; every message names the file and, where it
+/// applies, the line (`FILE:LINE: …`).
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum MeasuredFileError {
+    /// The file cannot be opened or read, is not a regular file, or is too large.
+    #[error("{0}")]
+    Unreadable(String),
+    /// The bytes are not UTF-8 text.
+    #[error("{0}")]
+    NotText(String),
+    /// The text is not a valid measured-data CSV.
+    #[error("{0}")]
+    Invalid(String),
+}
 
 /// Largest measured file read (bytes): far above any modal survey, small enough that a wrong
 /// path (a disk image, `/dev/zero`) is refused instead of filling memory.
@@ -17,38 +34,33 @@ pub const MAX_FILE_BYTES: u64 = 64 << 20;
 /// Columns some export tools add that eigenfit does not use: accepted and ignored with a note.
 const IGNORED_COLUMNS: [&str; 3] = ["damping_ratio", "damping", "mac"];
 
-/// Reads and validates a measured-data file. Every error names the file and, where it applies,
-/// the line. Notes (ignored columns) go to stderr.
-pub fn read(path: &Path) -> Result<Measurement, CliError> {
-    let (measurement, notes) = read_with_notes(path)?;
-    for note in notes {
-        eprintln!("eigenfit: note: {note}");
-    }
-    Ok(measurement)
-}
-
-/// [`read`], returning the notes instead of printing them.
-pub fn read_with_notes(path: &Path) -> Result<(Measurement, Vec<String>), CliError> {
+/// Reads and validates a measured-data file; returns the measurement and the notes the user
+/// should see (ignored columns), each starting with `FILE:LINE: `.
+pub fn read_with_notes(path: &Path) -> Result<(Measurement, Vec<String>), MeasuredFileError> {
     let bytes = read_regular_file(path, MAX_FILE_BYTES)?;
     let text = String::from_utf8(bytes).map_err(|e| {
         // Say where the first bad byte is: a binary file, or text saved in another encoding.
         let valid = std::str::from_utf8(&e.as_bytes()[..e.utf8_error().valid_up_to()]).unwrap_or_default();
         let line = valid.matches('\n').count() + 1;
         let column = valid.rsplit('\n').next().unwrap_or_default().chars().count() + 1;
-        input(format!("{}:{line}: not a UTF-8 text file (invalid byte at column {column})", path.display()))
+        MeasuredFileError::NotText(format!(
+            "{}:{line}: not a UTF-8 text file (invalid byte at column {column})",
+            path.display()
+        ))
     })?;
     // Spreadsheets often save CSV as "UTF-8 with BOM"; the BOM is not part of the first column's name.
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let (measurement, notes) =
-        parse_with_notes(text).map_err(|e| input(format!("{}:{e}", path.display())))?;
+        parse_with_notes(text).map_err(|e| MeasuredFileError::Invalid(format!("{}:{e}", path.display())))?;
     let notes = notes.into_iter().map(|n| format!("{}:{n}", path.display())).collect();
     Ok((measurement, notes))
 }
 
 /// The bytes of `path`, refusing anything but a regular file (a FIFO would block, a device never
 /// end) and files above `cap` bytes.
-pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, CliError> {
-    let cannot = |e: std::io::Error| input(format!("{}: cannot read: {e}", path.display()));
+pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, MeasuredFileError> {
+    let cannot =
+        |e: std::io::Error| MeasuredFileError::Unreadable(format!("{}: cannot read: {e}", path.display()));
     // Checked before opening: opening a FIFO for reading blocks until a writer appears.
     let meta = std::fs::metadata(path).map_err(cannot)?;
     if meta.is_dir() {
@@ -56,7 +68,7 @@ pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, CliError> {
         return std::fs::read(path).map_err(cannot);
     }
     if !meta.is_file() {
-        return Err(input(format!(
+        return Err(MeasuredFileError::Unreadable(format!(
             "{}: not a regular file (a FIFO, socket or device would block or never end)",
             path.display()
         )));
@@ -66,7 +78,7 @@ pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, CliError> {
     // `take` bounds the read even if the file grows after the check.
     file.take(cap + 1).read_to_end(&mut bytes).map_err(cannot)?;
     if bytes.len() as u64 > cap {
-        return Err(input(format!(
+        return Err(MeasuredFileError::Unreadable(format!(
             "{}: larger than the {} MB a measured file may have",
             path.display(),
             cap >> 20

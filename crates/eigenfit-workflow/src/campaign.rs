@@ -1,0 +1,198 @@
+//! `campaign`: several test configurations (one model and one data set each) estimated jointly
+//! (docs/test-data.md).
+
+use crate::error::{failure, input, WorkflowError};
+use crate::model::Updatable;
+use crate::named::Named;
+use crate::outcome::Outcome;
+use crate::overrides::fixed;
+use crate::progress::Progress;
+use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDataOptions};
+use eigenfit_core::analysis::Joint;
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
+use eigenfit_core::update::{Driver, StrategyKind};
+use eigenfit_rotor::campaign::Campaign;
+use eigenfit_rotor::{Rotor, UpdatableRotor};
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// A campaign to estimate, as the command line gives it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CampaignRequest {
+    /// The campaign file (TOML, `[[configuration]]` tables).
+    pub campaign: PathBuf,
+    /// Update strategy: newton, p-step or damped.
+    pub strategy: String,
+    /// Eigen-solver: banded (or auto) or dense.
+    pub solver: String,
+    /// Iteration limit.
+    pub max_iterations: usize,
+    /// Node matching, shape weight and MAC threshold for every configuration.
+    pub shape: ShapeOptions,
+}
+
+/// One configuration at the joint estimate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConfigurationReport {
+    /// Its name.
+    pub name: String,
+    /// Model frequencies (Hz).
+    pub frequencies_hz: Vec<f64>,
+    /// Measured frequencies (Hz).
+    pub measured_hz: Vec<f64>,
+    /// Measured mode number → model mode number, both from 1.
+    pub pairing: Named<usize>,
+    /// MAC matrix (shapes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mac: Option<Vec<Vec<f64>>>,
+    /// Measured modes below the MAC threshold (shapes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unpaired: Option<Vec<usize>>,
+    /// What the user should know about the data.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+    /// Measured mode numbers (from 1), in the data's order.
+    #[serde(skip)]
+    pub mode_numbers: Vec<usize>,
+    /// (measured mode, paired model mode, MAC) per measured mode (shapes).
+    #[serde(skip)]
+    pub mac_pairing: Option<Vec<(usize, usize, f64)>>,
+}
+
+/// `campaign`'s report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CampaignReport {
+    /// The campaign file.
+    pub campaign: String,
+    /// Strategy name.
+    pub strategy: &'static str,
+    /// Converged (with every mode paired), why it stopped, iterations, evaluations.
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// Initial values.
+    pub initial: Named<f64>,
+    /// Estimated values.
+    pub parameters: Named<f64>,
+    /// χ² of the joint fit.
+    pub chi2: f64,
+    /// Its degrees of freedom.
+    pub dof: usize,
+    /// 95 % intervals.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub intervals: Option<Named<[f64; 2]>>,
+    /// What the intervals were scaled by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interval_basis: Option<String>,
+    /// Each configuration.
+    pub configurations: Vec<ConfigurationReport>,
+    /// Every configuration has std and no shapes.
+    #[serde(skip)]
+    pub has_std: bool,
+    /// The residual scatter the intervals were scaled by.
+    #[serde(skip)]
+    pub scatter: Option<f64>,
+    /// Notes on the frequency CSVs' columns, for the log.
+    #[serde(skip)]
+    pub file_notes: Vec<String>,
+}
+
+/// Estimates a campaign jointly.
+pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<CampaignReport, WorkflowError> {
+    let campaign = Campaign::from_toml_file(&request.campaign).map_err(input)?;
+    let solver: Box<dyn EigenSolver> = match request.solver.as_str() {
+        "banded" | "auto" => Box::new(BandedSolver::default()),
+        "dense" => Box::new(DenseSolver),
+        other => return Err(input(format!("unknown solver `{other}`; available: banded, dense"))),
+    };
+    let strategy_kind = StrategyKind::from_name(&request.strategy).ok_or_else(|| {
+        input(format!(
+            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
+            request.strategy
+        ))
+    })?;
+    let mut models = Vec::new();
+    let mut data = Vec::new();
+    let mut names = Vec::new();
+    let mut file_notes = Vec::new();
+    for conf in &campaign.configurations {
+        let name = conf.name.clone().unwrap_or_default();
+        let rotor = Rotor::from_toml_file(&conf.model).map_err(|e| input(format!("{name}: {e}")))?;
+        let options = TestDataOptions {
+            shapes: conf.shapes.clone(),
+            sensor_map: conf.sensor_map.clone(),
+            shape: request.shape,
+            fix: Vec::new(),
+        };
+        let d = test_data::read(&conf.measured, Some(&rotor), &options)
+            .map_err(|e| input(format!("{name}: {e}")))?;
+        file_notes.extend(d.file_notes.iter().cloned());
+        let updatable = UpdatableRotor::new(rotor)
+            .map(|r| Updatable::Rotor(Box::new(r)))
+            .map_err(|e| input(format!("{}: {e}", conf.model.display())))?;
+        models.push(updatable);
+        data.push(d);
+        names.push(name);
+    }
+    let fixed: Vec<_> = models.iter().map(|m| fixed(m, &[])).collect::<Result<_, _>>()?;
+    let fits: Vec<Fit> = fixed
+        .iter()
+        .zip(&data)
+        .map(|(m, d)| {
+            let problem =
+                Problem::new(m, solver.as_ref(), d.measurement.clone()).with_kind(ResidualKind::Relative);
+            Fit::new(problem, d, request.shape.shape_std)
+        })
+        .collect();
+    let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Objective).collect())
+        .map_err(|e| input(format!("{}: {e}", request.campaign.display())))?;
+    let has_std = data.iter().all(|d| d.measurement.has_std() && d.sensors.is_none());
+    let initial = joint.parameters().nominal_values();
+    progress.begin(&format!("estimating the campaign ({})", strategy_kind.name()), None);
+    let mut strategy = strategy_kind.build();
+    let estimate = Driver { max_iterations: request.max_iterations }
+        .run(&joint, strategy.as_mut(), &initial, &mut [])
+        .map_err(|e| input(e.to_string()));
+    progress.end();
+    let estimate = estimate?;
+    let p = estimate.parameters.clone();
+    let (unc, scatter) = match estimate.termination.is_converged() {
+        true => joint.uncertainty(&estimate.last, has_std).map_or((None, None), |(u, s)| (Some(u), Some(s))),
+        false => (None, None),
+    };
+    let pnames: Vec<String> = joint.parameters().iter().map(|q| q.name.clone()).collect();
+    let mut configurations = Vec::new();
+    let mut unpaired = false;
+    for (k, fit) in fits.iter().enumerate() {
+        let sub = joint.part_values(k, &p);
+        let lin = joint.part_linearise(k, &p).map_err(|e| failure(format!("{}: {e}", names[k])))?;
+        let mac = fit.mac(&sub, request.shape.mac_threshold);
+        unpaired |= mac.as_ref().is_some_and(|r| !r.unpaired.is_empty());
+        configurations.push(ConfigurationReport {
+            name: names[k].clone(),
+            pairing: pairing(fit.measured(), &lin.paired_modes),
+            frequencies_hz: lin.frequencies_hz,
+            measured_hz: lin.measured_hz,
+            mac: mac.as_ref().map(|r| r.matrix.clone()),
+            unpaired: mac.as_ref().map(|r| r.unpaired.clone()),
+            notes: data[k].notes.clone(),
+            mode_numbers: data[k].measurement.modes().iter().map(|m| m.mode + 1).collect(),
+            mac_pairing: mac.map(|r| r.pairing),
+        });
+    }
+    Ok(CampaignReport {
+        campaign: request.campaign.display().to_string(),
+        strategy: estimate.strategy,
+        outcome: Outcome::of(&estimate, estimate.termination.is_converged() && !unpaired),
+        initial: Named::new(&pnames, initial.iter().copied()),
+        parameters: Named::new(&pnames, p.iter().copied()),
+        chi2: estimate.last.chi2(),
+        dof: estimate.last.degrees_of_freedom(),
+        intervals: unc.as_ref().map(|u| Named::new(&pnames, u.intervals.iter().copied())),
+        interval_basis: scatter.map(|s| interval_basis(s, has_std)),
+        configurations,
+        has_std,
+        scatter,
+        file_notes,
+    })
+}

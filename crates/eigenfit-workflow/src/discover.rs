@@ -1,0 +1,144 @@
+//! `discover`: calibrate, find where model and measurement disagree, name the missing effect
+//! and build the augmented model.
+
+use crate::error::{failure, input, WorkflowError};
+use crate::model::AnyModel;
+use crate::named::Named;
+use crate::progress::Progress;
+use eigenfit_core::discovery::{discover, DiscoveryOptions, Fit, NamedEffect};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::model::StructuralModel;
+use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
+use serde::Serialize;
+use std::path::Path;
+
+/// One measured mode before and after.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeReport {
+    /// Mode number from 1.
+    pub mode: usize,
+    /// Measured frequency (Hz).
+    pub measured_hz: f64,
+    /// Its standard deviation (Hz).
+    pub std_hz: f64,
+    /// Model before (Hz).
+    pub before_hz: f64,
+    /// Model after (Hz).
+    pub after_hz: f64,
+}
+
+/// `discover`'s report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DiscoverReport {
+    /// The model's label.
+    pub model: String,
+    /// χ² before.
+    pub chi2_before: f64,
+    /// Degrees of freedom before.
+    pub dof_before: usize,
+    /// P(χ² this large from noise alone).
+    pub p_value: f64,
+    /// Whether the misfit is beyond the noise.
+    pub disagreement_significant: bool,
+    /// The strongest named effect.
+    pub missing_effect: Option<NamedEffect>,
+    /// Every named effect, strongest first.
+    pub missing_effects: Vec<NamedEffect>,
+    /// Mesh refinement factor settled on (1: the user's mesh).
+    pub mesh_refinement: usize,
+    /// RMS residual before (Hz).
+    pub rms_residual_before_hz: f64,
+    /// RMS residual after (Hz).
+    pub rms_residual_after_hz: f64,
+    /// The nominal parameters calibrated.
+    pub calibrated_parameters: Named<f64>,
+    /// The best candidate after the first.
+    pub runner_up: Option<Fit>,
+    /// Every candidate refitted.
+    pub candidates_refitted: Vec<Fit>,
+    /// Each measured mode before and after.
+    pub modes: Vec<ModeReport>,
+    /// Files written (the augmented model, plots).
+    pub written: Vec<String>,
+    /// Eigen-solves the search spent (user's and refined mesh together).
+    pub evaluations: usize,
+    /// True when the search stopped at its budget of eigen-solves.
+    pub budget_exhausted: bool,
+}
+
+/// A discovery and its report.
+pub struct Discovery {
+    /// What the workflow found.
+    pub found: RotorDiscovery,
+    /// The report (`written` empty: the caller adds the files it writes).
+    pub report: DiscoverReport,
+}
+
+/// Runs the discovery on `model` against the measured CSV at `measured`, assuming a relative
+/// standard deviation `assumed_std` where the file gives none. Notes on the file go to `notes`.
+pub fn run(
+    label: &str,
+    model: &AnyModel,
+    solver: &dyn EigenSolver,
+    measured: &Path,
+    assumed_std: f64,
+    notes: &mut Vec<String>,
+    progress: &mut dyn Progress,
+) -> Result<Discovery, WorkflowError> {
+    let (data, file_notes) = crate::test_data::read_frequencies(measured)?;
+    notes.extend(file_notes);
+    if !(assumed_std.is_finite() && assumed_std > 0.0) {
+        return Err(input(format!("--assumed-std {assumed_std}: must be a positive number")));
+    }
+    let options = DiscoveryOptions { assumed_relative_std: assumed_std, ..Default::default() };
+    progress.begin("discovering: calibrate, detect, screen and refit candidates", None);
+    let found = match model {
+        AnyModel::Rotor(r) => discover_rotor(r, &solver, &data, &r.nominal_stiffnesses(), &options),
+        // A matrices model has no mesh to refine: the generic workflow over its [[candidate]]s.
+        AnyModel::Matrices(m) => {
+            discover(m, &solver, &data, &m.candidates(), &m.parameters().nominal_values(), &options)
+                .map(|report| RotorDiscovery { effects: report.effects.clone(), report, mesh_factor: 1 })
+        }
+    };
+    progress.end();
+    let found = found.map_err(|e| input(format!("{}: {e}", measured.display())))?;
+    let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
+    let r = &found.report;
+    let report = DiscoverReport {
+        model: label.to_string(),
+        disagreement_significant: r.disagreement_significant,
+        missing_effect: found.effects.first().cloned(),
+        missing_effects: found.effects.clone(),
+        mesh_refinement: found.mesh_factor,
+        rms_residual_before_hz: r.rms_before_hz,
+        rms_residual_after_hz: r.rms_after_hz,
+        chi2_before: r.chi2_before,
+        dof_before: r.dof_before,
+        p_value: r.p_value,
+        calibrated_parameters: Named::new(&names, r.base_parameters.iter().copied()),
+        runner_up: r.runner_up.clone(),
+        candidates_refitted: r.fits.clone(),
+        modes: r
+            .modes
+            .iter()
+            .map(|m| ModeReport {
+                mode: m.mode + 1,
+                measured_hz: m.measured_hz,
+                std_hz: m.std_hz,
+                before_hz: m.before_hz,
+                after_hz: m.after_hz,
+            })
+            .collect(),
+        written: Vec::new(),
+        evaluations: r.evaluations,
+        budget_exhausted: r.budget_exhausted,
+    };
+    Ok(Discovery { found, report })
+}
+
+/// The augmented model (calibrated stiffnesses and the named effects) as rotor TOML; a
+/// matrices model has no file form for its effects and says so.
+pub fn augmented_model_toml(found: &RotorDiscovery, model: &AnyModel) -> Result<String, WorkflowError> {
+    let augmented = found.augmented_model(model.rotor("--write-model")?).map_err(failure)?;
+    augmented.to_toml_string().map_err(failure)
+}

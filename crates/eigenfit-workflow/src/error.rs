@@ -1,0 +1,31 @@
+//! The one error type of the workflows: bad input (the user can fix it) or a failure inside
+//! eigenfit on valid input. The CLI maps them to exit codes 2 and 1.
+
+use thiserror::Error;
+
+/// What went wrong; every message names what and where.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum WorkflowError {
+    /// The input is wrong (arguments, files, data); the message says what and where.
+    #[error("{0}")]
+    Input(String),
+    /// eigenfit failed on valid input (a solver that broke).
+    #[error("{0}")]
+    Failure(String),
+}
+
+/// Shorthand for an input error.
+pub(crate) fn input(msg: impl Into<String>) -> WorkflowError {
+    WorkflowError::Input(msg.into())
+}
+
+/// Shorthand for a failure.
+pub(crate) fn failure(msg: impl ToString) -> WorkflowError {
+    WorkflowError::Failure(msg.to_string())
+}
+
+impl From<eigenfit_core::measurement::measured_csv::MeasuredFileError> for WorkflowError {
+    fn from(e: eigenfit_core::measurement::measured_csv::MeasuredFileError) -> Self {
+        WorkflowError::Input(e.to_string())
+    }
+}

@@ -1,0 +1,523 @@
+//! `estimate`: update a model's parameters to match measured frequencies (and shapes), with
+//! the verdict, intervals, other equally good solutions and the updated model file.
+
+use crate::error::{input, WorkflowError};
+use crate::named::Named;
+use crate::outcome::Outcome;
+use crate::overrides::{fixed, parameter_vector};
+use crate::progress::Progress;
+use crate::rotordynamics::{self, RunupEstimateReport};
+use crate::simulate::check_roundoff;
+use crate::source::ModelSource;
+use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
+use eigenfit_core::analysis::verdict::{at_limits, judge, unreachable_modes, FitQuality, FitVerdict};
+use eigenfit_core::analysis::{alternative_solutions_within, mirror_solutions, Identifiability, Uncertainty};
+use eigenfit_core::measurement::mac::MacReport;
+use eigenfit_core::measurement::measured_csv::{shown, shown_number};
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
+use eigenfit_core::update::{Budget, Driver, Estimate, LevenbergMarquardt, StrategyKind};
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// Another equally good parameter vector, with the exchanged pair when it is a mirror solution.
+type Alternative = (Vec<f64>, Option<(usize, usize)>);
+
+/// Restart-grid points refitted locally when searching for other equally good solutions.
+const ALTERNATIVE_STARTS: usize = 6;
+/// A measured mode this far (relative) outside every frequency the model reaches is refused.
+const UNREACHABLE_MARGIN: f64 = 0.1;
+
+/// What to estimate, as the command line gives it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EstimateRequest {
+    /// The model and solver.
+    pub source: ModelSource,
+    /// Measured data: frequency CSV, universal file, or (ROSS rotor) a run-up CSV.
+    pub measured: PathBuf,
+    /// Shapes, sensors and held parameters.
+    pub test_data: TestDataOptions,
+    /// Update strategy: newton, p-step or damped.
+    pub strategy: String,
+    /// Initial values `K1,K2,…` (default: the model's).
+    pub initial: Option<String>,
+    /// Residual: relative, hz or eigenvalue.
+    pub residual: String,
+    /// Iteration limit.
+    pub max_iterations: usize,
+    /// Most model evaluations the fit, its intervals and the search for other solutions spend.
+    pub budget: usize,
+    /// Also build the updated model file (rotor TOML).
+    pub write_model: bool,
+    /// ROSS rotors: the bearing coefficients to estimate (`kxx,kyy,…` or `kxy_<bearing>`; `None`:
+    /// kxx and kyy of every bearing). Refused for other models.
+    pub bearing_parameters: Option<String>,
+}
+
+/// Model evaluations allowed and spent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct BudgetReport {
+    /// The limit.
+    pub limit: usize,
+    /// Spent.
+    pub used: usize,
+    /// Whether it ran out.
+    pub exhausted: bool,
+}
+
+/// Another equally good parameter vector.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AlternativeSolution {
+    /// Its values.
+    pub parameters: Named<f64>,
+    /// The exchanged pair when it is a mirror solution of a symmetric model.
+    pub mirror_of: Option<[String; 2]>,
+}
+
+/// One iteration of the fit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HistoryRecord {
+    /// Iteration number.
+    pub iteration: usize,
+    /// Parameters.
+    pub parameters: Vec<f64>,
+    /// Model frequencies (Hz).
+    pub frequencies_hz: Vec<f64>,
+    /// Largest |model − measured| (Hz).
+    pub max_abs_diff_hz: f64,
+}
+
+/// What the data say about one parameter: `true`, or `{"identifiable": false}` with the one
+/// bound known.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum ParameterIdentifiability {
+    /// Determined.
+    Determined(bool),
+    /// Not determined; a bound where one is known.
+    Not {
+        /// Always false.
+        identifiable: bool,
+        /// The lower bound, when only that is known.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        lower_bound: Option<f64>,
+        /// The upper bound, when only that is known.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        upper_bound: Option<f64>,
+    },
+}
+
+impl From<&Identifiability> for ParameterIdentifiability {
+    fn from(i: &Identifiability) -> Self {
+        let not = |lower_bound, upper_bound| Self::Not { identifiable: false, lower_bound, upper_bound };
+        match *i {
+            Identifiability::Determined => Self::Determined(true),
+            Identifiability::LowerBoundOnly { lower } => not(Some(lower), None),
+            Identifiability::UpperBoundOnly { upper } => not(None, Some(upper)),
+            Identifiability::Undetermined => not(None, None),
+        }
+    }
+}
+
+/// The intervals part of an estimate report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct IntervalsReport {
+    /// 95 % intervals.
+    pub intervals: Named<[f64; 2]>,
+    /// Identifiability per parameter.
+    pub identifiable: Named<ParameterIdentifiability>,
+    /// Singular values of the scaled Jacobian.
+    pub singular_values: Vec<f64>,
+    /// Their ratio.
+    pub condition_number: f64,
+    /// Standard deviations.
+    pub standard_deviations: Named<f64>,
+}
+
+impl IntervalsReport {
+    /// The report of `u` for parameters `names`.
+    pub fn new(names: &[String], u: &Uncertainty) -> Self {
+        Self {
+            intervals: Named::new(names, u.intervals.iter().copied()),
+            identifiable: Named::new(names, u.identifiability.iter().map(Into::into)),
+            singular_values: u.singular_values.clone(),
+            condition_number: u.condition_number,
+            standard_deviations: Named::new(names, (0..names.len()).map(|i| u.covariance[(i, i)].sqrt())),
+        }
+    }
+}
+
+/// `estimate`'s report (the `--json` object).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EstimateReport {
+    /// The model's label.
+    pub model: String,
+    /// Strategy name.
+    pub strategy: &'static str,
+    /// Converged, why it stopped, iterations, model evaluations of the fit.
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// Converged, fit not poor, no parameter on a limit, budget not spent, every mode paired.
+    pub acceptable: bool,
+    /// The verdict in words.
+    pub verdict: String,
+    /// `acceptable`, `poor-fit` or `not-judged`.
+    pub fit_quality: &'static str,
+    /// χ² (with std).
+    pub chi2: Option<f64>,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// P(χ² this large from noise alone).
+    pub p_value: Option<f64>,
+    /// √(mean relative residual²).
+    pub relative_rms_residual: f64,
+    /// Measured mode numbers that disagree by more than 3σ.
+    pub disagreeing_modes: Vec<usize>,
+    /// The evaluation budget.
+    pub budget: BudgetReport,
+    /// Initial values.
+    pub initial: Named<f64>,
+    /// Estimated values.
+    pub parameters: Named<f64>,
+    /// What the data say about each parameter, in words.
+    pub parameter_status: Named<String>,
+    /// Parameters on a limit.
+    pub at_limit: Vec<String>,
+    /// Intervals and what the data determine (a converged run with std or scatter).
+    #[serde(flatten)]
+    pub uncertainty: Option<IntervalsReport>,
+    /// Other equally good solutions.
+    pub alternative_solutions: Vec<AlternativeSolution>,
+    /// Model frequencies at the estimate (Hz).
+    pub frequencies_hz: Vec<f64>,
+    /// Measured frequencies (Hz).
+    pub measured_hz: Vec<f64>,
+    /// The iterations.
+    pub history: Vec<HistoryRecord>,
+    /// Plot files written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plots: Option<Vec<String>>,
+    /// Pairing, MAC and sensors.
+    #[serde(flatten)]
+    pub test_data: ShapeReport,
+    /// Held parameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fixed: Option<Named<f64>>,
+}
+
+/// An estimation: the report and what a front end needs beside it (tables, plots, files).
+pub struct Estimation {
+    /// The report.
+    pub report: EstimateReport,
+    /// The estimate with its history.
+    pub estimate: Estimate,
+    /// The fit quality.
+    pub quality: FitQuality,
+    /// The intervals.
+    pub uncertainty: Option<Uncertainty>,
+    /// The MAC report (shapes).
+    pub mac: Option<MacReport>,
+    /// The data read.
+    pub data: TestData,
+    /// The residual scatter the shape intervals were scaled by.
+    pub scatter: Option<f64>,
+    /// Whether the data carry standard deviations.
+    pub has_std: bool,
+    /// Measured mode numbers (from 1), in the data's order.
+    pub mode_numbers: Vec<usize>,
+    /// Per parameter: whether it sits on a limit.
+    pub on_limit: Vec<bool>,
+    /// The unit of the first parameter (for plots).
+    pub unit: String,
+    /// The largest measured standard deviation (Hz).
+    pub sigma_max: Option<f64>,
+    /// The exit verdict: converged, fit not poor, nothing on a limit, budget left, all paired.
+    pub acceptable: bool,
+    /// The updated model as TOML, when asked for (or why there is none).
+    pub updated_model: Option<Result<String, WorkflowError>>,
+}
+
+/// What an estimation ended with.
+pub enum EstimateOutcome {
+    /// A two-plane (ROSS) rotor's bearing stiffnesses from run-up data.
+    Runup(Box<RunupEstimateReport>),
+    /// The budget ran out before the fit could start; nothing to report.
+    BudgetExhaustedBeforeFit {
+        /// The budget.
+        limit: usize,
+    },
+    /// The fit and its report.
+    Done(Box<Estimation>),
+}
+
+/// Runs an estimation. Notes for the log (ignored columns, strategy choices, round-off) go to
+/// `notes` as they arise.
+pub fn run(
+    request: &EstimateRequest,
+    notes: &mut Vec<String>,
+    progress: &mut dyn Progress,
+) -> Result<EstimateOutcome, WorkflowError> {
+    // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
+    if let Some(path) = rotordynamics::ross_model(request.source.model.as_deref()) {
+        return rotordynamics::estimate(
+            path,
+            &request.measured,
+            request.bearing_parameters.as_deref(),
+            request.max_iterations,
+        )
+        .map(|r| EstimateOutcome::Runup(Box::new(r)));
+    }
+    if request.bearing_parameters.is_some() {
+        return Err(input(
+            "--parameters selects bearing coefficients of a ROSS rotor model; \
+             this model's parameters are its [[parameter]] tables",
+        ));
+    }
+    let (any, label) = request.source.load_any()?;
+    let solver = request.source.solver()?;
+    let options = &request.test_data;
+    let data = test_data::read(&request.measured, any.layout(), options)?;
+    notes.extend(data.file_notes.iter().cloned());
+    let measurement = data.measurement.clone();
+    let strategy_kind = StrategyKind::from_name(&request.strategy).ok_or_else(|| {
+        input(format!(
+            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
+            shown(&request.strategy)
+        ))
+    })?;
+    let kind = match request.residual.as_str() {
+        "relative" => ResidualKind::Relative,
+        "hz" => ResidualKind::FrequencyHz,
+        "eigenvalue" => ResidualKind::Eigenvalue,
+        other => {
+            return Err(input(format!(
+                "unknown residual `{}`; available: relative, hz, eigenvalue",
+                shown(other)
+            )))
+        }
+    };
+    if request.budget == 0 {
+        return Err(input("--budget 0: at least one model evaluation is needed"));
+    }
+    let updatable = any.updatable(&label)?;
+    let initial = parameter_vector(&updatable, "--initial", request.initial.as_deref(), &[])?;
+    let model = fixed(&updatable, &options.fix)?;
+    let initial = model.reduce(&initial);
+    let np = model.parameters().len();
+    let measured_name = request.measured.display();
+    // With shapes every mode gives a row per sensor too: fewer modes than parameters may do.
+    let rows = measurement.len() * (1 + data.sensors.as_ref().map_or(0, |s| s.sensors.len()));
+    if rows < np {
+        return Err(input(format!(
+            "{measured_name}: {} measured modes for {np} parameters: at least {np} are needed",
+            measurement.len()
+        )));
+    }
+    if measurement.modes_needed() > any.dofs() {
+        return Err(input(format!(
+            "{measured_name}: mode {} measured but the model has only {} modes",
+            measurement.modes_needed(),
+            any.dofs()
+        )));
+    }
+    if matches!(strategy_kind, StrategyKind::Newton | StrategyKind::PStep) && measurement.len() > np {
+        notes.push(format!(
+            "the {} strategy solves the paper's square system: it uses the first {np} of the {} measured modes; \
+             the damped strategy uses all",
+            strategy_kind.name(),
+            measurement.len()
+        ));
+    }
+    let has_std = measurement.has_std();
+    let mode_numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
+    let sigma_max = measurement.modes().iter().filter_map(|m| m.std_hz).reduce(f64::max);
+    let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
+    let mut fit = Fit::new(problem, &data, options.shape.shape_std);
+    let budget = Budget::new(request.budget);
+    // Data no parameter value can produce is refused before any fitting.
+    let unreachable = unreachable_modes(&fit, UNREACHABLE_MARGIN, &budget);
+    if !unreachable.is_empty() {
+        let list: Vec<String> = unreachable
+            .iter()
+            .map(|u| {
+                format!(
+                    "mode {} at {} Hz (the model reaches {:.4}–{:.4} Hz)",
+                    mode_numbers[u.index],
+                    shown_number(u.measured_hz),
+                    u.reachable_hz[0],
+                    u.reachable_hz[1]
+                )
+            })
+            .collect();
+        return Err(input(format!(
+            "{measured_name}: no stiffness within the limits can produce {}: a typing slip or a wrong unit?",
+            list.join("; ")
+        )));
+    }
+    // A start inside the bounds where the model cannot be evaluated (a support so soft its mode
+    // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
+    // the best point of its coarse grid instead, and says so.
+    let mut start = initial.clone();
+    if strategy_kind == StrategyKind::LevenbergMarquardt {
+        let budgeted = budget.wrap(&fit);
+        if let Err(e) = budgeted.linearise(&initial) {
+            if let Some(seed) = LevenbergMarquardt::rank_seeds(&budgeted).first() {
+                notes.push(format!(
+                    "the model cannot be evaluated at --initial ({e}); starting from the best point of the coarse grid"
+                ));
+                start = seed.clone();
+            }
+        }
+    }
+    let mut strategy = strategy_kind.build();
+    progress.begin(&format!("estimating ({})", strategy_kind.name()), None);
+    let estimate = Driver { max_iterations: request.max_iterations }
+        .run_within(&fit, strategy.as_mut(), &start, &mut [], &budget)
+        .map_err(|e| input(e.to_string()));
+    progress.end();
+    let estimate = match estimate {
+        Err(_) if budget.exhausted() => {
+            return Ok(EstimateOutcome::BudgetExhaustedBeforeFit { limit: budget.limit() })
+        }
+        other => other?,
+    };
+    // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
+    let system = model.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
+    if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
+        notes.extend(check_roundoff(&system, &modes)?);
+    }
+    let converged = estimate.termination.is_converged();
+    let quality = judge(&estimate.last, np);
+    let limits = at_limits(model.parameters(), &estimate.parameters);
+    if converged {
+        progress.begin("intervals and other solutions", None);
+    }
+    let (unc, scatter) =
+        if converged { fit.uncertainty_within(&estimate.last, has_std, &budget) } else { (None, None) };
+    let mac = fit.mac(&estimate.parameters, options.shape.mac_threshold);
+    let mut alternatives: Vec<Alternative> = Vec::new();
+    if converged && quality.verdict != FitVerdict::Poor {
+        for (i, j, p) in mirror_solutions(&fit, &estimate.last, &budget) {
+            alternatives.push((p, Some((i, j))));
+        }
+        for p in alternative_solutions_within(&fit, &estimate.last, ALTERNATIVE_STARTS, &budget) {
+            let same = |q: &[f64]| {
+                model
+                    .parameters()
+                    .iter()
+                    .zip(q.iter().zip(&p))
+                    .all(|(par, (&a, &b))| (par.to_scaled(a) - par.to_scaled(b)).abs() <= 0.01)
+            };
+            if !alternatives.iter().any(|(q, _)| same(q)) {
+                alternatives.push((p, None));
+            }
+        }
+    }
+    if converged {
+        progress.end();
+    }
+    let budget_spent = budget.exhausted();
+    let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
+    let pinned: Vec<String> = (0..np).filter(|&i| limits[i] != 0).map(|i| names[i].clone()).collect();
+    // A measured mode below the MAC threshold makes the result not acceptable.
+    let unpaired = mac.as_ref().is_some_and(|r| !r.unpaired.is_empty());
+    let acceptable =
+        converged && quality.verdict != FitVerdict::Poor && pinned.is_empty() && !budget_spent && !unpaired;
+    let verdict = if !converged {
+        estimate.termination.label()
+    } else if budget_spent {
+        "budget-exhausted"
+    } else if quality.verdict == FitVerdict::Poor {
+        "poor-fit"
+    } else if !pinned.is_empty() {
+        "not-identifiable"
+    } else if quality.verdict == FitVerdict::NotJudged {
+        "converged (fit quality not judged: no std)"
+    } else {
+        "converged"
+    };
+    // What the data say about each parameter, in words.
+    let status = |i: usize| -> String {
+        let bound = unc.as_ref().map(|u| &u.identifiability[i]);
+        match (limits[i], bound) {
+            (_, Some(Identifiability::LowerBoundOnly { lower })) => {
+                format!("not identifiable: ≥ {lower:.4e}")
+            }
+            (_, Some(Identifiability::UpperBoundOnly { upper })) => {
+                format!("not identifiable: ≤ {upper:.4e}")
+            }
+            (0, Some(Identifiability::Determined)) => {
+                let u = unc.as_ref().map_or([0.0; 2], |u| u.intervals[i]);
+                format!("[{:.4e}, {:.4e}]", u[0], u[1])
+            }
+            (1, _) => "not identifiable: at its upper limit, the data see no upper bound".into(),
+            (-1, _) => "not identifiable: at its lower limit".into(),
+            (_, Some(_)) => "not identifiable".into(),
+            (_, None) if !converged => "(not computed: the run did not converge)".into(),
+            (_, None) if !has_std => "(no std given)".into(),
+            (_, None) => "(not computed)".into(),
+        }
+    };
+    let held = model.held();
+    let report = EstimateReport {
+        model: label,
+        strategy: estimate.strategy,
+        outcome: Outcome::of(&estimate, converged),
+        acceptable,
+        verdict: verdict.to_string(),
+        fit_quality: quality.verdict.label(),
+        chi2: quality.chi2,
+        dof: quality.dof,
+        p_value: quality.p_value,
+        relative_rms_residual: quality.relative_rms,
+        disagreeing_modes: quality.disagreeing.iter().map(|&k| mode_numbers[k]).collect(),
+        budget: BudgetReport { limit: budget.limit(), used: budget.used(), exhausted: budget_spent },
+        initial: Named::new(&names, initial.iter().copied()),
+        parameters: Named::new(&names, estimate.parameters.iter().copied()),
+        parameter_status: Named::new(&names, (0..np).map(status)),
+        at_limit: pinned,
+        alternative_solutions: alternatives
+            .iter()
+            .map(|(p, mirror)| AlternativeSolution {
+                parameters: Named::new(&names, p.iter().copied()),
+                mirror_of: mirror.map(|(i, j)| [names[i].clone(), names[j].clone()]),
+            })
+            .collect(),
+        frequencies_hz: estimate.last.frequencies_hz.clone(),
+        measured_hz: estimate.last.measured_hz.clone(),
+        history: estimate
+            .history
+            .iter()
+            .map(|r| HistoryRecord {
+                iteration: r.iteration,
+                parameters: r.parameters.clone(),
+                frequencies_hz: r.frequencies_hz.clone(),
+                max_abs_diff_hz: r.max_abs_diff_hz,
+            })
+            .collect(),
+        uncertainty: unc.as_ref().map(|u| IntervalsReport::new(&names, u)),
+        plots: None,
+        test_data: ShapeReport::new(&fit, &data, &estimate, mac.as_ref(), scatter),
+        fixed: (!held.is_empty()).then_some(Named(held)),
+    };
+    let updated_model =
+        request.write_model.then(|| updated_model_toml(&request.measured, &model, &estimate, unc.as_ref()));
+    let unit = any.parameters().iter().next().map_or(String::new(), |p| p.unit.clone());
+    drop(fit);
+    Ok(EstimateOutcome::Done(Box::new(Estimation {
+        report,
+        estimate,
+        quality,
+        uncertainty: unc,
+        mac,
+        data,
+        scatter,
+        has_std,
+        mode_numbers,
+        on_limit: limits.iter().map(|&l| l != 0).collect(),
+        unit,
+        sigma_max,
+        acceptable,
+        updated_model,
+    })))
+}

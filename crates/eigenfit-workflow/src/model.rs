@@ -1,0 +1,112 @@
+//! The models a job runs on: a planar rotor or, for a file with `kind = "matrices"`, sparse K
+//! and M from any FE tool ([`MatricesModel`]). Jobs that use only [`StructuralModel`]
+//! (estimate, compare, discover) take either; rotor-only features (effects, sweeps, rotor
+//! plots, writing a rotor file) say so for a matrices model.
+
+use crate::error::{input, WorkflowError};
+use eigenfit_core::matrix::{System, SystemDerivative};
+use eigenfit_core::model::{Candidate, ModelError, ParameterSet, StructuralModel};
+use eigenfit_matrices::MatricesModel;
+use eigenfit_rotor::{Rotor, UpdatableRotor};
+use std::path::Path;
+
+/// A rotor or a matrices model.
+pub enum AnyModel {
+    /// A planar rotor (model file without `kind`, or a preset).
+    Rotor(Rotor),
+    /// K(p) = K₀ + Σ pᵢKᵢ, M(p) = M₀ + Σ pᵢMᵢ from Matrix Market files.
+    Matrices(MatricesModel),
+}
+
+/// The model `estimate` updates: a rotor with its `[[parameter]]` tables resolved, or a
+/// matrices model as it is (its parameters are already declared in its file).
+pub enum Updatable<'a> {
+    /// A planar rotor.
+    Rotor(Box<UpdatableRotor>),
+    /// K(p) = K₀ + Σ pᵢKᵢ, M(p) = M₀ + Σ pᵢMᵢ.
+    Matrices(&'a MatricesModel),
+}
+
+/// Both enums hand every [`StructuralModel`] method to the model they hold: written once here
+/// (a macro, as the two enums hold different types: owned, boxed, borrowed).
+macro_rules! delegate_structural_model {
+    ($ty:ty, $name:ident) => {
+        impl StructuralModel for $ty {
+            fn parameters(&self) -> &ParameterSet {
+                match self {
+                    $name::Rotor(m) => m.parameters(),
+                    $name::Matrices(m) => m.parameters(),
+                }
+            }
+            fn dofs(&self) -> usize {
+                match self {
+                    $name::Rotor(m) => m.dofs(),
+                    $name::Matrices(m) => m.dofs(),
+                }
+            }
+            fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+                match self {
+                    $name::Rotor(m) => m.assemble(p),
+                    $name::Matrices(m) => m.assemble(p),
+                }
+            }
+            fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
+                match self {
+                    $name::Rotor(m) => m.derivative(p, i),
+                    $name::Matrices(m) => m.derivative(p, i),
+                }
+            }
+            fn candidates(&self) -> Vec<Candidate> {
+                match self {
+                    $name::Rotor(m) => m.candidates(),
+                    $name::Matrices(m) => m.candidates(),
+                }
+            }
+        }
+    };
+}
+
+delegate_structural_model!(AnyModel, AnyModel);
+delegate_structural_model!(Updatable<'_>, Updatable);
+
+impl AnyModel {
+    /// The rotor, or an input error naming the rotor-only `feature`.
+    pub fn rotor(&self, feature: &str) -> Result<&Rotor, WorkflowError> {
+        match self {
+            AnyModel::Rotor(r) => Ok(r),
+            AnyModel::Matrices(_) => Err(input(format!(
+                "{feature} applies to rotor models only, not to a `kind = \"matrices\"` model"
+            ))),
+        }
+    }
+
+    /// The rotor as the node layout measured shapes are tied to (a matrices model has none).
+    pub fn layout(&self) -> Option<&dyn eigenfit_core::measurement::sensors::NodeLayout> {
+        match self {
+            AnyModel::Rotor(r) => Some(r),
+            AnyModel::Matrices(_) => None,
+        }
+    }
+
+    /// The rotor with its `[[parameter]]` tables resolved (docs/rotor-model.md), or the
+    /// matrices model as it is; errors name `label`.
+    pub fn updatable(&self, label: &str) -> Result<Updatable<'_>, WorkflowError> {
+        match self {
+            AnyModel::Rotor(rotor) => UpdatableRotor::new(rotor.clone())
+                .map(|r| Updatable::Rotor(Box::new(r)))
+                .map_err(|e| input(format!("{label}: {e}"))),
+            AnyModel::Matrices(m) => Ok(Updatable::Matrices(m)),
+        }
+    }
+}
+
+/// Whether the model file at `path` declares `kind = "matrices"` (unreadable files are left to
+/// the rotor reader, whose errors name them).
+pub fn is_matrices_file(path: &Path) -> bool {
+    std::fs::read_to_string(path).is_ok_and(|text| eigenfit_matrices::is_matrices_file(&text))
+}
+
+/// Loads a matrices model; every error is bad input naming the file.
+pub fn load_matrices(path: &Path) -> Result<MatricesModel, WorkflowError> {
+    MatricesModel::from_toml_file(path).map_err(|e| input(e.to_string()))
+}

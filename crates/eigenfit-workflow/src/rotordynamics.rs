@@ -1,0 +1,374 @@
+//! Two-plane rotors (files written by ROSS `Rotor.save`): damped modes at one speed, bearing
+//! stiffnesses from run-up frequencies, and the Campbell diagram.
+
+use crate::error::{input, WorkflowError};
+use crate::named::Named;
+use crate::outcome::Outcome;
+use eigenfit_core::analysis::verdict::{judge, FitQuality, FitVerdict};
+use eigenfit_core::problem::Linearisation;
+use eigenfit_rotordynamics::identify::{
+    bearing_parameters, identify, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
+};
+use eigenfit_rotordynamics::{campbell, ross_file, rpm_to_rad, Campbell, Rotor, RotorDynError};
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+use std::path::Path;
+
+/// The model file if it is a ROSS rotor (judged by its content: tables `ShaftElement_…`).
+pub fn ross_model(path: Option<&Path>) -> Option<&Path> {
+    let path = path?;
+    let text = std::fs::read_to_string(path).ok()?;
+    ross_file::looks_like_ross(&text).then_some(path)
+}
+
+fn to_workflow(e: RotorDynError) -> WorkflowError {
+    match e {
+        RotorDynError::Solver(m) => WorkflowError::Failure(m),
+        other => input(other.to_string()),
+    }
+}
+
+/// Loads a ROSS rotor, errors naming the file.
+pub fn load(path: &Path) -> Result<Rotor, WorkflowError> {
+    ross_file::read(path).map_err(to_workflow)
+}
+
+fn check_speed(flag: &str, rpm: f64) -> Result<(), WorkflowError> {
+    if !rpm.is_finite() || rpm < 0.0 {
+        return Err(input(format!("{flag} {rpm}: speed must be a finite number of rpm ≥ 0")));
+    }
+    Ok(())
+}
+
+/// Damped modes of a two-plane rotor at one speed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SpeedReport {
+    /// The model file.
+    pub model: String,
+    /// The speed (rpm).
+    pub speed_rpm: f64,
+    /// Damped frequencies (Hz).
+    pub frequencies_hz: Vec<f64>,
+    /// Undamped natural frequencies (Hz).
+    pub natural_frequencies_hz: Vec<f64>,
+    /// `forward` or `backward`.
+    pub whirl: Vec<&'static str>,
+    /// Damping ratios.
+    pub damping_ratio: Vec<f64>,
+    /// Logarithmic decrements.
+    pub log_dec: Vec<f64>,
+    /// The rotor's DOFs.
+    #[serde(skip)]
+    pub dofs: usize,
+}
+
+/// `simulate --model ROSS-FILE [--speed RPM] --modes N`: damped modes at one speed.
+pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize) -> Result<SpeedReport, WorkflowError> {
+    let rotor = load(path)?;
+    let rpm = speed_rpm.unwrap_or(0.0);
+    check_speed("--speed", rpm)?;
+    if modes == 0 || modes > rotor.dofs() {
+        return Err(input(format!("--modes {modes}: must be between 1 and {} for this rotor", rotor.dofs())));
+    }
+    let all = rotor.lowest_modes(rpm_to_rad(rpm), modes).map_err(to_workflow)?;
+    if modes > all.len() {
+        return Err(input(format!(
+            "--modes {modes}: must be between 1 and {} (the oscillating modes of this rotor at {rpm} rpm)",
+            all.len()
+        )));
+    }
+    let shown = &all[..modes];
+    Ok(SpeedReport {
+        model: path.display().to_string(),
+        speed_rpm: rpm,
+        frequencies_hz: shown.iter().map(|m| m.frequency_hz()).collect(),
+        natural_frequencies_hz: shown.iter().map(|m| m.natural_frequency_hz()).collect(),
+        whirl: shown.iter().map(|m| m.whirl.name()).collect(),
+        damping_ratio: shown.iter().map(|m| m.damping_ratio()).collect(),
+        log_dec: shown.iter().map(|m| m.log_dec()).collect(),
+        dofs: rotor.dofs(),
+    })
+}
+
+/// One run-up point at the estimate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunupPointReport {
+    /// Speed (rpm).
+    pub speed_rpm: f64,
+    /// Mode number as measured.
+    pub mode: usize,
+    /// Measured frequency (Hz).
+    pub measured_hz: f64,
+    /// Model frequency at the estimate (Hz).
+    pub model_hz: f64,
+    /// Model whirl at the estimate.
+    pub model_whirl: &'static str,
+    /// Measured whirl, when given.
+    pub measured_whirl: Option<&'static str>,
+}
+
+/// A run-up point that disagrees with the model by more than 3σ.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunupPointId {
+    /// Speed (rpm).
+    pub speed_rpm: f64,
+    /// Mode number as measured.
+    pub mode: usize,
+}
+
+/// Bearing coefficients of a two-plane rotor from run-up frequencies.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunupEstimateReport {
+    /// The model file.
+    pub model: String,
+    /// Converged, why it stopped, iterations, eigen-solve rounds.
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// Converged and the fit not poor: the exit verdict.
+    pub acceptable: bool,
+    /// `converged`, `poor-fit`, `not-converged` or converged with the quality not judged.
+    pub verdict: &'static str,
+    /// Core's fit-quality label: `acceptable`, `poor-fit` or `not-judged`.
+    pub fit_quality: &'static str,
+    /// χ² (with std only).
+    pub chi2: Option<f64>,
+    /// Degrees of freedom: measured frequencies − parameters.
+    pub dof: usize,
+    /// P(χ²_dof > χ²) (with std only).
+    pub p_value: Option<f64>,
+    /// √(mean((f_model − f_measured)/f_measured)²).
+    pub relative_rms_residual: f64,
+    /// The points that miss by more than 3σ, worst first.
+    pub disagreeing_modes: Vec<RunupPointId>,
+    /// The speed the coefficients are reported at (the lowest measured, rpm).
+    pub reference_speed_rpm: f64,
+    /// Nominal coefficients (N/m or N·s/m).
+    pub initial: Named<f64>,
+    /// Estimated coefficients (N/m or N·s/m).
+    pub parameters: Named<f64>,
+    /// Each parameter's interval as text, or why there is none.
+    pub parameter_status: Named<String>,
+    /// Estimated scale factors on the nominal curves.
+    pub scales: Named<f64>,
+    /// Σ r².
+    pub cost: f64,
+    /// Whether every parameter is determined by the data.
+    pub identifiable: bool,
+    /// The run-up points at the estimate.
+    pub points: Vec<RunupPointReport>,
+    /// Intervals, with std only.
+    #[serde(flatten)]
+    pub with_std: Option<RunupIntervals>,
+}
+
+/// The part of a run-up estimate that needs standard deviations.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunupIntervals {
+    /// 95 % intervals (log-normal).
+    pub intervals: Named<[f64; 2]>,
+    /// Standard deviations of ln k.
+    pub standard_deviations_ln: Named<f64>,
+}
+
+/// The fit's quality judged by core's verdict rules, as for the planar model: the run-up's
+/// frequencies and residuals put in a [`Linearisation`] (eigenvalues λ = ω², Jacobians in the
+/// physical units of the parameters).
+fn fit_quality(id: &Identification, points: &[RunupPoint], values: &[f64]) -> FitQuality {
+    let has_std = points.iter().all(|p| p.std_hz.is_some());
+    let m = points.len();
+    let omega = |f: f64| 2.0 * std::f64::consts::PI * f;
+    // Residual measured − model in σ, or relative without std (the planar `relative` residual).
+    let sigma = |i: usize| points[i].std_hz.unwrap_or(points[i].frequency_hz);
+    // d f/d p = (d f/d ln s)/p in Hz per N/m (N·s/m); dλ/dp = 2ω·2π d f/d p.
+    let df_dp = DMatrix::from_fn(m, values.len(), |i, j| id.jacobian[(i, j)] / values[j]);
+    let lin = Linearisation {
+        parameters: values.to_vec(),
+        paired_modes: points.iter().map(|p| p.mode - 1).collect(),
+        model_eigenvalues: DVector::from_iterator(m, id.model_hz.iter().map(|&f| omega(f).powi(2))),
+        measured_eigenvalues: DVector::from_iterator(m, points.iter().map(|p| omega(p.frequency_hz).powi(2))),
+        eigenvalue_jacobian: DMatrix::from_fn(m, values.len(), |i, j| {
+            2.0 * omega(id.model_hz[i]) * 2.0 * std::f64::consts::PI * df_dp[(i, j)]
+        }),
+        frequencies_hz: id.model_hz.clone(),
+        measured_hz: points.iter().map(|p| p.frequency_hz).collect(),
+        residual: DVector::from_fn(m, |i, _| (points[i].frequency_hz - id.model_hz[i]) / sigma(i)),
+        jacobian: DMatrix::from_fn(m, values.len(), |i, j| df_dp[(i, j)] / sigma(i)),
+        has_std,
+    };
+    judge(&lin, values.len())
+}
+
+/// `estimate --model ROSS-FILE --measured RUNUP.csv [--parameters kxx,kyy,…]`: bearing
+/// coefficients from a run-up (`selection` `None`: kxx and kyy of every bearing).
+pub fn estimate(
+    path: &Path,
+    measured: &Path,
+    selection: Option<&str>,
+    max_iterations: usize,
+) -> Result<RunupEstimateReport, WorkflowError> {
+    let rotor = load(path)?;
+    let points = read_runup(measured).map_err(to_workflow)?;
+    let chosen: Vec<&str> = match selection {
+        Some(list) => list.split(',').map(str::trim).filter(|s| !s.is_empty()).collect(),
+        None => DEFAULT_COEFFICIENTS.to_vec(),
+    };
+    let params = bearing_parameters(&rotor, &chosen).map_err(|e| input(format!("--parameters: {e}")))?;
+    if params.is_empty() {
+        return Err(input(format!("{}: the rotor has no bearings to estimate", path.display())));
+    }
+    let initial = vec![1.0; params.len()];
+    let id = identify(&rotor, &params, &points, &initial, max_iterations).map_err(to_workflow)?;
+    // Report each coefficient at the lowest measured speed (constant bearings: their value).
+    let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
+    let nominal: Vec<f64> = params.iter().map(|p| p.nominal(&rotor, w0)).collect();
+    let value: Vec<f64> = nominal.iter().zip(&id.scales).map(|(k, s)| k * s).collect();
+    let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
+    // 95 % intervals, log-normal (the estimate is linearised in ln k); ordered low, high also
+    // for a negative (cross-coupled) coefficient.
+    let intervals: Option<Vec<[f64; 2]>> = id.ln_std.as_ref().map(|sd| {
+        value
+            .iter()
+            .zip(sd)
+            .map(|(v, s)| {
+                let (a, b) = (v * (-1.96 * s).exp(), v * (1.96 * s).exp());
+                [a.min(b), a.max(b)]
+            })
+            .collect()
+    });
+    let quality = fit_quality(&id, &points, &value);
+    let acceptable = id.converged && quality.verdict != FitVerdict::Poor;
+    let verdict = if !id.converged {
+        "not-converged"
+    } else if quality.verdict == FitVerdict::Poor {
+        "poor-fit"
+    } else if quality.verdict == FitVerdict::NotJudged {
+        "converged (fit quality not judged: no std)"
+    } else {
+        "converged"
+    };
+    let status = |i: usize| -> String {
+        match &intervals {
+            _ if !id.converged => "(not computed: the run did not converge)".into(),
+            Some(iv) => format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]),
+            None if !id.identifiable => {
+                "not identifiable: the frequencies fix only combinations of the parameters".into()
+            }
+            None => "(no std given)".into(),
+        }
+    };
+    let with_std = match (&intervals, &id.ln_std) {
+        (Some(iv), Some(sd)) => Some(RunupIntervals {
+            intervals: Named::new(&names, iv.iter().copied()),
+            standard_deviations_ln: Named::new(&names, sd.iter().copied()),
+        }),
+        _ => None,
+    };
+    Ok(RunupEstimateReport {
+        model: path.display().to_string(),
+        outcome: Outcome {
+            converged: id.converged,
+            termination: id.reason.clone(),
+            iterations: id.iterations,
+            evaluations: id.evaluations,
+        },
+        acceptable,
+        verdict,
+        fit_quality: quality.verdict.label(),
+        chi2: quality.chi2,
+        dof: quality.dof,
+        p_value: quality.p_value,
+        relative_rms_residual: quality.relative_rms,
+        disagreeing_modes: quality
+            .disagreeing
+            .iter()
+            .map(|&k| RunupPointId { speed_rpm: points[k].speed_rpm, mode: points[k].mode })
+            .collect(),
+        reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
+        initial: Named::new(&names, nominal.iter().copied()),
+        parameters: Named::new(&names, value.iter().copied()),
+        parameter_status: Named::new(&names, (0..params.len()).map(status)),
+        scales: Named::new(&names, id.scales.iter().copied()),
+        cost: id.cost,
+        identifiable: id.identifiable,
+        points: points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| RunupPointReport {
+                speed_rpm: p.speed_rpm,
+                mode: p.mode,
+                measured_hz: p.frequency_hz,
+                model_hz: id.model_hz[i],
+                model_whirl: id.model_whirl[i].name(),
+                measured_whirl: p.whirl.map(|w| w.name()),
+            })
+            .collect(),
+        with_std,
+    })
+}
+
+/// Parses `FROM:TO:COUNT` (rpm, linear).
+pub fn parse_speeds(text: &str) -> Result<Vec<f64>, WorkflowError> {
+    let bad = |why: &str| {
+        input(format!("--speeds `{text}`: {why} (expected FROM:TO:COUNT in rpm, e.g. 0:12000:50)"))
+    };
+    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+    let [from, to, count] = parts[..] else { return Err(bad("three fields needed")) };
+    let from: f64 = from.parse().map_err(|_| bad("FROM is not a number"))?;
+    let to: f64 = to.parse().map_err(|_| bad("TO is not a number"))?;
+    let count: usize = count.parse().map_err(|_| bad("COUNT is not a whole number"))?;
+    if !from.is_finite() || !to.is_finite() || from < 0.0 || to < from {
+        return Err(bad("speeds must be finite with 0 ≤ FROM ≤ TO"));
+    }
+    if count == 0 || count > 100_000 || (count == 1 && to != from) {
+        return Err(bad("COUNT must be 1 … 100000 (1 only when FROM = TO)"));
+    }
+    Ok((0..count)
+        .map(|i| if count == 1 { from } else { from + (to - from) * i as f64 / (count - 1) as f64 })
+        .collect())
+}
+
+/// The Campbell diagram of a two-plane rotor: the diagram's own keys (`speeds_rpm`,
+/// `frequencies_hz`, `whirl`, `log_dec`, `curves`, `critical_speeds`) and these.
+#[derive(Debug, Clone, Serialize)]
+pub struct CampbellReport {
+    /// The model file.
+    pub model: String,
+    /// The diagram.
+    #[serde(flatten)]
+    pub campbell: Campbell,
+    /// The critical speeds (rpm).
+    pub critical_speeds_rpm: Vec<f64>,
+    /// Plot files written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plots: Option<Vec<String>>,
+}
+
+/// `campbell`: damped frequencies, whirl and log decrement of a ROSS rotor against speed.
+pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<CampbellReport, WorkflowError> {
+    let speeds = parse_speeds(speeds)?;
+    let rotor = load(path)?;
+    if modes == 0 {
+        return Err(input("--modes 0: at least one mode"));
+    }
+    let c = campbell(&rotor, &speeds, modes).map_err(|e| input(format!("{}: {e}", path.display())))?;
+    Ok(CampbellReport {
+        model: path.display().to_string(),
+        critical_speeds_rpm: c.critical_speeds.iter().map(|k| k.rpm).collect(),
+        campbell: c,
+        plots: None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_speeds;
+
+    #[test]
+    fn speeds_are_linear_and_inclusive() {
+        assert_eq!(parse_speeds("0:1000:5").unwrap(), vec![0.0, 250.0, 500.0, 750.0, 1000.0]);
+        assert_eq!(parse_speeds("300:300:1").unwrap(), vec![300.0]);
+        for bad in ["0:10", "a:1:2", "10:0:3", "0:10:0", "-5:10:3", "0:10:1"] {
+            assert!(parse_speeds(bad).is_err(), "{bad}");
+        }
+    }
+}

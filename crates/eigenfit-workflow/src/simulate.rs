@@ -1,0 +1,253 @@
+//! Natural frequencies of a model: at one point with their sensitivities, or over a stiffness
+//! sweep (the critical speed map; one sweep for the table and the plot).
+
+use crate::error::{failure, input, WorkflowError};
+use crate::named::Named;
+use crate::progress::Progress;
+use eigenfit_core::eigen::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF};
+use eigenfit_core::eigen::{EigenSolver, Modes};
+use eigenfit_core::matrix::System;
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::sensitivity::Sensitivities;
+use eigenfit_rotor::{presets, Rotor};
+use serde::Serialize;
+
+/// Most points of a sweep: a smooth critical speed map needs a few hundred.
+pub const MAX_SWEEP_POINTS: usize = 100_000;
+
+/// Never a frequency lost to round-off without a word (issue 13): a fine mesh or an extreme
+/// value whose lowest eigenvalue the matrices cannot resolve is refused, saying why; a level
+/// worth knowing about is returned as a note.
+pub fn check_roundoff(system: &System, modes: &Modes) -> Result<Option<String>, WorkflowError> {
+    let levels = relative_roundoff(system, modes);
+    match levels.iter().position(|&r| r.is_nan() || r > MAX_RELATIVE_ROUNDOFF) {
+        None => Ok(levels.iter().position(|&r| r > NOTE_RELATIVE_ROUNDOFF).map(|j| {
+            format!(
+                "mode {}: round-off may reach {:.1e} of its eigenvalue (a fine mesh or an extreme value); \
+                 the trailing digits are not significant",
+                j + 1,
+                levels[j]
+            )
+        })),
+        Some(j) => Err(input(format!(
+            "mode {} cannot be trusted: round-off in the matrices (ε·(‖K‖/λ + ‖M‖)·‖φ‖² ≈ {:.1e}) exceeds {MAX_RELATIVE_ROUNDOFF:e} \
+             of its eigenvalue; the mesh is too fine or a value too extreme for double precision (use fewer elements, \
+             or values closer to the rest of the model)",
+            j + 1,
+            levels[j]
+        ))),
+    }
+}
+
+/// The lowest `modes` frequencies (Hz) at `p`, refusing round-off-lost ones (notes go to `notes`).
+pub fn frequencies(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    modes: usize,
+    notes: &mut Vec<String>,
+) -> Result<Vec<f64>, WorkflowError> {
+    let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
+    let m = solver.lowest(&system, modes).map_err(failure)?;
+    notes.extend(check_roundoff(&system, &m)?);
+    Ok(m.frequencies_hz())
+}
+
+/// The lowest `count` modes of `model` at `p` (for plots of mode shapes); a model that cannot
+/// be assembled or solved there is a failure.
+pub fn modes_at(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    count: usize,
+) -> Result<Modes, WorkflowError> {
+    let system = model.assemble(p).map_err(failure)?;
+    solver.lowest(&system, count).map_err(failure)
+}
+
+/// How a sweep treats round-off: the table refuses lost frequencies, the plot draws what it gets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SweepCheck {
+    /// Refuse a point whose frequencies are lost to round-off (notes for the doubtful ones).
+    RefuseRoundoff,
+    /// Take the solver's frequencies as they are.
+    None,
+}
+
+/// Frequencies (Hz, one row per point, `modes` columns) with every parameter of `model` at the
+/// same value `k` for each `k` of `stiffnesses`: the critical speed map (all supports equal).
+pub fn sweep(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    stiffnesses: &[f64],
+    modes: usize,
+    check: SweepCheck,
+    notes: &mut Vec<String>,
+    progress: &mut dyn Progress,
+) -> Result<Vec<Vec<f64>>, WorkflowError> {
+    let np = model.parameters().len();
+    let mut rows = Vec::with_capacity(stiffnesses.len());
+    progress.begin("sweep", Some(stiffnesses.len() as u64));
+    for &k in stiffnesses {
+        let p = vec![k; np];
+        let row = match check {
+            SweepCheck::RefuseRoundoff => frequencies(model, solver, &p, modes, notes),
+            SweepCheck::None => model
+                .assemble(&p)
+                .map_err(failure)
+                .and_then(|s| solver.lowest(&s, modes).map_err(failure))
+                .map(|m| m.frequencies_hz()),
+        };
+        match row {
+            Ok(row) => rows.push(row),
+            Err(e) => {
+                progress.end();
+                return Err(e);
+            }
+        }
+        progress.step();
+    }
+    progress.end();
+    Ok(rows)
+}
+
+/// Parses a sweep `FROM:TO:COUNT` (log-spaced, N/m) into its points.
+pub fn sweep_points(text: &str) -> Result<Vec<f64>, WorkflowError> {
+    let parts: Vec<&str> = text.split(':').collect();
+    let bad = || input(format!("--sweep `{text}`: expected FROM:TO:COUNT with 0 < FROM < TO and COUNT ≥ 2"));
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let ends = crate::overrides::parse_list("--sweep", &format!("{},{}", parts[0], parts[1]))?;
+    let count: usize = parts[2].trim().parse().map_err(|_| bad())?;
+    let (a, b) = (ends[0], ends[1]);
+    if !(a > 0.0 && b > a && count >= 2) {
+        return Err(bad());
+    }
+    // Checked before the points are allocated: each is an eigen-solve.
+    if count > MAX_SWEEP_POINTS {
+        return Err(input(format!(
+            "--sweep `{text}`: {count} points, more than the {MAX_SWEEP_POINTS} a sweep accepts"
+        )));
+    }
+    Ok(eigenfit_core::analysis::compare::log_space(a, b, count))
+}
+
+/// Whether `rotor` is the paper's rotor (whatever its current support stiffnesses).
+pub fn is_paper_rotor(rotor: &Rotor) -> bool {
+    let paper = presets::paper_rotor();
+    rotor.with_stiffnesses(&paper.nominal_stiffnesses()).is_ok_and(|r| r == paper)
+}
+
+/// Checks a mode count against the model.
+pub fn check_modes(modes: usize, dofs: usize) -> Result<(), WorkflowError> {
+    if modes == 0 || modes > dofs {
+        return Err(input(format!("--modes {modes}: must be between 1 and {dofs} for this model")));
+    }
+    Ok(())
+}
+
+/// `simulate` at one point: frequencies and their sensitivities.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointReport {
+    /// The model's label (file or preset).
+    pub model: String,
+    /// The eigen-solver's name.
+    pub solver: String,
+    /// DOFs (reported for a matrices model).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dofs: Option<usize>,
+    /// The parameter values.
+    pub parameters: Named<f64>,
+    /// Natural frequencies (Hz), lowest first.
+    pub frequencies_hz: Vec<f64>,
+    /// df_k/dp_i in Hz per parameter unit, one array over modes per parameter.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensitivities_hz: Option<Named<Vec<f64>>>,
+    /// Why there are no sensitivities (repeated or rigid-body modes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensitivities_unavailable: Option<String>,
+    /// Plot files written (the CLI's `--plot`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plots: Option<Vec<String>>,
+    /// Notes for the log (round-off that may reach the trailing digits).
+    #[serde(skip)]
+    pub notes: Vec<String>,
+}
+
+/// Frequencies and their sensitivities at `p` from one solve; a model whose modes have none
+/// (repeated or rigid-body modes) still gets its frequencies and says why. `check`: refuse
+/// round-off-lost frequencies (the rotor path does; a matrices model's path never did).
+pub fn at_point(
+    label: &str,
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    modes: usize,
+    check: SweepCheck,
+) -> Result<PointReport, WorkflowError> {
+    let names: Vec<String> = model.parameters().iter().map(|q| q.name.clone()).collect();
+    let mut notes = Vec::new();
+    let (f, sens) = match Sensitivities::compute(model, solver, p, modes) {
+        Ok(s) => {
+            if check == SweepCheck::RefuseRoundoff {
+                let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
+                notes.extend(check_roundoff(&system, &s.modes)?);
+            }
+            (s.modes.frequencies_hz(), Ok(s.frequencies_hz))
+        }
+        Err(e) => {
+            let f = match check {
+                SweepCheck::RefuseRoundoff => frequencies(model, solver, p, modes, &mut notes)?,
+                SweepCheck::None => {
+                    let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
+                    solver.lowest(&system, modes).map_err(failure)?.frequencies_hz()
+                }
+            };
+            (f, Err(e.to_string()))
+        }
+    };
+    let (sensitivities_hz, sensitivities_unavailable) = match sens {
+        Ok(df) => {
+            (Some(Named::new(&names, (0..names.len()).map(|i| df.column(i).iter().copied().collect()))), None)
+        }
+        Err(why) => (None, Some(why)),
+    };
+    Ok(PointReport {
+        model: label.to_string(),
+        solver: solver.name().to_string(),
+        dofs: None,
+        parameters: Named::new(&names, p.iter().copied()),
+        frequencies_hz: f,
+        sensitivities_hz,
+        sensitivities_unavailable,
+        plots: None,
+        notes,
+    })
+}
+
+/// One point of a stiffness sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SweepPoint {
+    /// Stiffness of every bearing (N/m).
+    pub stiffness: f64,
+    /// Natural frequencies (Hz).
+    pub frequencies_hz: Vec<f64>,
+}
+
+/// `simulate --sweep`: frequencies against support stiffness, all bearings equal.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SweepReport {
+    /// The model's label.
+    pub model: String,
+    /// The eigen-solver's name.
+    pub solver: String,
+    /// The points.
+    pub sweep: Vec<SweepPoint>,
+    /// Plot files written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plots: Option<Vec<String>>,
+    /// Notes for the log.
+    #[serde(skip)]
+    pub notes: Vec<String>,
+}
