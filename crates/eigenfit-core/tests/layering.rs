@@ -283,6 +283,7 @@ const ROTOR_LAYERS: &[&str] = &[
     "element",
     "spec",
     "model",
+    "pedestal",
     "effects",
     "structural",
     "builder",
@@ -291,6 +292,7 @@ const ROTOR_LAYERS: &[&str] = &[
     "updatable",
     "layout",
     "mesh",
+    "mirror",
     "discovery",
     "campaign",
 ];

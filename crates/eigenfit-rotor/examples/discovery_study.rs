@@ -3,6 +3,7 @@
 //! scored per case and noise level, with the slowest run's wall time.
 //!
 //! cargo run --release -p eigenfit-rotor --example discovery_study
+//! (`STUDY_CASES=pedestal,clean` for some cases only, `STUDY_VERBOSE=1` for every answer)
 
 #[path = "../tests/common/study.rs"]
 mod study;
@@ -15,7 +16,10 @@ fn main() {
     println!("| case | noise | named | ambiguous (honest) | nothing | wrong | truth in 95 % interval |");
     println!("|---|---|---|---|---|---|---|");
     let mut slowest = 0.0f64;
-    for case in &fixtures.case {
+    // STUDY_CASES=pedestal,clean runs only those cases.
+    let only = std::env::var("STUDY_CASES").ok();
+    let wanted = |name: &str| only.as_deref().is_none_or(|o| o.split(',').any(|c| c == name));
+    for case in fixtures.case.iter().filter(|c| wanted(&c.name)) {
         let mut noises: Vec<f64> =
             fixtures.draw.iter().filter(|d| d.case == case.name).map(|d| d.noise).collect();
         noises.dedup();
@@ -37,7 +41,7 @@ fn main() {
                         .iter()
                         .map(|n| {
                             let alts: Vec<&str> = n.ambiguous_with.iter().map(|a| a.label.as_str()).collect();
-                            format!("{}={:?} ~{:?}", n.label, n.value, alts)
+                            format!("{}={:?} (ΔAICc {:.1}) ~{:?}", n.label, n.value, n.delta_aicc, alts)
                         })
                         .collect();
                     eprintln!("{} {noise} {}: {outcome:?} {labels:?}", case.name, draw.draw);

@@ -39,7 +39,16 @@ impl RotorDiscovery {
         let fitted =
             self.report.selected.as_ref().map_or(&self.report.base_parameters[..], |s| &s.parameters[..nb]);
         let mut out = rotor.with_stiffnesses(fitted)?;
-        for e in self.effects.iter().filter(|e| e.kind != "mesh-refinement") {
+        for (entry, e) in self.effects.iter().enumerate().filter(|(_, e)| e.kind != "mesh-refinement") {
+            if e.kind == crate::pedestal::KIND {
+                // The model file has no pedestal DOF yet: refuse rather than write a different model.
+                return Err(RotorError::Effect {
+                    entry,
+                    kind: e.kind.clone(),
+                    why: "a pedestal adds a degree of freedom, which a rotor model file cannot describe yet"
+                        .into(),
+                });
+            }
             let mut spec = EffectSpec::new(e.kind.clone(), e.location, e.value.unwrap_or(1.0));
             spec.elements = e.elements.filter(|[a, b]| a != b);
             if e.kind == "point-mass" {
@@ -59,7 +68,8 @@ impl RotorDiscovery {
 /// When the user's mesh shows a significant misfit that no candidate explains, the workflow is run again on the mesh
 /// refined [`REFINEMENT`]-fold (candidates still located in the user's mesh); the refined
 /// result is kept only if its final AICc beats the user's mesh by `min_aicc_gain`, and then
-/// `mesh-refinement` is named with that gain.
+/// `mesh-refinement` is named with that gain. All runs together spend at most
+/// [`DiscoveryOptions::max_evaluations`] eigen-solves (the report's `evaluations` is the total).
 pub fn discover_rotor<S: EigenSolver>(
     rotor: &Rotor,
     solver: &S,
@@ -67,15 +77,44 @@ pub fn discover_rotor<S: EigenSolver>(
     initial: &[f64],
     options: &DiscoveryOptions,
 ) -> Result<RotorDiscovery, DiscoveryError> {
+    let mut found = search(rotor, solver, measured, initial, options)?;
+    // The mirror image of an effect on a symmetric rotor fits exactly as well: say so.
+    crate::mirror::add_images(rotor, &mut found.effects);
+    for e in &found.effects {
+        for r in found.report.effects.iter_mut().filter(|r| r.label == e.label) {
+            r.ambiguous_with = e.ambiguous_with.clone();
+        }
+    }
+    Ok(found)
+}
+
+/// The search of [`discover_rotor`]: the user's mesh, then the refined mesh when needed.
+fn search<S: EigenSolver>(
+    rotor: &Rotor,
+    solver: &S,
+    measured: &Measurement,
+    initial: &[f64],
+    options: &DiscoveryOptions,
+) -> Result<RotorDiscovery, DiscoveryError> {
     let coarse = discover(rotor, solver, measured, &effects::candidates(rotor), initial, options)?;
-    let coarse_result = RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
+    let mut coarse_result =
+        RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
     if !coarse_result.report.disagreement_significant {
         return Ok(coarse_result);
     }
     let Ok(fine_rotor) = mesh::refined(rotor, REFINEMENT) else { return Ok(coarse_result) };
+    // The refined-mesh runs share what the first run left of the evaluation budget.
+    let left = |spent: usize| DiscoveryOptions {
+        max_evaluations: options.max_evaluations.saturating_sub(spent),
+        ..options.clone()
+    };
     // First the refined mesh alone (one calibration): if it explains the data, that is the
     // answer — said instead of a physical effect, or beside one that fits about as well.
-    if let Ok(fine_base) = discover(&fine_rotor, solver, measured, &[], initial, options) {
+    let fine_base =
+        discover(&fine_rotor, solver, measured, &[], initial, &left(coarse_result.report.evaluations));
+    if let Ok(mut fine_base) = fine_base {
+        coarse_result.report.evaluations += fine_base.evaluations;
+        fine_base.evaluations = coarse_result.report.evaluations;
         if !fine_base.disagreement_significant {
             let gain = final_aicc(&coarse_result.report) - fine_base.aicc_before;
             if gain > -options.ambiguity_aicc {
@@ -89,9 +128,19 @@ pub fn discover_rotor<S: EigenSolver>(
         return Ok(coarse_result);
     }
     let candidates = effects::candidates_on(rotor, &fine_rotor, REFINEMENT);
-    let Ok(mut fine) = discover(&fine_rotor, solver, measured, &candidates, initial, options) else {
-        return Ok(coarse_result);
-    };
+    let fine = discover(
+        &fine_rotor,
+        solver,
+        measured,
+        &candidates,
+        initial,
+        &left(coarse_result.report.evaluations),
+    );
+    let Ok(mut fine) = fine else { return Ok(coarse_result) };
+    coarse_result.report.evaluations += fine.evaluations;
+    coarse_result.report.budget_exhausted |= fine.budget_exhausted;
+    fine.evaluations = coarse_result.report.evaluations;
+    fine.budget_exhausted = coarse_result.report.budget_exhausted;
     let gain = final_aicc(&coarse_result.report) - final_aicc(&fine);
     // Like any effect, the refinement is named only if what is left is noise.
     let (chi2, k) =
@@ -173,6 +222,7 @@ fn mesh_effect(gain: f64, ambiguous_with: Vec<Alternative>) -> NamedEffect {
         unit: "sub-elements per element".into(),
         delta_aicc: gain,
         ambiguous_with,
+        companions: Vec::new(),
     }
 }
 

@@ -386,6 +386,9 @@ pub fn candidates_on(rotor: &Rotor, fine: &Rotor, factor: usize) -> Vec<Candidat
                 law: law(&spec.kind),
                 position_m: spec.position_m,
                 elements: spec.elements,
+                extra_dofs: 0,
+                companions: Vec::new(),
+                rerouted: Vec::new(),
             });
         }
     };
@@ -469,6 +472,12 @@ pub fn candidates_on(rotor: &Rotor, fine: &Rotor, factor: usize) -> Vec<Candidat
         Some(Parameter::new("timoshenko_fraction", "", 0.0).with_bounds(0.0, 5.0)),
         (0.6, 1.4),
     );
+    // The same two at exactly the textbook value, as switches: a hypothesis with nothing to fit,
+    // which a proxy with a fitted value (a few grams somewhere, a stiffness loss) must beat by
+    // its extra parameter's AICc cost — the physics is not outvoted by a flexible stand-in.
+    push(at("shaft-rotary-inertia", None), None, (1.0, 1.0));
+    push(at("timoshenko-shaft", None), None, (1.0, 1.0));
+    out.extend(crate::pedestal::candidates(fine, mass));
     out
 }
 

@@ -66,6 +66,10 @@ pub struct DiscoverReport {
     pub modes: Vec<ModeReport>,
     /// Files written (the augmented model, plots).
     pub written: Vec<String>,
+    /// Eigen-solves the search spent (user's and refined mesh together).
+    pub evaluations: usize,
+    /// True when the search stopped at its budget of eigen-solves.
+    pub budget_exhausted: bool,
 }
 
 /// A parameter refitted with the named effect(s).
@@ -161,6 +165,8 @@ pub fn run(
             })
             .collect(),
         written: Vec::new(),
+        evaluations: r.evaluations,
+        budget_exhausted: r.budget_exhausted,
     };
     Ok(Discovery { found, report })
 }

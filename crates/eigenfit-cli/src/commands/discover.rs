@@ -125,6 +125,12 @@ fn print_report(
                 let interval =
                     e.interval.map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
                 println!("  {} = {value}{interval} (ΔAICc {:.2})", e.label, e.delta_aicc);
+                for c in &e.companions {
+                    let iv = c
+                        .interval
+                        .map_or(String::new(), |iv| format!(", 95% [{:.3e}, {:.3e}]", iv[0], iv[1]));
+                    println!("    with {} = {:.4e} {}{iv}", c.name, c.value, c.unit);
+                }
                 if e.kind == "mesh-refinement" {
                     println!("    the model's mesh is too coarse for this noise: refining it explains part of the gap");
                 }
@@ -154,6 +160,12 @@ fn print_report(
                 println!("  runner-up to the first effect: {} (AICc {:.2} on its own)", u.label, u.aicc);
             }
         }
+    }
+    if r.budget_exhausted {
+        println!(
+            "note: the search stopped at its budget of eigen-solves ({} spent): effects it had not reached were not tried",
+            r.evaluations
+        );
     }
     println!(
         "{:>5}{:>14}{:>10}{:>14}{:>9}{:>14}{:>9}",

@@ -1,7 +1,7 @@
 //! Candidate effects: physics a model may lack, as extra matrix contributions with a value.
 
-use crate::matrix::{CscSymmetric, SparseSymmetric, System, SystemDerivative};
-use crate::model::{ModelError, Parameter, ParameterSet, StructuralModel};
+use crate::matrix::SparseSymmetric;
+use crate::model::Parameter;
 
 /// How a candidate's value enters K and M.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -68,6 +68,29 @@ pub struct Candidate {
     pub position_m: Option<f64>,
     /// First and last element of an effect spread over a run of elements, if any.
     pub elements: Option<[usize; 2]>,
+    /// Degrees of freedom the effect adds after the model's (a pedestal's mass: 1; most
+    /// effects: 0). Its matrices are then sized model DOFs + `extra_dofs`, the added DOFs last.
+    pub extra_dofs: usize,
+    /// Further fitted values beside [`parameter`](Self::parameter), each linear in K and M (a
+    /// pedestal's stiffness beside its mass).
+    pub companions: Vec<Companion>,
+    /// Model parameters whose contribution the effect re-routes through its added DOFs:
+    /// `(parameter index, ΔK per unit value of that parameter)` (a bearing spring that now ends
+    /// on the pedestal instead of the ground).
+    pub rerouted: Vec<(usize, SparseSymmetric)>,
+}
+
+/// A further value of a [`Candidate`], entering K and M linearly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Companion {
+    /// The value as a parameter (name, unit, start, bounds).
+    pub parameter: Parameter,
+    /// Physically plausible values.
+    pub plausible: (f64, f64),
+    /// ΔK per unit value.
+    pub stiffness: SparseSymmetric,
+    /// ΔM per unit value.
+    pub mass: SparseSymmetric,
 }
 
 impl Candidate {
@@ -90,7 +113,31 @@ impl Candidate {
             law: ValueLaw::Linear,
             position_m: None,
             elements: None,
+            extra_dofs: 0,
+            companions: Vec::new(),
+            rerouted: Vec::new(),
         }
+    }
+
+    /// The fitted values: [`parameter`](Self::parameter) (if any), then the companions'.
+    pub fn parameters(&self) -> impl Iterator<Item = &Parameter> {
+        self.parameter.iter().chain(self.companions.iter().map(|c| &c.parameter))
+    }
+
+    /// Plausible ranges of [`parameters`](Self::parameters), in the same order.
+    pub fn plausible_ranges(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.parameter.iter().map(|_| self.plausible).chain(self.companions.iter().map(|c| c.plausible))
+    }
+
+    /// Number of fitted values.
+    pub fn parameter_count(&self) -> usize {
+        usize::from(self.parameter.is_some()) + self.companions.len()
+    }
+
+    /// True for an effect a linear screen cannot judge (a switch, one that adds degrees of
+    /// freedom and with them a mode, one with several values): always refitted.
+    pub fn needs_refit(&self) -> bool {
+        self.parameter.is_none() || self.extra_dofs > 0 || !self.companions.is_empty()
     }
 
     /// `kind@location` (or `kind@first-last`, `kind@x=…m`), or `kind` without a location.
@@ -107,122 +154,4 @@ impl Candidate {
     pub fn unit(&self) -> &str {
         self.parameter.as_ref().map_or("", |p| p.unit.as_str())
     }
-}
-
-/// A base model with candidate effects added; its parameters are the base's followed by each
-/// effect's value (none for a switch), in order.
-pub struct Augmented<'a, M: ?Sized> {
-    base: &'a M,
-    candidates: Vec<&'a Candidate>,
-    params: ParameterSet,
-}
-
-impl<'a, M: StructuralModel + ?Sized> Augmented<'a, M> {
-    /// Augments `base` with `candidate`.
-    pub fn new(base: &'a M, candidate: &'a Candidate) -> Result<Self, ModelError> {
-        Self::with_all(base, &[candidate])
-    }
-
-    /// Augments `base` with every candidate of `candidates` at once.
-    pub fn with_all(base: &'a M, candidates: &[&'a Candidate]) -> Result<Self, ModelError> {
-        let mut list = base.parameters().as_slice().to_vec();
-        list.extend(candidates.iter().filter_map(|c| c.parameter.clone()));
-        Ok(Self { base, candidates: candidates.to_vec(), params: ParameterSet::new(list)? })
-    }
-
-    /// The candidates' values (1 for a switch) and, for each, its parameter index if it has one.
-    fn values(&self, p: &[f64]) -> Vec<(f64, Option<usize>)> {
-        let mut next = self.base.parameters().len();
-        self.candidates
-            .iter()
-            .map(|c| match c.parameter {
-                Some(_) => {
-                    next += 1;
-                    (p[next - 1], Some(next - 1))
-                }
-                None => (1.0, None),
-            })
-            .collect()
-    }
-}
-
-impl<M: StructuralModel + ?Sized> StructuralModel for Augmented<'_, M> {
-    fn parameters(&self) -> &ParameterSet {
-        &self.params
-    }
-
-    fn dofs(&self) -> usize {
-        self.base.dofs()
-    }
-
-    fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
-        self.params.check(p)?;
-        let nb = self.base.parameters().len();
-        let base = self.base.assemble(&p[..nb])?;
-        let factors: Vec<(f64, f64)> = self
-            .candidates
-            .iter()
-            .zip(self.values(p))
-            .map(|(c, (value, _))| match c.parameter {
-                Some(_) => c.law.factors(value),
-                None => (1.0, 1.0),
-            })
-            .collect();
-        if let Some((k, m)) = base.sparse_pair() {
-            // A sparse base stays sparse: a dense copy of 10⁵ DOFs would take 80 GB.
-            let add = |a: CscSymmetric, s: &SparseSymmetric, f: f64| {
-                let delta = CscSymmetric::from_triplets(a.dim(), s.entries().iter().copied());
-                CscSymmetric::combination(1.0, &a, f, &delta)
-            };
-            let (mut k, mut m) = (k.clone(), m.clone());
-            for (c, &(fk, fm)) in self.candidates.iter().zip(&factors) {
-                k = add(k, &c.stiffness, fk);
-                m = add(m, &c.mass, fm);
-            }
-            return Ok(System::sparse(k, m)?);
-        }
-        let (mut k, mut m) = base.into_parts();
-        for (c, &(fk, fm)) in self.candidates.iter().zip(&factors) {
-            add_scaled(&mut k, &c.stiffness, fk);
-            add_scaled(&mut m, &c.mass, fm);
-        }
-        Ok(System::new(k, m)?)
-    }
-
-    fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
-        let nb = self.base.parameters().len();
-        if i < nb {
-            return self.base.derivative(&p[..nb], i);
-        }
-        for (c, (value, index)) in self.candidates.iter().zip(self.values(p)) {
-            if index == Some(i) {
-                let (dk, dm) = c.law.derivatives(value);
-                return Ok(SystemDerivative {
-                    stiffness: scaled(&c.stiffness, dk),
-                    mass: scaled(&c.mass, dm),
-                });
-            }
-        }
-        Err(ModelError::ParameterIndex { index: i, count: self.params.len() })
-    }
-}
-
-fn add_scaled(a: &mut nalgebra::DMatrix<f64>, s: &SparseSymmetric, factor: f64) {
-    if factor == 0.0 {
-        return;
-    }
-    for &(i, j, v) in s.entries() {
-        a[(i, j)] += factor * v;
-        if i != j {
-            a[(j, i)] += factor * v;
-        }
-    }
-}
-
-fn scaled(s: &SparseSymmetric, factor: f64) -> SparseSymmetric {
-    let mut out = SparseSymmetric::zeros(s.dim());
-    for &(i, j, v) in s.entries() {
-        out.add(i, j, factor * v);
-    }
-    out
 }

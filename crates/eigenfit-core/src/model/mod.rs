@@ -4,12 +4,14 @@
 //!
 //! Depends on [`matrix`](crate::matrix) and below.
 
+pub(crate) mod augmented;
 pub(crate) mod candidate;
 pub(crate) mod fixed;
 pub(crate) mod parameters;
 pub(crate) mod structural_model;
 
-pub use candidate::{Augmented, Candidate, ValueLaw};
+pub use augmented::Augmented;
+pub use candidate::{Candidate, Companion, ValueLaw};
 pub use fixed::Fixed;
 pub use parameters::{Parameter, ParameterError, ParameterSet, Scale};
 pub use structural_model::{finite_difference_derivative, ModelError, StructuralModel};

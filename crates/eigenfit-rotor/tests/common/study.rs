@@ -6,11 +6,14 @@
 #![allow(dead_code)]
 
 use eigenfit_core::discovery::{DiscoveryOptions, NamedEffect};
-use eigenfit_core::eigen::BandedSolver;
+use eigenfit_core::eigen::{BandedSolver, EigenSolver, Modes, SolveError};
+use eigenfit_core::matrix::System;
 use eigenfit_core::measurement::{MeasuredMode, Measurement};
-use eigenfit_rotor::discovery::discover_rotor;
+use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use eigenfit_rotor::presets;
+use nalgebra::DVector;
 use serde::Deserialize;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The fixture file.
 pub const FIXTURES: &str =
@@ -25,6 +28,7 @@ pub struct Fixtures {
 #[derive(Debug, Deserialize)]
 pub struct Case {
     pub name: String,
+    pub exact_hz: Vec<f64>,
     #[serde(default)]
     pub expect: Vec<Expected>,
 }
@@ -130,22 +134,60 @@ pub fn score(expected: &[Expected], named: &[NamedEffect]) -> (Outcome, bool) {
 
 /// Runs discovery on one draw; returns the named effects.
 pub fn run(draw: &Draw) -> Vec<NamedEffect> {
+    run_counted(&draw.frequency_hz, &draw.std_hz, &CountingSolver::default()).effects
+}
+
+/// Runs rotor discovery on the paper rotor against `frequency_hz` (std `std_hz`), every
+/// eigen-solve going through `solver`.
+pub fn run_counted(frequency_hz: &[f64], std_hz: &[f64], solver: &CountingSolver) -> RotorDiscovery {
     let rotor = presets::paper_rotor();
-    let modes: Vec<MeasuredMode> = draw
-        .frequency_hz
+    let modes: Vec<MeasuredMode> = frequency_hz
         .iter()
-        .zip(&draw.std_hz)
+        .zip(std_hz)
         .enumerate()
         .map(|(m, (&f, &s))| MeasuredMode::new(m, f).with_std(s))
         .collect();
     let measured = Measurement::new(modes).expect("fixture frequencies are valid");
-    discover_rotor(
-        &rotor,
-        &BandedSolver::default(),
-        &measured,
-        &rotor.nominal_stiffnesses(),
-        &DiscoveryOptions::default(),
-    )
-    .expect("discovery runs on valid data")
-    .effects
+    discover_rotor(&rotor, solver, &measured, &rotor.nominal_stiffnesses(), &DiscoveryOptions::default())
+        .expect("discovery runs on valid data")
+}
+
+/// The banded solver, counting every solve (bounded work is asserted by counting, not timing).
+#[derive(Default)]
+pub struct CountingSolver {
+    inner: BandedSolver,
+    /// Solves so far.
+    pub solves: AtomicUsize,
+}
+
+impl CountingSolver {
+    fn count(&self) {
+        self.solves.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+impl EigenSolver for CountingSolver {
+    fn name(&self) -> &'static str {
+        "counting"
+    }
+    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
+        self.count();
+        self.inner.lowest(system, count)
+    }
+    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
+        self.count();
+        self.inner.lowest_eigenvalues(system, count)
+    }
+    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
+        self.count();
+        self.inner.lowest_with_next(system, count)
+    }
+    fn lowest_eigenvalues_with_next(
+        &self,
+        system: &System,
+        count: usize,
+    ) -> Result<(DVector<f64>, f64), SolveError> {
+        self.count();
+        self.inner.lowest_eigenvalues_with_next(system, count)
+    }
 }
