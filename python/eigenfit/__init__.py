@@ -15,6 +15,7 @@ Batches on a Dask cluster: :mod:`eigenfit.batch`.
 
 from ._api import EXIT_NOT_CONVERGED, EigenfitError, compare, discover, estimate, run, simulate
 from ._native import version as _native_version
+from .matrices import MatricesModel
 from ._results import CompareResult, DiscoverResult, EstimateResult, Result, SimulateResult
 
 __version__: str = _native_version()
@@ -25,6 +26,7 @@ __all__ = [
     "discover",
     "compare",
     "run",
+    "MatricesModel",
     "EigenfitError",
     "EXIT_NOT_CONVERGED",
     "Result",

@@ -230,10 +230,11 @@ fn read_text(path: &Path) -> Result<String, CliError> {
 /// Reads `--measured` (CSV or universal file) and `--shapes`, checking every option against
 /// the data they apply to.
 pub fn read(path: &Path, layout: Option<&dyn NodeLayout>, args: &TestDataArgs) -> Result<TestData, CliError> {
-    // Shapes are tied to model DOFs through node coordinates, which a matrices model lacks.
+    // Shapes are tied to model DOFs through node coordinates: a rotor's, or a matrices model's
+    // DOF map.
     let rotor = || {
         layout.ok_or_else(|| {
-            input("measured shapes (a universal file or --shapes) need a rotor model; a matrices model takes frequencies only")
+            input("measured shapes (a universal file or --shapes) need node coordinates: a rotor model, or a matrices model with a DOF map (`dofs = \"dofs.csv\"`, docs/matrices.md)")
         })
     };
     if !(args.node_tolerance.is_finite() && args.node_tolerance >= 0.0) {

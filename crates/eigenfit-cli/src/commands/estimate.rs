@@ -43,6 +43,12 @@ pub struct EstimateArgs {
     /// solutions may spend together; when it runs out the run ends with exit code 3 and says so.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_EVALUATIONS)]
     pub budget: usize,
+    /// Points of the coarse grid refitted locally when searching for other equally good
+    /// solutions (0: no such search; the exchange of like parameters is still checked). Each is
+    /// a local fit of several model evaluations: on a large model most of a run's time
+    /// (`evaluations_by_phase` in --json).
+    #[arg(long, value_name = "N", default_value_t = ALTERNATIVE_STARTS)]
+    pub alternative_starts: usize,
     /// Write the convergence history (convergence.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
@@ -74,7 +80,8 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let solver = args.model.solver()?;
     let layout: Option<&dyn eigenfit_core::testdata::sensors::NodeLayout> = match &model {
         AnyModel::Rotor(r) => Some(r),
-        AnyModel::Matrices(_) => None,
+        // Shapes find a matrices model's DOFs through its DOF map (`dofs = "…"`).
+        AnyModel::Matrices(m) => m.layout().map(|l| l as &dyn eigenfit_core::testdata::sensors::NodeLayout),
     };
     let data = testdata::read(&args.measured, layout, &args.test_data)?;
     let measurement = data.measurement.clone();
@@ -136,6 +143,8 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let budget = Budget::new(args.budget);
     // Data no parameter value can produce is refused before any fitting.
     let unreachable = unreachable_modes(&fit, UNREACHABLE_MARGIN, &budget);
+    // Evaluations per phase, reported: on a large model each is an eigen-solve of seconds.
+    let mut phases: Vec<(&str, usize)> = vec![("reachability", budget.used())];
     if !unreachable.is_empty() {
         let list: Vec<String> = unreachable
             .iter()
@@ -176,6 +185,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         .run_within(&fit, strategy.as_mut(), &start, &mut [], &budget)
         .map_err(|e| input(e.to_string()));
     pb.finish_and_clear();
+    phases.push(("fit", budget.used()));
     let estimate = match estimate {
         Err(_) if budget.exhausted() => {
             crate::error::set_exit_on_closed_pipe(EXIT_NOT_CONVERGED);
@@ -201,13 +211,21 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     } else {
         (None, None)
     };
+    phases.push(("intervals", budget.used()));
     let mac = fit.mac(&estimate.parameters, args.test_data.mac_threshold);
     let mut alternatives: Vec<Alternative> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {
         for (i, j, p) in mirror_solutions(&fit, &estimate.last, &budget) {
             alternatives.push((p, Some((i, j))));
         }
-        for p in alternative_solutions_within(&fit, &estimate.last, ALTERNATIVE_STARTS, &budget) {
+        phases.push(("mirror_solutions", budget.used()));
+        // Ranking the coarse grid alone costs an evaluation per point: skipped with no start.
+        let others = if args.alternative_starts == 0 {
+            Vec::new()
+        } else {
+            alternative_solutions_within(&fit, &estimate.last, args.alternative_starts, &budget)
+        };
+        for p in others {
             let same = |q: &[f64]| {
                 model
                     .parameters()
@@ -221,6 +239,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         }
     }
     pb.finish_and_clear();
+    phases.push(("other_solutions", budget.used()));
     let budget_spent = budget.exhausted();
     let names: Vec<&str> = model.parameters().iter().map(|p| p.name.as_str()).collect();
     let pinned: Vec<&str> = (0..np).filter(|&i| limits[i] != 0).map(|i| names[i]).collect();
@@ -305,6 +324,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             "iterations": estimate.iterations,
             "evaluations": estimate.evaluations,
             "budget": {"limit": budget.limit(), "used": budget.used(), "exhausted": budget_spent},
+            "evaluations_by_phase": phase_counts(&phases),
             "initial": obj(initial.iter().map(|&v| json!(v)).collect()),
             "parameters": obj(estimate.parameters.iter().map(|&v| json!(v)).collect()),
             "parameter_status": obj((0..np).map(|i| json!(status(i))).collect()),
@@ -418,6 +438,17 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         }
     }
     Ok(code)
+}
+
+/// `{phase: evaluations}` from the running totals after each phase (a phase not reached is left out).
+fn phase_counts(totals: &[(&str, usize)]) -> Map<String, Value> {
+    let mut before = 0;
+    let mut out = Map::new();
+    for &(name, total) in totals {
+        out.insert(name.to_string(), json!(total - before));
+        before = total;
+    }
+    out
 }
 
 /// Four significant digits, in exponent form outside [1e-3, 1e5).
