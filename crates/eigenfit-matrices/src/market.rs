@@ -135,7 +135,7 @@ fn parse_with(text: &str, expected: Option<usize>, streaming: bool) -> Result<Cs
 /// Files from this size on are read by [`read_entries_streaming`]: nalgebra-sparse's grammar-based
 /// parser reads about 0.5 M entries per second, 10× slower than scipy's reader on a 10⁵-DOF
 /// model's files (docs/performance.md).
-const LARGE_FILE_BYTES: usize = 4 << 20;
+const LARGE_FILE_BYTES: usize = 1 << 20;
 
 /// Rows, columns and the entries (0-based, as stored).
 type Entries = (usize, usize, Vec<(usize, usize, f64)>);
@@ -278,7 +278,7 @@ mod tests {
         for name in ["K0.mtx", "K1.mtx", "M0.mtx"] {
             let text = std::fs::read_to_string(dir.join(name)).unwrap();
             let kept = parse_with(&text, None, false).unwrap();
-            assert!(kept.nnz() > 900, "{name}");
+            assert!(kept.nnz() > 200, "{name}: {}", kept.nnz());
             assert_eq!(parse_with(&text, None, true).unwrap(), kept, "{name}");
         }
     }
