@@ -3,15 +3,20 @@
 //! LAPACK backend); figures and ratios are in docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use eigenfit::compare::{log_space, run_grid, run_grid_serial, tensor_grid, CompareSettings};
-use eigenfit::discovery::{discover, DiscoveryOptions};
-use eigenfit::monte_carlo::{self, StudySettings};
-use eigenfit::rotor::presets::{paper_rotor, uniform_rotor};
-use eigenfit::rotor::Rotor;
-use eigenfit::{
-    BandedSolver, BandedSymmetric, Damped, DenseSolver, Driver, EigenSolver, MeasuredMode, Measurement,
-    Problem, Sensitivities, StrategyKind, StructuralModel, System,
+use eigenfit::core::analysis::{
+    compare::log_space, compare::run_grid, compare::run_grid_serial, compare::tensor_grid,
+    compare::CompareSettings,
 };
+use eigenfit::core::analysis::{monte_carlo, monte_carlo::StudySettings};
+use eigenfit::core::discovery::{discover, DiscoveryOptions};
+use eigenfit::core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit::core::matrix::{BandedSymmetric, System};
+use eigenfit::core::measurement::{MeasuredMode, Measurement};
+use eigenfit::core::model::StructuralModel;
+use eigenfit::core::problem::Problem;
+use eigenfit::core::sensitivity::Sensitivities;
+use eigenfit::core::update::{Driver, LevenbergMarquardt, StrategyKind};
+use eigenfit::rotor::{presets::paper_rotor, presets::uniform_rotor, Rotor};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -116,14 +121,14 @@ fn estimation(c: &mut Criterion) {
     // The local Levenberg–Marquardt alone, without the coarse-grid start and restarts.
     g.bench_function("damped_local", |b| {
         b.iter(|| {
-            let mut s = Damped::default().with_max_restarts(0);
+            let mut s = LevenbergMarquardt::default().with_max_restarts(0);
             Driver::default().run(&problem, &mut s, black_box(&[1e2, 1e2]), &mut []).unwrap()
         })
     });
     let dense = paper_problem(DenseSolver);
     g.bench_function("damped_dense_solver", |b| {
         b.iter(|| {
-            let mut s = Damped::default();
+            let mut s = LevenbergMarquardt::default();
             Driver::default().run(&dense, &mut s, black_box(&[1e2, 1e2]), &mut []).unwrap()
         })
     });

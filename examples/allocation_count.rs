@@ -4,11 +4,18 @@
 //!
 //! `cargo run --release --example allocation_count`
 
+use eigenfit::core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+
+use eigenfit::core::measurement::Measurement;
+
+use eigenfit::core::model::StructuralModel;
+
+use eigenfit::core::problem::Problem;
+
+use eigenfit::core::sensitivity::Sensitivities;
+
+use eigenfit::core::update::{Driver, LevenbergMarquardt};
 use eigenfit::rotor::presets::paper_rotor;
-use eigenfit::{
-    BandedSolver, Damped, DenseSolver, Driver, EigenSolver, Measurement, Problem, Sensitivities,
-    StructuralModel,
-};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -63,7 +70,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("  one linearisation                  {:>5}", count(|| problem.linearise(&[1e3, 2e4])));
     println!("  one cost evaluation                {:>5}", count(|| problem.cost(&[1e3, 2e4])));
     let run = |restarts: bool| {
-        let mut damped = if restarts { Damped::default() } else { Damped::default().with_max_restarts(0) };
+        let mut damped = if restarts {
+            LevenbergMarquardt::default()
+        } else {
+            LevenbergMarquardt::default().with_max_restarts(0)
+        };
         Driver::default().run(&problem, &mut damped, &[1e2, 1e2], &mut [])
     };
     let estimate = run(true)?;

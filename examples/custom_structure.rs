@@ -15,23 +15,20 @@
 //! the intervals. The same program on data without it recovers every storey stiffness within
 //! its interval.
 
-use eigenfit::discovery::{discover_configurations, DiscoveryReport};
-use eigenfit::multi::Stacked;
-use eigenfit::statistics::uncertainty;
-use eigenfit::update::Evaluate;
-use eigenfit::{
-    DenseSolver, Driver, EigenSolver, Estimate, MeasuredMode, Measurement, Newton, PStep, Problem,
-    StrategyKind, StructuralModel, UpdateStrategy,
-};
+use eigenfit::core::analysis::uncertainty;
+use eigenfit::core::discovery::{discover_configurations, DiscoveryReport};
+use eigenfit::core::eigen::{DenseSolver, EigenSolver};
+use eigenfit::core::measurement::{MeasuredMode, Measurement};
+use eigenfit::core::model::StructuralModel;
+use eigenfit::core::problem::multi::Stacked;
+use eigenfit::core::problem::{Objective, Problem};
+use eigenfit::core::update::{Driver, Estimate, Newton, PStep, StrategyKind, UpdateStrategy};
 use model::ShearBuilding;
 
 // --- model: begin
 pub mod model {
-    use eigenfit::discovery::Candidate;
-    use eigenfit::{
-        ModelError, Parameter, ParameterSet, Scale, SparseSymmetric, StructuralModel, System,
-        SystemDerivative,
-    };
+    use eigenfit::core::matrix::{SparseSymmetric, System, SystemDerivative};
+    use eigenfit::core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
     use nalgebra::{DMatrix, DVector};
 
     /// A shear building: rigid floors on massless storey springs. DOF i is the sway of floor i
@@ -138,7 +135,7 @@ pub const NOISE: f64 = 2e-3;
 pub const SEED: u64 = 2;
 
 /// Reproducible normal noise (SplitMix64 with Box–Muller), from eigenfit.
-pub use eigenfit::synthetic::Gaussian as Noise;
+pub use eigenfit::core::measurement::synthetic::NoiseRng as Noise;
 
 /// The model as the engineer knows it: design stiffnesses, drawing masses.
 pub fn building() -> ShearBuilding {
@@ -185,19 +182,20 @@ pub struct Run {
 /// Every strategy from the design stiffnesses. Newton and p-step solve the paper's square system
 /// (as many modes as parameters: the first test); damped fits all tests at once.
 pub fn update_all(problems: &[Problem<ShearBuilding, DenseSolver>]) -> Vec<Run> {
-    let all = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect()).expect("same parameters");
+    let all = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect()).expect("same parameters");
     StrategyKind::ALL
         .into_iter()
         .map(|strategy| {
-            let data: &dyn Evaluate = if strategy == StrategyKind::Damped { &all } else { &problems[0] };
+            let data: &dyn Objective =
+                if strategy == StrategyKind::LevenbergMarquardt { &all } else { &problems[0] };
             let mut s: Box<dyn UpdateStrategy> = match strategy {
                 // The paper's 0.01 Hz suits a 40–200 Hz rotor; a 2–14 Hz building needs finer.
                 StrategyKind::Newton => Box::new(Newton { tolerance_hz: 1e-4 }),
                 StrategyKind::PStep => Box::new(PStep::new(1e-4, 0.5, 5)),
-                StrategyKind::Damped => strategy.build(),
+                StrategyKind::LevenbergMarquardt => strategy.build(),
             };
             let estimate = Driver::default().run(data, s.as_mut(), &DESIGN, &mut []).expect("runs");
-            let intervals = (strategy == StrategyKind::Damped)
+            let intervals = (strategy == StrategyKind::LevenbergMarquardt)
                 .then(|| uncertainty(data, &estimate.last, true))
                 .flatten()
                 .map(|u| u.intervals);
@@ -240,7 +238,7 @@ fn report(title: &str, data: &[Measurement], runs: &[Run]) -> bool {
             k.join(", ")
         );
     }
-    let damped = runs.iter().find(|r| r.strategy == StrategyKind::Damped).expect("damped ran");
+    let damped = runs.iter().find(|r| r.strategy == StrategyKind::LevenbergMarquardt).expect("damped ran");
     let intervals = damped.intervals.as_ref().expect("the data carry std");
     println!("\n| storey | truth [MN/m] | damped [MN/m] | 95% interval [MN/m] | truth inside |");
     println!("|---|---|---|---|---|");

@@ -9,13 +9,14 @@
 //! search over which node carries what (see docs/paper-rotor.md); this program fits the continuous
 //! part and prints the side-by-side table.
 
-use eigenfit::multi::Stacked;
+use eigenfit::core::eigen::{DenseSolver, EigenSolver};
+use eigenfit::core::matrix::System;
+use eigenfit::core::measurement::{MeasuredMode, Measurement};
+use eigenfit::core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
+use eigenfit::core::problem::multi::Stacked;
+use eigenfit::core::problem::{Objective, Problem};
+use eigenfit::core::update::{Driver, LevenbergMarquardt};
 use eigenfit::rotor::{presets, Rotor};
-use eigenfit::update::Evaluate;
-use eigenfit::{
-    Damped, DenseSolver, Driver, EigenSolver, MeasuredMode, Measurement, ModelError, Parameter, ParameterSet,
-    Problem, Scale, StructuralModel, System,
-};
 
 use presets::PAPER_TABLE_1 as TABLE_1;
 
@@ -73,9 +74,9 @@ fn main() {
             })
             .collect();
         let stacked =
-            Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect()).expect("same parameters");
+            Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect()).expect("same parameters");
         let e = Driver::default()
-            .run(&stacked, &mut Damped::default(), &start, &mut [])
+            .run(&stacked, &mut LevenbergMarquardt::default(), &start, &mut [])
             .expect("calibration runs");
         let rel: Vec<f64> =
             e.last.frequencies_hz.iter().zip(&e.last.measured_hz).map(|(a, b)| (a / b - 1.0).abs()).collect();

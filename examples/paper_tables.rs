@@ -3,9 +3,14 @@
 //!
 //! Run: `cargo run --release --example paper_tables`
 
-use eigenfit::compare::{reference_measurement, run_case, CompareRun, CompareSettings, SharedData};
+use eigenfit::core::analysis::{
+    compare::reference_measurement, compare::run_case, compare::CompareRun, compare::CompareSettings,
+    compare::SharedData,
+};
+use eigenfit::core::eigen::DenseSolver;
+use eigenfit::core::problem::Problem;
+use eigenfit::core::update::StrategyKind;
 use eigenfit::rotor::presets;
-use eigenfit::{DenseSolver, Problem, StrategyKind};
 
 /// One case of a paper table: the initial guess and what the paper reports.
 struct Case {

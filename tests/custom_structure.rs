@@ -7,7 +7,9 @@
 #[allow(dead_code)]
 mod example;
 
-use eigenfit::{finite_difference_derivative, ModelError, StrategyKind, StructuralModel};
+use eigenfit::core::model::{finite_difference_derivative, ModelError, StructuralModel};
+
+use eigenfit::core::update::StrategyKind;
 use example::model::ShearBuilding;
 use example::{
     building, chi2_95, discover_storey_mass, measurements, problems, update_all, Noise, Run, DESIGN,
@@ -22,7 +24,7 @@ fn inside(run: &Run) -> Vec<bool> {
 }
 
 fn damped(runs: &[Run]) -> &Run {
-    runs.iter().find(|r| r.strategy == StrategyKind::Damped).expect("damped ran")
+    runs.iter().find(|r| r.strategy == StrategyKind::LevenbergMarquardt).expect("damped ran")
 }
 
 #[test]
@@ -43,7 +45,7 @@ fn every_strategy_converges_on_clean_data() {
         assert!(e.termination.is_converged(), "{}: {}", run.strategy.name(), e.termination);
         let err = e.parameters.iter().zip(TRUTH).map(|(k, t)| (k / t - 1.0).abs()).fold(0.0, f64::max);
         // Newton and p-step stop at 1e-4 Hz; damped fits to round-off.
-        let tol = if run.strategy == StrategyKind::Damped { 1e-6 } else { 1e-3 };
+        let tol = if run.strategy == StrategyKind::LevenbergMarquardt { 1e-6 } else { 1e-3 };
         assert!(err < tol, "{}: relative error {err:e}", run.strategy.name());
     }
 }

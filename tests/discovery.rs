@@ -1,13 +1,15 @@
 //! Missing-effect discovery on data in which an effect is hidden (issue: discovery).
 
-use eigenfit::discovery::{discover, Augmented, DiscoveryOptions, DiscoveryReport};
+use eigenfit::core::discovery::{discover, DiscoveryOptions, DiscoveryReport};
+
+use eigenfit::core::eigen::DenseSolver;
+use eigenfit::core::measurement::{synthetic::synthesise, synthetic::NoiseRng, Measurement};
+use eigenfit::core::model::{Augmented, StructuralModel};
 use eigenfit::rotor::{presets, EffectSpec, Rotor};
-use eigenfit::synthetic::{synthesise, Gaussian};
-use eigenfit::{DenseSolver, Measurement, StructuralModel};
 
 /// `modes` measured frequencies of `truth` at `stiffness`, with relative noise `rel`.
 fn measure(truth: &Rotor, stiffness: &[f64], modes: usize, rel: f64, seed: u64) -> Measurement {
-    synthesise(truth, &DenseSolver, stiffness, modes, rel, Some(&mut Gaussian(seed))).unwrap()
+    synthesise(truth, &DenseSolver, stiffness, modes, rel, Some(&mut NoiseRng(seed))).unwrap()
 }
 
 fn run(hidden: Option<EffectSpec>, seed: u64) -> DiscoveryReport {

@@ -1,8 +1,11 @@
 //! A support in the shaft-dependent zone is flagged as not identifiable, with a correct bound.
 
+use eigenfit::core::analysis::{uncertainty, Identifiability};
+use eigenfit::core::eigen::DenseSolver;
+use eigenfit::core::measurement::{MeasuredMode, Measurement};
+use eigenfit::core::problem::Problem;
+use eigenfit::core::update::{Driver, LevenbergMarquardt};
 use eigenfit::rotor::presets;
-use eigenfit::statistics::uncertainty;
-use eigenfit::{Damped, DenseSolver, Driver, Identifiability, MeasuredMode, Measurement, Problem};
 
 /// χ² with parameter `i` held at `value` and the others refitted.
 fn profile(
@@ -14,7 +17,7 @@ fn profile(
     let mut p = start.to_vec();
     p[i] = value;
     let fixed = (0..p.len()).map(|j| j == i).collect();
-    let mut local = Damped::default().with_fixed(fixed).with_max_restarts(0);
+    let mut local = LevenbergMarquardt::default().with_fixed(fixed).with_max_restarts(0);
     let est = Driver::default().run(problem, &mut local, &p, &mut []).unwrap();
     2.0 * est.last.cost()
 }
@@ -25,7 +28,8 @@ fn stiff_support_gets_a_one_sided_profile_bound() {
     let data = [(59.029, 0.06), (203.444, 0.2), (670.711, 0.6)];
     let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
     let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est = Driver::default().run(&problem, &mut Damped::default(), &[1e3, 1e3], &mut []).unwrap();
+    let est =
+        Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut []).unwrap();
     assert!(est.termination.is_converged());
     let u = uncertainty(&problem, &est.last, true).unwrap();
     let Identifiability::LowerBoundOnly { lower } = u.identifiability[1] else {
@@ -48,7 +52,8 @@ fn soft_supports_are_determined_with_tight_intervals() {
     let data = [(36.107, 0.036), (84.066, 0.084), (305.649, 0.31)];
     let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
     let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est = Driver::default().run(&problem, &mut Damped::default(), &[1e3, 1e3], &mut []).unwrap();
+    let est =
+        Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut []).unwrap();
     let u = uncertainty(&problem, &est.last, true).unwrap();
     assert!(u.identifiability.iter().all(Identifiability::is_determined), "{:?}", u.identifiability);
     for iv in &u.intervals {

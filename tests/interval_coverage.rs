@@ -4,9 +4,9 @@
 //! 93–97% is ±4 of them (with 240 trials, one seed gave 99.2% for K2 — a 3σ draw from a rate
 //! that 4,000-trial runs put at 94.4–95.8%). The study runs in parallel (`monte_carlo::run`).
 
-use eigenfit::monte_carlo::{run, StudySettings};
+use eigenfit::core::analysis::{monte_carlo::run, monte_carlo::StudySettings};
+use eigenfit::core::eigen::BandedSolver;
 use eigenfit::rotor::presets;
-use eigenfit::BandedSolver;
 
 #[test]
 fn intervals_cover_the_truth_at_the_nominal_rate() {

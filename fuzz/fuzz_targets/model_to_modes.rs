@@ -12,7 +12,8 @@
 
 #![no_main]
 
-use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorSpec, Section, ShaftSpec};
 use libfuzzer_sys::arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;

@@ -6,10 +6,10 @@
 use crate::commands::simulate::SimulateArgs;
 use crate::error::{input, CliError};
 use crate::source::parameter_vector;
-use eigenfit_core::discovery::Candidate;
-use eigenfit_core::{
-    EigenSolver, ModelError, ParameterSet, Sensitivities, StructuralModel, System, SystemDerivative,
-};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::matrix::{System, SystemDerivative};
+use eigenfit_core::model::{Candidate, ModelError, ParameterSet, StructuralModel};
+use eigenfit_core::sensitivity::Sensitivities;
 use eigenfit_matrices::{MatricesError, MatricesModel};
 use eigenfit_rotor::Rotor;
 use serde_json::json;

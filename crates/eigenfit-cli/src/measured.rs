@@ -5,7 +5,7 @@
 //! increase with mode number, and a mode listed twice.
 
 use crate::error::{input, CliError};
-use eigenfit_core::{MeasuredMode, Measurement};
+use eigenfit_core::measurement::{MeasuredMode, Measurement};
 use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;

@@ -3,7 +3,8 @@
 use crate::any_model::{self, AnyModel};
 use crate::error::{input, CliError};
 use clap::Args;
-use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, SparseSolver, StructuralModel};
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver, SparseSolver};
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{presets, Rotor, RotorError};
 use std::path::PathBuf;
 

@@ -1,20 +1,19 @@
 //! Test data on the command line: universal files and shape CSV in, the frequency-or-shape fit,
 //! and the MAC part of the `estimate` report (docs/test-data.md). The reading, mapping and
-//! fitting themselves live in `eigenfit_core::testdata` and the rotor's `NodeLayout`.
+//! fitting themselves live in `eigenfit_core::measurement` and the rotor's `NodeLayout`.
 
 use crate::any_model::AnyModel;
 use crate::error::{input, CliError};
 use crate::measured;
 use clap::Args;
-use eigenfit_core::fixed::Fixed;
-use eigenfit_core::testdata::sensors::NodeLayout;
-use eigenfit_core::testdata::{sensors, uff, MacReport, SensorSet, ShapeFit};
-use eigenfit_core::StructuralModel;
-use eigenfit_core::{
-    EigenSolver, Estimate, Evaluate, Linearisation, Measurement, Pairing, ParameterSet, Problem,
-    ResidualError, Uncertainty,
-};
-use eigenfit_core::{ModelError, System, SystemDerivative};
+use eigenfit_core::analysis::{ShapeFit, Uncertainty};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::matrix::{System, SystemDerivative};
+use eigenfit_core::measurement::sensors::NodeLayout;
+use eigenfit_core::measurement::{mac::MacReport, sensors, sensors::SensorSet, uff, Measurement};
+use eigenfit_core::model::{Fixed, ModelError, ParameterSet, StructuralModel};
+use eigenfit_core::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
+use eigenfit_core::update::Estimate;
 use eigenfit_matrices::MatricesModel;
 use eigenfit_rotor::{Rotor, UpdatableRotor};
 use serde_json::{json, Value};
@@ -35,7 +34,7 @@ pub struct TestDataArgs {
     #[arg(long, default_value_t = 1e-3, value_name = "M")]
     pub node_tolerance: f64,
     /// Standard deviation of the entries of a unit-length measured shape (shape residual weight).
-    #[arg(long, default_value_t = eigenfit_core::testdata::shapes::DEFAULT_SHAPE_STD, value_name = "S")]
+    #[arg(long, default_value_t = eigenfit_core::analysis::DEFAULT_SHAPE_STD, value_name = "S")]
     pub shape_std: f64,
     /// Lowest MAC at which a measured mode counts as paired; below it the mode is named
     /// unpaired and the run is not acceptable (exit code 3).
@@ -142,7 +141,7 @@ pub fn write_model(
         utc_date(),
         data_file.display(),
         estimate.last.chi2(),
-        estimate.last.dof()
+        estimate.last.degrees_of_freedom()
     );
     for (i, p) in model.parameters().iter().enumerate() {
         let interval = unc.map_or("no interval".to_string(), |u| {
@@ -338,7 +337,7 @@ impl<'a> Fit<'a> {
     /// were scaled by (1 when the data carry standard deviations).
     pub fn uncertainty(&mut self, at: &Linearisation, has_std: bool) -> Option<(Uncertainty, f64)> {
         match self {
-            Fit::Frequencies(p) => eigenfit_core::statistics::uncertainty(p, at, has_std).map(|u| (u, 1.0)),
+            Fit::Frequencies(p) => eigenfit_core::analysis::uncertainty(p, at, has_std).map(|u| (u, 1.0)),
             Fit::Shapes(s) => s.uncertainty(at),
         }
     }
@@ -358,7 +357,7 @@ impl<'a> Fit<'a> {
     }
 }
 
-impl Evaluate for Fit<'_> {
+impl Objective for Fit<'_> {
     fn parameters(&self) -> &ParameterSet {
         match self {
             Fit::Frequencies(p) => p.parameters(),
@@ -373,8 +372,8 @@ impl Evaluate for Fit<'_> {
     }
     fn cost(&self, p: &[f64]) -> Option<f64> {
         match self {
-            Fit::Frequencies(q) => Evaluate::cost(q, p),
-            Fit::Shapes(s) => Evaluate::cost(s, p),
+            Fit::Frequencies(q) => Objective::cost(q, p),
+            Fit::Shapes(s) => Objective::cost(s, p),
         }
     }
 }
@@ -385,10 +384,10 @@ pub fn uncertainty(
     fit: &mut Fit,
     at: &Linearisation,
     has_std: bool,
-    budget: &eigenfit_core::Budget,
+    budget: &eigenfit_core::update::Budget,
 ) -> (Option<Uncertainty>, Option<f64>) {
     match fit {
-        Fit::Frequencies(p) => (eigenfit_core::statistics::uncertainty_within(p, at, has_std, budget), None),
+        Fit::Frequencies(p) => (eigenfit_core::analysis::uncertainty_within(p, at, has_std, budget), None),
         Fit::Shapes(s) => s.uncertainty(at).map_or((None, None), |(u, sc)| (Some(u), Some(sc))),
     }
 }

@@ -9,10 +9,9 @@
 //! Every result is refused for a repeated or nearly repeated eigenvalue: there the derivative of
 //! an individual mode is not defined, and any number returned would be silently wrong.
 
+use crate::eigen::{EigenSolver, Modes, SolveError};
+use crate::matrix::{System, SystemDerivative};
 use crate::model::{ModelError, StructuralModel};
-use crate::modes::Modes;
-use crate::solver::{EigenSolver, SolveError};
-use crate::system::{System, SystemDerivative};
 use nalgebra::{DMatrix, DVector};
 use thiserror::Error;
 
@@ -49,7 +48,7 @@ pub enum SensitivityError {
 /// Checks that mode `k` is separated from every other computed mode.
 ///
 /// Two eigenvalues count as repeated when |λₖ − λₗ| ≤ `tolerance`·max(|λₖ|, |λₗ|), or when both
-/// are zero to round-off (|λ| ≤ `floor`, rigid-body modes), see [`noise_floor`]. The solver keeps
+/// are zero to round-off (|λ| ≤ `floor`, rigid-body modes), see [`rigid_body_tolerance`]. The solver keeps
 /// low eigenvalues accurate relative to themselves, so closely spaced low modes are told apart
 /// however large the highest eigenvalue is.
 pub fn check_distinct(modes: &Modes, k: usize, tolerance: f64, floor: f64) -> Result<(), SensitivityError> {
@@ -85,7 +84,7 @@ fn distinct(lam: &[f64], next: f64, k: usize, tolerance: f64, floor: f64) -> Res
 /// The dense solver leaves a rigid-body eigenvalue at about ε times the lowest elastic one, at
 /// most ε·max|K|/max|M|, so this sits three decades above its round-off; an elastic mode would
 /// need a stiffness contrast of 10¹² to fall below it.
-pub fn noise_floor(system: &System) -> f64 {
+pub fn rigid_body_tolerance(system: &System) -> f64 {
     let (kmax, mmax) = system.amax();
     if mmax > 0.0 {
         1e-12 * kmax / mmax
@@ -140,12 +139,12 @@ impl Sensitivities {
         S: EigenSolver + ?Sized,
     {
         let system = model.assemble(p)?;
-        crate::solver::check_count(&system, count)?;
+        crate::eigen::check_count(&system, count)?;
         if let Some(&k) = wanted.iter().find(|&&k| k >= count) {
             return Err(SensitivityError::ModeIndex { mode: k, count });
         }
         let (modes, next) = solver.lowest_with_next(&system, count)?;
-        let floor = noise_floor(&system);
+        let floor = rigid_body_tolerance(&system);
         check_wanted_distinct(modes.eigenvalues.as_slice(), next, wanted.iter().copied(), floor)?;
         let np = model.parameters().len();
         let mut dl = DMatrix::from_element(count, np, f64::NAN);
@@ -163,7 +162,7 @@ impl Sensitivities {
             }
         }
         for &k in wanted {
-            let f = crate::eigenvalue_to_hz(modes.eigenvalues[k]);
+            let f = crate::units::eigenvalue_to_hz(modes.eigenvalues[k]);
             let factor = 1.0 / (8.0 * std::f64::consts::PI.powi(2) * f);
             df.row_mut(k).copy_from(&(dl.row(k) * factor));
         }
@@ -219,7 +218,7 @@ pub fn eigenvector_derivative_nelson(
     k: usize,
     d: &SystemDerivative,
 ) -> Result<DVector<f64>, SensitivityError> {
-    check_distinct(modes, k, DEFAULT_REPEATED_TOLERANCE, noise_floor(system))?;
+    check_distinct(modes, k, DEFAULT_REPEATED_TOLERANCE, rigid_body_tolerance(system))?;
     let lk = modes.eigenvalues[k];
     let phi = DVector::from_column_slice(modes.shape(k));
     let dlk = eigenvalue_derivative(modes, k, d);
@@ -244,7 +243,8 @@ pub fn eigenvector_derivative_nelson(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{DenseSolver, SparseSymmetric};
+    use crate::eigen::DenseSolver;
+    use crate::matrix::SparseSymmetric;
 
     fn chain() -> (System, Modes) {
         let k = DMatrix::from_row_slice(3, 3, &[3.0, -1.0, 0.0, -1.0, 2.0, -1.0, 0.0, -1.0, 1.5]);

@@ -1,7 +1,8 @@
 //! A spring–mass chain for unit tests: ground –k₁– m₁ –k₂– m₂ – … –kₙ– mₙ, one stiffness
 //! parameter per spring (N/m, log scale, nominal 1e4, bounds [1e-3, 1e9]).
 
-use crate::{ModelError, Parameter, ParameterSet, Scale, StructuralModel, System};
+use crate::matrix::System;
+use crate::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use nalgebra::{DMatrix, DVector};
 
 /// The chain with the given masses (kg), bottom up.

@@ -1,7 +1,8 @@
 //! The banded solver (Lanczos, subspace-iteration fallback, Sturm check) against the dense one on
 //! random band systems, repeated eigenvalues, rigid-body modes and bad mass matrices.
 
-use eigenfit_core::{BandedSolver, BandedSymmetric, DenseSolver, EigenSolver, Modes, SolveError, System};
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver, Modes, SolveError};
+use eigenfit_core::matrix::{BandedSymmetric, System};
 use proptest::prelude::*;
 
 /// A random symmetric positive definite band matrix: random band entries, diagonal made

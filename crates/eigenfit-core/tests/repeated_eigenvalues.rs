@@ -15,13 +15,14 @@ mod common;
 
 use common::runner::{cases, check};
 use common::{all_modes, relative_gap, spec, RandomModel};
+use eigenfit_core::eigen::{DenseSolver, Modes};
+use eigenfit_core::matrix::{SparseSymmetric, System, SystemDerivative};
+use eigenfit_core::model::{ModelError, ParameterSet, StructuralModel};
 use eigenfit_core::sensitivity::{
-    eigenvector_derivative_modal, eigenvector_derivative_nelson, noise_floor, DEFAULT_REPEATED_TOLERANCE,
+    eigenvector_derivative_modal, eigenvector_derivative_nelson, rigid_body_tolerance,
+    DEFAULT_REPEATED_TOLERANCE,
 };
-use eigenfit_core::{
-    DenseSolver, ModelError, Modes, ParameterSet, Sensitivities, SensitivityError, SparseSymmetric,
-    StructuralModel, System, SystemDerivative,
-};
+use eigenfit_core::sensitivity::{Sensitivities, SensitivityError};
 use nalgebra::DMatrix;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
@@ -133,7 +134,7 @@ fn doubled_structure_is_refused_everywhere() {
             let model = Twin { inner: RandomModel::from_spec(&spec), perm };
             let p = model.inner.point.clone();
             let (sys, modes) = all_modes(&model, &p);
-            let floor = noise_floor(&sys);
+            let floor = rigid_body_tolerance(&sys);
             for k in 0..modes.count() {
                 worst.note("twin relative gap (must be ≤ 1e-8)", relative_gap(&modes.eigenvalues, k));
                 for i in 0..p.len() {
@@ -235,7 +236,7 @@ fn one_repeated_pair_is_refused_and_only_that_pair() {
             let p = model.inner.point.clone();
             let n = model.inner.dofs();
             let (sys, modes) = all_modes(&model, &p);
-            let floor = noise_floor(&sys);
+            let floor = rigid_body_tolerance(&sys);
             let (lo, hi) = pair(&modes, n);
             worst.note("pair relative gap (must be ≤ 1e-8)", relative_gap(&modes.eigenvalues, lo));
             prop_assert_eq!(hi, lo + 1, "the pair is adjacent in the sorted spectrum");
@@ -317,7 +318,7 @@ fn close_but_distinct_pair_is_answered_exactly() {
                 let scale = exact.amax().max(inner_modes.shapes.column(j).amax() / p[i].abs());
                 for (name, got) in [
                     ("Nelson", eigenvector_derivative_nelson(&sys, &modes, k, &d)),
-                    ("modal", eigenvector_derivative_modal(&modes, k, &d, noise_floor(&sys))),
+                    ("modal", eigenvector_derivative_modal(&modes, k, &d, rigid_body_tolerance(&sys))),
                 ] {
                     let got = got.map_err(|e| TestCaseError::fail(format!("{name}: {e}")))?;
                     prop_assert!(got[n].abs() <= 1e-9 * scale, "{name}: extra DOF moved");
@@ -345,7 +346,7 @@ fn close_but_distinct_pair_is_answered_exactly() {
 #[test]
 fn refusal_message_names_the_modes() {
     let sys = System::new(DMatrix::from_diagonal_element(3, 3, 2.0), DMatrix::identity(3, 3)).unwrap();
-    let modes = eigenfit_core::EigenSolver::lowest(&DenseSolver, &sys, 3).unwrap();
+    let modes = eigenfit_core::eigen::EigenSolver::lowest(&DenseSolver, &sys, 3).unwrap();
     let err = eigenvector_derivative_nelson(&sys, &modes, 1, &SystemDerivative::zeros(3)).unwrap_err();
     let text = err.to_string();
     assert!(text.contains("modes 1 and 0"), "{text}");

@@ -22,13 +22,14 @@ use common::{
     aligned_modes, all_modes, near_symmetric, reference_modes, relative_gap, spec, FdOnly, Kind,
     NearSymmetric, ParamSpec, RandomModel, Spec, Sweep, MIN_RELATIVE_GAP,
 };
+use eigenfit_core::eigen::{DenseSolver, EigenSolver, Modes};
+use eigenfit_core::matrix::System;
+use eigenfit_core::model::{finite_difference_derivative, StructuralModel};
 use eigenfit_core::sensitivity::{
-    eigenvalue_derivative, eigenvector_derivative_modal, eigenvector_derivative_nelson, noise_floor,
+    eigenvalue_derivative, eigenvector_derivative_modal, eigenvector_derivative_nelson, rigid_body_tolerance,
 };
-use eigenfit_core::{
-    eigenvalue_to_hz, finite_difference_derivative, DenseSolver, EigenSolver, Modes, Sensitivities,
-    SensitivityError, StructuralModel, System,
-};
+use eigenfit_core::sensitivity::{Sensitivities, SensitivityError};
+use eigenfit_core::units::eigenvalue_to_hz;
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -293,7 +294,7 @@ fn eigenvalue_sensitivities_of_close_pairs_match_finite_differences() {
 fn check_eigenvector_derivatives(model: &impl StructuralModel, p: &[f64], worst: &Worst) -> TestCaseResult {
     let (sys, modes) = all_modes(model, p);
     let (k_mat, m_mat) = (sys.stiffness(), sys.mass());
-    let floor = noise_floor(&sys);
+    let floor = rigid_body_tolerance(&sys);
     let n = modes.count();
     let sweeps: Vec<Sweep> =
         (0..p.len()).map(|i| Sweep::new(p, i, |q| aligned_modes(model, q, &modes, m_mat))).collect();
@@ -427,7 +428,7 @@ fn default_finite_difference_derivative_matches_analytic() {
                 }
             }
             // Sparsity: nothing outside the exact pattern survives.
-            let pattern = |s: &eigenfit_core::SparseSymmetric| {
+            let pattern = |s: &eigenfit_core::matrix::SparseSymmetric| {
                 let d = s.to_dense();
                 d.map(|v| v != 0.0)
             };
@@ -497,7 +498,8 @@ fn truncation_errors(model: &RandomModel, k: usize, i: usize) -> Result<Vec<(f64
     let m_scale = m_norm(&exact).max(1.0 / p[i].abs());
     (k + 1..=modes.count())
         .map(|m| {
-            let approx = eigenvector_derivative_modal(&leading(&modes, m), k, &d, noise_floor(&sys))?;
+            let approx =
+                eigenvector_derivative_modal(&leading(&modes, m), k, &d, rigid_body_tolerance(&sys))?;
             let e = approx - &exact;
             Ok((e.amax() / scale, m_norm(&e) / m_scale))
         })

@@ -1,7 +1,7 @@
 //! The UFF reader against files written by pyuff (tests/data/uff/generate.py), with the values
 //! pyuff was given beside them in JSON.
 
-use eigenfit_core::testdata::uff;
+use eigenfit_core::measurement::uff;
 use serde_json::Value;
 use std::path::PathBuf;
 

@@ -4,7 +4,7 @@
 //! dimension n. Only the upper triangle of K and M is read (`UPLO = 'U'`).
 
 use crate::backend;
-use eigenfit_core::SolveError;
+use eigenfit_core::eigen::SolveError;
 
 /// `ITYPE = 1`: A x = λ B x.
 const ITYPE: [i32; 1] = [1];

@@ -27,7 +27,8 @@
 //! 1e-14.
 //!
 //! ```
-//! use eigenfit_core::{EigenSolver, System};
+//! use eigenfit_core::eigen::EigenSolver;
+//! use eigenfit_core::matrix::System;
 //! use eigenfit_lapack::LapackSolver;
 //! use nalgebra::DMatrix;
 //!
@@ -40,8 +41,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! [`DenseSolver`]: eigenfit_core::DenseSolver
-//! [`apply_sign_rule`]: eigenfit_core::apply_sign_rule
+//! [`DenseSolver`]: eigenfit_core::eigen::DenseSolver
+//! [`apply_sign_rule`]: eigenfit_core::eigen::apply_sign_rule
 
 #![warn(missing_docs)]
 
@@ -50,8 +51,8 @@ extern crate openblas_src;
 
 mod driver;
 
-use eigenfit_core::solver::{check_count, shifted_twice};
-use eigenfit_core::{apply_sign_rule, EigenSolver, Modes, SolveError, System};
+use eigenfit_core::eigen::{apply_sign_rule, check_count, shifted_twice, EigenSolver, Modes, SolveError};
+use eigenfit_core::matrix::System;
 use nalgebra::{DMatrix, DVector};
 
 /// Backend name reported by [`LapackSolver`] and used in [`SolveError::Backend`].
@@ -99,7 +100,8 @@ impl Method {
 /// convergence, non-finite results, a system too large for LAPACK's 32-bit integers).
 ///
 /// ```
-/// use eigenfit_core::{EigenSolver, SolveError, System};
+/// use eigenfit_core::eigen::{EigenSolver, SolveError};
+/// use eigenfit_core::matrix::System;
 /// use eigenfit_lapack::{LapackSolver, Method};
 /// use nalgebra::DMatrix;
 ///
@@ -154,7 +156,7 @@ impl EigenSolver for LapackSolver {
 
 /// The lowest `count` modes of (K, M) with the given driver (`All` or `Subset`).
 ///
-/// Like [`DenseSolver`](eigenfit_core::DenseSolver): for at most half the modes, the inverted
+/// Like [`DenseSolver`](eigenfit_core::eigen::DenseSolver): for at most half the modes, the inverted
 /// problem M x = μ (K + σM) x (μ = 1/(λ + σ), the lowest modes the largest μ), so each low mode
 /// keeps round-off relative to its own eigenvalue; σ = 0 when K is well-conditioned positive
 /// definite, else the shared two-shift strategy. For more than half, the textbook reduction with

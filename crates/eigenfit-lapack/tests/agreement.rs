@@ -2,7 +2,8 @@
 //! well-separated spectrum, banded beam-like chains, the subset path vs the full path, the
 //! orthogonality identities, and the typed error for a mass matrix that is not positive definite.
 
-use eigenfit_core::{DenseSolver, EigenSolver, Modes, SolveError, System};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver, Modes, SolveError};
+use eigenfit_core::matrix::System;
 use eigenfit_lapack::{LapackSolver, Method};
 use nalgebra::{Cholesky, DMatrix, DVector, QR};
 use proptest::prelude::*;
@@ -482,7 +483,7 @@ fn low_modes_of_a_stiff_cantilever_agree_relative_to_themselves() {
     for elements in [11, 50, 200] {
         let system = cantilever(elements);
         let dense = DenseSolver.lowest(&system, 5).unwrap();
-        let banded = eigenfit_core::BandedSolver::default().lowest(&system, 5).unwrap();
+        let banded = eigenfit_core::eigen::BandedSolver::default().lowest(&system, 5).unwrap();
         let d = compare(&banded, &dense, 5);
         assert!(d.eigenvalue_rel < 1e-12 && d.shape_rel < 1e-9, "{elements} elements, banded: {d:?}");
         for (name, solver) in [("all", ALL), ("subset", SUBSET)] {

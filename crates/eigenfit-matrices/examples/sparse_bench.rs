@@ -6,7 +6,9 @@
 //! cargo run --release -p eigenfit-matrices --example sparse_bench -- MODEL.toml [MODES]
 //! ```
 
-use eigenfit_core::{EigenSolver, Sensitivities, SparseSolver, StructuralModel};
+use eigenfit_core::eigen::{EigenSolver, SparseSolver};
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::sensitivity::Sensitivities;
 use eigenfit_matrices::MatricesModel;
 use std::time::Instant;
 

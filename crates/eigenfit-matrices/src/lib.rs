@@ -21,8 +21,8 @@
 //! stiffness = "K1.mtx"
 //! ```
 //!
-//! [`MatricesModel`] implements [`StructuralModel`](eigenfit_core::StructuralModel); its systems
-//! are stored sparse, for [`SparseSolver`](eigenfit_core::SparseSolver).
+//! [`MatricesModel`] implements [`StructuralModel`](eigenfit_core::model::StructuralModel); its systems
+//! are stored sparse, for [`SparseSolver`](eigenfit_core::eigen::SparseSolver).
 
 mod error;
 mod layout;

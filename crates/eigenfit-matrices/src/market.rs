@@ -11,7 +11,7 @@
 //!   is mirrored.
 
 use crate::error::MatricesError;
-use eigenfit_core::CscSymmetric;
+use eigenfit_core::matrix::CscSymmetric;
 use nalgebra_sparse::io::load_coo_from_matrix_market_str;
 use std::collections::HashMap;
 use std::path::Path;

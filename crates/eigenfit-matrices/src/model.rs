@@ -4,10 +4,8 @@
 use crate::error::MatricesError;
 use crate::layout::DofLayout;
 use crate::market::read_symmetric;
-use eigenfit_core::discovery::Candidate;
-use eigenfit_core::{
-    CscSymmetric, ModelError, Parameter, ParameterSet, Scale, StructuralModel, System, SystemDerivative,
-};
+use eigenfit_core::matrix::{CscSymmetric, System, SystemDerivative};
+use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -398,8 +396,10 @@ impl StructuralModel for MatricesModel {
         self.params.check(p)?;
         let n = self.dofs();
         let convert = |t: &Option<Term>| {
-            t.as_ref()
-                .map_or_else(|| eigenfit_core::SparseSymmetric::zeros(n), |t| t.matrix.to_sparse_symmetric())
+            t.as_ref().map_or_else(
+                || eigenfit_core::matrix::SparseSymmetric::zeros(n),
+                |t| t.matrix.to_sparse_symmetric(),
+            )
         };
         Ok(SystemDerivative { stiffness: convert(dk), mass: convert(dm) })
     }

@@ -1,6 +1,6 @@
 //! Model files: every mistake is reported naming the file and the entry or table.
 
-use eigenfit_core::StructuralModel;
+use eigenfit_core::model::StructuralModel;
 use eigenfit_matrices::MatricesModel;
 use std::path::{Path, PathBuf};
 

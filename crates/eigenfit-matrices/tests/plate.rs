@@ -2,9 +2,9 @@
 //! (scipy_reference.json, measured.csv: ARPACK shift-invert, an independent solver) and
 //! against eigenfit's own dense solver and finite differences.
 
-use eigenfit_core::{
-    finite_difference_derivative, DenseSolver, EigenSolver, Sensitivities, SparseSolver, StructuralModel,
-};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver, SparseSolver};
+use eigenfit_core::model::{finite_difference_derivative, StructuralModel};
+use eigenfit_core::sensitivity::Sensitivities;
 use eigenfit_matrices::MatricesModel;
 use serde_json::Value;
 use std::path::PathBuf;

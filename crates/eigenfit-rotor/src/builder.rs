@@ -4,7 +4,7 @@
 use crate::error::RotorError;
 use crate::file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section};
 use crate::model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
-use eigenfit_core::{Parameter, ParameterSet, Scale};
+use eigenfit_core::model::{Parameter, ParameterSet, Scale};
 
 /// The entry of a description an error is about, in file order (0-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -73,7 +73,8 @@ fn effect_site(error: &RotorError) -> Option<Site> {
 /// Collects a rotor description; nothing is checked until [`build`](Self::build).
 ///
 /// ```
-/// use eigenfit_core::{DenseSolver, EigenSolver, StructuralModel};
+/// use eigenfit_core::eigen::{DenseSolver, EigenSolver};
+/// use eigenfit_core::model::StructuralModel;
 /// use eigenfit_rotor::{BearingSpec, Disk, Material, Rotor};
 ///
 /// // The ROSS cross-check rotor: Ø14 mm × 500 mm steel shaft in 10 elements, two point disks,

@@ -6,10 +6,12 @@ use crate::effects::{self, EffectSpec};
 use crate::mesh;
 use crate::model::Rotor;
 use crate::RotorError;
+use eigenfit_core::analysis::chi2_upper_tail;
 use eigenfit_core::discovery::{
-    chi2_upper_tail, discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect,
+    discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect,
 };
-use eigenfit_core::{EigenSolver, Measurement};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::measurement::Measurement;
 
 /// Sub-elements per element of the refined mesh: Hermite elements converge as h⁴ in frequency,
 /// so a factor 4 cuts the discretisation error ~250-fold — far below any measurement noise

@@ -28,8 +28,8 @@
 use crate::element;
 use crate::error::RotorError;
 use crate::model::{Bearing, Rotor, ShaftElement};
-use eigenfit_core::discovery::{Candidate, ValueLaw};
-use eigenfit_core::{Parameter, SparseSymmetric};
+use eigenfit_core::matrix::SparseSymmetric;
+use eigenfit_core::model::{Candidate, Parameter, ValueLaw};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 

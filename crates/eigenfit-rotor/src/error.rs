@@ -203,7 +203,7 @@ pub enum RotorError {
     },
     /// The bearing parameters could not be formed (should be prevented by the checks above).
     #[error(transparent)]
-    Parameter(#[from] eigenfit_core::ParameterError),
+    Parameter(#[from] eigenfit_core::model::ParameterError),
 }
 
 impl RotorError {

@@ -7,8 +7,8 @@
 //! position z alone (sensors sit on the surface, not on the axis).
 
 use crate::model::Rotor;
-use eigenfit_core::testdata::{NodeLayout, UffMode, UffNode};
-use eigenfit_core::Modes;
+use eigenfit_core::eigen::Modes;
+use eigenfit_core::measurement::{sensors::NodeLayout, uff::UffMode, uff::UffNode};
 
 impl NodeLayout for Rotor {
     fn node_coordinates(&self) -> Vec<[f64; 3]> {

@@ -12,10 +12,11 @@
 //!
 //! A [`Rotor`] is built once from a [`RotorBuilder`] or a TOML file ([`Rotor::from_toml_str`],
 //! schema in `docs/rotor-model.md`), validated with typed [`RotorError`]s, and then implements
-//! [`StructuralModel`](eigenfit_core::StructuralModel) with the exact sparse bearing derivative.
+//! [`StructuralModel`](eigenfit_core::model::StructuralModel) with the exact sparse bearing derivative.
 //!
 //! ```
-//! use eigenfit_core::{DenseSolver, EigenSolver, StructuralModel};
+//! use eigenfit_core::eigen::{DenseSolver, EigenSolver};
+//! use eigenfit_core::model::StructuralModel;
 //! use eigenfit_rotor::Rotor;
 //!
 //! let rotor = Rotor::from_toml_str(r#"

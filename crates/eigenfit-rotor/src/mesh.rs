@@ -70,7 +70,7 @@ pub fn refined(rotor: &Rotor, factor: usize) -> Result<Rotor, RotorError> {
 #[cfg(test)]
 mod tests {
     use crate::presets;
-    use eigenfit_core::{DenseSolver, EigenSolver};
+    use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 
     #[test]
     fn refining_converges_from_above_and_keeps_the_parts() {

@@ -5,9 +5,8 @@ use crate::element;
 use crate::error::RotorError;
 use crate::file::{Disk, Material, PointMass, RotorSpec};
 use crate::RotorBuilder;
-use eigenfit_core::{
-    BandedSymmetric, ModelError, ParameterSet, SparseSymmetric, StructuralModel, System, SystemDerivative,
-};
+use eigenfit_core::matrix::{BandedSymmetric, SparseSymmetric, System, SystemDerivative};
+use eigenfit_core::model::{ModelError, ParameterSet, StructuralModel};
 use nalgebra::Matrix4;
 
 /// Lower bound of every bearing-stiffness parameter (N/m): positive, as the log scale needs.
@@ -19,7 +18,7 @@ pub const STIFFNESS_UPPER: f64 = 1e15;
 /// Most shaft elements a rotor may have. K and M are kept by band (half-bandwidth 3: 32 bytes
 /// per DOF and matrix), so memory is no limit; 10⁵ elements (200,002 DOFs) is far beyond any
 /// sensible mesh. A dense solver would need 8n² bytes per matrix: solve large rotors with
-/// [`BandedSolver`](eigenfit_core::BandedSolver).
+/// [`BandedSolver`](eigenfit_core::eigen::BandedSolver).
 pub const MAX_ELEMENTS: usize = 100_000;
 
 /// One resolved shaft element between nodes `index` and `index + 1`.
@@ -54,7 +53,7 @@ pub struct Bearing {
 ///
 /// Build one with [`Rotor::builder`] or read one with [`Rotor::from_toml_str`]; once built it is
 /// trusted. Its parameters are the bearings' translational stiffnesses, one per bearing in
-/// order, named `k_<bearing name>`, unit N/m, [`Scale::Log`](eigenfit_core::Scale::Log), bounds
+/// order, named `k_<bearing name>`, unit N/m, [`Scale::Log`](eigenfit_core::model::Scale::Log), bounds
 /// [[`STIFFNESS_LOWER`], [`STIFFNESS_UPPER`]].
 ///
 /// The parameter-independent part of K and M (shaft, disks, point masses, rotational bearing
@@ -277,7 +276,7 @@ impl StructuralModel for Rotor {
         Ok(d)
     }
 
-    fn candidates(&self) -> Vec<eigenfit_core::discovery::Candidate> {
+    fn candidates(&self) -> Vec<eigenfit_core::model::Candidate> {
         effects::candidates(self)
     }
 }
@@ -286,7 +285,7 @@ impl StructuralModel for Rotor {
 mod tests {
     use super::*;
     use crate::file::{BearingSpec, Disk, Material, PointMass, Section};
-    use eigenfit_core::Scale;
+    use eigenfit_core::model::Scale;
 
     fn rotor() -> Rotor {
         Rotor::builder()

@@ -134,7 +134,8 @@ mod tests {
 
     #[test]
     fn banded_solver_agrees_with_dense_on_modes_and_sensitivities() {
-        use eigenfit_core::{BandedSolver, DenseSolver, Sensitivities};
+        use eigenfit_core::eigen::{BandedSolver, DenseSolver};
+        use eigenfit_core::sensitivity::Sensitivities;
         let rotor = super::uniform_rotor(150).unwrap();
         for p in [[1e7, 1e7], [1e3, 1e9], [1e2, 1e4]] {
             let a = Sensitivities::compute(&rotor, &BandedSolver::default(), &p, 6)
@@ -155,7 +156,8 @@ mod tests {
 
     #[test]
     fn uniform_rotor_scales_and_keeps_its_low_modes() {
-        use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver, StructuralModel};
+        use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+        use eigenfit_core::model::StructuralModel;
         assert!(super::uniform_rotor(3).is_err());
         assert!(super::uniform_rotor(crate::MAX_ELEMENTS + 1).is_err());
         let coarse = super::uniform_rotor(40).unwrap();
@@ -172,7 +174,7 @@ mod tests {
 
     #[test]
     fn paper_rotor_reproduces_every_value_of_table_1_within_3_percent() {
-        use eigenfit_core::{DenseSolver, EigenSolver};
+        use eigenfit_core::eigen::{DenseSolver, EigenSolver};
         let rotor = super::paper_rotor();
         let mut worst: f64 = 0.0;
         for (k, f) in super::PAPER_TABLE_1 {

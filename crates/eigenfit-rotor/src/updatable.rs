@@ -12,9 +12,8 @@
 use crate::element;
 use crate::model::Rotor;
 use crate::{Material, RotorBuilder, Section};
-use eigenfit_core::{
-    ModelError, Parameter, ParameterSet, Scale, SparseSymmetric, StructuralModel, System, SystemDerivative,
-};
+use eigenfit_core::matrix::{SparseSymmetric, System, SystemDerivative};
+use eigenfit_core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use serde::{Deserialize, Serialize};
 
 /// A `[[parameter]]` table: one more updatable quantity of the model.
@@ -347,7 +346,7 @@ impl StructuralModel for UpdatableRotor {
         Ok(d)
     }
 
-    fn candidates(&self) -> Vec<eigenfit_core::discovery::Candidate> {
+    fn candidates(&self) -> Vec<eigenfit_core::model::Candidate> {
         self.rotor.candidates()
     }
 }

@@ -1,6 +1,6 @@
 //! Closed-form limits: a pinned–pinned beam and a rigid shaft bouncing on soft springs.
 
-use eigenfit_core::{DenseSolver, EigenSolver};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 use eigenfit_rotor::{element, BearingSpec, Material, Rotor};
 use std::f64::consts::PI;
 

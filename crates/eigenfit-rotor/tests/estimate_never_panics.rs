@@ -1,12 +1,13 @@
 //! Property (issue 7): random — often degenerate — rotors and measured data through the whole
-//! estimate path (`Rotor` build → `Measurement` → `Problem` → `Driver` with `Damped`, and the
+//! estimate path (`Rotor` build → `Measurement` → `Problem` → `Driver` with `LevenbergMarquardt`, and the
 //! paper's `Newton` and `PStep`, with the dense and the banded solver) never panic: every stage
 //! returns a result or a typed error, and every result is finite and within the parameter bounds.
 
-use eigenfit_core::{
-    BandedSolver, DenseSolver, Driver, EigenSolver, MeasuredMode, Measurement, Problem, StrategyKind,
-    StructuralModel, Termination,
-};
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit_core::measurement::{MeasuredMode, Measurement};
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::problem::Problem;
+use eigenfit_core::update::{Driver, StrategyKind, Termination};
 use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorBuilder, Section};
 use proptest::prelude::*;
 

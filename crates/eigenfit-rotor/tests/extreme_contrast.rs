@@ -4,7 +4,7 @@
 //! dense solver's. The banded solver now checks the true residual of such pairs and the order,
 //! and falls back (here to the dense solver) rather than return them.
 
-use eigenfit_core::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
 use eigenfit_rotor::Rotor;
 
 const MODEL: &str = r#"

@@ -7,8 +7,7 @@
 mod common;
 
 use common::study::{self, Outcome};
-use eigenfit_core::discovery::Augmented;
-use eigenfit_core::{finite_difference_derivative, StructuralModel};
+use eigenfit_core::model::{finite_difference_derivative, Augmented, StructuralModel};
 use eigenfit_rotor::presets;
 
 /// Runs `draws` draws of `case` at 0.1 % noise; counts (named or honestly ambiguous, wrong, nothing).

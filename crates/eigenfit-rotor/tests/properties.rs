@@ -18,8 +18,9 @@
 //! derivative of an individual mode is ill-defined there). The criterion compares FD with FD
 //! only, so it cannot hide a wrong analytic value; the tests require at least a third of the pairs to be compared.
 
+use eigenfit_core::eigen::{DenseSolver, EigenSolver, Modes};
+use eigenfit_core::model::{finite_difference_derivative, StructuralModel};
 use eigenfit_core::sensitivity::{eigenvalue_derivative, eigenvector_derivative_nelson};
-use eigenfit_core::{finite_difference_derivative, DenseSolver, EigenSolver, Modes, StructuralModel};
 use eigenfit_rotor::{BearingSpec, Disk, Material, Rotor, Section};
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;

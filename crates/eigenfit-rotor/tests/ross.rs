@@ -1,6 +1,7 @@
 //! Cross-check against ROSS (petrobras/ross) for the paper's rotor geometry, and the example file.
 
-use eigenfit_core::{DenseSolver, EigenSolver, StructuralModel};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver};
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::Rotor;
 
 /// 10 equal elements, Ø14 mm × 500 mm steel shaft, point disks 0.4 kg at node 2 and 1.35 kg at

@@ -1,11 +1,11 @@
 //! Real test data on the planar rotor: UFF round trip, a pyuff-written export of an independent
 //! finite-element model, and the mirror ambiguity of a symmetric rotor resolved by shapes.
 
-use eigenfit_core::testdata::{sensors, uff, ShapeFit};
-use eigenfit_core::{
-    statistics::uncertainty, Damped, DenseSolver, Driver, EigenSolver, Evaluate, Measurement, Pairing,
-    Problem, UpdateStrategy,
-};
+use eigenfit_core::analysis::{uncertainty, ShapeFit};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver};
+use eigenfit_core::measurement::{sensors, uff, Measurement};
+use eigenfit_core::problem::{Objective, Pairing, Problem};
+use eigenfit_core::update::{Driver, LevenbergMarquardt, UpdateStrategy};
 use eigenfit_rotor::Rotor;
 use serde_json::Value;
 use std::path::PathBuf;
@@ -106,10 +106,13 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
     assert!(notes.is_empty());
     let start = [0.9e5, 2.0e5];
 
-    let without_shapes =
-        measured.modes().iter().map(|m| eigenfit_core::MeasuredMode { shape: None, ..m.clone() }).collect();
+    let without_shapes = measured
+        .modes()
+        .iter()
+        .map(|m| eigenfit_core::measurement::MeasuredMode { shape: None, ..m.clone() })
+        .collect();
     let freq_only = Problem::new(&rotor, DenseSolver, Measurement::new(without_shapes).unwrap());
-    let est = Driver::default().run(&freq_only, &mut Damped::default(), &start, &mut []).unwrap();
+    let est = Driver::default().run(&freq_only, &mut LevenbergMarquardt::default(), &start, &mut []).unwrap();
     let p = &est.parameters;
     let swapped = [p[1], p[0]];
     let (c1, c2) = (freq_only.cost(p).unwrap(), freq_only.cost(&swapped).unwrap());
@@ -120,7 +123,7 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
         Problem::new(&rotor, DenseSolver, measured).with_pairing(Pairing::Mac { sensor_dofs: set.dofs() }),
         0.05,
     );
-    let mut damped = Damped::default();
+    let mut damped = LevenbergMarquardt::default();
     let est = Driver::default().run(&fit, &mut damped as &mut dyn UpdateStrategy, &start, &mut []).unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
     let u = uncertainty(&fit, &est.last, true).unwrap();
@@ -134,7 +137,7 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
     // The shapes make the mirror a much worse fit than the estimate.
     let mirror = [est.parameters[1], est.parameters[0]];
     let (at, at_mirror) =
-        (Evaluate::cost(&fit, &est.parameters).unwrap(), Evaluate::cost(&fit, &mirror).unwrap());
+        (Objective::cost(&fit, &est.parameters).unwrap(), Objective::cost(&fit, &mirror).unwrap());
     assert!(at_mirror > 100.0 * at, "{at} vs mirror {at_mirror}");
 }
 
@@ -148,7 +151,7 @@ fn equal_macs_pair_with_the_lowest_mode() {
     let dof = Rotor::displacement_dof(2);
     let measured = Measurement::new(
         (0..3)
-            .map(|k| eigenfit_core::MeasuredMode {
+            .map(|k| eigenfit_core::measurement::MeasuredMode {
                 mode: k,
                 frequency_hz: f[k],
                 std_hz: None,

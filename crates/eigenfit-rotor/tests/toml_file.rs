@@ -1,6 +1,6 @@
 //! The TOML format: parse errors with line and column, round trip.
 
-use eigenfit_core::StructuralModel;
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorError, Section};
 
 const VALID: &str = r#"

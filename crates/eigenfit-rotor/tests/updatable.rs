@@ -1,10 +1,11 @@
 //! `[[parameter]]` tables: exact derivatives, the nominal point, and values written back into a
 //! plain rotor that reads back (through TOML) to the same matrices.
 
-use eigenfit_core::{
-    finite_difference_derivative, Damped, DenseSolver, Driver, EigenSolver, Measurement, Problem,
-    StructuralModel,
-};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver};
+use eigenfit_core::measurement::Measurement;
+use eigenfit_core::model::{finite_difference_derivative, StructuralModel};
+use eigenfit_core::problem::Problem;
+use eigenfit_core::update::{Driver, LevenbergMarquardt};
 use eigenfit_rotor::{Rotor, UpdatableRotor};
 
 const MODEL: &str = r#"
@@ -138,7 +139,7 @@ fn a_disk_mass_is_estimated() {
     let f = DenseSolver.lowest(&m.assemble(&truth).unwrap(), 4).unwrap().frequencies_hz();
     let problem = Problem::new(&m, DenseSolver, Measurement::from_frequencies(&f).unwrap());
     let est = Driver::default()
-        .run(&problem, &mut Damped::default(), &m.parameters().nominal_values(), &mut [])
+        .run(&problem, &mut LevenbergMarquardt::default(), &m.parameters().nominal_values(), &mut [])
         .unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
     for (a, b) in est.parameters.iter().zip(truth) {

@@ -222,7 +222,7 @@ fn sections() {
 
 #[test]
 fn parameters_outside_bounds_are_refused_by_assemble() {
-    use eigenfit_core::StructuralModel;
+    use eigenfit_core::model::StructuralModel;
     let rotor = base().build().unwrap();
     assert_eq!(
         rotor.assemble(&[1e5, -1.0]).unwrap_err().to_string(),

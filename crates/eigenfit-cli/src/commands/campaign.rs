@@ -4,10 +4,10 @@ use crate::error::{input, CliError, EXIT_NOT_CONVERGED};
 use crate::progress;
 use crate::testdata::{self, Fit, TestDataArgs};
 use clap::Args;
-use eigenfit_core::testdata::Joint;
-use eigenfit_core::{
-    BandedSolver, DenseSolver, Driver, EigenSolver, Evaluate, Problem, ResidualKind, StrategyKind,
-};
+use eigenfit_core::analysis::Joint;
+use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
+use eigenfit_core::update::{Driver, StrategyKind};
 use eigenfit_rotor::campaign::Campaign;
 use eigenfit_rotor::Rotor;
 use serde_json::{json, Value};
@@ -20,7 +20,7 @@ pub struct CampaignArgs {
     /// `name`, `shapes`, `sensor_map`.
     #[arg(value_name = "CAMPAIGN.toml")]
     pub campaign: PathBuf,
-    /// Update strategy: newton, p-step or damped.
+    /// Update strategy: newton, p-step or damped (Levenberg–Marquardt; `levenberg-marquardt` is accepted too).
     #[arg(long, default_value = "damped")]
     pub strategy: String,
     /// Eigen-solver backend: banded (default) or dense.
@@ -33,7 +33,7 @@ pub struct CampaignArgs {
     #[arg(long, default_value_t = 1e-3, value_name = "M")]
     pub node_tolerance: f64,
     /// Standard deviation of the entries of a unit-length measured shape.
-    #[arg(long, default_value_t = eigenfit_core::testdata::shapes::DEFAULT_SHAPE_STD, value_name = "S")]
+    #[arg(long, default_value_t = eigenfit_core::analysis::DEFAULT_SHAPE_STD, value_name = "S")]
     pub shape_std: f64,
     /// Lowest MAC at which a measured mode counts as paired.
     #[arg(long, default_value_t = 0.6, value_name = "MAC")]
@@ -55,7 +55,10 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         other => return Err(input(format!("unknown solver `{other}`; available: banded, dense"))),
     };
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
-        input(format!("unknown strategy `{}`; available: newton, p-step, damped", args.strategy))
+        input(format!(
+            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
+            args.strategy
+        ))
     })?;
     let mut rotors = Vec::new();
     let mut data = Vec::new();
@@ -92,7 +95,7 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             Fit::new(problem, d, options)
         })
         .collect();
-    let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Evaluate).collect())
+    let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Objective).collect())
         .map_err(|e| input(format!("{}: {e}", args.campaign.display())))?;
     let has_std = data.iter().all(|d| d.measurement.has_std() && d.sensors.is_none());
     let initial = joint.parameters().nominal_values();
@@ -140,7 +143,7 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             "initial": obj(&initial),
             "parameters": obj(&p),
             "chi2": estimate.last.chi2(),
-            "dof": estimate.last.dof(),
+            "dof": estimate.last.degrees_of_freedom(),
         });
         if let Some(u) = &unc {
             out["intervals"] =

@@ -6,8 +6,13 @@ use crate::plot::compare_map::{CompareMaps, MapKind};
 use crate::source::{parse_list, ModelArgs};
 use crate::{plot, progress};
 use clap::Args;
-use eigenfit_core::compare::{log_space, run_grid, tensor_grid, CompareRun, CompareSettings};
-use eigenfit_core::{Identifiability, StrategyKind, StructuralModel};
+use eigenfit_core::analysis::Identifiability;
+use eigenfit_core::analysis::{
+    compare::log_space, compare::run_grid, compare::tensor_grid, compare::CompareRun,
+    compare::CompareSettings,
+};
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::update::StrategyKind;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -106,7 +111,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         .map(|s| {
             StrategyKind::from_name(s.trim()).ok_or_else(|| {
                 input(format!(
-                    "--strategies: unknown strategy `{}`; available: newton, p-step, damped",
+                    "--strategies: unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
                     s.trim()
                 ))
             })
@@ -199,7 +204,11 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
                 fmt(s.max_iterations),
                 s.max_relative_error,
                 // Only damped runs are checked for other solutions: a 0 elsewhere would mean nothing.
-                if s.strategy == StrategyKind::Damped { s.ambiguous.to_string() } else { "-".to_string() }
+                if s.strategy == StrategyKind::LevenbergMarquardt {
+                    s.ambiguous.to_string()
+                } else {
+                    "-".to_string()
+                }
             );
         }
         println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged damped runs whose data also fit another solution, - where not checked)");
@@ -273,7 +282,7 @@ fn run_json(r: &CompareRun, timing: bool) -> Value {
     if timing {
         v["seconds"] = json!(r.seconds);
     }
-    if r.strategy == StrategyKind::Damped && r.converged {
+    if r.strategy == StrategyKind::LevenbergMarquardt && r.converged {
         v["alternative_solutions"] = json!(r.alternatives);
     }
     if let Some(ids) = &r.identifiability {
@@ -311,7 +320,7 @@ impl Summary {
             "runs": self.runs,
             "converged": self.converged,
             "converged_within_1e-6": self.within_1e6,
-            "ambiguous": (self.strategy == StrategyKind::Damped).then_some(self.ambiguous),
+            "ambiguous": (self.strategy == StrategyKind::LevenbergMarquardt).then_some(self.ambiguous),
             "median_iterations": self.median_iterations,
             "max_iterations": self.max_iterations,
             "max_relative_error": self.max_relative_error,

@@ -9,9 +9,15 @@ use crate::plot::critical_speed::PAPER_TABLE_1;
 use crate::plot::discovery::DiscoveryPlot;
 use crate::{measured, plot, progress};
 use clap::Args;
-use eigenfit_core::compare::{log_space, reference_measurement, run_grid, tensor_grid, CompareSettings};
+use eigenfit_core::analysis::{
+    compare::log_space, compare::reference_measurement, compare::run_grid, compare::tensor_grid,
+    compare::CompareSettings,
+};
 use eigenfit_core::discovery::{discover, DiscoveryOptions};
-use eigenfit_core::{DenseSolver, Driver, EigenSolver, Problem, StrategyKind, StructuralModel};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver};
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::problem::Problem;
+use eigenfit_core::update::{Driver, StrategyKind};
 use eigenfit_rotor::presets;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};

@@ -8,7 +8,7 @@ use crate::source::ModelArgs;
 use crate::{measured, plot, progress};
 use clap::Args;
 use eigenfit_core::discovery::{discover, Alternative, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
-use eigenfit_core::StructuralModel;
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde_json::{json, Value};
 use std::path::PathBuf;

@@ -6,12 +6,13 @@ use crate::plot::convergence::{Convergence, Run};
 use crate::source::{parameter_vector, ModelArgs};
 use crate::{measured, plot, progress, testdata};
 use clap::Args;
-use eigenfit_core::statistics::{alternative_solutions_within, mirror_solutions};
-use eigenfit_core::update::DEFAULT_EVALUATIONS;
-use eigenfit_core::verdict::{at_limits, judge, unreachable_modes, FitVerdict};
-use eigenfit_core::{
-    Budget, Driver, Evaluate, Identifiability, Problem, ResidualKind, StrategyKind, StructuralModel,
+use eigenfit_core::analysis::{alternative_solutions_within, mirror_solutions, Identifiability};
+use eigenfit_core::analysis::{
+    verdict::at_limits, verdict::judge, verdict::unreachable_modes, verdict::FitVerdict,
 };
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
+use eigenfit_core::update::{Budget, Driver, StrategyKind, DEFAULT_EVALUATIONS};
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
 
@@ -27,7 +28,7 @@ pub struct EstimateArgs {
     pub measured: PathBuf,
     #[command(flatten)]
     pub test_data: testdata::TestDataArgs,
-    /// Update strategy: newton, p-step or damped.
+    /// Update strategy: newton, p-step or damped (Levenberg–Marquardt; `levenberg-marquardt` is accepted too).
     #[arg(long, default_value = "damped")]
     pub strategy: String,
     /// Initial bearing stiffnesses K1,K2,… in N/m (default: the model's values).
@@ -78,7 +79,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let (model, label) = args.model.load_any()?;
     let rotor = &model;
     let solver = args.model.solver()?;
-    let layout: Option<&dyn eigenfit_core::testdata::sensors::NodeLayout> = match &model {
+    let layout: Option<&dyn eigenfit_core::measurement::sensors::NodeLayout> = match &model {
         AnyModel::Rotor(r) => Some(r),
         // Shapes find a matrices model's DOFs through its DOF map (`dofs = "…"`).
         AnyModel::Matrices(m) => m.layout().map(|l| l as &dyn eigenfit_core::testdata::sensors::NodeLayout),
@@ -87,7 +88,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let measurement = data.measurement.clone();
     let strategy_kind = StrategyKind::from_name(&args.strategy).ok_or_else(|| {
         input(format!(
-            "unknown strategy `{}`; available: newton, p-step, damped",
+            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
             measured::shown(&args.strategy)
         ))
     })?;
@@ -168,10 +169,10 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
     // the best point of its coarse grid instead, and says so.
     let mut start = initial.clone();
-    if strategy_kind == StrategyKind::Damped {
+    if strategy_kind == StrategyKind::LevenbergMarquardt {
         let budgeted = budget.wrap(&fit);
         if let Err(e) = budgeted.linearise(&initial) {
-            if let Some(seed) = eigenfit_core::Damped::rank_seeds(&budgeted).first() {
+            if let Some(seed) = eigenfit_core::update::LevenbergMarquardt::rank_seeds(&budgeted).first() {
                 eprintln!(
                     "eigenfit: note: the model cannot be evaluated at --initial ({e}); starting from the best point of the coarse grid"
                 );

@@ -7,7 +7,9 @@ use crate::plot::mode_shapes::ModeShapes;
 use crate::source::{parameter_vector, parse_list, ModelArgs};
 use crate::{plot, progress};
 use clap::Args;
-use eigenfit_core::{EigenSolver, Sensitivities, StructuralModel};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::model::StructuralModel;
+use eigenfit_core::sensitivity::Sensitivities;
 use eigenfit_rotor::{presets, EffectSpec, Rotor};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -253,10 +255,12 @@ fn frequencies(
 /// Never a frequency lost to round-off with exit 0 (issue 13): a fine mesh or an extreme value
 /// whose lowest eigenvalue the matrices cannot resolve is refused, saying why.
 pub(crate) fn refuse_roundoff(
-    system: &eigenfit_core::System,
-    modes: &eigenfit_core::Modes,
+    system: &eigenfit_core::matrix::System,
+    modes: &eigenfit_core::eigen::Modes,
 ) -> Result<(), CliError> {
-    use eigenfit_core::roundoff::{relative_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF};
+    use eigenfit_core::eigen::{
+        roundoff::relative_roundoff, roundoff::MAX_RELATIVE_ROUNDOFF, roundoff::NOTE_RELATIVE_ROUNDOFF,
+    };
     let levels = relative_roundoff(system, modes);
     match levels.iter().position(|&r| r.is_nan() || r > MAX_RELATIVE_ROUNDOFF) {
         None => {
@@ -301,5 +305,5 @@ fn sweep_points(text: &str) -> Result<Vec<f64>, CliError> {
             "--sweep `{text}`: {count} points, more than the {MAX_SWEEP_POINTS} a sweep accepts"
         )));
     }
-    Ok(eigenfit_core::compare::log_space(a, b, count))
+    Ok(eigenfit_core::analysis::compare::log_space(a, b, count))
 }

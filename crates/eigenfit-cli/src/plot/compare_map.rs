@@ -4,8 +4,8 @@
 
 use super::style::{self, log_tick, short_sci, strategy_colour, Swatch, INK, LIGHT};
 use super::{err, DrawResult, Figure};
-use eigenfit_core::compare::CompareRun;
-use eigenfit_core::StrategyKind;
+use eigenfit_core::analysis::compare::CompareRun;
+use eigenfit_core::update::StrategyKind;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

@@ -3,7 +3,7 @@
 
 use super::style::{self, log_bounds, log_tick, strategy_colour, Swatch, INK};
 use super::{err, DrawResult, Figure};
-use eigenfit_core::Estimate;
+use eigenfit_core::update::Estimate;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

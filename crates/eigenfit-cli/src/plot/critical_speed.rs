@@ -4,7 +4,8 @@
 use super::style::{self, log_bounds, log_tick, mode_colour, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
-use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::model::StructuralModel;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -52,7 +53,7 @@ impl CriticalSpeedMap {
         let count = count.max(2);
         let mut stiffness = Vec::with_capacity(count);
         let mut frequencies = Vec::with_capacity(count);
-        for k in eigenfit_core::compare::log_space(range.0, range.1, count) {
+        for k in eigenfit_core::analysis::compare::log_space(range.0, range.1, count) {
             let system = model.assemble(&vec![k; np]).map_err(|e| CliError::Failure(e.to_string()))?;
             let m = solver.lowest(&system, modes).map_err(|e| CliError::Failure(e.to_string()))?;
             stiffness.push(k);

@@ -4,7 +4,7 @@
 
 use super::style::{self, INK};
 use super::{err, DrawResult, Figure};
-use eigenfit_core::testdata::MacReport;
+use eigenfit_core::measurement::mac::MacReport;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

@@ -3,7 +3,8 @@
 use super::style::{self, mode_colour, short_sci, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
-use eigenfit_core::{EigenSolver, StructuralModel};
+use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::Rotor;
 use plotters::coord::Shift;
 use plotters::prelude::*;

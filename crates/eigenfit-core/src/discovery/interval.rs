@@ -1,22 +1,21 @@
 //! Covariance (Wald) 95 % intervals for refitted candidates.
 //!
 //! Discovery refits dozens of candidates per round; the profile-likelihood bounds of
-//! [`crate::statistics::uncertainty`] refit the model again for every poorly determined
+//! [`crate::analysis::uncertainty`] refit the model again for every poorly determined
 //! parameter and can take minutes per candidate. A candidate's interval only decides whether its
 //! value is clear of zero and plausible, for which the linearised covariance suffices.
 
-use crate::residual::Linearisation;
-use crate::update::Evaluate;
+use crate::problem::{Linearisation, Objective};
 
 /// 1.96: the two-sided 95 % quantile of the normal distribution.
 const Z_95: f64 = 1.959_963_984_540_054;
 
 /// The 95 % covariance interval of every parameter (in each parameter's scale, mapped back), or
 /// `None` for a parameter the data do not determine (singular information matrix).
-pub(crate) fn covariance_intervals(problem: &dyn Evaluate, at: &Linearisation) -> Vec<Option<[f64; 2]>> {
+pub(crate) fn covariance_intervals(problem: &dyn Objective, at: &Linearisation) -> Vec<Option<[f64; 2]>> {
     let params = problem.parameters();
     let np = params.len();
-    let js = crate::update::damped::scaled_jacobian(params, at);
+    let js = at.scaled_jacobian(params);
     let info = js.transpose() * &js;
     let Some(cov) = info.try_inverse() else { return vec![None; np] };
     params

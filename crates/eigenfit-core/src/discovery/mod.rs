@@ -10,19 +10,15 @@
 //!
 //! Nothing here is rotor-specific: a plugin offers [`Candidate`]s, the engine does the rest.
 
-mod candidate;
-mod chi2;
 mod interval;
 
-pub use candidate::{Augmented, Candidate, ValueLaw};
-
-pub use chi2::chi2_upper_tail;
-
+use crate::analysis::chi2_upper_tail;
+use crate::eigen::EigenSolver;
 use crate::measurement::{MeasuredMode, Measurement};
-use crate::multi::Stacked;
-use crate::residual::{Linearisation, Problem};
-use crate::update::{Damped, Driver, Evaluate};
-use crate::{EigenSolver, StructuralModel};
+use crate::model::{Augmented, Candidate, StructuralModel};
+use crate::problem::multi::Stacked;
+use crate::problem::{Linearisation, Objective, Problem};
+use crate::update::{Driver, LevenbergMarquardt};
 use nalgebra::DVector;
 use thiserror::Error;
 
@@ -325,11 +321,11 @@ where
     }
     let problems: Vec<Problem<&M, &S>> =
         models.iter().zip(&measured).map(|(&m, d)| Problem::new(m, solver, d.clone())).collect();
-    let base = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect())
+    let base = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect())
         .ok_or_else(|| DiscoveryError::Data("the configurations' parameters differ".into()))?;
     // (a) calibrate
     let est = Driver::default()
-        .run(&base, &mut Damped::default(), initial, &mut [])
+        .run(&base, &mut LevenbergMarquardt::default(), initial, &mut [])
         .map_err(|e| DiscoveryError::Calibration(e.to_string()))?;
     let base_lin = est.last;
     let chi2_before = 2.0 * base_lin.cost();
@@ -527,8 +523,8 @@ struct Projector {
 }
 
 impl Projector {
-    fn new(base: &dyn Evaluate, lin: &Linearisation) -> Self {
-        let js = crate::update::damped::scaled_jacobian(base.parameters(), lin);
+    fn new(base: &dyn Objective, lin: &Linearisation) -> Self {
+        let js = lin.scaled_jacobian(base.parameters());
         // Orthonormal basis of the column space (thin SVD, dropping null directions).
         let svd = js.svd(true, false);
         let u = svd.u.expect("requested"); // proof: svd(true, _) always computes U
@@ -554,7 +550,7 @@ fn with_augmented<M, S, T>(
     solver: &S,
     measured: &[Measurement],
     set: &[&Candidate],
-    f: impl FnOnce(&dyn Evaluate) -> Option<T>,
+    f: impl FnOnce(&dyn Objective) -> Option<T>,
 ) -> Option<T>
 where
     M: StructuralModel,
@@ -564,7 +560,7 @@ where
         models.iter().map(|&m| Augmented::with_all(m, set)).collect::<Result<_, _>>().ok()?;
     let problems: Vec<Problem<&Augmented<'_, M>, &S>> =
         augmented.iter().zip(measured).map(|(a, d)| Problem::new(a, solver, d.clone())).collect();
-    let stacked = Stacked::new(problems.iter().map(|p| p as &dyn Evaluate).collect())?;
+    let stacked = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect())?;
     f(&stacked)
 }
 
@@ -613,7 +609,9 @@ fn refit<M: StructuralModel, S: EigenSolver>(
     with_augmented(models, solver, measured, set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
-        let est = Driver { max_iterations: 60 }.run(problem, &mut Damped::default(), &start, &mut []).ok()?;
+        let est = Driver { max_iterations: 60 }
+            .run(problem, &mut LevenbergMarquardt::default(), &start, &mut [])
+            .ok()?;
         let k = problem.parameters().len();
         let chi2 = 2.0 * est.last.cost();
         let intervals = interval::covariance_intervals(problem, &est.last);

@@ -1,9 +1,8 @@
 //! A cap on model evaluations, shared by every fit, refit and interval of one task, so that no
 //! input — a typing slip, data no stiffness can produce — can make eigenfit run for hours.
 
-use super::Evaluate;
-use crate::parameters::ParameterSet;
-use crate::residual::{Linearisation, ResidualError};
+use crate::model::ParameterSet;
+use crate::problem::{Linearisation, Objective, ResidualError};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// Evaluations a task may spend when the user sets no budget: a few seconds on the largest
@@ -61,19 +60,19 @@ impl Budget {
     }
 
     /// `problem` with every evaluation charged to this budget.
-    pub fn wrap<'a>(&'a self, problem: &'a dyn Evaluate) -> Budgeted<'a> {
+    pub fn wrap<'a>(&'a self, problem: &'a dyn Objective) -> Budgeted<'a> {
         Budgeted { inner: problem, budget: self }
     }
 }
 
-/// An [`Evaluate`] that charges each evaluation to a [`Budget`] and fails with
+/// An [`Objective`] that charges each evaluation to a [`Budget`] and fails with
 /// [`ResidualError::BudgetExhausted`] once it is spent.
 pub struct Budgeted<'a> {
-    inner: &'a dyn Evaluate,
+    inner: &'a dyn Objective,
     budget: &'a Budget,
 }
 
-impl Evaluate for Budgeted<'_> {
+impl Objective for Budgeted<'_> {
     fn parameters(&self) -> &ParameterSet {
         self.inner.parameters()
     }

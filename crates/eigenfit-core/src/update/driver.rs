@@ -1,7 +1,7 @@
 //! The iteration loop: termination reasons, observers, history.
 
-use super::{Budget, Evaluate, StepStatus, UpdateError, UpdateStrategy};
-use crate::residual::Linearisation;
+use super::{Budget, StepStatus, UpdateError, UpdateStrategy};
+use crate::problem::{Linearisation, Objective};
 
 /// Why a run ended.
 #[derive(Debug, Clone, PartialEq)]
@@ -128,7 +128,7 @@ impl Driver {
     /// a [`Termination`] and keeps what was computed.
     pub fn run(
         &self,
-        problem: &dyn Evaluate,
+        problem: &dyn Objective,
         strategy: &mut dyn UpdateStrategy,
         initial: &[f64],
         observers: &mut [&mut dyn Observer],
@@ -141,14 +141,14 @@ impl Driver {
     /// evaluation is refused, keeping the best point reached.
     pub fn run_within(
         &self,
-        problem: &dyn Evaluate,
+        problem: &dyn Objective,
         strategy: &mut dyn UpdateStrategy,
         initial: &[f64],
         observers: &mut [&mut dyn Observer],
         budget: &Budget,
     ) -> Result<Estimate, UpdateError> {
         let budgeted = budget.wrap(problem);
-        let problem: &dyn Evaluate = &budgeted;
+        let problem: &dyn Objective = &budgeted;
         if problem.parameters().is_empty() {
             return Err(UpdateError::Setup("the model has no parameter: nothing to estimate".into()));
         }

@@ -5,49 +5,21 @@
 //! reason, like argmin's `Executor`.
 
 mod budget;
-pub(crate) mod damped;
 mod driver;
+pub(crate) mod levenberg_marquardt;
 mod newton;
 mod pstep;
 #[cfg(test)]
 mod tests;
 
 pub use budget::{Budget, Budgeted, DEFAULT_EVALUATIONS};
-pub use damped::Damped;
 pub use driver::{Driver, Estimate, IterationRecord, IterationRecordSink, Observer, Termination};
+pub use levenberg_marquardt::LevenbergMarquardt;
 pub use newton::Newton;
 pub use pstep::PStep;
 
-use crate::parameters::ParameterSet;
-use crate::residual::{Linearisation, Problem, ResidualError};
-use crate::{EigenSolver, StructuralModel};
+use crate::problem::{Linearisation, Objective, ResidualError};
 use thiserror::Error;
-
-/// What a strategy sees of the problem: the parameters and the linearisation at any point.
-pub trait Evaluate {
-    /// The model's parameters.
-    fn parameters(&self) -> &ParameterSet;
-    /// Residual and Jacobian at `p`.
-    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError>;
-    /// ½‖r‖² at `p`, `None` where the residual cannot be evaluated: equal to
-    /// `linearise(p)`'s cost to round-off; implementations may skip the Jacobian (used to rank
-    /// many points).
-    fn cost(&self, p: &[f64]) -> Option<f64> {
-        self.linearise(p).ok().map(|l| l.cost())
-    }
-}
-
-impl<M: StructuralModel, S: EigenSolver> Evaluate for Problem<M, S> {
-    fn parameters(&self) -> &ParameterSet {
-        Problem::parameters(self)
-    }
-    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
-        Problem::linearise(self, p)
-    }
-    fn cost(&self, p: &[f64]) -> Option<f64> {
-        Problem::cost(self, p).ok()
-    }
-}
 
 /// Why an update step could not be taken.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -92,11 +64,11 @@ pub trait UpdateStrategy {
     /// Name for reports, e.g. `newton`.
     fn name(&self) -> &'static str;
     /// Resets internal state before a run starting at `initial`.
-    fn start(&mut self, problem: &dyn Evaluate, initial: &Linearisation) -> Result<(), UpdateError>;
+    fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError>;
     /// Whether `lin` already satisfies the convergence test (checked at the start).
     fn converged(&self, lin: &Linearisation) -> bool;
     /// Takes one step.
-    fn step(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError>;
+    fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError>;
 }
 
 /// Solves the paper's eq. 28, S Δk = Δλ, on the first N modes (N = number of parameters, as in
@@ -133,7 +105,7 @@ pub(crate) fn square_max_diff_hz(lin: &Linearisation) -> f64 {
 }
 
 /// Linearises at `p`, turning a point outside the bounds or a failed model into `Diverged`.
-pub(crate) fn evaluate_or_diverge(problem: &dyn Evaluate, p: &[f64]) -> Result<Linearisation, UpdateError> {
+pub(crate) fn evaluate_or_diverge(problem: &dyn Objective, p: &[f64]) -> Result<Linearisation, UpdateError> {
     problem.parameters().check(p).map_err(|e| UpdateError::Diverged(e.to_string()))?;
     problem.linearise(p).map_err(|e| UpdateError::Diverged(e.to_string()))
 }
@@ -145,25 +117,30 @@ pub enum StrategyKind {
     Newton,
     /// [`PStep`], the paper's Fig. 1.
     PStep,
-    /// [`Damped`] least squares.
-    Damped,
+    /// [`LevenbergMarquardt`] least squares.
+    LevenbergMarquardt,
 }
 
 impl StrategyKind {
     /// Every built-in strategy.
-    pub const ALL: [StrategyKind; 3] = [StrategyKind::Newton, StrategyKind::PStep, StrategyKind::Damped];
+    pub const ALL: [StrategyKind; 3] =
+        [StrategyKind::Newton, StrategyKind::PStep, StrategyKind::LevenbergMarquardt];
 
     /// The name used on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
             StrategyKind::Newton => "newton",
             StrategyKind::PStep => "p-step",
-            StrategyKind::Damped => "damped",
+            StrategyKind::LevenbergMarquardt => "damped",
         }
     }
 
-    /// Looks a strategy up by [`name`](Self::name).
+    /// Looks a strategy up by [`name`](Self::name), or by the descriptive
+    /// `levenberg-marquardt` for the strategy whose reports keep the name `damped`.
     pub fn from_name(name: &str) -> Option<Self> {
+        if name == "levenberg-marquardt" {
+            return Some(StrategyKind::LevenbergMarquardt);
+        }
         Self::ALL.into_iter().find(|k| k.name() == name)
     }
 
@@ -172,7 +149,7 @@ impl StrategyKind {
         match self {
             StrategyKind::Newton => Box::new(Newton::default()),
             StrategyKind::PStep => Box::new(PStep::default()),
-            StrategyKind::Damped => Box::new(Damped::default()),
+            StrategyKind::LevenbergMarquardt => Box::new(LevenbergMarquardt::default()),
         }
     }
 }

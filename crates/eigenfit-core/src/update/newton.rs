@@ -1,10 +1,9 @@
 //! The paper's plain method (section III): Δk from eq. 28, added to k every iteration.
 
 use super::{
-    evaluate_or_diverge, newton_point, square_max_diff_hz, Evaluate, Step, StepStatus, UpdateError,
-    UpdateStrategy,
+    evaluate_or_diverge, newton_point, square_max_diff_hz, Step, StepStatus, UpdateError, UpdateStrategy,
 };
-use crate::residual::Linearisation;
+use crate::problem::{Linearisation, Objective};
 
 /// Plain Newton on eigenvalues in linear stiffness, as in the paper: square system (as many
 /// modes as parameters), no damping, no bounds handling — a step that leaves the physical range
@@ -26,7 +25,7 @@ impl UpdateStrategy for Newton {
         "newton"
     }
 
-    fn start(&mut self, _: &dyn Evaluate, initial: &Linearisation) -> Result<(), UpdateError> {
+    fn start(&mut self, _: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
         newton_point(initial, &initial.measured_eigenvalues).map(|_| ())
     }
 
@@ -34,7 +33,7 @@ impl UpdateStrategy for Newton {
         square_max_diff_hz(lin) < self.tolerance_hz
     }
 
-    fn step(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError> {
+    fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
         let p = newton_point(current, &current.measured_eigenvalues)?;
         let next = evaluate_or_diverge(problem, &p)?;
         let status = if self.converged(&next) { StepStatus::Converged } else { StepStatus::Continue };

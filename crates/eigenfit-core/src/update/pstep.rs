@@ -1,11 +1,10 @@
 //! The paper's Fig. 1: large eigenvalue differences are split into p parts, converged one by one.
 
 use super::{
-    evaluate_or_diverge, newton_point, square_max_diff_hz, Evaluate, Step, StepStatus, UpdateError,
-    UpdateStrategy,
+    evaluate_or_diverge, newton_point, square_max_diff_hz, Step, StepStatus, UpdateError, UpdateStrategy,
 };
-use crate::eigenvalue_to_hz;
-use crate::residual::Linearisation;
+use crate::problem::{Linearisation, Objective};
+use crate::units::eigenvalue_to_hz;
 use nalgebra::DVector;
 
 /// The paper's p-step method. When the largest frequency difference at the start exceeds
@@ -64,7 +63,7 @@ impl UpdateStrategy for PStep {
         "p-step"
     }
 
-    fn start(&mut self, _: &dyn Evaluate, initial: &Linearisation) -> Result<(), UpdateError> {
+    fn start(&mut self, _: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
         newton_point(initial, &initial.measured_eigenvalues)?;
         self.start_eigenvalues = initial.model_eigenvalues.clone();
         self.stages = if square_max_diff_hz(initial) > self.split_above_hz { self.parts } else { 1 };
@@ -76,7 +75,7 @@ impl UpdateStrategy for PStep {
         square_max_diff_hz(lin) < self.tolerance_hz
     }
 
-    fn step(&mut self, problem: &dyn Evaluate, current: &Linearisation) -> Result<Step, UpdateError> {
+    fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
         let p = newton_point(current, &self.target(current))?;
         let next = evaluate_or_diverge(problem, &p)?;
         // Advance through every stage whose target the new point already meets.

@@ -1,11 +1,13 @@
 //! Strategy and driver tests on a two-mass chain whose answer is known exactly.
 
 use super::*;
+use crate::eigen::{DenseSolver, EigenSolver};
+use crate::matrix::System;
+use crate::measurement::{MeasuredMode, Measurement};
+use crate::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
+use crate::problem::Problem;
 use crate::test_chain::Chain;
-use crate::{
-    DenseSolver, EigenSolver, IterationRecordSink, MeasuredMode, Measurement, ModelError, Parameter,
-    ParameterSet, Problem, Scale, System,
-};
+use crate::update::IterationRecordSink;
 use nalgebra::DMatrix;
 
 /// ground –k₁– m₁ –k₂– m₂, m = (1, 2) kg; stiffnesses around 1e4 N/m give modes of 10–30 Hz.
@@ -26,7 +28,7 @@ fn every_strategy_recovers_the_chain_from_a_nearby_start() {
         let est = Driver::default().run(&p, kind.build().as_mut(), &[2.5e4, 1.3e4], &mut []).unwrap();
         assert!(est.termination.is_converged(), "{}: {}", kind.name(), est.termination);
         // Paper strategies stop at 0.01 Hz; damped fits to round-off.
-        let tol = if kind == StrategyKind::Damped { 1e-8 } else { 1e-2 };
+        let tol = if kind == StrategyKind::LevenbergMarquardt { 1e-8 } else { 1e-2 };
         assert!((est.parameters[0] / 3e4 - 1.0).abs() < tol, "{}: {:?}", kind.name(), est.parameters);
         assert!((est.parameters[1] / 1e4 - 1.0).abs() < tol, "{}: {:?}", kind.name(), est.parameters);
         assert_eq!(est.history.len(), est.iterations + 1);
@@ -48,7 +50,7 @@ fn newton_leaving_the_physical_range_is_reported_as_diverged_with_history() {
 #[test]
 fn damped_converges_from_far_away() {
     let p = problem(&[3e4, 1e4]);
-    let est = Driver::default().run(&p, &mut Damped::default(), &[5e8, 2e-2], &mut []).unwrap();
+    let est = Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[5e8, 2e-2], &mut []).unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
     assert!(est.last.max_rel_diff() < 1e-10);
 }
@@ -77,7 +79,8 @@ fn strategies_refuse_too_few_modes() {
 fn observers_see_every_iteration() {
     let p = problem(&[3e4, 1e4]);
     let mut sink = IterationRecordSink::default();
-    let est = Driver::default().run(&p, &mut Damped::default(), &[1e3, 1e3], &mut [&mut sink]).unwrap();
+    let est =
+        Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut [&mut sink]).unwrap();
     assert_eq!(sink.records, est.history);
 }
 
@@ -116,7 +119,7 @@ fn a_free_free_structure_is_updated_from_its_elastic_mode() {
     let f = (1.5 * truth).sqrt() / (2.0 * std::f64::consts::PI);
     let p =
         Problem::new(FreeFree(params), DenseSolver, Measurement::new(vec![MeasuredMode::new(1, f)]).unwrap());
-    let est = Driver::default().run(&p, &mut Damped::default(), &[1e3], &mut []).unwrap();
+    let est = Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[1e3], &mut []).unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
     assert!((est.parameters[0] / truth - 1.0).abs() < 1e-8, "{:?}", est.parameters);
     // Asking for the rigid-body mode itself is refused, never answered with a number.

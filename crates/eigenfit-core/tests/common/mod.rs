@@ -32,10 +32,9 @@
 
 pub mod runner;
 
-use eigenfit_core::{
-    DenseSolver, EigenSolver, ModelError, Modes, Parameter, ParameterSet, SparseSymmetric, StructuralModel,
-    System, SystemDerivative,
-};
+use eigenfit_core::eigen::{DenseSolver, EigenSolver, Modes};
+use eigenfit_core::matrix::{SparseSymmetric, System, SystemDerivative};
+use eigenfit_core::model::{ModelError, Parameter, ParameterSet, StructuralModel};
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 

@@ -6,7 +6,8 @@
 #![allow(dead_code)]
 
 use eigenfit_core::discovery::{DiscoveryOptions, NamedEffect};
-use eigenfit_core::{BandedSolver, MeasuredMode, Measurement};
+use eigenfit_core::eigen::BandedSolver;
+use eigenfit_core::measurement::{MeasuredMode, Measurement};
 use eigenfit_rotor::discovery::discover_rotor;
 use eigenfit_rotor::presets;
 use serde::Deserialize;

@@ -1,0 +1,322 @@
+//! Strategy comparison: targets × initial guesses × strategies on reference data synthesised
+//! from the model itself (the paper's Tables 2–5 and convergence maps).
+
+use crate::analysis::{alternatives_among, local_solutions, uncertainty, Identifiability};
+use crate::eigen::EigenSolver;
+use crate::measurement::{MeasuredMode, Measurement};
+use crate::model::StructuralModel;
+use crate::problem::{Linearisation, Objective, Problem};
+use crate::update::{Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
+use rayon::prelude::*;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Local fits tried when looking for other solutions of a damped run.
+const ALTERNATIVE_STARTS: usize = 6;
+
+/// How the reference data are made and how each run is limited.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareSettings {
+    /// Number of lowest modes measured (the paper: as many as parameters).
+    pub modes: usize,
+    /// Round reference frequencies to this many decimals (the paper's Table 1: 3), or exact.
+    pub decimals: Option<i32>,
+    /// Standard deviation attached to each reference frequency (Hz), enabling intervals and
+    /// identifiability flags for the damped strategy.
+    pub std_hz: Option<f64>,
+    /// Iteration limit per run.
+    pub max_iterations: usize,
+}
+
+/// One run of the comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareRun {
+    /// Strategy.
+    pub strategy: StrategyKind,
+    /// True parameters.
+    pub target: Vec<f64>,
+    /// Initial guess.
+    pub initial: Vec<f64>,
+    /// Converged?
+    pub converged: bool,
+    /// Termination reason as text.
+    pub termination: String,
+    /// Iterations taken.
+    pub iterations: usize,
+    /// Model evaluations (eigen-solves), including rejected trials.
+    pub evaluations: usize,
+    /// Final parameters.
+    pub estimate: Vec<f64>,
+    /// max |estimate / target − 1| over the parameters.
+    pub relative_error: f64,
+    /// Wall-clock time of the run (s); for reports, never for tests.
+    pub seconds: f64,
+    /// Per parameter, whether the data determine it (damped runs with `std_hz` only).
+    pub identifiability: Option<Vec<Identifiability>>,
+    /// Other parameter vectors that fit the data equally well (damped runs only): when not
+    /// empty, the data cannot choose between them and the estimate.
+    pub alternatives: Vec<Vec<f64>>,
+}
+
+/// Reference data: the lowest `modes` frequencies of `model` at `target`, optionally rounded.
+pub fn reference_measurement<M, S>(
+    model: &M,
+    solver: &S,
+    target: &[f64],
+    settings: &CompareSettings,
+) -> Result<Measurement, String>
+where
+    M: StructuralModel + ?Sized,
+    S: EigenSolver + ?Sized,
+{
+    let system = model.assemble(target).map_err(|e| e.to_string())?;
+    let modes = solver.lowest(&system, settings.modes).map_err(|e| e.to_string())?;
+    let round = |f: f64| match settings.decimals {
+        Some(d) => (f * 10f64.powi(d)).round() / 10f64.powi(d),
+        None => f,
+    };
+    let measured = modes
+        .frequencies_hz()
+        .into_iter()
+        .enumerate()
+        .map(|(k, f)| MeasuredMode { mode: k, frequency_hz: round(f), std_hz: settings.std_hz, shape: None })
+        .collect();
+    Measurement::new(measured).map_err(|e| e.to_string())
+}
+
+/// What every damped run on the same reference data shares, computed once: the coarse grid of
+/// restart seeds ranked by residual, and the local solutions of the data (for the check for
+/// alternative solutions). Both depend on the data only, not on the initial guess.
+pub struct SharedData {
+    seeds: Arc<Vec<Vec<f64>>>,
+    solutions: Vec<Linearisation>,
+}
+
+impl SharedData {
+    /// Ranks the seeds and finds the local solutions of `problem`'s data.
+    pub fn new(problem: &dyn Objective) -> Self {
+        Self {
+            seeds: LevenbergMarquardt::rank_seeds(problem),
+            solutions: local_solutions(problem, ALTERNATIVE_STARTS),
+        }
+    }
+
+    /// What runs of `strategies` on `problem` share: the seeds and local solutions when one of
+    /// them is damped, nothing otherwise.
+    pub fn for_runs(problem: &dyn Objective, strategies: &[StrategyKind]) -> Self {
+        if strategies.contains(&StrategyKind::LevenbergMarquardt) {
+            Self::new(problem)
+        } else {
+            Self::none()
+        }
+    }
+
+    /// Nothing shared (for grids without a damped run).
+    pub fn none() -> Self {
+        Self { seeds: Arc::new(Vec::new()), solutions: Vec::new() }
+    }
+}
+
+/// Runs one strategy from one initial guess against reference data made at `target`. A damped
+/// run uses `shared`'s seeds, so its `evaluations` leave out the one-off ranking of the grid.
+pub fn run_case<M, S>(
+    problem: &Problem<M, S>,
+    shared: &SharedData,
+    target: &[f64],
+    initial: &[f64],
+    strategy: StrategyKind,
+    settings: &CompareSettings,
+) -> CompareRun
+where
+    M: StructuralModel,
+    S: EigenSolver,
+{
+    let start = Instant::now();
+    let mut s: Box<dyn UpdateStrategy> = match strategy {
+        StrategyKind::LevenbergMarquardt if !shared.seeds.is_empty() => {
+            Box::new(LevenbergMarquardt::default().with_seeds(shared.seeds.clone()))
+        }
+        _ => strategy.build(),
+    };
+    let outcome =
+        Driver { max_iterations: settings.max_iterations }.run(problem, s.as_mut(), initial, &mut []);
+    let seconds = start.elapsed().as_secs_f64();
+    match outcome {
+        Ok(est) => {
+            let converged = est.termination.is_converged();
+            let identifiability = (converged && strategy == StrategyKind::LevenbergMarquardt)
+                .then(|| uncertainty(problem, &est.last, problem.measured.has_std()))
+                .flatten()
+                .map(|u| u.identifiability);
+            let alternatives = if converged && strategy == StrategyKind::LevenbergMarquardt {
+                alternatives_among(problem, &est.last, &shared.solutions)
+            } else {
+                Vec::new()
+            };
+            CompareRun {
+                alternatives,
+                strategy,
+                target: target.to_vec(),
+                initial: initial.to_vec(),
+                converged,
+                termination: est.termination.to_string(),
+                iterations: est.iterations,
+                evaluations: est.evaluations,
+                relative_error: relative_error(&est.parameters, target),
+                estimate: est.parameters,
+                seconds,
+                identifiability,
+            }
+        }
+        Err(e) => CompareRun {
+            strategy,
+            target: target.to_vec(),
+            initial: initial.to_vec(),
+            converged: false,
+            termination: e.to_string(),
+            iterations: 0,
+            evaluations: 0,
+            estimate: initial.to_vec(),
+            relative_error: relative_error(initial, target),
+            seconds,
+            identifiability: None,
+            alternatives: Vec::new(),
+        },
+    }
+}
+
+/// Every combination of targets × initial guesses × strategies, in that nesting order, run in
+/// parallel (rayon); `on_run` sees each finished run on the calling thread, in the order the runs
+/// finish (progress, streaming output). The result is identical to [`run_grid_serial`]'s but for
+/// the wall-clock `seconds` of each run.
+pub fn run_grid<M, S>(
+    model: &M,
+    solver: &S,
+    targets: &[Vec<f64>],
+    initials: &[Vec<f64>],
+    strategies: &[StrategyKind],
+    settings: &CompareSettings,
+    mut on_run: impl FnMut(&CompareRun),
+) -> Result<Vec<CompareRun>, String>
+where
+    M: StructuralModel + Sync,
+    S: EigenSolver + Sync,
+{
+    let problems = targets
+        .iter()
+        .map(|target| {
+            Ok(Problem::new(model, solver, reference_measurement(model, solver, target, settings)?))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let shared: Vec<SharedData> = problems.iter().map(|p| SharedData::for_runs(p, strategies)).collect();
+    let cases: Vec<(usize, &Vec<f64>, StrategyKind)> = (0..targets.len())
+        .flat_map(|t| initials.iter().flat_map(move |i| strategies.iter().map(move |&s| (t, i, s))))
+        .collect();
+    let (sender, receiver) = std::sync::mpsc::channel::<CompareRun>();
+    std::thread::scope(|scope| {
+        let worker = scope.spawn(move || {
+            cases
+                .par_iter()
+                .map_with(sender, |sender, &(t, initial, strategy)| {
+                    let run = run_case(&problems[t], &shared[t], &targets[t], initial, strategy, settings);
+                    // The receiver lives until every run is sent; a failed send only loses progress.
+                    let _ = sender.send(run.clone());
+                    run
+                })
+                .collect::<Vec<_>>()
+        });
+        for run in receiver {
+            on_run(&run);
+        }
+        worker.join().map_err(|_| "a comparison run panicked".to_string())
+    })
+}
+
+/// [`run_grid`] on the calling thread only, one run after another.
+pub fn run_grid_serial<M, S>(
+    model: &M,
+    solver: &S,
+    targets: &[Vec<f64>],
+    initials: &[Vec<f64>],
+    strategies: &[StrategyKind],
+    settings: &CompareSettings,
+    mut on_run: impl FnMut(&CompareRun),
+) -> Result<Vec<CompareRun>, String>
+where
+    M: StructuralModel,
+    S: EigenSolver,
+{
+    let mut runs = Vec::with_capacity(targets.len() * initials.len() * strategies.len());
+    for target in targets {
+        let measured = reference_measurement(model, solver, target, settings)?;
+        let problem = Problem::new(model, solver, measured);
+        let shared = SharedData::for_runs(&problem, strategies);
+        for initial in initials {
+            for &strategy in strategies {
+                let run = run_case(&problem, &shared, target, initial, strategy, settings);
+                on_run(&run);
+                runs.push(run);
+            }
+        }
+    }
+    Ok(runs)
+}
+
+/// `n` log-spaced values from `lo` to `hi` inclusive.
+pub fn log_space(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    if n < 2 {
+        return vec![lo];
+    }
+    let (a, b) = (lo.log10(), hi.log10());
+    (0..n).map(|i| 10f64.powf(a + (b - a) * i as f64 / (n - 1) as f64)).collect()
+}
+
+/// The full tensor grid of `axis` over `dims` parameters.
+pub fn tensor_grid(axis: &[f64], dims: usize) -> Vec<Vec<f64>> {
+    let mut out: Vec<Vec<f64>> = vec![Vec::new()];
+    for _ in 0..dims {
+        out = out
+            .into_iter()
+            .flat_map(|prefix| {
+                axis.iter().map(move |&v| {
+                    let mut p = prefix.clone();
+                    p.push(v);
+                    p
+                })
+            })
+            .collect();
+    }
+    out
+}
+
+fn relative_error(estimate: &[f64], target: &[f64]) -> f64 {
+    estimate.iter().zip(target).map(|(e, t)| (e / t - 1.0).abs()).fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eigen::DenseSolver;
+    use crate::test_chain::Chain;
+
+    #[test]
+    fn parallel_grid_equals_serial_in_content_and_order() {
+        let chain = Chain::new(&[1.0, 2.0, 1.5]);
+        let targets = vec![vec![3e4, 1e4, 2e4], vec![1e3, 5e4, 1e4]];
+        let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
+        let strategies = StrategyKind::ALL;
+        let settings =
+            CompareSettings { modes: 3, decimals: Some(3), std_hz: Some(0.01), max_iterations: 100 };
+        let mut seen = 0;
+        let par = run_grid(&chain, &DenseSolver, &targets, &initials, &strategies, &settings, |_| seen += 1)
+            .unwrap();
+        let ser = run_grid_serial(&chain, &DenseSolver, &targets, &initials, &strategies, &settings, |_| {})
+            .unwrap();
+        assert_eq!(seen, par.len());
+        assert_eq!(par.len(), 2 * 27 * strategies.len());
+        let strip = |runs: Vec<CompareRun>| -> Vec<CompareRun> {
+            runs.into_iter().map(|r| CompareRun { seconds: 0.0, ..r }).collect()
+        };
+        assert_eq!(strip(par), strip(ser));
+    }
+}

@@ -1,0 +1,124 @@
+//! Test campaigns: configurations with their own parameter lists, estimated jointly. A
+//! parameter of the same name in several configurations is one parameter (the same bearing in
+//! every run); one that appears in one configuration only (a bearing changed for that run) is
+//! estimated from that configuration's data alone. Rows are stacked as in [`crate::problem::multi`].
+
+use crate::analysis::{uncertainty, Uncertainty};
+use crate::model::{Parameter, ParameterSet};
+use crate::problem::multi::stack;
+use crate::problem::{Linearisation, Objective, ResidualError};
+use nalgebra::DMatrix;
+
+/// Several configurations' objectives over the union of their parameters.
+pub struct Joint<'a> {
+    parts: Vec<&'a dyn Objective>,
+    /// For each part, the joint index of each of its parameters.
+    maps: Vec<Vec<usize>>,
+    parameters: ParameterSet,
+    /// Divides every row (the residual scatter for intervals from data without std).
+    pub scale: f64,
+}
+
+impl<'a> Joint<'a> {
+    /// Joins `parts`; a shared name must have the same unit, bounds and scale everywhere (its
+    /// nominal value is the first configuration's).
+    pub fn new(parts: Vec<&'a dyn Objective>) -> Result<Self, String> {
+        let mut all: Vec<Parameter> = Vec::new();
+        let mut maps = Vec::with_capacity(parts.len());
+        for (k, part) in parts.iter().enumerate() {
+            let mut map = Vec::new();
+            for q in part.parameters().iter() {
+                match all.iter().position(|a| a.name == q.name) {
+                    Some(i) => {
+                        let a = &all[i];
+                        if (a.unit.as_str(), a.lower, a.upper, a.scale)
+                            != (q.unit.as_str(), q.lower, q.upper, q.scale)
+                        {
+                            return Err(format!(
+                                "configuration {k}: parameter `{}` differs from the first configuration's (unit, bounds or scale)",
+                                q.name
+                            ));
+                        }
+                        map.push(i);
+                    }
+                    None => {
+                        all.push(q.clone());
+                        map.push(all.len() - 1);
+                    }
+                }
+            }
+            maps.push(map);
+        }
+        let parameters = ParameterSet::new(all).map_err(|e| e.to_string())?;
+        Ok(Self { parts, maps, parameters, scale: 1.0 })
+    }
+
+    /// Part `k`'s parameter vector within the joint vector `p`.
+    pub fn part_values(&self, k: usize, p: &[f64]) -> Vec<f64> {
+        self.maps[k].iter().map(|&i| p[i]).collect()
+    }
+
+    /// Part `k`'s linearisation at the joint vector `p`, as the part itself computes it.
+    pub fn part_linearise(&self, k: usize, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        self.parts[k].linearise(&self.part_values(k, p))
+    }
+
+    /// Number of configurations.
+    pub fn len(&self) -> usize {
+        self.parts.len()
+    }
+
+    /// Always false: a joint problem has a part.
+    pub fn is_empty(&self) -> bool {
+        self.parts.is_empty()
+    }
+
+    /// 95 % intervals at `at`: from the weights when `has_std`, else from the residual scatter
+    /// σ̂ = √(‖r‖²/dof) as in [`ShapeFit::uncertainty`](super::ShapeFit::uncertainty).
+    pub fn uncertainty(&mut self, at: &Linearisation, has_std: bool) -> Option<(Uncertainty, f64)> {
+        if has_std {
+            return uncertainty(self, at, true).map(|u| (u, 1.0));
+        }
+        let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
+        let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
+        if !(scatter > 0.0 && scatter.is_finite()) {
+            return None;
+        }
+        let old = self.scale;
+        self.scale = old * scatter;
+        let out = self
+            .linearise(&at.parameters)
+            .ok()
+            .and_then(|l| uncertainty(self, &l, true))
+            .map(|u| (u, scatter));
+        self.scale = old;
+        out
+    }
+}
+
+impl Objective for Joint<'_> {
+    fn parameters(&self) -> &ParameterSet {
+        &self.parameters
+    }
+
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        let np = p.len();
+        let mut lins = Vec::with_capacity(self.parts.len());
+        for k in 0..self.parts.len() {
+            let mut lin = self.part_linearise(k, p)?;
+            let widen = |m: &DMatrix<f64>| {
+                let mut out = DMatrix::zeros(m.nrows(), np);
+                for (j, &i) in self.maps[k].iter().enumerate() {
+                    out.column_mut(i).copy_from(&m.column(j));
+                }
+                out
+            };
+            lin.jacobian = widen(&lin.jacobian) / self.scale;
+            lin.eigenvalue_jacobian = widen(&lin.eigenvalue_jacobian);
+            lin.residual /= self.scale;
+            lin.parameters = p.to_vec();
+            lins.push(lin);
+        }
+        Ok(stack(p, &lins))
+    }
+}

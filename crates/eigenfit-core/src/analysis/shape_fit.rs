@@ -1,0 +1,150 @@
+//! Shape residuals: measured mode shapes in the objective beside the frequencies.
+//!
+//! For each measured mode paired (by MAC) with model mode k, the model shape at the sensors
+//! s = Pφₖ and the measured shape d are both scaled to unit length, the measured one turned to
+//! point the model's way (dᵀs ≥ 0); the residual rows are (d/‖d‖ − s/‖s‖)/σ_shape, one per
+//! sensor. Unit length makes the residual independent of how the test system scaled its shapes
+//! (mass-normalised, unit maximum, …). Their derivatives follow from Nelson's method:
+//! d(s/‖s‖)/dp = (I − uuᵀ) P dφₖ/dp / ‖s‖.
+
+use crate::eigen::EigenSolver;
+use crate::model::{ParameterSet, StructuralModel};
+use crate::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
+use crate::sensitivity::{eigenvector_derivative_nelson, SensitivityError};
+use nalgebra::{DMatrix, DVector};
+
+/// Default standard deviation of a unit-length measured shape's entries.
+pub const DEFAULT_SHAPE_STD: f64 = 0.05;
+/// Default relative standard deviation given to frequencies that come without one, when shapes
+/// are fitted too: it sets how frequencies weigh against shapes (10:1 with the shape default).
+pub const DEFAULT_FREQUENCY_STD_REL: f64 = 0.005;
+
+/// Frequencies and shapes together: an [`Objective`] for the update strategies and the
+/// statistics. The frequency rows are the wrapped [`Problem`]'s (MAC pairing) times
+/// `frequency_weight`; the shape rows follow them; every row is divided by `scale`.
+pub struct ShapeFit<M, S> {
+    /// The frequency problem, with [`Pairing::Mac`] and measured shapes.
+    pub problem: Problem<M, S>,
+    /// σ of a unit-length measured shape's entries.
+    pub shape_std: f64,
+    /// Factor on the frequency rows (1 when the data carry standard deviations).
+    pub frequency_weight: f64,
+    /// Divides every row: 1 for fitting; the residual scatter σ̂ for intervals from data
+    /// without standard deviations.
+    pub scale: f64,
+}
+
+impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
+    /// A shape fit with the default weights: frequencies without a std count as
+    /// [`DEFAULT_FREQUENCY_STD_REL`] relative (for the relative residual).
+    pub fn new(problem: Problem<M, S>, shape_std: f64) -> Self {
+        let frequency_weight = if problem.measured.has_std() { 1.0 } else { 1.0 / DEFAULT_FREQUENCY_STD_REL };
+        Self { problem, shape_std, frequency_weight, scale: 1.0 }
+    }
+
+    /// The model shapes at the sensors, one per computed mode, and the paired model modes,
+    /// at `p`.
+    pub fn model_at_sensors(&self, p: &[f64]) -> Result<(Vec<Vec<f64>>, Vec<usize>), ResidualError> {
+        let lin = self.problem.linearise(p)?;
+        let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
+            return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
+        };
+        let system = self.problem.model.assemble(p).map_err(SensitivityError::from)?;
+        let modes = self.problem.solver.lowest(&system, self.count()).map_err(SensitivityError::from)?;
+        let shapes =
+            (0..modes.count()).map(|k| sensor_dofs.iter().map(|&d| modes.shapes[(d, k)]).collect()).collect();
+        Ok((shapes, lin.paired_modes))
+    }
+
+    /// 95 % intervals at the estimate `at` (a linearisation of this fit). With standard
+    /// deviations in the data they come from the weights. Without, from the residual scatter:
+    /// every row is divided by σ̂ = √(‖r‖²/dof), the usual regression estimate, so the weights
+    /// only set how frequencies and shapes count against each other; `None` when there are no
+    /// more rows than parameters. Returns the intervals and σ̂ (1 with given std).
+    pub fn uncertainty(&mut self, at: &Linearisation) -> Option<(crate::analysis::Uncertainty, f64)> {
+        if self.problem.measured.has_std() {
+            return crate::analysis::uncertainty(self, at, true).map(|u| (u, 1.0));
+        }
+        let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
+        let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
+        if !(scatter > 0.0 && scatter.is_finite()) {
+            return None;
+        }
+        let old = self.scale;
+        self.scale = old * scatter;
+        let result = self
+            .linearise(&at.parameters)
+            .ok()
+            .and_then(|lin| crate::analysis::uncertainty(self, &lin, true))
+            .map(|u| (u, scatter));
+        self.scale = old;
+        result
+    }
+
+    /// Modes solved: as many as MAC pairing considers.
+    fn count(&self) -> usize {
+        (2 * self.problem.measured.modes_needed() + 2).min(self.problem.model.dofs())
+    }
+}
+
+impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
+    fn parameters(&self) -> &ParameterSet {
+        self.problem.parameters()
+    }
+
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        let mut lin = self.problem.linearise(p)?;
+        let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
+            return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
+        };
+        let model = &self.problem.model;
+        let system = model.assemble(p).map_err(SensitivityError::from)?;
+        let modes = self.problem.solver.lowest(&system, self.count()).map_err(SensitivityError::from)?;
+        let np = p.len();
+        let derivatives = (0..np)
+            .map(|i| model.derivative(p, i))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(SensitivityError::from)?;
+        let m = lin.residual.len();
+        let ns = sensor_dofs.len();
+        let rows = m + m * ns;
+        let mut residual = DVector::zeros(rows);
+        let mut jacobian = DMatrix::zeros(rows, np);
+        let w = self.frequency_weight / self.scale;
+        residual.rows_mut(0, m).copy_from(&(&lin.residual * w));
+        jacobian.rows_mut(0, m).copy_from(&(&lin.jacobian * w));
+        let ws = 1.0 / (self.shape_std * self.scale);
+        for (j, (meas, &k)) in self.problem.measured.modes().iter().zip(&lin.paired_modes).enumerate() {
+            let d = meas
+                .shape
+                .as_ref()
+                .ok_or_else(|| ResidualError::Mac(format!("mode {} has no shape", meas.mode + 1)))?;
+            let s = DVector::from_iterator(ns, sensor_dofs.iter().map(|&dof| modes.shapes[(dof, k)]));
+            let d = DVector::from_column_slice(d);
+            let (sn, dn) = (s.norm(), d.norm());
+            if sn == 0.0 || dn == 0.0 {
+                return Err(ResidualError::Mac(format!(
+                    "mode {}: the {} shape is zero at every sensor",
+                    meas.mode + 1,
+                    if sn == 0.0 { "model" } else { "measured" }
+                )));
+            }
+            let u = &s / sn;
+            let sign = if d.dot(&s) < 0.0 { -1.0 } else { 1.0 };
+            let ud = &d * (sign / dn);
+            let row0 = m + j * ns;
+            residual.rows_mut(row0, ns).copy_from(&((ud - &u) * ws));
+            for (i, der) in derivatives.iter().enumerate() {
+                let dphi = eigenvector_derivative_nelson(&system, &modes, k, der)?;
+                let ds = DVector::from_iterator(ns, sensor_dofs.iter().map(|&dof| dphi[dof]));
+                let du = (&ds - &u * u.dot(&ds)) / sn;
+                jacobian.view_mut((row0, i), (ns, 1)).copy_from(&(du * ws));
+            }
+        }
+        lin.residual = residual;
+        lin.jacobian = jacobian;
+        // Every row is now weighted by a standard deviation: given, or the documented defaults.
+        lin.has_std = true;
+        Ok(lin)
+    }
+}

@@ -1,0 +1,14 @@
+//! Matrix layer: the stiffness–mass pair [`System`] and its storage — dense, [`SparseSymmetric`]
+//! (triplets), [`BandedSymmetric`] with its [`BandCholesky`] factor, and [`CscSymmetric`].
+//!
+//! Depends only on [`units`](crate::units). Files are named after their main type.
+
+pub(crate) mod banded;
+pub(crate) mod csc;
+pub(crate) mod sparse;
+pub(crate) mod system;
+
+pub use banded::{BandCholesky, BandedSymmetric};
+pub use csc::CscSymmetric;
+pub use sparse::SparseSymmetric;
+pub use system::{System, SystemDerivative, SystemError};

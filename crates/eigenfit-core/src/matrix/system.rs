@@ -1,0 +1,286 @@
+//! Assembled matrices K, M of a structure at one parameter vector, and their parameter derivatives.
+
+use crate::matrix::{BandedSymmetric, CscSymmetric, SparseSymmetric};
+use nalgebra::DMatrix;
+use std::sync::OnceLock;
+use thiserror::Error;
+
+/// Why a pair (K, M) is not a valid symmetric eigenproblem.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum SystemError {
+    /// K or M is not square, or they differ in size.
+    #[error("K is {k_rows}×{k_cols} and M is {m_rows}×{m_cols}: both must be the same square size")]
+    Shape { k_rows: usize, k_cols: usize, m_rows: usize, m_cols: usize },
+    /// The system has no degree of freedom.
+    #[error("the system has no degree of freedom")]
+    Empty,
+    /// An entry is NaN or infinite.
+    #[error("{matrix}[{row}, {col}] is {value}: every entry must be finite")]
+    NonFinite { matrix: &'static str, row: usize, col: usize, value: f64 },
+    /// A matrix is not symmetric.
+    #[error("{matrix} is not symmetric: [{row}, {col}] = {a} but [{col}, {row}] = {b}")]
+    NotSymmetric { matrix: &'static str, row: usize, col: usize, a: f64, b: f64 },
+}
+
+/// Stiffness K and mass M of a structure (n×n, symmetric; M positive definite for a solve).
+///
+/// Stored densely ([`System::new`]), by band ([`System::banded`], for large beam-like models
+/// whose dense matrices would not fit: 10⁴ DOFs are 800 MB per dense matrix, 320 kB per band) or
+/// as general sparse matrices ([`System::sparse`], for plates, shells and solids from any FE tool).
+/// [`stiffness`](Self::stiffness) and [`mass`](Self::mass) always answer with dense matrices —
+/// for a banded or sparse system they are built on first use and kept, at O(n²) memory — so dense
+/// solvers work on any; band- and sparse-aware code asks [`band`](Self::band) or
+/// [`sparse`](Self::sparse_pair) first.
+#[derive(Debug, Clone)]
+pub struct System {
+    storage: Storage,
+}
+
+#[derive(Debug, Clone)]
+enum Storage {
+    Dense {
+        stiffness: DMatrix<f64>,
+        mass: DMatrix<f64>,
+    },
+    Banded {
+        stiffness: BandedSymmetric,
+        mass: BandedSymmetric,
+        dense: OnceLock<(DMatrix<f64>, DMatrix<f64>)>,
+    },
+    Sparse {
+        stiffness: CscSymmetric,
+        mass: CscSymmetric,
+        dense: OnceLock<(DMatrix<f64>, DMatrix<f64>)>,
+    },
+}
+
+impl PartialEq for System {
+    /// Equal matrices, whatever the storage.
+    fn eq(&self, other: &Self) -> bool {
+        match (&self.storage, &other.storage) {
+            (
+                Storage::Banded { stiffness: k1, mass: m1, .. },
+                Storage::Banded { stiffness: k2, mass: m2, .. },
+            ) if k1.bandwidth() == k2.bandwidth() && m1.bandwidth() == m2.bandwidth() => k1 == k2 && m1 == m2,
+            (
+                Storage::Sparse { stiffness: k1, mass: m1, .. },
+                Storage::Sparse { stiffness: k2, mass: m2, .. },
+            ) if k1.same_pattern(k2) && m1.same_pattern(m2) => k1 == k2 && m1 == m2,
+            _ => self.stiffness() == other.stiffness() && self.mass() == other.mass(),
+        }
+    }
+}
+
+impl System {
+    /// Checks shape, finiteness and symmetry (to 1e-12 relative) and builds the system.
+    pub fn new(stiffness: DMatrix<f64>, mass: DMatrix<f64>) -> Result<Self, SystemError> {
+        let (n, c) = stiffness.shape();
+        if n != c || mass.shape() != (n, n) {
+            return Err(SystemError::Shape {
+                k_rows: n,
+                k_cols: c,
+                m_rows: mass.nrows(),
+                m_cols: mass.ncols(),
+            });
+        }
+        if n == 0 {
+            return Err(SystemError::Empty);
+        }
+        check_matrix("K", &stiffness)?;
+        check_matrix("M", &mass)?;
+        Ok(Self { storage: Storage::Dense { stiffness, mass } })
+    }
+
+    /// A system stored by band (symmetric by construction): checks size and finiteness, O(n·b).
+    pub fn banded(stiffness: BandedSymmetric, mass: BandedSymmetric) -> Result<Self, SystemError> {
+        check_pair((stiffness.dim(), stiffness.first_non_finite()), (mass.dim(), mass.first_non_finite()))?;
+        Ok(Self { storage: Storage::Banded { stiffness, mass, dense: OnceLock::new() } })
+    }
+
+    /// A system stored as general sparse matrices (symmetric by construction): checks size and
+    /// finiteness, O(nnz).
+    pub fn sparse(stiffness: CscSymmetric, mass: CscSymmetric) -> Result<Self, SystemError> {
+        check_pair((stiffness.dim(), stiffness.first_non_finite()), (mass.dim(), mass.first_non_finite()))?;
+        Ok(Self { storage: Storage::Sparse { stiffness, mass, dense: OnceLock::new() } })
+    }
+
+    /// Number of degrees of freedom n.
+    pub fn dofs(&self) -> usize {
+        match &self.storage {
+            Storage::Dense { stiffness, .. } => stiffness.nrows(),
+            Storage::Banded { stiffness, .. } => stiffness.dim(),
+            Storage::Sparse { stiffness, .. } => stiffness.dim(),
+        }
+    }
+
+    /// (K, M) by band when the system is stored so.
+    pub fn band(&self) -> Option<(&BandedSymmetric, &BandedSymmetric)> {
+        match &self.storage {
+            Storage::Banded { stiffness, mass, .. } => Some((stiffness, mass)),
+            _ => None,
+        }
+    }
+
+    /// (K, M) as general sparse matrices when the system is stored so.
+    pub fn sparse_pair(&self) -> Option<(&CscSymmetric, &CscSymmetric)> {
+        match &self.storage {
+            Storage::Sparse { stiffness, mass, .. } => Some((stiffness, mass)),
+            _ => None,
+        }
+    }
+
+    fn dense_pair(&self) -> (&DMatrix<f64>, &DMatrix<f64>) {
+        match &self.storage {
+            Storage::Dense { stiffness, mass } => (stiffness, mass),
+            Storage::Banded { stiffness, mass, dense } => {
+                let (k, m) = dense.get_or_init(|| (stiffness.to_dense(), mass.to_dense()));
+                (k, m)
+            }
+            Storage::Sparse { stiffness, mass, dense } => {
+                let (k, m) = dense.get_or_init(|| (stiffness.to_dense(), mass.to_dense()));
+                (k, m)
+            }
+        }
+    }
+
+    /// Stiffness matrix K (dense; built and kept on first use for a banded or sparse system).
+    pub fn stiffness(&self) -> &DMatrix<f64> {
+        self.dense_pair().0
+    }
+
+    /// Mass matrix M (dense; built and kept on first use for a banded or sparse system).
+    pub fn mass(&self) -> &DMatrix<f64> {
+        self.dense_pair().1
+    }
+
+    /// Largest |Kᵢⱼ| and largest |Mᵢⱼ|, without densifying a banded or sparse system.
+    pub fn amax(&self) -> (f64, f64) {
+        match &self.storage {
+            Storage::Dense { stiffness, mass } => (stiffness.amax(), mass.amax()),
+            Storage::Banded { stiffness, mass, .. } => (stiffness.amax(), mass.amax()),
+            Storage::Sparse { stiffness, mass, .. } => (stiffness.amax(), mass.amax()),
+        }
+    }
+
+    /// Consumes the system, returning (K, M) dense.
+    pub fn into_parts(self) -> (DMatrix<f64>, DMatrix<f64>) {
+        match self.storage {
+            Storage::Dense { stiffness, mass } => (stiffness, mass),
+            Storage::Banded { stiffness, mass, dense } => {
+                dense.into_inner().unwrap_or_else(|| (stiffness.to_dense(), mass.to_dense()))
+            }
+            Storage::Sparse { stiffness, mass, dense } => {
+                dense.into_inner().unwrap_or_else(|| (stiffness.to_dense(), mass.to_dense()))
+            }
+        }
+    }
+}
+
+/// Size and finiteness of a stored K, M pair, each given as (dimension, first non-finite entry):
+/// the checks the band and sparse constructors share (their storage is symmetric by construction).
+fn check_pair(
+    (n, k_bad): (usize, Option<(usize, usize, f64)>),
+    (m_dim, m_bad): (usize, Option<(usize, usize, f64)>),
+) -> Result<(), SystemError> {
+    if m_dim != n {
+        return Err(SystemError::Shape { k_rows: n, k_cols: n, m_rows: m_dim, m_cols: m_dim });
+    }
+    if n == 0 {
+        return Err(SystemError::Empty);
+    }
+    for (matrix, bad) in [("K", k_bad), ("M", m_bad)] {
+        if let Some((row, col, value)) = bad {
+            return Err(SystemError::NonFinite { matrix, row, col, value });
+        }
+    }
+    Ok(())
+}
+
+fn check_matrix(name: &'static str, a: &DMatrix<f64>) -> Result<(), SystemError> {
+    let scale = a.iter().fold(0.0_f64, |s, v| s.max(v.abs()));
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            let v = a[(i, j)];
+            if !v.is_finite() {
+                return Err(SystemError::NonFinite { matrix: name, row: i, col: j, value: v });
+            }
+            if i < j {
+                let w = a[(j, i)];
+                if (v - w).abs() > 1e-12 * scale {
+                    return Err(SystemError::NotSymmetric { matrix: name, row: i, col: j, a: v, b: w });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// ∂K/∂pᵢ and ∂M/∂pᵢ for one parameter, sparse.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SystemDerivative {
+    /// ∂K/∂pᵢ.
+    pub stiffness: SparseSymmetric,
+    /// ∂M/∂pᵢ.
+    pub mass: SparseSymmetric,
+}
+
+impl SystemDerivative {
+    /// Zero derivative of an n-DOF system.
+    pub fn zeros(dim: usize) -> Self {
+        Self { stiffness: SparseSymmetric::zeros(dim), mass: SparseSymmetric::zeros(dim) }
+    }
+
+    /// φᵀ(∂K − λ ∂M)ψ: the building block of every eigen-sensitivity.
+    pub fn shifted_bilinear(&self, lambda: f64, phi: &[f64], psi: &[f64]) -> f64 {
+        let k = self.stiffness.bilinear(phi, psi);
+        if self.mass.is_empty() {
+            k
+        } else {
+            k - lambda * self.mass.bilinear(phi, psi)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_matrices_with_location() {
+        let k = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 0.0, 1.0]);
+        let m = DMatrix::identity(2, 2);
+        assert_eq!(
+            System::new(k, m.clone()).unwrap_err().to_string(),
+            "K is not symmetric: [0, 1] = 2 but [1, 0] = 0"
+        );
+        let k = DMatrix::from_row_slice(2, 2, &[f64::NAN, 0.0, 0.0, 1.0]);
+        assert!(matches!(
+            System::new(k, m.clone()),
+            Err(SystemError::NonFinite { matrix: "K", row: 0, col: 0, .. })
+        ));
+        assert!(matches!(System::new(DMatrix::identity(3, 3), m), Err(SystemError::Shape { .. })));
+        assert_eq!(System::new(DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)), Err(SystemError::Empty));
+    }
+
+    #[test]
+    fn banded_storage_answers_like_dense() {
+        let k = DMatrix::from_row_slice(3, 3, &[2.0, -1.0, 0.0, -1.0, 2.0, -1.0, 0.0, -1.0, 1.0]);
+        let m = DMatrix::from_diagonal_element(3, 3, 0.5);
+        let dense = System::new(k.clone(), m.clone()).unwrap();
+        let banded =
+            System::banded(BandedSymmetric::from_dense(&k), BandedSymmetric::from_dense(&m)).unwrap();
+        assert_eq!(banded.dofs(), 3);
+        assert_eq!(banded.band().unwrap().0.bandwidth(), 1);
+        assert_eq!(banded.amax(), (2.0, 0.5));
+        assert_eq!(banded.stiffness(), &k);
+        assert_eq!(banded, dense);
+        assert_eq!(banded.clone().into_parts(), (k, m));
+        let mut bad = BandedSymmetric::zeros(3, 1);
+        bad.add(2, 1, f64::INFINITY);
+        assert!(matches!(
+            System::banded(bad, BandedSymmetric::zeros(3, 0)),
+            Err(SystemError::NonFinite { matrix: "K", row: 2, col: 1, .. })
+        ));
+    }
+}

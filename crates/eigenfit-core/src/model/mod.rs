@@ -1,0 +1,15 @@
+//! Model layer: what a structure is ([`StructuralModel`]), its updatable [`ParameterSet`], a
+//! model with some parameters held [`Fixed`], and the [`Candidate`] effects a model can offer to
+//! discovery (with the [`Augmented`] model that adds them).
+//!
+//! Depends on [`matrix`](crate::matrix) and below.
+
+pub(crate) mod candidate;
+pub(crate) mod fixed;
+pub(crate) mod parameters;
+pub(crate) mod structural_model;
+
+pub use candidate::{Augmented, Candidate, ValueLaw};
+pub use fixed::Fixed;
+pub use parameters::{Parameter, ParameterError, ParameterSet, Scale};
+pub use structural_model::{finite_difference_derivative, ModelError, StructuralModel};

@@ -1,0 +1,62 @@
+//! Several test configurations of one structure, updated together: the residuals and Jacobians
+//! of each configuration are stacked into one least-squares problem.
+
+use crate::model::ParameterSet;
+use crate::problem::{Linearisation, Objective, ResidualError};
+use nalgebra::{DMatrix, DVector};
+
+/// Stacks problems that share one parameter set (e.g. one rotor measured at several support
+/// settings, each with its own [`Problem`](crate::problem::Problem)).
+pub struct Stacked<'a> {
+    parts: Vec<&'a dyn Objective>,
+}
+
+impl<'a> Stacked<'a> {
+    /// Stacks `parts`; `None` when empty or when the parts' parameter sets differ.
+    pub fn new(parts: Vec<&'a dyn Objective>) -> Option<Self> {
+        let first = parts.first()?.parameters();
+        parts.iter().all(|p| p.parameters() == first).then_some(Self { parts })
+    }
+}
+
+impl Objective for Stacked<'_> {
+    fn parameters(&self) -> &ParameterSet {
+        self.parts[0].parameters()
+    }
+
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        let lins = self.parts.iter().map(|part| part.linearise(p)).collect::<Result<Vec<_>, _>>()?;
+        Ok(stack(p, &lins))
+    }
+}
+
+/// One linearisation holding the rows of all of `parts`, in order.
+pub fn stack(p: &[f64], parts: &[Linearisation]) -> Linearisation {
+    let rows: usize = parts.iter().map(|l| l.residual.len()).sum();
+    let np = p.len();
+    let vec = |f: &dyn Fn(&Linearisation) -> &DVector<f64>| {
+        DVector::from_iterator(rows, parts.iter().flat_map(|l| f(l).iter().copied()))
+    };
+    let mat = |f: &dyn Fn(&Linearisation) -> &DMatrix<f64>| {
+        let mut m = DMatrix::zeros(rows, np);
+        let mut r = 0;
+        for l in parts {
+            let block = f(l);
+            m.rows_mut(r, block.nrows()).copy_from(block);
+            r += block.nrows();
+        }
+        m
+    };
+    Linearisation {
+        parameters: p.to_vec(),
+        paired_modes: parts.iter().flat_map(|l| l.paired_modes.iter().copied()).collect(),
+        model_eigenvalues: vec(&|l| &l.model_eigenvalues),
+        measured_eigenvalues: vec(&|l| &l.measured_eigenvalues),
+        eigenvalue_jacobian: mat(&|l| &l.eigenvalue_jacobian),
+        frequencies_hz: parts.iter().flat_map(|l| l.frequencies_hz.iter().copied()).collect(),
+        measured_hz: parts.iter().flat_map(|l| l.measured_hz.iter().copied()).collect(),
+        residual: vec(&|l| &l.residual),
+        jacobian: mat(&|l| &l.jacobian),
+        has_std: parts.iter().all(|l| l.has_std),
+    }
+}

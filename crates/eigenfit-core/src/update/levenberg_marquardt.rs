@@ -1,0 +1,424 @@
+//! Damped least squares (Levenberg–Marquardt) in scaled parameters, with bounds and restarts.
+
+use super::{Step, StepStatus, UpdateError, UpdateStrategy};
+use crate::model::ParameterSet;
+use crate::problem::{Linearisation, Objective};
+use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
+
+/// Levenberg–Marquardt on the weighted residual, in each parameter's scale (log for
+/// stiffnesses), with Marquardt's diagonal scaling, a gain-ratio test that accepts or rejects
+/// each trial (Nielsen's damping update), bounds by an active set, and a cap on the scaled step so
+/// a flat start (a stiff support, where the frequencies barely move) cannot jump across decades.
+/// Any number of modes ≥ the number of free parameters.
+///
+/// Robust from any start: when the iteration settles on a point that does not fit (a local
+/// minimum, or a plateau where a support is so stiff the data no longer see it), it restarts from
+/// the untried point of a coarse log grid with the lowest residual, and at the end returns the
+/// best point it found. Restarts count as iterations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LevenbergMarquardt {
+    /// A fit is exact when every |f_model − f_measured| / f_measured is below this.
+    pub residual_tolerance: f64,
+    /// Converged when a scaled step ‖δ‖∞ falls below this without heavy damping.
+    pub step_tolerance: f64,
+    /// Largest ‖δ‖∞ of one step in scaled units (ln 100: two decades for a log parameter).
+    pub max_step: f64,
+    /// Rejected trials allowed per iteration before the run counts as stuck.
+    pub max_trials: usize,
+    /// Restarts from the coarse grid allowed before the best point found is returned.
+    pub max_restarts: usize,
+    /// Parameters held at their starting value (profile likelihood, partial updates).
+    pub fixed: Vec<bool>,
+    mu: f64,
+    nu: f64,
+    seeds: Option<Vec<Vec<f64>>>,
+    shared_seeds: Option<Arc<Vec<Vec<f64>>>>,
+    far_checked: bool,
+    best: Option<Linearisation>,
+    restarts: usize,
+    stuck_for: usize,
+    recent_cost: f64,
+}
+
+impl Default for LevenbergMarquardt {
+    fn default() -> Self {
+        Self {
+            residual_tolerance: 1e-10,
+            step_tolerance: 1e-10,
+            max_step: 100f64.ln(),
+            max_trials: 30,
+            max_restarts: 8,
+            fixed: Vec::new(),
+            mu: 1e-3,
+            nu: 2.0,
+            seeds: None,
+            shared_seeds: None,
+            far_checked: false,
+            best: None,
+            restarts: 0,
+            stuck_for: 0,
+            recent_cost: f64::INFINITY,
+        }
+    }
+}
+
+/// Iterations without a 0.1% cost reduction after which a run counts as stuck on a plateau.
+const PLATEAU_ITERATIONS: usize = 12;
+/// Grid points per free parameter for restart seeds: 5 for one or two free parameters, fewer
+/// beyond, and never more than [`MAX_SEEDS`] in all.
+fn seeds_per_axis(free: usize) -> usize {
+    match free {
+        0..=2 => 5,
+        3 => 4,
+        4 => 3,
+        _ => 2,
+    }
+}
+/// Most restart seeds evaluated.
+const MAX_SEEDS: usize = 243;
+/// Relative frequency misfit above which a run starts from the best coarse-grid point.
+const FAR_START: f64 = 0.2;
+
+impl LevenbergMarquardt {
+    /// Holds the parameters flagged `true` fixed.
+    pub fn with_fixed(mut self, fixed: Vec<bool>) -> Self {
+        self.fixed = fixed;
+        self
+    }
+
+    /// Sets the number of restarts (0: a plain local Levenberg–Marquardt).
+    pub fn with_max_restarts(mut self, max_restarts: usize) -> Self {
+        self.max_restarts = max_restarts;
+        self
+    }
+
+    /// Uses restart seeds ranked once for several runs on the same data ([`LevenbergMarquardt::rank_seeds`]),
+    /// instead of ranking the coarse grid again in every run.
+    pub fn with_seeds(mut self, seeds: Arc<Vec<Vec<f64>>>) -> Self {
+        self.shared_seeds = Some(seeds);
+        self
+    }
+
+    /// The coarse log grid of restart seeds for `problem`, ranked by residual (lowest first).
+    pub fn rank_seeds(problem: &dyn Objective) -> Arc<Vec<Vec<f64>>> {
+        let around = problem.parameters().nominal_values();
+        Arc::new(ranked_seeds(problem, &around, &[]))
+    }
+
+    /// This run's seeds (ranked on first use, or copied from shared ones) and the evaluations spent.
+    fn seeds(&mut self, problem: &dyn Objective, around: &[f64]) -> (&mut Vec<Vec<f64>>, usize) {
+        let mut spent = 0;
+        if self.seeds.is_none() {
+            let fixed = self.fixed.iter().any(|&f| f);
+            self.seeds = Some(match (&self.shared_seeds, fixed) {
+                (Some(shared), false) => shared.as_ref().clone(),
+                _ => {
+                    let ranked = ranked_seeds(problem, around, &self.fixed);
+                    spent = ranked.len();
+                    ranked
+                }
+            });
+        }
+        (self.seeds.as_mut().expect("set above"), spent) // proof: assigned just above when None
+    }
+
+    /// Restarts taken in the last run.
+    pub fn restarts(&self) -> usize {
+        self.restarts
+    }
+
+    fn is_free(&self, i: usize) -> bool {
+        !self.fixed.get(i).copied().unwrap_or(false)
+    }
+
+    /// Good enough to stop without restarting: an exact fit, or with standard deviations a
+    /// χ² per degree of freedom that noise can explain (≤ 4).
+    fn acceptable(&self, lin: &Linearisation, free: usize) -> bool {
+        if self.converged(lin) {
+            return true;
+        }
+        let dof = lin.residual.len().saturating_sub(free);
+        lin.has_std && dof > 0 && 2.0 * lin.cost() / dof as f64 <= 4.0
+    }
+
+    fn remember(&mut self, lin: &Linearisation) {
+        if self.best.as_ref().is_none_or(|b| lin.cost() < b.cost()) {
+            self.best = Some(lin.clone());
+        }
+    }
+
+    /// The point reached does not fit: restart from the best untried seed, or end with the best
+    /// point found.
+    fn restart(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
+        self.remember(current);
+        let (_, mut evaluations) = self.seeds(problem, &current.parameters);
+        while self.restarts < self.max_restarts {
+            let Some(p) = self.seeds.as_mut().and_then(|s| (!s.is_empty()).then(|| s.remove(0))) else {
+                break;
+            };
+            evaluations += 1;
+            if let Ok(next) = problem.linearise(&p) {
+                self.restarts += 1;
+                self.mu = 1e-3;
+                self.nu = 2.0;
+                self.stuck_for = 0;
+                self.recent_cost = next.cost();
+                return Ok(Step { next, status: StepStatus::Continue, evaluations });
+            }
+        }
+        let best = self.best.clone().unwrap_or_else(|| current.clone());
+        Ok(Step { next: best, status: StepStatus::Converged, evaluations })
+    }
+}
+
+/// Coarse log grid over each free parameter's search range, ranked by residual (lowest first).
+pub(crate) fn ranked_seeds(problem: &dyn Objective, around: &[f64], fixed: &[bool]) -> Vec<Vec<f64>> {
+    let params = problem.parameters();
+    let per_axis =
+        seeds_per_axis((0..params.len()).filter(|&i| !fixed.get(i).copied().unwrap_or(false)).count());
+    let axes: Vec<Vec<f64>> = params
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            if fixed.get(i).copied().unwrap_or(false) {
+                return vec![around[i]];
+            }
+            let (lo, hi) = p.search_range();
+            let t = |k: usize| (k as f64 + 0.5) / per_axis as f64;
+            if lo > 0.0 && hi / lo > 100.0 {
+                // A positive range spanning decades is searched in log spacing, whatever the scale.
+                (0..per_axis).map(|k| (lo.ln() + (hi / lo).ln() * t(k)).exp()).collect()
+            } else {
+                let (a, b) = (p.to_scaled(lo), p.to_scaled(hi));
+                (0..per_axis).map(|k| p.from_scaled(a + (b - a) * t(k))).collect()
+            }
+        })
+        .collect();
+    let mut points: Vec<Vec<f64>> = vec![Vec::new()];
+    for axis in &axes {
+        points = points
+            .into_iter()
+            .flat_map(|pre| {
+                axis.iter().map(move |&v| {
+                    let mut q = pre.clone();
+                    q.push(v);
+                    q
+                })
+            })
+            .take(MAX_SEEDS)
+            .collect();
+    }
+    let mut ranked: Vec<(f64, Vec<f64>)> = points
+        .into_iter()
+        .filter_map(|p| problem.cost(&p).map(|c| (c, p)))
+        .filter(|(c, _)| c.is_finite())
+        .collect();
+    ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
+    ranked.into_iter().map(|(_, p)| p).collect()
+}
+
+impl UpdateStrategy for LevenbergMarquardt {
+    fn name(&self) -> &'static str {
+        "damped"
+    }
+
+    fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
+        let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
+        if initial.residual.len() < free {
+            return Err(UpdateError::Setup(format!(
+                "damped least squares needs at least as many measured modes as free parameters: {} modes, {free} parameters",
+                initial.residual.len()
+            )));
+        }
+        self.mu = 1e-3;
+        self.nu = 2.0;
+        self.seeds = None;
+        self.far_checked = false;
+        self.best = None;
+        self.restarts = 0;
+        self.stuck_for = 0;
+        self.recent_cost = initial.cost();
+        Ok(())
+    }
+
+    fn converged(&self, lin: &Linearisation) -> bool {
+        // Exact frequencies end the run only when they are the whole residual: with shape rows
+        // (testdata::shapes) a mirror solution matches every frequency and still misfits.
+        lin.max_rel_diff() <= self.residual_tolerance && lin.residual.len() == lin.frequencies_hz.len()
+    }
+
+    fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
+        let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
+        // Far from the data at the start (a frequency off by more than FAR_START): begin from
+        // the best point of the coarse grid instead, when it fits better.
+        if !self.far_checked && self.max_restarts > 0 && current.max_rel_diff() > FAR_START {
+            self.far_checked = true;
+            let (seeds, evaluations) = self.seeds(problem, &current.parameters);
+            if let Some(Ok(next)) =
+                (!seeds.is_empty()).then(|| seeds.remove(0)).map(|p| problem.linearise(&p))
+            {
+                if next.cost() < current.cost() {
+                    self.remember(current);
+                    self.recent_cost = next.cost();
+                    return Ok(Step { next, status: StepStatus::Continue, evaluations: evaluations + 1 });
+                }
+            }
+        }
+        match self.lm_step(problem, current) {
+            Ok(Some(step)) => {
+                let next = step.next;
+                if self.converged(&next) {
+                    return Ok(Step { next, status: StepStatus::Converged, evaluations: step.evaluations });
+                }
+                // Plateau watch: a long run of negligible progress on a point that does not fit.
+                if next.cost() < 0.999 * self.recent_cost {
+                    self.recent_cost = next.cost();
+                    self.stuck_for = 0;
+                } else {
+                    self.stuck_for += 1;
+                }
+                if self.stuck_for >= PLATEAU_ITERATIONS && !self.acceptable(&next, free) {
+                    let mut restarted = self.restart(problem, &next)?;
+                    restarted.evaluations += step.evaluations;
+                    return Ok(restarted);
+                }
+                Ok(Step { next, status: StepStatus::Continue, evaluations: step.evaluations })
+            }
+            // Stationary, or no step reduces the residual: done if the fit is good, else restart.
+            Ok(None) | Err(UpdateError::Stalled(_))
+                if self.acceptable(current, free) || self.max_restarts == 0 =>
+            {
+                self.remember(current);
+                let best = self.best.clone().unwrap_or_else(|| current.clone());
+                Ok(Step { next: best, status: StepStatus::Converged, evaluations: 0 })
+            }
+            Ok(None) | Err(UpdateError::Stalled(_)) => self.restart(problem, current),
+            Err(e) => Err(e),
+        }
+    }
+}
+
+impl LevenbergMarquardt {
+    /// One Levenberg–Marquardt iteration: `Ok(None)` when the current point is stationary.
+    fn lm_step(
+        &mut self,
+        problem: &dyn Objective,
+        current: &Linearisation,
+    ) -> Result<Option<Step>, UpdateError> {
+        let params = problem.parameters();
+        let np = params.len();
+        let js = current.scaled_jacobian(params);
+        let g_full = js.transpose() * &current.residual;
+        let s0: Vec<f64> = params.iter().zip(&current.parameters).map(|(p, &v)| p.to_scaled(v)).collect();
+        let (lo, hi) = scaled_bounds(params);
+        // Active set: a parameter on a bound whose gradient pushes outward stays there this step.
+        let free: Vec<bool> = (0..np)
+            .map(|i| {
+                self.is_free(i)
+                    && !(s0[i] <= lo[i] && g_full[i] < 0.0)
+                    && !(s0[i] >= hi[i] && g_full[i] > 0.0)
+            })
+            .collect();
+        let mut js_free = js;
+        for i in (0..np).filter(|&i| !free[i]) {
+            js_free.column_mut(i).fill(0.0);
+        }
+        if stationary(&js_free, &current.residual) {
+            return Ok(None);
+        }
+        let a = js_free.transpose() * &js_free;
+        let g = js_free.transpose() * &current.residual;
+        // Marquardt scaling, floored so a (nearly) insensitive parameter still gets damped.
+        let amax = a.diagonal().amax().max(f64::MIN_POSITIVE);
+        let d = DVector::from_iterator(np, (0..np).map(|i| a[(i, i)].max(1e-12 * amax)));
+        let cost0 = current.cost();
+        let mut evaluations = 0;
+        for _ in 0..self.max_trials {
+            let mut lhs = a.clone();
+            for i in 0..np {
+                if free[i] {
+                    lhs[(i, i)] += self.mu * d[i];
+                } else {
+                    lhs[(i, i)] = 1.0;
+                }
+            }
+            let Some(mut delta) = lhs.cholesky().map(|c| c.solve(&g)) else {
+                self.reject();
+                continue;
+            };
+            let cap = delta.amax();
+            if cap > self.max_step {
+                delta *= self.max_step / cap;
+            }
+            let mut p_new = Vec::with_capacity(np);
+            for (i, par) in params.iter().enumerate() {
+                let s = (s0[i] + delta[i]).clamp(lo[i], hi[i]);
+                delta[i] = s - s0[i];
+                p_new.push(par.from_scaled(s).clamp(par.lower, par.upper));
+            }
+            if delta.amax() <= self.step_tolerance {
+                // Gauss–Newton has nothing left to do: a minimum — unless heavy damping alone
+                // made the step small, which is a stall, not a solution.
+                return if self.mu <= 1e6 {
+                    Ok(None)
+                } else {
+                    Err(UpdateError::Stalled(format!(
+                        "steps shrank to {:.1e} under damping {:.1e} without reducing the residual",
+                        delta.amax(),
+                        self.mu
+                    )))
+                };
+            }
+            let predicted = delta.dot(&g) - 0.5 * delta.dot(&(&a * &delta));
+            evaluations += 1;
+            let trial = match problem.linearise(&p_new) {
+                Ok(t) if t.residual.iter().all(|v| v.is_finite()) => t,
+                _ => {
+                    self.reject();
+                    continue;
+                }
+            };
+            let actual = cost0 - trial.cost();
+            if predicted > 0.0 && actual / predicted > 1e-4 {
+                let rho = actual / predicted;
+                self.mu *= f64::max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0).powi(3));
+                self.nu = 2.0;
+                return Ok(Some(Step { next: trial, status: StepStatus::Continue, evaluations }));
+            }
+            self.reject();
+        }
+        Err(UpdateError::Stalled(format!("no acceptable step in {} trials", self.max_trials)))
+    }
+
+    fn reject(&mut self) {
+        self.mu *= self.nu;
+        self.nu *= 2.0;
+    }
+}
+
+/// Scaled lower and upper bounds (±∞ where a bound is infinite).
+fn scaled_bounds(params: &ParameterSet) -> (Vec<f64>, Vec<f64>) {
+    params
+        .iter()
+        .map(|p| {
+            let lo = if p.lower.is_finite() { p.to_scaled(p.lower) } else { f64::NEG_INFINITY };
+            let hi = if p.upper.is_finite() { p.to_scaled(p.upper) } else { f64::INFINITY };
+            (lo, hi)
+        })
+        .unzip()
+}
+
+/// MINPACK's gradient test: the residual is orthogonal to every Jacobian column (cosine below
+/// 1e-10), so no parameter change can reduce it further. A zero column (a parameter the data do
+/// not see) counts as orthogonal.
+fn stationary(js: &DMatrix<f64>, r: &DVector<f64>) -> bool {
+    let rn = r.norm();
+    if rn == 0.0 {
+        return true;
+    }
+    js.column_iter().all(|c| {
+        let cn = c.norm();
+        cn == 0.0 || (c.dot(r) / (cn * rn)).abs() <= 1e-10
+    })
+}
