@@ -2,7 +2,7 @@
 //! directions, or a shape CSV) find a matrices model's DOFs, as they find a rotor's.
 
 use crate::model::Dof;
-use eigenfit_core::testdata::sensors::{NodeLayout, DIRECTIONS};
+use eigenfit_core::measurement::sensors::{NodeLayout, DIRECTIONS};
 use std::collections::HashMap;
 
 /// The model's nodes (in order of first appearance in the DOF map, model node 0, 1, …) with
