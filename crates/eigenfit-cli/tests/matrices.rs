@@ -198,9 +198,9 @@ fn discover_names_a_user_supplied_candidate_matrix() {
 
 #[test]
 fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
+    use eigenfit_core::eigen::{EigenSolver, SparseSolver};
     use eigenfit_core::measurement::sensors::NodeLayout;
     use eigenfit_core::measurement::uff::{self, UffMode, UffNode};
-    use eigenfit_core::eigen::{EigenSolver, SparseSolver};
     use eigenfit_core::model::StructuralModel;
     // A test campaign on the plate: w measured at every 5th node of the DOF map (coordinates
     // only, as a test system exports them), six modes of the plate at known zone factors.

@@ -82,7 +82,9 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let layout: Option<&dyn eigenfit_core::measurement::sensors::NodeLayout> = match &model {
         AnyModel::Rotor(r) => Some(r),
         // Shapes find a matrices model's DOFs through its DOF map (`dofs = "…"`).
-        AnyModel::Matrices(m) => m.layout().map(|l| l as &dyn eigenfit_core::measurement::sensors::NodeLayout),
+        AnyModel::Matrices(m) => {
+            m.layout().map(|l| l as &dyn eigenfit_core::measurement::sensors::NodeLayout)
+        }
     };
     let data = testdata::read(&args.measured, layout, &args.test_data)?;
     let measurement = data.measurement.clone();
