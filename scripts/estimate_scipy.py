@@ -34,13 +34,7 @@ import scipy.io
 import scipy.optimize
 import scipy.sparse.linalg as sla
 
-
-def peak_kb():
-    with open("/proc/self/status") as f:
-        for line in f:
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1])
-    return 0
+from bench_sparse import peak_kb  # scripts/ beside this file
 
 
 def read_measured(path):

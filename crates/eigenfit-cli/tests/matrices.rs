@@ -237,19 +237,24 @@ fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
     let dir = std::env::temp_dir().join(format!("eigenfit-cli-matrices-shapes-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("campaign.unv");
-    std::fs::write(&file, uff::write("plate campaign", &nodes, &uff_modes)).unwrap();
     // No search for other solutions: its local shape fits from the coarse grid would take this
     // test minutes in a debug build; what is tested here is the tie of sensors to DOFs.
-    let (code, v, err) = eigenfit(&[
-        "estimate",
-        "--model",
-        &plate("model.toml"),
-        "--measured",
-        file.to_str().unwrap(),
-        "--alternative-starts",
-        "0",
-        "--json",
-    ]);
+    let estimate = |nodes: &[UffNode]| {
+        std::fs::write(&file, uff::write("plate campaign", nodes, &uff_modes)).unwrap();
+        let measured = file.to_str().unwrap();
+        let model = plate("model.toml");
+        eigenfit(&[
+            "estimate",
+            "--model",
+            &model,
+            "--measured",
+            measured,
+            "--alternative-starts",
+            "0",
+            "--json",
+        ])
+    };
+    let (code, v, err) = estimate(&nodes);
     assert_eq!(code, 0, "{err}\n{v}");
     for (i, name) in ["zone1", "zone2", "zone3", "zone4"].iter().enumerate() {
         let a = v["parameters"][name].as_f64().unwrap();
@@ -262,15 +267,7 @@ fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
     // A sensor off the plate is named, not silently dropped.
     let mut off = nodes.clone();
     off[0].coordinates[2] = 0.05;
-    std::fs::write(&file, uff::write("plate campaign", &off, &uff_modes)).unwrap();
-    let (code, _, err) = eigenfit(&[
-        "estimate",
-        "--model",
-        &plate("model.toml"),
-        "--measured",
-        file.to_str().unwrap(),
-        "--json",
-    ]);
+    let (code, _, err) = estimate(&off);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains(&format!("node {}", nodes[0].label)), "{err}");
 }
