@@ -1,9 +1,11 @@
 //! [`RotorBuilder`]: collect a rotor description unchecked, validate it once in
 //! [`build`](RotorBuilder::build).
 
+use crate::effects;
 use crate::error::RotorError;
-use crate::file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section};
 use crate::model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
+use crate::spec::{BearingSpec, Disk, EffectSpec, Material, PointMass, RotorSpec, Section};
+use eigenfit_core::matrix::{BandedSymmetric, SparseSymmetric};
 use eigenfit_core::model::{Parameter, ParameterSet, Scale};
 
 /// The entry of a description an error is about, in file order (0-based).
@@ -454,4 +456,48 @@ fn resolve_elements(spec: &RotorSpec, nodes: &[f64]) -> Result<Vec<ShaftElement>
         });
     }
     Ok(elements)
+}
+
+// Construction's last step and the rebuilding constructors live here, beside the builder they
+// call: the checked model below knows nothing of effects or of the builder (no import cycle).
+impl Rotor {
+    /// Adds the `[[effect]]` entries of the description to the parameter-independent matrices.
+    pub(crate) fn apply_effects(mut self) -> Result<Self, RotorError> {
+        let effects = self.spec.effects.clone();
+        for (i, e) in effects.iter().enumerate() {
+            let value = effects::check_value(e, i)?;
+            let (dk, dm) = effects::unit_contribution(&self.parts(), e, i)?;
+            let (fk, fm) = effects::law(&e.kind).factors(value);
+            add_sparse(&mut self.base_stiffness, &dk, fk);
+            add_sparse(&mut self.base_mass, &dm, fm);
+        }
+        Ok(self)
+    }
+
+    /// This rotor with one more effect switched on (validated like a file's `[[effect]]`).
+    pub fn with_effect(&self, effect: EffectSpec) -> Result<Rotor, RotorError> {
+        let mut spec = self.spec.clone();
+        spec.effects.push(effect);
+        RotorBuilder::from_spec(spec).build()
+    }
+
+    /// This rotor with its bearings' nominal stiffnesses replaced (N/m, in parameter order).
+    pub fn with_stiffnesses(&self, stiffnesses: &[f64]) -> Result<Rotor, RotorError> {
+        self.parameters.check(stiffnesses).map_err(RotorError::Parameter)?;
+        let mut spec = self.spec.clone();
+        for (b, &k) in spec.bearings.iter_mut().zip(stiffnesses) {
+            b.stiffness = k;
+        }
+        RotorBuilder::from_spec(spec).build()
+    }
+}
+
+fn add_sparse(a: &mut BandedSymmetric, s: &SparseSymmetric, factor: f64) {
+    let reach = s.entries().iter().map(|&(i, j, _)| j - i).max().unwrap_or(0);
+    if reach > a.bandwidth() {
+        *a = a.widened(reach);
+    }
+    for &(i, j, v) in s.entries() {
+        a.add(i, j, factor * v);
+    }
 }

@@ -31,7 +31,9 @@ use crate::model::{Bearing, Rotor, ShaftElement};
 use eigenfit_core::matrix::SparseSymmetric;
 use eigenfit_core::model::{Candidate, Parameter, ValueLaw};
 use nalgebra::DMatrix;
-use serde::{Deserialize, Serialize};
+
+// Defined with the other plain descriptions (a rotor's spec holds them); still reachable here.
+pub use crate::spec::EffectSpec;
 
 /// The effect kinds, in the order of the table above.
 pub const KINDS: [&str; 10] = [
@@ -46,26 +48,6 @@ pub const KINDS: [&str; 10] = [
     "timoshenko-shaft",
     "section-change",
 ];
-
-/// An `[[effect]]` entry: one effect switched on at a value.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EffectSpec {
-    /// One of [`KINDS`].
-    pub kind: String,
-    /// Location index (disk, bearing, node or element), where the kind has one.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub location: Option<usize>,
-    /// The effect's value (ignored by `shear-deformation`).
-    #[serde(default)]
-    pub value: f64,
-    /// Position along the shaft (m) of a `point-mass` placed by coordinate.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub position_m: Option<f64>,
-    /// First and last element of a `section-change` over a run of elements.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub elements: Option<[usize; 2]>,
-}
 
 impl EffectSpec {
     /// An effect of `kind` at `location` with `value`.
@@ -507,4 +489,19 @@ fn on_refined(spec: &EffectSpec, factor: usize) -> EffectSpec {
         _ => {}
     }
     out
+}
+
+// Here rather than in model.rs: the checked model sits below the effects and does not know `Parts`.
+impl Rotor {
+    /// The parts effect contributions are computed from.
+    pub(crate) fn parts(&self) -> Parts<'_> {
+        Parts {
+            nodes: self.nodes.len(),
+            positions: &self.nodes,
+            elements: &self.elements,
+            bearings: &self.bearings,
+            disk_nodes: self.spec.disks.iter().map(|d| d.node).collect(),
+            materials: &self.spec.materials,
+        }
+    }
 }

@@ -63,11 +63,14 @@ mod layout;
 pub mod mesh;
 mod model;
 pub mod presets;
+mod spec;
+mod structural;
 pub mod updatable;
 
 pub use builder::RotorBuilder;
-pub use effects::EffectSpec;
 pub use error::RotorError;
-pub use file::{BearingSpec, Disk, Material, PointMass, RotorSpec, Section, ShaftSpec};
 pub use model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
-pub use updatable::{ParameterSpec, UpdatableRotor};
+pub use spec::{
+    BearingSpec, Disk, EffectSpec, Material, ParameterSpec, PointMass, RotorSpec, Section, ShaftSpec,
+};
+pub use updatable::UpdatableRotor;

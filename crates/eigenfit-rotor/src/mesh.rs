@@ -2,8 +2,8 @@
 //! discretisation error from missing physics.
 
 use crate::error::RotorError;
-use crate::file::Section;
 use crate::model::Rotor;
+use crate::spec::Section;
 use crate::RotorBuilder;
 
 /// `rotor` with every shaft element split into `factor` equal elements. Disks, bearings and

@@ -1,11 +1,10 @@
-//! The checked [`Rotor`] and its [`StructuralModel`] implementation.
+//! The checked [`Rotor`]: its parts, base matrices and accessors. Its [`StructuralModel`]
+//! implementation is in `structural.rs`, its construction in `builder.rs` (they sit above the
+//! effects, which this module does not know).
 
-use crate::effects::{self, EffectSpec};
 use crate::element;
-use crate::error::RotorError;
-use crate::file::{Disk, Material, PointMass, RotorSpec};
-use crate::RotorBuilder;
-use eigenfit_core::matrix::{BandedSymmetric, SparseSymmetric, System, SystemDerivative};
+use crate::spec::{Disk, Material, PointMass, RotorSpec};
+use eigenfit_core::matrix::{BandedSymmetric, System};
 use eigenfit_core::model::{ModelError, ParameterSet, StructuralModel};
 use nalgebra::Matrix4;
 
@@ -62,13 +61,15 @@ pub struct Bearing {
 /// solvers densify it on first use).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rotor {
+    // pub(crate): the builder (effects), the effects (their parts) and the StructuralModel
+    // implementation live in the modules above this one.
     pub(crate) spec: RotorSpec,
-    nodes: Vec<f64>,
-    elements: Vec<ShaftElement>,
-    bearings: Vec<Bearing>,
-    parameters: ParameterSet,
-    base_stiffness: BandedSymmetric,
-    base_mass: BandedSymmetric,
+    pub(crate) nodes: Vec<f64>,
+    pub(crate) elements: Vec<ShaftElement>,
+    pub(crate) bearings: Vec<Bearing>,
+    pub(crate) parameters: ParameterSet,
+    pub(crate) base_stiffness: BandedSymmetric,
+    pub(crate) base_mass: BandedSymmetric,
 }
 
 impl Rotor {
@@ -102,48 +103,6 @@ impl Rotor {
             k.add(2 * b.node + 1, 2 * b.node + 1, b.rotational_stiffness);
         }
         Self { spec, nodes, elements, bearings, parameters, base_stiffness: k, base_mass: m }
-    }
-
-    /// Adds the `[[effect]]` entries of the description to the parameter-independent matrices.
-    pub(crate) fn apply_effects(mut self) -> Result<Self, RotorError> {
-        let effects = self.spec.effects.clone();
-        for (i, e) in effects.iter().enumerate() {
-            let value = effects::check_value(e, i)?;
-            let (dk, dm) = effects::unit_contribution(&self.parts(), e, i)?;
-            let (fk, fm) = effects::law(&e.kind).factors(value);
-            add_sparse(&mut self.base_stiffness, &dk, fk);
-            add_sparse(&mut self.base_mass, &dm, fm);
-        }
-        Ok(self)
-    }
-
-    /// The parts effect contributions are computed from.
-    pub(crate) fn parts(&self) -> effects::Parts<'_> {
-        effects::Parts {
-            nodes: self.nodes.len(),
-            positions: &self.nodes,
-            elements: &self.elements,
-            bearings: &self.bearings,
-            disk_nodes: self.spec.disks.iter().map(|d| d.node).collect(),
-            materials: &self.spec.materials,
-        }
-    }
-
-    /// This rotor with one more effect switched on (validated like a file's `[[effect]]`).
-    pub fn with_effect(&self, effect: EffectSpec) -> Result<Rotor, RotorError> {
-        let mut spec = self.spec.clone();
-        spec.effects.push(effect);
-        RotorBuilder::from_spec(spec).build()
-    }
-
-    /// This rotor with its bearings' nominal stiffnesses replaced (N/m, in parameter order).
-    pub fn with_stiffnesses(&self, stiffnesses: &[f64]) -> Result<Rotor, RotorError> {
-        self.parameters.check(stiffnesses).map_err(RotorError::Parameter)?;
-        let mut spec = self.spec.clone();
-        for (b, &k) in spec.bearings.iter_mut().zip(stiffnesses) {
-            b.stiffness = k;
-        }
-        RotorBuilder::from_spec(spec).build()
     }
 
     /// Node positions along the shaft (m), strictly increasing.
@@ -224,16 +183,6 @@ impl Rotor {
     }
 }
 
-fn add_sparse(a: &mut BandedSymmetric, s: &SparseSymmetric, factor: f64) {
-    let reach = s.entries().iter().map(|&(i, j, _)| j - i).max().unwrap_or(0);
-    if reach > a.bandwidth() {
-        *a = a.widened(reach);
-    }
-    for &(i, j, v) in s.entries() {
-        a.add(i, j, factor * v);
-    }
-}
-
 /// Adds a 4×4 element matrix for element `e` (global DOFs 2e … 2e + 3), lower triangle.
 fn add_element(global: &mut BandedSymmetric, e: usize, local: &Matrix4<f64>) {
     for c in 0..4 {
@@ -243,48 +192,10 @@ fn add_element(global: &mut BandedSymmetric, e: usize, local: &Matrix4<f64>) {
     }
 }
 
-impl StructuralModel for Rotor {
-    fn parameters(&self) -> &ParameterSet {
-        &self.parameters
-    }
-
-    fn dofs(&self) -> usize {
-        2 * self.nodes.len()
-    }
-
-    fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
-        self.parameters.check(p)?;
-        let mut k = self.base_stiffness.clone();
-        for (b, &kb) in self.bearings.iter().zip(p) {
-            let j = Self::displacement_dof(b.node);
-            k.add(j, j, kb);
-        }
-        Ok(System::banded(k, self.base_mass.clone())?)
-    }
-
-    /// Exact: ∂K/∂kᵢ has the single entry 1 at the bearing's displacement DOF; ∂M/∂kᵢ = 0.
-    fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
-        let b = self
-            .bearings
-            .get(i)
-            .ok_or(ModelError::ParameterIndex { index: i, count: self.bearings.len() })?;
-        self.parameters.check(p)?;
-        let mut d = SystemDerivative::zeros(self.dofs());
-        let j = Self::displacement_dof(b.node);
-        d.stiffness.add(j, j, 1.0);
-        debug_assert!(d.mass == SparseSymmetric::zeros(self.dofs()));
-        Ok(d)
-    }
-
-    fn candidates(&self) -> Vec<eigenfit_core::model::Candidate> {
-        effects::candidates(self)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::file::{BearingSpec, Disk, Material, PointMass, Section};
+    use crate::spec::{BearingSpec, Disk, Material, PointMass, Section};
     use eigenfit_core::model::Scale;
 
     fn rotor() -> Rotor {

@@ -11,31 +11,13 @@
 
 use crate::element;
 use crate::model::Rotor;
-use crate::{Material, RotorBuilder, Section};
+use crate::spec::{Material, Section};
+use crate::RotorBuilder;
 use eigenfit_core::matrix::{SparseSymmetric, System, SystemDerivative};
 use eigenfit_core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
-use serde::{Deserialize, Serialize};
 
-/// A `[[parameter]]` table: one more updatable quantity of the model.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ParameterSpec {
-    /// One of [`KINDS`].
-    pub kind: String,
-    /// Which bearing, disk, point mass or `[[shaft.section]]` (0-based, in file order); for the
-    /// section kinds, absent means the whole shaft.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub index: Option<usize>,
-    /// Parameter name; a default is derived from the kind and index when absent.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    /// Lower bound (default: nominal / 100 for scales, nominal·1e-6 otherwise).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lower: Option<f64>,
-    /// Upper bound (default: nominal·100 for scales, nominal·1e6 otherwise).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub upper: Option<f64>,
-}
+// Defined with the other plain descriptions (a rotor's spec holds them); still reachable here.
+pub use crate::spec::ParameterSpec;
 
 /// The parameter kinds a `[[parameter]]` table may declare.
 pub const KINDS: [&str; 6] = [
