@@ -10,13 +10,23 @@ JSON the command-line tool prints for the same arguments.
     >>> e = eigenfit.estimate(model="paper-rotor", measured="examples/measured_no_effect.csv")
     >>> e.parameters                           # {"k_K1": …, "k_K2": …}
 
+Two-plane rotors saved by ROSS: ``eigenfit.campbell(model="rotor.toml", speeds=(0, 12000, 50),
+modes=6)``.
+
 Batches on a Dask cluster: :mod:`eigenfit.batch`.
 """
 
-from ._api import EXIT_NOT_CONVERGED, EigenfitError, compare, discover, estimate, run, simulate
+from ._api import EXIT_NOT_CONVERGED, EigenfitError, campbell, compare, discover, estimate, run, simulate
 from ._native import version as _native_version
 from .matrices import MatricesModel
-from ._results import CompareResult, DiscoverResult, EstimateResult, Result, SimulateResult
+from ._results import (
+    CampbellResult,
+    CompareResult,
+    DiscoverResult,
+    EstimateResult,
+    Result,
+    SimulateResult,
+)
 
 __version__: str = _native_version()
 
@@ -25,6 +35,7 @@ __all__ = [
     "estimate",
     "discover",
     "compare",
+    "campbell",
     "run",
     "MatricesModel",
     "EigenfitError",
@@ -34,5 +45,6 @@ __all__ = [
     "EstimateResult",
     "DiscoverResult",
     "CompareResult",
+    "CampbellResult",
     "__version__",
 ]

@@ -7,7 +7,7 @@ from typing import Any, Mapping, Optional, Sequence, Type, TypeVar, Union
 
 from . import _native
 from ._args import TempFiles, is_ross_rotor, measured_args, model_args, option_args
-from ._results import CompareResult, DiscoverResult, EstimateResult, Result, SimulateResult
+from ._results import CampbellResult, CompareResult, DiscoverResult, EstimateResult, Result, SimulateResult
 
 #: A preset name (``"paper-rotor"``), a model file path, or (once the CLI reads ROSS files) a
 #: ROSS ``Rotor``.
@@ -213,3 +213,24 @@ def compare(
             **options,
         },
     )
+
+
+def campbell(
+    model: Model,
+    speeds: Union[str, Sequence[float]],
+    *,
+    modes: int = 6,
+    **options: Any,
+) -> CampbellResult:
+    """Campbell diagram of a two-plane rotor (a ROSS rotor file or ``Rotor``), as ``eigenfit campbell``.
+
+    Args:
+        model: a rotor file saved by ROSS ``Rotor.save`` (TOML or JSON), or a ROSS ``Rotor``.
+        speeds: ``(from, to, count)`` in rpm, linearly spaced, or the CLI's ``"FROM:TO:COUNT"``.
+        modes: number of modes per speed.
+        **options: any other ``eigenfit campbell`` option, e.g. ``plot="out/"``.
+
+    Returns:
+        CampbellResult; ``to_dict()`` is the CLI's JSON.
+    """
+    return _call("campbell", CampbellResult, model, None, {"speeds": speeds, "modes": modes, **options})

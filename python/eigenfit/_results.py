@@ -292,9 +292,35 @@ class CompareResult(Result):
         return np.asarray([r["estimate"] for r in self._data["runs"]], dtype=float)
 
 
+def _float_array(key: str, doc: str) -> Any:
+    """A read-only property: the JSON field ``key`` as a float array."""
+    return property(lambda self: np.asarray(self._data[key], dtype=float), doc=doc)
+
+
+class CampbellResult(Result):
+    """``eigenfit campbell``: damped whirl frequencies of a two-plane rotor over speed."""
+
+    command = "campbell"
+
+    speeds_rpm = _float_array("speeds_rpm", "The rotor speeds (rpm).")
+    frequencies_hz = _float_array(
+        "frequencies_hz", "Damped natural frequencies (Hz), shape (speeds, modes), ascending at each speed."
+    )
+    log_dec = _float_array("log_dec", "Logarithmic decrements, shape (speeds, modes).")
+    critical_speeds_rpm = _float_array(
+        "critical_speeds_rpm", "Speeds (rpm) where a followed mode crosses the 1× line, ascending."
+    )
+
+    @property
+    def whirl(self) -> List[List[str]]:
+        """Whirl of each mode at each speed: ``forward``, ``backward`` or ``mixed``."""
+        return copy.deepcopy(self._data["whirl"])
+
+
 #: Result class by name, for unpickling (the name, not the class, travels in the pickle).
 RESULT_CLASSES = {
-    c.__name__: c for c in (SimulateResult, EstimateResult, DiscoverResult, CompareResult, Result)
+    c.__name__: c
+    for c in (SimulateResult, EstimateResult, DiscoverResult, CompareResult, CampbellResult, Result)
 }
 
 

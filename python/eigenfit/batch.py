@@ -27,6 +27,7 @@ FUNCTIONS: Dict[str, Callable[..., Result]] = {
     "estimate": _api.estimate,
     "discover": _api.discover,
     "compare": _api.compare,
+    "campbell": _api.campbell,
 }
 
 

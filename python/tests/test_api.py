@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import threading
+from pathlib import Path
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -227,3 +228,22 @@ def test_unreadable_rotor_object_names_what_it_was():
 def test_other_objects_are_refused():
     with pytest.raises(TypeError, match="preset name or a model file path"):
         eigenfit.simulate(42)
+
+
+ROSS_DATA = Path(__file__).resolve().parents[2] / "crates/eigenfit-rotordynamics/tests/data"
+
+
+def test_campbell_matches_cli(cli):
+    rotor = ROSS_DATA / "rotor_example.toml"
+    r = eigenfit.campbell(model=rotor, speeds=(0, 9000, 7), modes=4)
+    expected, code = cli(["campbell", "--model", str(rotor), "--speeds", "0:9000:7", "--modes", "4"])
+    assert r.to_dict() == expected
+    assert code == 0 and r.exit_code == 0
+    assert isinstance(r, eigenfit.CampbellResult)
+    np.testing.assert_array_equal(r.speeds_rpm, np.linspace(0, 9000, 7))
+    assert r.frequencies_hz.shape == (7, 4) and r.log_dec.shape == (7, 4)
+    assert np.all(np.diff(r.frequencies_hz, axis=1) >= 0)  # ascending at each speed
+    assert len(r.whirl) == 7 and all(w in ("forward", "backward", "mixed") for row in r.whirl for w in row)
+    np.testing.assert_array_equal(r.critical_speeds_rpm, expected["critical_speeds_rpm"])
+    # The string form of the speeds is the same call.
+    assert eigenfit.campbell(model=str(rotor), speeds="0:9000:7", modes=4) == r

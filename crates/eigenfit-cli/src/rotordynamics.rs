@@ -2,8 +2,13 @@
 //! `campbell`: the hooks in those commands route here when the model file is a ROSS rotor.
 
 use crate::error::{input, CliError, EXIT_NOT_CONVERGED, EXIT_OK};
-use eigenfit_rotordynamics::identify::{identify, read_runup, stiffness_parameters};
+use eigenfit_core::analysis::verdict::{judge, FitQuality, FitVerdict};
+use eigenfit_core::problem::Linearisation;
+use eigenfit_rotordynamics::identify::{
+    bearing_parameters, identify, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
+};
 use eigenfit_rotordynamics::{ross_file, rpm_to_rad, Rotor, RotorDynError};
+use nalgebra::{DMatrix, DVector};
 use serde_json::{json, Map, Value};
 use std::path::Path;
 
@@ -81,38 +86,119 @@ pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize, json_out: boo
     Ok(())
 }
 
-/// `estimate --model ROSS-FILE --measured RUNUP.csv`: kxx and kyy of every bearing.
-pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: bool) -> Result<u8, CliError> {
+/// The fit's quality judged by core's verdict rules, as for the planar model: the run-up's
+/// frequencies and residuals put in a [`Linearisation`] (eigenvalues λ = ω², Jacobians in the
+/// physical units of the parameters).
+fn fit_quality(id: &Identification, points: &[RunupPoint], values: &[f64]) -> FitQuality {
+    let has_std = points.iter().all(|p| p.std_hz.is_some());
+    let m = points.len();
+    let omega = |f: f64| 2.0 * std::f64::consts::PI * f;
+    // Residual measured − model in σ, or relative without std (the planar `relative` residual).
+    let sigma = |i: usize| points[i].std_hz.unwrap_or(points[i].frequency_hz);
+    // d f/d p = (d f/d ln s)/p in Hz per N/m (N·s/m); dλ/dp = 2ω·2π d f/d p.
+    let df_dp = DMatrix::from_fn(m, values.len(), |i, j| id.jacobian[(i, j)] / values[j]);
+    let lin = Linearisation {
+        parameters: values.to_vec(),
+        paired_modes: points.iter().map(|p| p.mode - 1).collect(),
+        model_eigenvalues: DVector::from_iterator(m, id.model_hz.iter().map(|&f| omega(f).powi(2))),
+        measured_eigenvalues: DVector::from_iterator(m, points.iter().map(|p| omega(p.frequency_hz).powi(2))),
+        eigenvalue_jacobian: DMatrix::from_fn(m, values.len(), |i, j| {
+            2.0 * omega(id.model_hz[i]) * 2.0 * std::f64::consts::PI * df_dp[(i, j)]
+        }),
+        frequencies_hz: id.model_hz.clone(),
+        measured_hz: points.iter().map(|p| p.frequency_hz).collect(),
+        residual: DVector::from_fn(m, |i, _| (points[i].frequency_hz - id.model_hz[i]) / sigma(i)),
+        jacobian: DMatrix::from_fn(m, values.len(), |i, j| df_dp[(i, j)] / sigma(i)),
+        has_std,
+    };
+    judge(&lin, values.len())
+}
+
+/// `estimate --model ROSS-FILE --measured RUNUP.csv [--parameters kxx,kyy,…]`: bearing
+/// coefficients from a run-up (default kxx and kyy of every bearing).
+pub fn estimate(
+    path: &Path,
+    measured: &Path,
+    selection: Option<&str>,
+    max_iterations: usize,
+    json_out: bool,
+) -> Result<u8, CliError> {
     let rotor = load(path)?;
     let points = read_runup(measured).map_err(to_cli)?;
-    let params = stiffness_parameters(&rotor);
+    let chosen: Vec<&str> = match selection {
+        Some(list) => list.split(',').map(str::trim).filter(|s| !s.is_empty()).collect(),
+        None => DEFAULT_COEFFICIENTS.to_vec(),
+    };
+    let params = bearing_parameters(&rotor, &chosen).map_err(|e| input(format!("--parameters: {e}")))?;
     if params.is_empty() {
         return Err(input(format!("{}: the rotor has no bearings to estimate", path.display())));
     }
     let initial = vec![1.0; params.len()];
     let id = identify(&rotor, &params, &points, &initial, max_iterations).map_err(to_cli)?;
-    // Report each stiffness in N/m at the lowest measured speed (constant bearings: their value).
+    // Report each coefficient at the lowest measured speed (constant bearings: their value).
     let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
-    let nominal: Vec<f64> = params.iter().map(|p| rotor.bearings[p.bearing].k[p.entry].at(w0)).collect();
+    let nominal: Vec<f64> = params.iter().map(|p| p.nominal(&rotor, w0)).collect();
     let value: Vec<f64> = nominal.iter().zip(&id.scales).map(|(k, s)| k * s).collect();
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
     let obj = |values: Vec<Value>| -> Map<String, Value> { names.iter().cloned().zip(values).collect() };
-    // 95 % intervals, log-normal (the estimate is linearised in ln k).
-    let intervals: Option<Vec<[f64; 2]>> = id
-        .ln_std
-        .as_ref()
-        .map(|sd| value.iter().zip(sd).map(|(v, s)| [v * (-1.96 * s).exp(), v * (1.96 * s).exp()]).collect());
-    let dof = points.len().saturating_sub(params.len());
+    // 95 % intervals, log-normal (the estimate is linearised in ln k); ordered low, high also
+    // for a negative (cross-coupled) coefficient.
+    let intervals: Option<Vec<[f64; 2]>> = id.ln_std.as_ref().map(|sd| {
+        value
+            .iter()
+            .zip(sd)
+            .map(|(v, s)| {
+                let (a, b) = (v * (-1.96 * s).exp(), v * (1.96 * s).exp());
+                [a.min(b), a.max(b)]
+            })
+            .collect()
+    });
+    let quality = fit_quality(&id, &points, &value);
+    let acceptable = id.converged && quality.verdict != FitVerdict::Poor;
+    let verdict = if !id.converged {
+        "not-converged"
+    } else if quality.verdict == FitVerdict::Poor {
+        "poor-fit"
+    } else if quality.verdict == FitVerdict::NotJudged {
+        "converged (fit quality not judged: no std)"
+    } else {
+        "converged"
+    };
+    let status = |i: usize| -> String {
+        match &intervals {
+            _ if !id.converged => "(not computed: the run did not converge)".into(),
+            Some(iv) => format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]),
+            None if !id.identifiable => {
+                "not identifiable: the frequencies fix only combinations of the parameters".into()
+            }
+            None => "(no std given)".into(),
+        }
+    };
+    let disagreeing: Vec<Value> = quality
+        .disagreeing
+        .iter()
+        .map(|&k| json!({"speed_rpm": points[k].speed_rpm, "mode": points[k].mode}))
+        .collect();
+    let dof = quality.dof;
     if json_out {
         let mut out = json!({
             "model": path.display().to_string(),
             "converged": id.converged,
+            "acceptable": acceptable,
+            "verdict": verdict,
+            "fit_quality": quality.verdict.label(),
+            "chi2": quality.chi2,
+            "dof": dof,
+            "p_value": quality.p_value,
+            "relative_rms_residual": quality.relative_rms,
+            "disagreeing_modes": disagreeing,
             "termination": id.reason,
             "iterations": id.iterations,
             "evaluations": id.evaluations,
             "reference_speed_rpm": w0 * 30.0 / std::f64::consts::PI,
             "initial": obj(nominal.iter().map(|&v| json!(v)).collect()),
             "parameters": obj(value.iter().map(|&v| json!(v)).collect()),
+            "parameter_status": obj((0..params.len()).map(|i| json!(status(i))).collect()),
             "scales": obj(id.scales.iter().map(|&v| json!(v)).collect()),
             "cost": id.cost,
             "identifiable": id.identifiable,
@@ -128,29 +214,20 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
         if let (Some(iv), Some(sd)) = (&intervals, &id.ln_std) {
             out["intervals"] = Value::Object(obj(iv.iter().map(|i| json!(i)).collect()));
             out["standard_deviations_ln"] = Value::Object(obj(sd.iter().map(|&s| json!(s)).collect()));
-            out["chi2"] = json!(id.cost);
-            out["dof"] = json!(dof);
         }
         crate::output::emit_json(out);
     } else {
         println!(
-            "{}: {} bearing stiffnesses from {} run-up frequencies: {} after {} iterations",
+            "{}: {} bearing coefficients from {} run-up frequencies: {} after {} iterations; verdict: {verdict}",
             path.display(),
             params.len(),
             points.len(),
             if id.converged { "converged" } else { "NOT converged" },
             id.iterations
         );
-        println!(
-            "{:<28}{:>16}{:>16}{:>32}",
-            "parameter", "initial [N/m]", "estimate [N/m]", "95% interval [N/m]"
-        );
+        println!("{:<28}{:>16}{:>16}{:>32}", "parameter", "initial", "estimate", "95% interval / status");
         for i in 0..params.len() {
-            let none = if id.identifiable { "(no std_hz given)" } else { "(not identifiable)" };
-            let iv = intervals
-                .as_ref()
-                .map_or(none.to_string(), |iv| format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]));
-            println!("{:<28}{:>16.4e}{:>16.6e}{iv:>32}", names[i], nominal[i], value[i]);
+            println!("{:<28}{:>16.4e}{:>16.6e}{:>32}", names[i], nominal[i], value[i], status(i));
         }
         println!(
             "{:>10}{:>6}{:>16}{:>16}{:>12}{:>10}",
@@ -167,8 +244,11 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
                 id.model_whirl[i].name()
             );
         }
-        if id.ln_std.is_some() {
-            println!("chi² = {:.4} with {dof} degrees of freedom", id.cost);
+        if let (Some(chi2), Some(p)) = (quality.chi2, quality.p_value) {
+            println!("chi² = {chi2:.4} with {dof} degrees of freedom, p = {p:.3}");
+        }
+        if !disagreeing.is_empty() {
+            println!("disagreeing by more than 3σ (rpm, mode): {}", Value::Array(disagreeing.clone()));
         }
         if !id.identifiable {
             println!(
@@ -177,5 +257,5 @@ pub fn estimate(path: &Path, measured: &Path, max_iterations: usize, json_out: b
             );
         }
     }
-    Ok(if id.converged { EXIT_OK } else { EXIT_NOT_CONVERGED })
+    Ok(if acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED })
 }

@@ -124,3 +124,53 @@ fn ross_input_errors_exit_2_and_name_the_problem() {
     let out = run(&["campbell", "--model", "/nonexistent/rotor.toml", "--speeds", "0:100:3"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// A run-up computed by ROSS on a rotor whose bearings' kxx, kyy, kxy, kyx, cxx and cyy were
+/// changed by known factors (scripts/ross_runup_reference.py): with `--parameters` all twelve
+/// come back and the verdict is acceptable; with the default kxx, kyy alone the rest of the
+/// bearings stay wrong, and the verdict says the fit is poor (exit code 3) and where it misses.
+#[test]
+fn estimate_with_cross_coupled_and_damping_parameters_and_verdicts() {
+    let model = data("runup_nominal.toml");
+    let measured = data("runup_truth.csv");
+    let truth: Value =
+        serde_json::from_str(&std::fs::read_to_string(data("runup_truth.json")).unwrap()).unwrap();
+    let out = run(&[
+        "estimate",
+        "--model",
+        &model,
+        "--measured",
+        &measured,
+        "--parameters",
+        "kxx,kyy,kxy,kyx,cxx,cyy",
+        "--json",
+    ]);
+    let v = json(&out);
+    assert_eq!(v["verdict"], "converged");
+    assert_eq!(v["acceptable"], true);
+    assert_eq!(v["dof"], 24 - 12);
+    assert!(v["p_value"].as_f64().unwrap() > 0.01, "{}", v["p_value"]);
+    let factors = truth["factors"].as_object().unwrap();
+    assert_eq!(v["scales"].as_object().unwrap().len(), factors.len());
+    for (name, t) in factors {
+        let s = v["scales"][name].as_f64().unwrap_or_else(|| panic!("{name} missing"));
+        let t = t.as_f64().unwrap();
+        assert!((s - t).abs() < 1e-5 * t, "{name}: {s} vs {t}");
+        let status = v["parameter_status"][name].as_str().unwrap();
+        assert!(status.starts_with('['), "{name}: {status}");
+    }
+
+    let out = run(&["estimate", "--model", &model, "--measured", &measured, "--json"]);
+    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["verdict"], "poor-fit");
+    assert_eq!(v["acceptable"], false);
+    assert!(v["p_value"].as_f64().unwrap() < 0.01);
+    assert!(v["chi2"].as_f64().unwrap() > 0.0 && v["relative_rms_residual"].as_f64().unwrap() > 0.0);
+    let worst = &v["disagreeing_modes"][0];
+    assert!(worst["speed_rpm"].is_number() && worst["mode"].is_number(), "{v}");
+
+    let out = run(&["estimate", "--model", &model, "--measured", &measured, "--parameters", "kzz", "--json"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("kzz"));
+}

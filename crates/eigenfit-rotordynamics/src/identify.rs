@@ -1,5 +1,6 @@
-//! Identification at speed: the bearings' kxx and kyy from whirl frequencies measured over a
-//! run-up. Each parameter scales one coefficient curve of one bearing (kxx(Ω) → s·kxx(Ω)); a
+//! Identification at speed: the bearings' kxx and kyy (and, on request, their cross-coupled
+//! stiffness and their damping) from whirl frequencies measured over a run-up. Each parameter
+//! scales one coefficient curve of one bearing (kxx(Ω) → s·kxx(Ω)); a
 //! small Levenberg–Marquardt works in ln s so stiffnesses stay positive and the steps are
 //! relative, with the Jacobian from the analytic eigenvalue sensitivities.
 //!
@@ -129,42 +130,95 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, String> {
     Ok(out)
 }
 
+/// The bearing coefficients a run-up can estimate, in ROSS's names: stiffness (N/m) and damping
+/// (N·s/m), direct and cross-coupled.
+pub const COEFFICIENT_NAMES: [&str; 8] = ["kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy"];
+
+/// The coefficients estimated by default: the direct stiffnesses.
+pub const DEFAULT_COEFFICIENTS: [&str; 2] = ["kxx", "kyy"];
+
 /// Which coefficient of which bearing a parameter scales.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Parameter {
-    /// `kxx_<tag>` or `kyy_<tag>`.
+    /// `<coefficient>_<tag>`, e.g. `kxx_Bearing 0`, `cxy_Seal 3`.
     pub name: String,
     /// Bearing index.
     pub bearing: usize,
-    /// 0 = kxx, 3 = kyy (index into `Bearing::k`).
-    pub entry: usize,
+    /// Index into [`COEFFICIENT_NAMES`]: 0–3 stiffness (`Bearing::k`), 4–7 damping (`Bearing::c`).
+    pub coefficient: usize,
+}
+
+impl Parameter {
+    fn curve<'a>(&self, rotor: &'a Rotor) -> &'a Coefficient {
+        let b = &rotor.bearings[self.bearing];
+        if self.coefficient < 4 {
+            &b.k[self.coefficient]
+        } else {
+            &b.c[self.coefficient - 4]
+        }
+    }
+
+    fn curve_mut<'a>(&self, rotor: &'a mut Rotor) -> &'a mut Coefficient {
+        let b = &mut rotor.bearings[self.bearing];
+        if self.coefficient < 4 {
+            &mut b.k[self.coefficient]
+        } else {
+            &mut b.c[self.coefficient - 4]
+        }
+    }
+
+    /// The nominal value of this coefficient at speed Ω (rad/s).
+    pub fn nominal(&self, rotor: &Rotor, speed: f64) -> f64 {
+        self.curve(rotor).at(speed)
+    }
 }
 
 /// The kxx and kyy of every bearing, in file order.
 pub fn stiffness_parameters(rotor: &Rotor) -> Vec<Parameter> {
-    let mut out = Vec::new();
-    for (b, brg) in rotor.bearings.iter().enumerate() {
-        out.push(Parameter { name: format!("kxx_{}", brg.tag), bearing: b, entry: 0 });
-        out.push(Parameter { name: format!("kyy_{}", brg.tag), bearing: b, entry: 3 });
-    }
-    out
+    bearing_parameters(rotor, &DEFAULT_COEFFICIENTS).expect("known coefficient names")
 }
 
-/// A rotor with its stiffness parameters scaled.
+/// Parameters for a selection: each item is a coefficient name (`kxy`: that coefficient of every
+/// bearing) or a full parameter name (`kxy_Bearing 0`). Bearing-major order, coefficients in
+/// [`COEFFICIENT_NAMES`] order; an unknown item is an error naming it and the choices.
+pub fn bearing_parameters(rotor: &Rotor, selection: &[&str]) -> Result<Vec<Parameter>, RotorDynError> {
+    let mut chosen = vec![[false; 8]; rotor.bearings.len()];
+    for item in selection.iter().map(|s| s.trim()) {
+        let mut hit = false;
+        for (b, brg) in rotor.bearings.iter().enumerate() {
+            for (c, name) in COEFFICIENT_NAMES.iter().enumerate() {
+                if item == *name || item == format!("{name}_{}", brg.tag) {
+                    chosen[b][c] = true;
+                    hit = true;
+                }
+            }
+        }
+        if !hit {
+            let tags: Vec<&str> = rotor.bearings.iter().map(|b| b.tag.as_str()).collect();
+            return Err(RotorDynError::Data(format!(
+                "parameter `{item}`: not one of {} (every bearing) or <coefficient>_<bearing> with a bearing of {}",
+                COEFFICIENT_NAMES.join(", "),
+                tags.join(", ")
+            )));
+        }
+    }
+    let mut out = Vec::new();
+    for (b, brg) in rotor.bearings.iter().enumerate() {
+        for (c, name) in COEFFICIENT_NAMES.iter().enumerate().filter(|(c, _)| chosen[b][*c]) {
+            out.push(Parameter { name: format!("{name}_{}", brg.tag), bearing: b, coefficient: c });
+        }
+    }
+    Ok(out)
+}
+
+/// A rotor with the chosen coefficient curves scaled.
 pub fn scaled_rotor(rotor: &Rotor, params: &[Parameter], scales: &[f64]) -> Rotor {
     let mut r = rotor.clone();
     for (p, &s) in params.iter().zip(scales) {
-        let c = &mut r.bearings[p.bearing].k[p.entry];
-        *c = scale(c, s);
+        let c = p.curve_mut(&mut r);
+        *c = c.scaled(s);
     }
     r
-}
-
-fn scale(c: &Coefficient, s: f64) -> Coefficient {
-    match c {
-        Coefficient::Constant(v) => Coefficient::Constant(v * s),
-        Coefficient::Table(t) => Coefficient::Table(t.scaled(s)),
-    }
 }
 
 /// Model frequencies (Hz) of the measured points and their derivatives d f/d ln s.
@@ -198,13 +252,16 @@ pub fn evaluate(
         let derivs: Vec<MatrixDerivative> = params
             .iter()
             .map(|p| {
-                let b = &r.bearings[p.bearing];
                 let mut block = [[0.0; 2]; 2];
                 // d(s·k)/d ln s = s·k: the scaled coefficient itself.
-                block[p.entry / 2][p.entry % 2] = b.k[p.entry].at(w);
-                let mut k = Mat::<f64>::zeros(r.dofs(), r.dofs());
-                r.add_bearing_block(&mut k, b, block);
-                MatrixDerivative { k: Some(k), ..Default::default() }
+                block[(p.coefficient % 4) / 2][p.coefficient % 2] = p.nominal(&r, w);
+                let mut a = Mat::<f64>::zeros(r.dofs(), r.dofs());
+                r.add_bearing_block(&mut a, &r.bearings[p.bearing], block);
+                if p.coefficient < 4 {
+                    MatrixDerivative { k: Some(a), ..Default::default() }
+                } else {
+                    MatrixDerivative { d: Some(a), ..Default::default() }
+                }
             })
             .collect();
         let d = eigenvalue_derivatives(&mats, &modes, &derivs);
@@ -239,6 +296,8 @@ pub struct Identification {
     pub model_hz: Vec<f64>,
     /// Model whirl at the estimate.
     pub model_whirl: Vec<Whirl>,
+    /// d f_i / d ln s_j at the estimate (Hz), unweighted.
+    pub jacobian: DMatrix<f64>,
     /// Σ r² (weighted by std_hz, or relative residuals without).
     pub cost: f64,
     /// Iterations taken.
@@ -254,7 +313,12 @@ pub struct Identification {
     pub reason: String,
 }
 
-/// Levenberg–Marquardt in ln s from `initial` scales.
+/// Levenberg–Marquardt in ln s from `initial` scales, in stages when the selection holds more
+/// than the direct stiffnesses: first kxx and kyy alone (the rest held at `initial`), then
+/// everything from there. The direct stiffnesses move the frequencies most; fitted together from
+/// a nominal start the weak cross-coupled and damping directions (singular values 10⁴–10⁵
+/// below) pull the iteration into other minima (a 12-parameter ROSS run-up from factors 0.8–1.25
+/// away: stalled; staged: recovered).
 pub fn identify(
     rotor: &Rotor,
     params: &[Parameter],
@@ -262,6 +326,43 @@ pub fn identify(
     initial: &[f64],
     max_iterations: usize,
 ) -> Result<Identification, RotorDynError> {
+    let whole = Fit { rotor, params, points, max_iterations };
+    let direct: Vec<usize> = (0..params.len()).filter(|&i| matches!(params[i].coefficient, 0 | 3)).collect();
+    if direct.is_empty() || direct.len() == params.len() {
+        return levenberg_marquardt(&whole, initial);
+    }
+    let (held, held_scales): (Vec<Parameter>, Vec<f64>) =
+        (0..params.len()).filter(|i| !direct.contains(i)).map(|i| (params[i].clone(), initial[i])).unzip();
+    let held_rotor = scaled_rotor(rotor, &held, &held_scales);
+    let sub: Vec<Parameter> = direct.iter().map(|&i| params[i].clone()).collect();
+    let sub_start: Vec<f64> = direct.iter().map(|&i| initial[i]).collect();
+    let first = levenberg_marquardt(&Fit { rotor: &held_rotor, params: &sub, ..whole }, &sub_start)?;
+    let mut start = initial.to_vec();
+    for (k, &i) in direct.iter().enumerate() {
+        start[i] = first.scales[k];
+    }
+    let mut out = levenberg_marquardt(&whole, &start)?;
+    out.iterations += first.iterations;
+    out.evaluations += first.evaluations;
+    Ok(out)
+}
+
+/// One least-squares problem: a rotor, the parameters on it, the run-up, the iteration limit.
+#[derive(Clone, Copy)]
+struct Fit<'a> {
+    rotor: &'a Rotor,
+    params: &'a [Parameter],
+    points: &'a [RunupPoint],
+    max_iterations: usize,
+}
+
+/// Largest change of any ln s in one step (a trust region): whirl frequencies are sorted at each
+/// speed, so modes that trade places kink the residual, and long steps jump into other basins.
+const MAX_LN_STEP: f64 = 0.2;
+
+/// Levenberg–Marquardt in ln s from `initial` scales.
+fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, RotorDynError> {
+    let Fit { rotor, params, points, max_iterations } = *fit;
     let m = points.len();
     let np = params.len();
     if m < np {
@@ -269,6 +370,16 @@ pub fn identify(
             "{m} measured frequencies for {np} parameters ({}): at least {np} are needed",
             params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
         )));
+    }
+    // A factor on a curve that is zero wherever measured changes nothing: refuse it by name.
+    for p in params {
+        if points.iter().all(|pt| p.nominal(rotor, rpm_to_rad(pt.speed_rpm)) == 0.0) {
+            return Err(RotorDynError::Data(format!(
+                "parameter {}: the model's coefficient is 0 at every measured speed, and a factor on 0 \
+                 cannot be estimated (give the rotor file a nominal value)",
+                p.name
+            )));
+        }
     }
     let sigma: Vec<f64> = points.iter().map(|p| p.std_hz.unwrap_or(p.frequency_hz)).collect();
     let weighted = |e: &Evaluation| -> (DVector<f64>, DMatrix<f64>) {
@@ -295,7 +406,7 @@ pub fn identify(
             break;
         }
         let mut accepted = false;
-        for _ in 0..30 {
+        for _ in 0..60 {
             let mut a = jtj.clone();
             for k in 0..np {
                 a[(k, k)] += mu * jtj[(k, k)].max(1e-12);
@@ -304,9 +415,14 @@ pub fn identify(
                 mu *= 10.0;
                 continue;
             };
-            // Keep steps moderate in ln s (a factor e per iteration at most).
-            let largest = step.amax();
-            let step = if largest > 1.0 { step / largest } else { step };
+            // Keep steps within MAX_LN_STEP in ln s by damping more, not by shortening the
+            // Gauss–Newton step: that step is dominated by the poorly determined directions
+            // (a 12-parameter run-up has singular values 10⁴ apart) and, shortened, hardly
+            // descends; a larger μ turns it toward the well-determined ones.
+            if step.amax() > MAX_LN_STEP {
+                mu *= 4.0;
+                continue;
+            }
             let trial = &theta + &step;
             let scales: Vec<f64> = trial.iter().map(|t| t.exp()).collect();
             let e = evaluate(rotor, params, &scales, points)?;
@@ -371,6 +487,7 @@ pub fn identify(
         ln_std,
         model_hz: eval.frequencies_hz.clone(),
         model_whirl: eval.whirl.clone(),
+        jacobian: eval.jacobian.clone(),
         cost,
         iterations,
         evaluations,

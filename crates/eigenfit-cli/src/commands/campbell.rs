@@ -28,6 +28,9 @@ pub struct CampbellArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Accepted like every other command's `--quiet` (campbell shows no progress indicator).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// Parses `FROM:TO:COUNT` (rpm, linear).

@@ -59,6 +59,11 @@ pub struct EstimateArgs {
     /// Print one JSON object instead of a report.
     #[arg(long)]
     pub json: bool,
+    /// ROSS rotors: the bearing coefficients to estimate, comma-separated — kxx, kxy, kyx, kyy,
+    /// cxx, cxy, cyx, cyy (that coefficient of every bearing) or `<coefficient>_<bearing>`
+    /// (default kxx,kyy).
+    #[arg(long, value_name = "kxx,kyy,…")]
+    pub parameters: Option<String>,
 }
 
 /// Another equally good parameter vector, with the exchanged pair when it is a mirror solution.
@@ -74,7 +79,19 @@ const UNREACHABLE_MARGIN: f64 = 0.1;
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
     if let Some(path) = crate::rotordynamics::ross_model(args.model.model.as_deref()) {
-        return crate::rotordynamics::estimate(path, &args.measured, args.max_iterations, args.json);
+        return crate::rotordynamics::estimate(
+            path,
+            &args.measured,
+            args.parameters.as_deref(),
+            args.max_iterations,
+            args.json,
+        );
+    }
+    if args.parameters.is_some() {
+        return Err(input(
+            "--parameters selects bearing coefficients of a ROSS rotor model; \
+             this model's parameters are its [[parameter]] tables",
+        ));
     }
     let (model, label) = args.model.load_any()?;
     let rotor = &model;
