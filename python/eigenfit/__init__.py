@@ -18,6 +18,7 @@ Batches on a Dask cluster: :mod:`eigenfit.batch`.
 
 from ._api import EXIT_NOT_CONVERGED, EigenfitError, campbell, compare, discover, estimate, run, simulate
 from ._native import version as _native_version
+from .matrices import MatricesModel
 from ._results import (
     CampbellResult,
     CompareResult,
@@ -36,6 +37,7 @@ __all__ = [
     "compare",
     "campbell",
     "run",
+    "MatricesModel",
     "EigenfitError",
     "EXIT_NOT_CONVERGED",
     "Result",

@@ -18,6 +18,8 @@ from typing import Any, Optional
 
 import numpy as np
 
+from .matrices import MatricesModel
+
 #: Options given as ``FROM:TO`` or ``FROM:TO:COUNT`` (a tuple in Python).
 _COLON_OPTIONS = {"range", "sweep", "speeds"}
 #: Options that repeat once per item (``--set a=1 --set b=2``); a mapping gives NAME=VALUE items.
@@ -106,6 +108,9 @@ def model_args(model: Any, tmp: TempFiles) -> list[str]:
     if isinstance(model, str):
         looks_like_file = os.path.exists(model) or os.sep in model or "/" in model or model.endswith(".toml")
         return ["--model", model] if looks_like_file else ["--preset", model]
+    if isinstance(model, MatricesModel):
+        # eigenfit.MatricesModel: its matrices and model file in the call's temporary folder.
+        return ["--model", os.fspath(model.save(tmp.path("matrices")))]
     saved = _save_ross_rotor(model, tmp)
     if saved is not None:
         return ["--model", os.fspath(saved)]

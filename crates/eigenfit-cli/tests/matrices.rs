@@ -192,3 +192,84 @@ fn discover_names_a_user_supplied_candidate_matrix() {
     let value = v["missing_effect"]["value"].as_f64().unwrap();
     assert!((value / 3.0 - 1.0).abs() < 1e-3, "fitted mass {value}");
 }
+
+#[test]
+fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
+    use eigenfit_core::eigen::{EigenSolver, SparseSolver};
+    use eigenfit_core::measurement::sensors::NodeLayout;
+    use eigenfit_core::measurement::uff::{self, UffMode, UffNode};
+    use eigenfit_core::model::StructuralModel;
+    // A test campaign on the plate: w measured at every 5th node of the DOF map (coordinates
+    // only, as a test system exports them), six modes of the plate at known zone factors.
+    let model = eigenfit_matrices::MatricesModel::from_toml_file(plate("model.toml").as_ref()).unwrap();
+    let layout = model.layout().expect("the committed plate has a DOF map");
+    let truth = [1.25, 0.8, 1.1, 0.9];
+    let modes = SparseSolver::default().lowest(&model.assemble(&truth).unwrap(), 6).unwrap();
+    let coordinates = layout.node_coordinates();
+    let sensors: Vec<(usize, usize)> = (0..coordinates.len())
+        .step_by(5)
+        .filter_map(|node| layout.dof(node, 3).map(|(dof, _)| (node, dof)))
+        .collect();
+    assert!(sensors.len() > 30, "{} sensors", sensors.len());
+    let label = |node: usize| layout.label(node).unwrap() as i64;
+    let nodes: Vec<UffNode> = sensors
+        .iter()
+        .map(|&(node, _)| UffNode { label: label(node), coordinates: coordinates[node] })
+        .collect();
+    let uff_modes: Vec<UffMode> = (0..6)
+        .map(|k| UffMode {
+            number: k as i64 + 1,
+            frequency_hz: modes.frequencies_hz()[k],
+            modal_mass: 1.0,
+            damping_ratio: 0.0,
+            values: sensors
+                .iter()
+                .map(|&(node, dof)| (label(node), vec![0.0, 0.0, modes.shapes[(dof, k)], 0.0, 0.0, 0.0]))
+                .collect(),
+            complex: false,
+            realness: 1.0,
+            line: 0,
+        })
+        .collect();
+    let dir = std::env::temp_dir().join(format!("eigenfit-cli-matrices-shapes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("campaign.unv");
+    // No search for other solutions, two zones held at their true values: every shape
+    // linearisation takes a dense n×n LU per mode and parameter (Nelson's method), minutes for
+    // this test otherwise; what is tested here is the tie of sensors to DOFs.
+    let estimate = |nodes: &[UffNode]| {
+        std::fs::write(&file, uff::write("plate campaign", nodes, &uff_modes)).unwrap();
+        let measured = file.to_str().unwrap();
+        let model = plate("model.toml");
+        eigenfit(&[
+            "estimate",
+            "--model",
+            &model,
+            "--measured",
+            measured,
+            "--alternative-starts",
+            "0",
+            "--fix",
+            "zone3=1.1",
+            "--fix",
+            "zone4=0.9",
+            "--json",
+        ])
+    };
+    let (code, v, err) = estimate(&nodes);
+    assert_eq!(code, 0, "{err}\n{v}");
+    for (i, name) in ["zone1", "zone2"].iter().enumerate() {
+        let a = v["parameters"][name].as_f64().unwrap();
+        assert!((a / truth[i] - 1.0).abs() < 1e-6, "{name}: estimated {a}, true {}", truth[i]);
+    }
+    let mac = v["mac"].as_array().expect("a MAC report");
+    for (k, row) in mac.iter().enumerate() {
+        assert!(row[k].as_f64().unwrap() > 0.999, "MAC of mode {}: {row}", k + 1);
+    }
+    // A sensor off the plate is named, not silently dropped.
+    let mut off = nodes.clone();
+    off[0].coordinates[2] = 0.05;
+    let (code, _, err) = estimate(&off);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains(&format!("node {}", nodes[0].label)), "{err}");
+}

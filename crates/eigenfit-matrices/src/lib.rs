@@ -25,10 +25,12 @@
 //! are stored sparse, for [`SparseSolver`](eigenfit_core::eigen::SparseSolver).
 
 mod error;
+mod layout;
 pub mod market;
 mod model;
 
 pub use error::MatricesError;
+pub use layout::DofLayout;
 pub use model::{Dof, MatricesModel};
 
 /// Whether the TOML text declares `kind = "matrices"` (cheap, for routing a `--model` file).

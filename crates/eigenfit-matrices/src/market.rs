@@ -29,6 +29,11 @@ pub fn read_symmetric(path: &Path, expected: Option<usize>) -> Result<CscSymmetr
 
 /// [`read_symmetric`] on the file's text; the error names the entry (1-based, as in the file).
 pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetric, String> {
+    parse_with(text, expected, text.len() >= LARGE_FILE_BYTES)
+}
+
+/// [`parse_symmetric`] with the entries read by [`read_entries_streaming`] or by the kept reader.
+fn parse_with(text: &str, expected: Option<usize>, streaming: bool) -> Result<CscSymmetric, String> {
     let header = text.lines().next().unwrap_or_default().to_ascii_lowercase();
     if !header.starts_with("%%matrixmarket") {
         return Err("not a Matrix Market file: the first line must start with `%%MatrixMarket`".into());
@@ -49,21 +54,11 @@ pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetr
         Some(other) => return Err(format!("header `{}`: `{other}` matrices cannot be stiffness or mass matrices; use `symmetric` or `general`", header.trim())),
         None => return Err(format!("header `{}`: the symmetry field is missing", header.trim())),
     };
-    // Read every file as `real general`, entries as they are stored: the triangle logic below
-    // is the same for both headers, an upper-triangle `symmetric` file needs no special case,
-    // and nalgebra-sparse reads `integer` entries only into integer types.
-    let text = if symmetric || words.get(3) == Some(&"integer") {
-        let mut owned = String::with_capacity(text.len());
-        let (_, rest) = text.split_once('\n').unwrap_or((text, ""));
-        owned.push_str("%%MatrixMarket matrix coordinate real general");
-        owned.push('\n');
-        owned.push_str(rest);
-        std::borrow::Cow::Owned(owned)
+    let (rows, cols, entries) = if streaming {
+        read_entries_streaming(text)?
     } else {
-        std::borrow::Cow::Borrowed(text)
+        read_entries_kept(text, symmetric || words.get(3) == Some(&"integer"))?
     };
-    let coo = load_coo_from_matrix_market_str::<f64>(&text).map_err(|e| e.message().to_string())?;
-    let (rows, cols) = (coo.nrows(), coo.ncols());
     if rows != cols {
         return Err(format!("the matrix is {rows}×{cols}: it must be square"));
     }
@@ -79,7 +74,7 @@ pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetr
     }
     let (mut lower, mut upper) = (false, false);
     let mut largest = 0.0_f64;
-    for (r, c, &v) in coo.triplet_iter() {
+    for &(r, c, v) in &entries {
         if !v.is_finite() {
             return Err(format!("entry ({}, {}) is {v}: every entry must be finite", r + 1, c + 1));
         }
@@ -90,7 +85,7 @@ pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetr
     let n = rows;
     if !(lower && upper) {
         // One triangle (or a diagonal): the other is its mirror.
-        return Ok(CscSymmetric::from_triplets(n, coo.triplet_iter().map(|(r, c, &v)| (r, c, v))));
+        return Ok(CscSymmetric::from_triplets(n, entries));
     }
     if symmetric {
         return Err(
@@ -98,8 +93,8 @@ pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetr
         );
     }
     // Both triangles: sum each (i, j) as stored, then compare with (j, i).
-    let mut sums: HashMap<(usize, usize), f64> = HashMap::with_capacity(coo.nnz());
-    for (r, c, &v) in coo.triplet_iter() {
+    let mut sums: HashMap<(usize, usize), f64> = HashMap::with_capacity(entries.len());
+    for &(r, c, v) in &entries {
         *sums.entry((r, c)).or_insert(0.0) += v;
     }
     let tolerance = SYMMETRY_TOLERANCE * largest;
@@ -137,6 +132,71 @@ pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetr
     ))
 }
 
+/// Files from this size on are read by [`read_entries_streaming`]: nalgebra-sparse's grammar-based
+/// parser reads about 0.5 M entries per second, 10× slower than scipy's reader on a 10⁵-DOF
+/// model's files (docs/performance.md).
+const LARGE_FILE_BYTES: usize = 1 << 20;
+
+/// Rows, columns and the entries (0-based, as stored).
+type Entries = (usize, usize, Vec<(usize, usize, f64)>);
+
+/// Size and entries by nalgebra-sparse's Matrix Market reader. `as_general`: read a `symmetric`
+/// or `integer` file as `real general` (the triangle logic of [`parse_symmetric`] is the same
+/// for both headers, an upper-triangle `symmetric` file needs no special case, and
+/// nalgebra-sparse reads `integer` entries only into integer types).
+fn read_entries_kept(text: &str, as_general: bool) -> Result<Entries, String> {
+    let text = if as_general {
+        let (_, rest) = text.split_once('\n').unwrap_or((text, ""));
+        std::borrow::Cow::Owned(format!("%%MatrixMarket matrix coordinate real general\n{rest}"))
+    } else {
+        std::borrow::Cow::Borrowed(text)
+    };
+    let coo = load_coo_from_matrix_market_str::<f64>(&text).map_err(|e| e.message().to_string())?;
+    Ok((coo.nrows(), coo.ncols(), coo.triplet_iter().map(|(r, c, &v)| (r, c, v)).collect()))
+}
+
+/// The same as [`read_entries_kept`] for large files, one pass over the lines with the standard
+/// library's number parsing (correctly rounded, as the kept reader's). Written here because no
+/// kept Rust crate reads Matrix Market faster (sprs's reader would add ndarray for this alone);
+/// the unit tests hold both readers to the same entries and the same refusals. Validates what
+/// the kept reader does: the size line, whole 1-based indices within the size, three fields
+/// per entry, the entry count the size line declares.
+fn read_entries_streaming(text: &str) -> Result<Entries, String> {
+    let mut lines = text.lines().enumerate().skip(1).filter(|(_, l)| {
+        let l = l.trim_start();
+        !l.is_empty() && !l.starts_with('%')
+    });
+    let (size_line, size) = lines.next().ok_or("the size line (rows columns entries) is missing")?;
+    let fields: Vec<&str> = size.split_ascii_whitespace().collect();
+    let number = |s: &str, line: usize, what: &str| {
+        s.parse::<usize>().map_err(|_| format!("line {}: {what} `{s}` is not a whole number", line + 1))
+    };
+    if fields.len() != 3 {
+        return Err(format!("line {}: the size line must hold rows, columns, entries", size_line + 1));
+    }
+    let rows = number(fields[0], size_line, "rows")?;
+    let cols = number(fields[1], size_line, "columns")?;
+    let nnz = number(fields[2], size_line, "entries")?;
+    let mut entries = Vec::with_capacity(nnz);
+    for (line, entry) in lines {
+        let mut f = entry.split_ascii_whitespace();
+        let (Some(r), Some(c), Some(v), None) = (f.next(), f.next(), f.next(), f.next()) else {
+            return Err(format!("line {}: an entry must be `row column value`", line + 1));
+        };
+        let (r, c) = (number(r, line, "row")?, number(c, line, "column")?);
+        if r == 0 || r > rows || c == 0 || c > cols {
+            return Err(format!("line {}: entry ({r}, {c}) lies outside the {rows}×{cols} matrix", line + 1));
+        }
+        let v: f64 =
+            v.parse().map_err(|_| format!("line {}: entry ({r}, {c}): `{v}` is not a number", line + 1))?;
+        entries.push((r - 1, c - 1, v));
+    }
+    if entries.len() != nnz {
+        return Err(format!("the size line declares {nnz} entries but the file holds {}", entries.len()));
+    }
+    Ok((rows, cols, entries))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -159,41 +219,77 @@ mod tests {
 
     #[test]
     fn every_storage_of_one_matrix_reads_the_same() {
-        let lower_sym =
+        for streaming in [false, true] {
+            let parse = |t: &str, e: Option<usize>| parse_with(t, e, streaming);
+            let lower_sym =
             "%%MatrixMarket matrix coordinate real symmetric\n3 3 5\n1 1 4\n2 1 -1\n2 2 3\n3 2 0.5\n3 3 2\n";
-        let upper_sym =
+            let upper_sym =
             "%%MatrixMarket matrix coordinate real symmetric\n3 3 5\n1 1 4\n1 2 -1\n2 2 3\n2 3 0.5\n3 3 2\n";
-        let upper_gen = "%%MatrixMarket matrix coordinate real general\n% comment\n3 3 5\n1 1 4\n1 2 -1\n2 2 3\n2 3 0.5\n3 3 2\n";
-        let both_gen = "%%MatrixMarket matrix coordinate real general\n3 3 7\n1 1 4\n1 2 -1\n2 1 -1\n2 2 3\n2 3 0.5\n3 2 0.5\n3 3 2\n";
-        let integer = "%%MatrixMarket matrix coordinate integer symmetric\n3 3 3\n1 1 4\n2 2 3\n3 3 2\n";
-        for text in [lower_sym, upper_sym, upper_gen, both_gen] {
-            assert_eq!(dense(&parse_symmetric(text, Some(3)).unwrap()), FULL, "{text}");
+            let upper_gen = "%%MatrixMarket matrix coordinate real general\n% comment\n3 3 5\n1 1 4\n1 2 -1\n2 2 3\n2 3 0.5\n3 3 2\n";
+            let both_gen = "%%MatrixMarket matrix coordinate real general\n3 3 7\n1 1 4\n1 2 -1\n2 1 -1\n2 2 3\n2 3 0.5\n3 2 0.5\n3 3 2\n";
+            let integer = "%%MatrixMarket matrix coordinate integer symmetric\n3 3 3\n1 1 4\n2 2 3\n3 3 2\n";
+            for text in [lower_sym, upper_sym, upper_gen, both_gen] {
+                assert_eq!(dense(&parse(text, Some(3)).unwrap()), FULL, "{text}");
+            }
+            assert_eq!(parse(integer, None).unwrap().nnz(), 3);
         }
-        assert_eq!(parse_symmetric(integer, None).unwrap().nnz(), 3);
     }
 
     #[test]
     fn bad_files_are_refused_naming_the_entry() {
-        let disagree =
-            "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 4\n1 2 -1\n2 1 -1.5\n3 3 1\n";
-        let e = parse_symmetric(disagree, None).unwrap_err();
-        assert!(e.contains("entry (2, 1) = -1.5 but (1, 2) = -1"), "{e}");
-        let lonely = "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 4\n1 2 -1\n3 2 5\n3 3 1\n";
-        let e = parse_symmetric(lonely, None).unwrap_err();
-        assert!(e.contains("not symmetric"), "{e}");
-        let nan = "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 4\n2 2 nan\n";
-        let e = parse_symmetric(nan, None).unwrap_err();
-        assert!(e.contains("(2, 2)") || e.to_lowercase().contains("pars"), "{e}");
-        let rect = "%%MatrixMarket matrix coordinate real general\n2 3 1\n1 1 4\n";
-        assert!(parse_symmetric(rect, None).unwrap_err().contains("square"));
-        let size = "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 1 4\n";
-        assert!(parse_symmetric(size, Some(3)).unwrap_err().contains("model has 3 DOFs"));
-        let skew = "%%MatrixMarket matrix coordinate real skew-symmetric\n2 2 1\n2 1 4\n";
-        assert!(parse_symmetric(skew, None).unwrap_err().contains("skew-symmetric"));
-        let array = "%%MatrixMarket matrix array real general\n1 1\n4\n";
-        assert!(parse_symmetric(array, None).unwrap_err().contains("coordinate"));
-        assert!(parse_symmetric("1 1 1\n", None).unwrap_err().contains("Matrix Market"));
-        let outside = "%%MatrixMarket matrix coordinate real general\n2 2 1\n3 1 4\n";
-        assert!(parse_symmetric(outside, None).is_err());
+        for streaming in [false, true] {
+            let parse = |t: &str, e: Option<usize>| parse_with(t, e, streaming);
+            let disagree =
+                "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 4\n1 2 -1\n2 1 -1.5\n3 3 1\n";
+            let e = parse(disagree, None).unwrap_err();
+            assert!(e.contains("entry (2, 1) = -1.5 but (1, 2) = -1"), "{e}");
+            let lonely =
+                "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 4\n1 2 -1\n3 2 5\n3 3 1\n";
+            let e = parse(lonely, None).unwrap_err();
+            assert!(e.contains("not symmetric"), "{e}");
+            let nan = "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 4\n2 2 nan\n";
+            let e = parse(nan, None).unwrap_err();
+            assert!(e.contains("(2, 2)") || e.to_lowercase().contains("pars"), "{e}");
+            let rect = "%%MatrixMarket matrix coordinate real general\n2 3 1\n1 1 4\n";
+            assert!(parse(rect, None).unwrap_err().contains("square"));
+            let size = "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 1 4\n";
+            assert!(parse(size, Some(3)).unwrap_err().contains("model has 3 DOFs"));
+            let skew = "%%MatrixMarket matrix coordinate real skew-symmetric\n2 2 1\n2 1 4\n";
+            assert!(parse(skew, None).unwrap_err().contains("skew-symmetric"));
+            let array = "%%MatrixMarket matrix array real general\n1 1\n4\n";
+            assert!(parse(array, None).unwrap_err().contains("coordinate"));
+            assert!(parse("1 1 1\n", None).unwrap_err().contains("Matrix Market"));
+            let outside = "%%MatrixMarket matrix coordinate real general\n2 2 1\n3 1 4\n";
+            assert!(parse(outside, None).is_err());
+            for short in [
+                "%%MatrixMarket matrix coordinate real general\n2 2 2\n1 1 4\n",
+                "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 1\n",
+                "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 x 4\n",
+                "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 1 four\n",
+            ] {
+                assert!(parse(short, None).is_err(), "{short}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_streaming_reader_reads_the_committed_plate_as_the_kept_one() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/plate");
+        for name in ["K0.mtx", "K1.mtx", "M0.mtx"] {
+            let text = std::fs::read_to_string(dir.join(name)).unwrap();
+            let kept = parse_with(&text, None, false).unwrap();
+            assert!(kept.nnz() > 200, "{name}: {}", kept.nnz());
+            assert_eq!(parse_with(&text, None, true).unwrap(), kept, "{name}");
+        }
+    }
+
+    #[test]
+    fn the_streaming_reader_names_the_line_at_fault() {
+        let text = "%%MatrixMarket matrix coordinate real general\n% c\n2 2 2\n1 1 4\n2 1 2 7\n";
+        let e = parse_with(text, None, true).unwrap_err();
+        assert!(e.contains("line 5"), "{e}");
+        let text = "%%MatrixMarket matrix coordinate real general\n2 2 1\n3 1 4\n";
+        let e = parse_with(text, None, true).unwrap_err();
+        assert!(e.contains("line 3: entry (3, 1) lies outside the 2×2 matrix"), "{e}");
     }
 }

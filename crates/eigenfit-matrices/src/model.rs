@@ -2,6 +2,7 @@
 //! [`StructuralModel`].
 
 use crate::error::MatricesError;
+use crate::layout::DofLayout;
 use crate::market::read_symmetric;
 use eigenfit_core::matrix::{CscSymmetric, System, SystemDerivative};
 use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
@@ -103,6 +104,8 @@ pub struct MatricesModel {
     derivatives: Vec<(Option<Term>, Option<Term>)>,
     candidates: Vec<Candidate>,
     dofs: Option<Vec<Dof>>,
+    /// The DOF map's nodes and directions, for measured shapes.
+    layout: Option<DofLayout>,
 }
 
 impl MatricesModel {
@@ -181,7 +184,11 @@ impl MatricesModel {
             ));
         }
         let dofs = match &file.dofs {
-            Some(p) => Some(read_dof_map(&at(p), n)?),
+            Some(p) => {
+                let map = read_dof_map(&at(p), n)?;
+                DofLayout::new(&map).map_err(|e| MatricesError::invalid(&at(p), e))?;
+                Some(map)
+            }
             None => None,
         };
         let name = file.name.unwrap_or_else(|| path.display().to_string());
@@ -226,7 +233,9 @@ impl MatricesModel {
         let stiffness = term(k0);
         let mass = term(m0);
         let derivatives = derivatives.into_iter().map(|(k, m)| (k.map(term), m.map(term))).collect();
-        Self { name, params, pattern, stiffness, mass, derivatives, candidates, dofs }
+        // A map that fails here was refused by `from_toml_file` already.
+        let layout = dofs.as_deref().and_then(|d| DofLayout::new(d).ok());
+        Self { name, params, pattern, stiffness, mass, derivatives, candidates, dofs, layout }
     }
 
     /// The model's name (the `name` key, or the file's path).
@@ -242,6 +251,12 @@ impl MatricesModel {
     /// The DOF map, when the model file gives one: entry i describes DOF i.
     pub fn dof_map(&self) -> Option<&[Dof]> {
         self.dofs.as_deref()
+    }
+
+    /// The DOF map as nodes and directions (measured shapes are tied to DOFs through it), when
+    /// the model file gives one.
+    pub fn layout(&self) -> Option<&DofLayout> {
+        self.layout.as_ref()
     }
 
     /// `base + Σ pᵢ·termᵢ` on the common pattern.

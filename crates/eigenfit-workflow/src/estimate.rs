@@ -24,7 +24,7 @@ use std::path::PathBuf;
 type Alternative = (Vec<f64>, Option<(usize, usize)>);
 
 /// Restart-grid points refitted locally when searching for other equally good solutions.
-const ALTERNATIVE_STARTS: usize = 6;
+pub const ALTERNATIVE_STARTS: usize = 6;
 
 /// What to estimate, as the command line gives it.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,6 +47,10 @@ pub struct EstimateRequest {
     pub budget: usize,
     /// Also build the updated model file (rotor TOML).
     pub write_model: bool,
+    /// Points of the coarse grid refitted locally when searching for other equally good
+    /// solutions (0: no such search; the exchange of like parameters is still checked; default
+    /// [`ALTERNATIVE_STARTS`]). On a large model most of a run's evaluations.
+    pub alternative_starts: usize,
     /// ROSS rotors: the bearing coefficients to estimate (`kxx,kyy,…` or `kxy_<bearing>`; `None`:
     /// kxx and kyy of every bearing). Refused for other models.
     pub bearing_parameters: Option<String>,
@@ -173,6 +177,9 @@ pub struct EstimateReport {
     pub disagreeing_modes: Vec<usize>,
     /// The evaluation budget.
     pub budget: BudgetReport,
+    /// Evaluations spent in each phase reached: reachability, fit, intervals,
+    /// mirror_solutions, other_solutions (on a large model each is an eigen-solve of seconds).
+    pub evaluations_by_phase: Named<usize>,
     /// Initial values.
     pub initial: Named<f64>,
     /// Estimated values.
@@ -334,6 +341,8 @@ pub fn run(
     let budget = Budget::new(request.budget);
     // Data no parameter value can produce is refused before any fitting.
     check_reachable(&fit, &mode_numbers, &budget).map_err(|e| input(format!("{measured_name}: {e}")))?;
+    // Running totals of evaluations after each phase, reported per phase.
+    let mut phases: Vec<(&str, usize)> = vec![("reachability", budget.used())];
     // A start inside the bounds where the model cannot be evaluated (a support so soft its mode
     // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
     // the best point of its coarse grid instead, and says so.
@@ -361,6 +370,7 @@ pub fn run(
         }
         other => other?,
     };
+    phases.push(("fit", budget.used()));
     // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
     let system = model.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
     if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
@@ -378,6 +388,7 @@ pub fn run(
     } else {
         (None, None)
     };
+    phases.push(("intervals", budget.used()));
     if converged {
         progress.begin("searching for other solutions", None);
     }
@@ -387,7 +398,14 @@ pub fn run(
         for (i, j, p) in mirror_solutions(&fit, &estimate.last, &budget) {
             alternatives.push((p, Some((i, j))));
         }
-        for p in alternative_solutions_within(&fit, &estimate.last, ALTERNATIVE_STARTS, &budget) {
+        phases.push(("mirror_solutions", budget.used()));
+        // Ranking the coarse grid alone costs an evaluation per point: skipped with no start.
+        let others = if request.alternative_starts == 0 {
+            Vec::new()
+        } else {
+            alternative_solutions_within(&fit, &estimate.last, request.alternative_starts, &budget)
+        };
+        for p in others {
             let same = |q: &[f64]| {
                 model
                     .parameters()
@@ -403,6 +421,7 @@ pub fn run(
     if converged {
         progress.end();
     }
+    phases.push(("other_solutions", budget.used()));
     let budget_spent = budget.exhausted();
     let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
     let pinned: Vec<String> = (0..np).filter(|&i| limits[i] != 0).map(|i| names[i].clone()).collect();
@@ -459,6 +478,7 @@ pub fn run(
         relative_rms_residual: quality.relative_rms,
         disagreeing_modes: quality.disagreeing.iter().map(|&k| mode_numbers[k]).collect(),
         budget: BudgetReport { limit: budget.limit(), used: budget.used(), exhausted: budget_spent },
+        evaluations_by_phase: phase_counts(&phases),
         initial: Named::new(&names, initial.iter().copied()),
         parameters: Named::new(&names, estimate.parameters.iter().copied()),
         parameter_status: Named::new(&names, (0..np).map(status)),
@@ -507,4 +527,20 @@ pub fn run(
         acceptable,
         updated_model,
     })))
+}
+
+/// `{phase: evaluations}` from the running totals after each phase (a phase not reached is left
+/// out).
+fn phase_counts(totals: &[(&str, usize)]) -> Named<usize> {
+    let mut before = 0;
+    Named(
+        totals
+            .iter()
+            .map(|&(name, total)| {
+                let n = total - before;
+                before = total;
+                (name.to_string(), n)
+            })
+            .collect(),
+    )
 }

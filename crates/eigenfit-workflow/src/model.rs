@@ -80,11 +80,14 @@ impl AnyModel {
         }
     }
 
-    /// The rotor as the node layout measured shapes are tied to (a matrices model has none).
+    /// The node layout measured shapes are tied to: a rotor's, or a matrices model's DOF map
+    /// (`dofs = "…"`; none without one).
     pub fn layout(&self) -> Option<&dyn eigenfit_core::measurement::sensors::NodeLayout> {
         match self {
             AnyModel::Rotor(r) => Some(r),
-            AnyModel::Matrices(_) => None,
+            AnyModel::Matrices(m) => {
+                m.layout().map(|l| l as &dyn eigenfit_core::measurement::sensors::NodeLayout)
+            }
         }
     }
 

@@ -102,7 +102,7 @@ pub fn read(
     // Shapes are tied to model DOFs through node coordinates, which a matrices model lacks.
     let rotor = || {
         layout.ok_or_else(|| {
-            input("measured shapes (a universal file or --shapes) need a rotor model; a matrices model takes frequencies only")
+            input("measured shapes (a universal file or --shapes) need node coordinates: a rotor model, or a matrices model with a DOF map (`dofs = \"dofs.csv\"`, docs/matrices.md)")
         })
     };
     let ShapeOptions { node_tolerance, shape_std, mac_threshold } = options.shape;

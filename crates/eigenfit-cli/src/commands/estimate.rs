@@ -40,6 +40,12 @@ pub struct EstimateArgs {
     /// solutions may spend together; when it runs out the run ends with exit code 3 and says so.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_EVALUATIONS)]
     pub budget: usize,
+    /// Points of the coarse grid refitted locally when searching for other equally good
+    /// solutions (0: no such search; the exchange of like parameters is still checked). Each is
+    /// a local fit of several model evaluations: on a large model most of a run's time
+    /// (`evaluations_by_phase` in --json).
+    #[arg(long, value_name = "N", default_value_t = eigenfit_workflow::estimate::ALTERNATIVE_STARTS)]
+    pub alternative_starts: usize,
     /// Write the convergence history (convergence.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
@@ -65,6 +71,7 @@ fn request(args: &EstimateArgs) -> EstimateRequest {
         max_iterations: args.max_iterations,
         budget: args.budget,
         write_model: args.test_data.write_model.is_some(),
+        alternative_starts: args.alternative_starts,
         bearing_parameters: args.parameters.clone(),
     }
 }
