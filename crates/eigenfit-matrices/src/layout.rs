@@ -1,9 +1,23 @@
 //! The DOF map as a [`NodeLayout`]: how measured shapes (a universal file's nodes and
 //! directions, or a shape CSV) find a matrices model's DOFs, as they find a rotor's.
 
-use crate::model::Dof;
 use eigenfit_core::measurement::sensors::{NodeLayout, DIRECTIONS};
+use serde::Deserialize;
 use std::collections::HashMap;
+
+/// One DOF of the optional DOF map: where it is and which way it points, so measured shapes
+/// (sensor node + direction) can be matched to model DOFs.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct Dof {
+    /// Node number (the FE tool's).
+    pub node: u64,
+    /// Direction label, e.g. `x`, `y`, `z`, `rx`, `ry`, `rz`.
+    pub direction: String,
+    /// Node coordinates.
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+}
 
 /// The model's nodes (in order of first appearance in the DOF map, model node 0, 1, …) with
 /// their coordinates, and the DOF of each (node, direction) the map lists.

@@ -30,8 +30,8 @@ pub mod market;
 mod model;
 
 pub use error::MatricesError;
-pub use layout::DofLayout;
-pub use model::{Dof, MatricesModel};
+pub use layout::{Dof, DofLayout};
+pub use model::MatricesModel;
 
 /// Whether the TOML text declares `kind = "matrices"` (cheap, for routing a `--model` file).
 pub fn is_matrices_file(text: &str) -> bool {

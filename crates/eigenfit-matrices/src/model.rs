@@ -2,7 +2,7 @@
 //! [`StructuralModel`].
 
 use crate::error::MatricesError;
-use crate::layout::DofLayout;
+use crate::layout::{Dof, DofLayout};
 use crate::market::read_symmetric;
 use eigenfit_core::matrix::{CscSymmetric, System, SystemDerivative};
 use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
@@ -63,20 +63,6 @@ struct CandidateTable {
     stiffness: Option<PathBuf>,
     #[serde(default)]
     mass: Option<PathBuf>,
-}
-
-/// One DOF of the optional DOF map: where it is and which way it points, so measured shapes
-/// (sensor node + direction) can be matched to model DOFs.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-pub struct Dof {
-    /// Node number (the FE tool's).
-    pub node: u64,
-    /// Direction label, e.g. `x`, `y`, `z`, `rx`, `ry`, `rz`.
-    pub direction: String,
-    /// Node coordinates.
-    pub x: f64,
-    pub y: f64,
-    pub z: f64,
 }
 
 /// A matrix of the model with the positions of its entries in the common pattern.
