@@ -26,7 +26,7 @@ fi
 py_venv="$(mktemp -d)/venv"
 trap 'rm -rf "$(dirname "$py_venv")"' EXIT
 python3 -m venv "$py_venv"
-"$py_venv/bin/python" -m pip install --quiet --disable-pip-version-check ./python pytest numpy dask distributed
+"$py_venv/bin/python" -m pip install --quiet --disable-pip-version-check ./python pytest numpy scipy dask distributed
 py_status=0
 EIGENFIT_BIN="$PWD/target/debug/eigenfit" "$py_venv/bin/python" -m pytest python/tests -p no:cacheprovider -q \
   || py_status=$?
