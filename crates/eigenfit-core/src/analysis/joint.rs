@@ -3,7 +3,8 @@
 //! every run); one that appears in one configuration only (a bearing changed for that run) is
 //! estimated from that configuration's data alone. Rows are stacked as in [`crate::problem::multi`].
 
-use crate::analysis::{uncertainty, Uncertainty};
+use crate::analysis::statistics::scatter_uncertainty;
+use crate::analysis::Uncertainty;
 use crate::model::{Parameter, ParameterSet};
 use crate::problem::multi::stack;
 use crate::problem::{Linearisation, Objective, ResidualError};
@@ -76,23 +77,7 @@ impl<'a> Joint<'a> {
     /// 95 % intervals at `at`: from the weights when `has_std`, else from the residual scatter
     /// σ̂ = √(‖r‖²/dof) as in [`ShapeFit::uncertainty`](super::ShapeFit::uncertainty).
     pub fn uncertainty(&mut self, at: &Linearisation, has_std: bool) -> Option<(Uncertainty, f64)> {
-        if has_std {
-            return uncertainty(self, at, true).map(|u| (u, 1.0));
-        }
-        let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
-        let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
-        if !(scatter > 0.0 && scatter.is_finite()) {
-            return None;
-        }
-        let old = self.scale;
-        self.scale = old * scatter;
-        let out = self
-            .linearise(&at.parameters)
-            .ok()
-            .and_then(|l| uncertainty(self, &l, true))
-            .map(|u| (u, scatter));
-        self.scale = old;
-        out
+        scatter_uncertainty(self, |joint| &mut joint.scale, at, has_std)
     }
 }
 

@@ -62,23 +62,8 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     /// only set how frequencies and shapes count against each other; `None` when there are no
     /// more rows than parameters. Returns the intervals and σ̂ (1 with given std).
     pub fn uncertainty(&mut self, at: &Linearisation) -> Option<(crate::analysis::Uncertainty, f64)> {
-        if self.problem.measured.has_std() {
-            return crate::analysis::uncertainty(self, at, true).map(|u| (u, 1.0));
-        }
-        let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
-        let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
-        if !(scatter > 0.0 && scatter.is_finite()) {
-            return None;
-        }
-        let old = self.scale;
-        self.scale = old * scatter;
-        let result = self
-            .linearise(&at.parameters)
-            .ok()
-            .and_then(|lin| crate::analysis::uncertainty(self, &lin, true))
-            .map(|u| (u, scatter));
-        self.scale = old;
-        result
+        let has_std = self.problem.measured.has_std();
+        crate::analysis::statistics::scatter_uncertainty(self, |fit| &mut fit.scale, at, has_std)
     }
 
     /// Modes solved: as many as MAC pairing considers.

@@ -80,6 +80,36 @@ pub fn uncertainty_within(
     uncertainty_observed(problem, at, has_std, budget, &mut [])
 }
 
+/// 95 % intervals at `at`: from the weights when `has_std`; without, from the residual scatter:
+/// every row is divided by σ̂ = √(‖r‖²/dof) (through `scale`, the objective's row divisor), the
+/// usual regression estimate. `None` when there are no more rows than parameters. Returns the
+/// intervals and σ̂ (1 with given std). Shared by [`ShapeFit`](super::ShapeFit) and
+/// [`Joint`](super::Joint).
+pub(crate) fn scatter_uncertainty<P: Objective>(
+    problem: &mut P,
+    scale: fn(&mut P) -> &mut f64,
+    at: &Linearisation,
+    has_std: bool,
+) -> Option<(Uncertainty, f64)> {
+    if has_std {
+        return uncertainty(problem, at, true).map(|u| (u, 1.0));
+    }
+    let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
+    let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
+    if !(scatter > 0.0 && scatter.is_finite()) {
+        return None;
+    }
+    let old = *scale(problem);
+    *scale(problem) = old * scatter;
+    let result = problem
+        .linearise(&at.parameters)
+        .ok()
+        .and_then(|lin| uncertainty(problem, &lin, true))
+        .map(|u| (u, scatter));
+    *scale(problem) = old;
+    result
+}
+
 /// [`uncertainty_within`] telling `observers` how many of the profile-likelihood bounds are done
 /// ([`Observer::steps_done`]): the interval phase's progress.
 pub fn uncertainty_observed(
