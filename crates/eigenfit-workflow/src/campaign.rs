@@ -151,7 +151,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     progress.begin(&format!("estimating the campaign ({})", strategy_kind.name()), None);
     let mut strategy = strategy_kind.build();
     let estimate = Driver { max_iterations: request.max_iterations }
-        .run(&joint, strategy.as_mut(), &initial, &mut [])
+        .run(&joint, strategy.as_mut(), &initial)
         .map_err(|e| input(e.to_string()));
     progress.end();
     let estimate = estimate?;

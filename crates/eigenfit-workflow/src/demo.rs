@@ -169,9 +169,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
     for kind in StrategyKind::ALL {
         let mut strategy = kind.build();
         estimates.push(
-            Driver { max_iterations: 1000 }
-                .run(&problem, strategy.as_mut(), &INITIAL, &mut [])
-                .map_err(failure)?,
+            Driver { max_iterations: 1000 }.run(&problem, strategy.as_mut(), &INITIAL).map_err(failure)?,
         );
     }
     // 3. Where each strategy converges from: a grid of initial guesses.

@@ -143,8 +143,7 @@ where
         }
         _ => strategy.build(),
     };
-    let outcome =
-        Driver { max_iterations: settings.max_iterations }.run(problem, s.as_mut(), initial, &mut []);
+    let outcome = Driver { max_iterations: settings.max_iterations }.run(problem, s.as_mut(), initial);
     let seconds = start.elapsed().as_secs_f64();
     match outcome {
         Ok(est) => {

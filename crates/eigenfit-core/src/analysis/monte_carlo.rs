@@ -159,7 +159,7 @@ where
         let problem = Problem::new(model, solver, data);
         let driver = Driver { max_iterations: settings.max_iterations };
         let est = driver
-            .run(&problem, &mut LevenbergMarquardt::default(), &settings.initial, &mut [])
+            .run(&problem, &mut LevenbergMarquardt::default(), &settings.initial)
             .map_err(|e| e.to_string())?;
         let intervals = uncertainty(&problem, &est.last, true).map(|u| u.intervals);
         Ok(TrialEstimate {

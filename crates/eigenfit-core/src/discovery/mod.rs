@@ -379,7 +379,7 @@ where
     let budget = Budget::new(options.max_evaluations);
     // (a) calibrate
     let est = Driver::default()
-        .run_within(&base, &mut LevenbergMarquardt::default(), initial, &mut [], &budget)
+        .run_within(&base, &mut LevenbergMarquardt::default(), initial, &budget)
         .map_err(|e| DiscoveryError::Calibration(e.to_string()))?;
     let base_lin = est.last;
     let chi2_before = 2.0 * base_lin.cost();
@@ -679,7 +679,7 @@ fn refit<M: StructuralModel, S: EigenSolver>(
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
         let est = Driver { max_iterations: 60 }
-            .run_within(problem, &mut LevenbergMarquardt::default(), &start, &mut [], budget)
+            .run_within(problem, &mut LevenbergMarquardt::default(), &start, budget)
             .ok()?;
         // A fit cut short by the budget is not a fit.
         if matches!(est.termination, Termination::BudgetExhausted { .. }) {

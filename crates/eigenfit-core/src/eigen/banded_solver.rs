@@ -5,7 +5,8 @@
 use crate::eigen::lanczos::{self, pseudo_random, LanczosWork};
 use crate::eigen::small_eigen::symmetric_eigen;
 use crate::eigen::{
-    apply_sign_rule, check_count, shifted_twice, DenseSolver, EigenSolver, Modes, SolveError,
+    apply_sign_rule, check_count, drop_shapes, shifted_twice, DenseSolver, EigenSolver, ModeRequest, Modes,
+    SolveError, SolvedModes,
 };
 use crate::matrix::{BandCholesky, BandedSymmetric, System};
 use nalgebra::{DMatrix, DVector};
@@ -129,39 +130,18 @@ impl EigenSolver for BandedSolver {
         "banded"
     }
 
-    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
-        match self.banded(system, count, self.tolerance)? {
-            Some((modes, _)) => Ok(modes),
-            None => DenseSolver.lowest(system, count),
-        }
-    }
-
     /// The next eigenvalue's bound is the Sturm check's shift: no eigenvalue beyond the modes
-    /// returned lies below it, at no extra cost.
-    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
-        match self.banded(system, count, self.tolerance)? {
-            Some(found) => Ok(found),
-            None => DenseSolver.lowest_with_next(system, count),
-        }
-    }
-
-    /// The eigenvalues are Rayleigh quotients of the converged vectors, whose error is the square
-    /// of the vectors': the vectors are iterated to √tolerance / 10 only.
-    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
-        match self.banded(system, count, self.eigenvalue_tolerance())? {
-            Some((modes, _)) => Ok(modes.eigenvalues),
-            None => DenseSolver.lowest_eigenvalues(system, count),
-        }
-    }
-
-    fn lowest_eigenvalues_with_next(
-        &self,
-        system: &System,
-        count: usize,
-    ) -> Result<(DVector<f64>, f64), SolveError> {
-        match self.banded(system, count, self.eigenvalue_tolerance())? {
-            Some((modes, next)) => Ok((modes.eigenvalues, next)),
-            None => DenseSolver.lowest_eigenvalues_with_next(system, count),
+    /// returned lies below it, at no extra cost. Eigenvalues only: they are Rayleigh quotients
+    /// of the converged vectors, whose error is the square of the vectors', so the vectors are
+    /// iterated to √tolerance / 10 only.
+    fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
+        let tolerance = if request.vectors { self.tolerance } else { self.eigenvalue_tolerance() };
+        match self.banded(system, request.count, tolerance)? {
+            Some((modes, next)) => Ok(SolvedModes {
+                modes: drop_shapes(modes, request.vectors),
+                next_eigenvalue: request.certificate.then_some(next),
+            }),
+            None => DenseSolver.solve(system, request),
         }
     }
 }
@@ -199,7 +179,7 @@ impl BandedSolver {
         };
         let found = WORKSPACE.with(|ws| {
             let ws = &mut *ws.try_borrow_mut().map_err(|_| backend("workspace in use (re-entrant solve)"))?;
-            Self { tolerance, ..*self }.solve(k, m, count, ws)
+            Self { tolerance, ..*self }.solve_band(k, m, count, ws)
         })?;
         match found {
             Some(found) => Ok(Some(found)),
@@ -238,7 +218,7 @@ fn backend(detail: impl Into<String>) -> SolveError {
 impl BandedSolver {
     /// The lowest `count` modes and a lower bound on the next eigenvalue, or `None` when the
     /// Sturm check shows a missed mode.
-    fn solve(
+    fn solve_band(
         &self,
         k: &BandedSymmetric,
         m: &BandedSymmetric,

@@ -5,8 +5,9 @@
 //! was missed.
 
 use crate::eigen::{
-    apply_sign_rule, check_count, lanczos, lanczos::LanczosWork, lanczos::Locked, lanczos::ShiftInvert,
-    shifted_twice, DenseSolver, EigenSolver, Modes, SolveError,
+    apply_sign_rule, check_count, drop_shapes, lanczos, lanczos::LanczosWork, lanczos::Locked,
+    lanczos::ShiftInvert, shifted_twice, DenseSolver, EigenSolver, ModeRequest, Modes, SolveError,
+    SolvedModes,
 };
 use crate::matrix::{CscSymmetric, System};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -260,27 +261,16 @@ impl EigenSolver for SparseSolver {
         "sparse"
     }
 
-    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
-        self.lowest_with_next(system, count).map(|(m, _)| m)
-    }
-
-    /// The next eigenvalue's bound is the Sturm count's shift.
-    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
-        self.solve(system, count, self.tolerance)
-    }
-
-    /// The eigenvalues are Rayleigh quotients of the converged vectors, accurate to the square
-    /// of the vectors' error: the vectors are iterated to √tolerance / 10 only.
-    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
-        self.solve(system, count, self.eigenvalue_tolerance()).map(|(m, _)| m.eigenvalues)
-    }
-
-    fn lowest_eigenvalues_with_next(
-        &self,
-        system: &System,
-        count: usize,
-    ) -> Result<(DVector<f64>, f64), SolveError> {
-        self.solve(system, count, self.eigenvalue_tolerance()).map(|(m, next)| (m.eigenvalues, next))
+    /// The next eigenvalue's bound is the Sturm count's shift. Eigenvalues only: they are
+    /// Rayleigh quotients of the converged vectors, accurate to the square of the vectors'
+    /// error, so the vectors are iterated to √tolerance / 10 only.
+    fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
+        let tolerance = if request.vectors { self.tolerance } else { self.eigenvalue_tolerance() };
+        let (modes, next) = self.solve_with_tolerance(system, request.count, tolerance)?;
+        Ok(SolvedModes {
+            modes: drop_shapes(modes, request.vectors),
+            next_eigenvalue: request.certificate.then_some(next),
+        })
     }
 }
 
@@ -289,7 +279,12 @@ impl SparseSolver {
         self.tolerance.max(0.1 * self.tolerance.sqrt())
     }
 
-    fn solve(&self, system: &System, count: usize, tolerance: f64) -> Result<(Modes, f64), SolveError> {
+    fn solve_with_tolerance(
+        &self,
+        system: &System,
+        count: usize,
+        tolerance: f64,
+    ) -> Result<(Modes, f64), SolveError> {
         check_count(system, count)?;
         let n = system.dofs();
         let converted;

@@ -6,12 +6,11 @@
 #![allow(dead_code)]
 
 use eigenfit_core::discovery::{DiscoveryOptions, NamedEffect};
-use eigenfit_core::eigen::{BandedSolver, EigenSolver, Modes, SolveError};
+use eigenfit_core::eigen::{BandedSolver, EigenSolver, ModeRequest, SolveError, SolvedModes};
 use eigenfit_core::matrix::System;
 use eigenfit_core::measurement::{MeasuredMode, Measurement};
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use eigenfit_rotor::presets;
-use nalgebra::DVector;
 use serde::Deserialize;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -170,24 +169,8 @@ impl EigenSolver for CountingSolver {
     fn name(&self) -> &'static str {
         "counting"
     }
-    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
+    fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
         self.count();
-        self.inner.lowest(system, count)
-    }
-    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
-        self.count();
-        self.inner.lowest_eigenvalues(system, count)
-    }
-    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
-        self.count();
-        self.inner.lowest_with_next(system, count)
-    }
-    fn lowest_eigenvalues_with_next(
-        &self,
-        system: &System,
-        count: usize,
-    ) -> Result<(DVector<f64>, f64), SolveError> {
-        self.count();
-        self.inner.lowest_eigenvalues_with_next(system, count)
+        self.inner.solve(system, request)
     }
 }
