@@ -68,32 +68,62 @@ impl EffectSpec {
     }
 
     /// Parses `KIND[@LOCATION]=VALUE` (the value may be left out for `shear-deformation`).
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> Result<Self, EffectParseError> {
         let (head, value) = match text.split_once('=') {
             Some((h, v)) => {
                 let value: f64 = v
                     .trim()
                     .parse()
-                    .map_err(|_| format!("`{text}`: value `{}` is not a number", v.trim()))?;
+                    .map_err(|_| EffectParseError::Value { text: text.into(), value: v.trim().into() })?;
                 (h.trim(), value)
             }
             None => (text.trim(), 1.0),
         };
         let (kind, location) = match head.split_once('@') {
             Some((k, l)) => {
-                let loc: usize = l
-                    .trim()
-                    .parse()
-                    .map_err(|_| format!("`{text}`: location `{}` is not an index", l.trim()))?;
+                let loc: usize = l.trim().parse().map_err(|_| EffectParseError::Location {
+                    text: text.into(),
+                    location: l.trim().into(),
+                })?;
                 (k.trim(), Some(loc))
             }
             None => (head, None),
         };
         if !KINDS.contains(&kind) {
-            return Err(format!("`{text}`: unknown effect `{kind}`; known: {}", KINDS.join(", ")));
+            return Err(EffectParseError::UnknownKind { text: text.into(), kind: kind.into() });
         }
         Ok(Self::new(kind, location, value))
     }
+}
+
+/// Why an effect written as `KIND[@LOCATION]=VALUE` could not be read; each names the text.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum EffectParseError {
+    /// The part after `=` is not a number.
+    #[error("`{text}`: value `{value}` is not a number")]
+    Value {
+        /// The whole effect text.
+        text: String,
+        /// The value as written.
+        value: String,
+    },
+    /// The part after `@` is not an index.
+    #[error("`{text}`: location `{location}` is not an index")]
+    Location {
+        /// The whole effect text.
+        text: String,
+        /// The location as written.
+        location: String,
+    },
+    /// The kind is not one of [`KINDS`].
+    #[error("`{text}`: unknown effect `{kind}`; known: {}", KINDS.join(", "))]
+    UnknownKind {
+        /// The whole effect text.
+        text: String,
+        /// The kind as written.
+        kind: String,
+    },
 }
 
 /// What a location index refers to for each kind.

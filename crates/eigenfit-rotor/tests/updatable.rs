@@ -155,6 +155,7 @@ fn bad_declarations_are_named() {
                 .unwrap(),
         )
         .unwrap_err()
+        .to_string()
     };
     assert_eq!(
         bad("[[parameter]]\nkind = \"disk-mass\"\nindex = 3\n"),

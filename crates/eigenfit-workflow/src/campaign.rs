@@ -99,7 +99,7 @@ pub struct CampaignReport {
 
 /// Estimates a campaign jointly.
 pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<CampaignReport, WorkflowError> {
-    let campaign = Campaign::from_toml_file(&request.campaign).map_err(input)?;
+    let campaign = Campaign::from_toml_file(&request.campaign).map_err(|e| input(e.to_string()))?;
     let solver: Box<dyn EigenSolver> = match request.solver.as_str() {
         "banded" | "auto" => Box::new(BandedSolver::default()),
         "dense" => Box::new(DenseSolver),

@@ -53,7 +53,10 @@ impl<'a> Joint<'a> {
                         if (a.unit.as_str(), a.lower, a.upper, a.scale)
                             != (q.unit.as_str(), q.lower, q.upper, q.scale)
                         {
-                            return Err(JointError::ParameterDiffers { configuration: k, name: q.name.clone() });
+                            return Err(JointError::ParameterDiffers {
+                                configuration: k,
+                                name: q.name.clone(),
+                            });
                         }
                         map.push(i);
                     }

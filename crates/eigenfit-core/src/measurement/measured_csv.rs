@@ -168,10 +168,13 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), CsvErr
                 continue;
             }
             other => {
-                return Err(at(hline, format!(
-                    "unknown column `{}`; the header must be `mode,frequency_hz[,std_hz]`",
-                    shown(other)
-                )))
+                return Err(at(
+                    hline,
+                    format!(
+                        "unknown column `{}`; the header must be `mode,frequency_hz[,std_hz]`",
+                        shown(other)
+                    ),
+                ))
             }
         };
         if col[slot].replace(i).is_some() {
@@ -180,9 +183,10 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), CsvErr
     }
     for (slot, name) in [(0, "mode"), (1, "frequency_hz")] {
         if col[slot].is_none() {
-            return Err(at(hline, format!(
-                "missing column `{name}`; the header must be `mode,frequency_hz[,std_hz]`"
-            )));
+            return Err(at(
+                hline,
+                format!("missing column `{name}`; the header must be `mode,frequency_hz[,std_hz]`"),
+            ));
         }
     }
     // Line of each mode seen: a hash map keeps the duplicate check linear in the row count.
@@ -198,9 +202,9 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), CsvErr
             field(slot)
                 .map(|s| match s {
                     "" => Err(at(line, format!("{name} is empty"))),
-                    _ => {
-                        s.parse::<f64>().map_err(|_| at(line, format!("{name} `{}` is not a number", shown(s))))
-                    }
+                    _ => s
+                        .parse::<f64>()
+                        .map_err(|_| at(line, format!("{name} `{}` is not a number", shown(s)))),
                 })
                 .transpose()
         };
@@ -210,7 +214,10 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), CsvErr
         })?;
         let f = number(1, "frequency_hz")?.unwrap_or_default();
         if !(f.is_finite() && f > 0.0) {
-            return Err(at(line, format!("frequency_hz {} must be a positive finite number", shown_number(f))));
+            return Err(at(
+                line,
+                format!("frequency_hz {} must be a positive finite number", shown_number(f)),
+            ));
         }
         let std = number(2, "std_hz")?;
         if let Some(s) = std {
@@ -227,8 +234,8 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), CsvErr
         return Err(at(hline, "no data rows after the header".into()));
     }
     check_order(&modes)?;
-    let measurement =
-        Measurement::new(modes.into_iter().map(|(_, m)| m).collect()).map_err(|e| at(hline, e.to_string()))?;
+    let measurement = Measurement::new(modes.into_iter().map(|(_, m)| m).collect())
+        .map_err(|e| at(hline, e.to_string()))?;
     Ok((measurement, notes))
 }
 
@@ -270,23 +277,29 @@ fn check_order(modes: &[(usize, MeasuredMode)]) -> Result<(), CsvError> {
         let ((l0, a), (l1, b)) = (pair[0], pair[1]);
         let later = l0.max(l1);
         if b.frequency_hz == a.frequency_hz {
-            return Err(at(*later, format!(
-                "mode {} has the same frequency as mode {} ({} Hz, lines {l0} and {l1}): \
+            return Err(at(
+                *later,
+                format!(
+                    "mode {} has the same frequency as mode {} ({} Hz, lines {l0} and {l1}): \
                  the model's modes are distinct, so the two cannot both be paired",
-                b.mode + 1,
-                a.mode + 1,
-                a.frequency_hz
-            )));
+                    b.mode + 1,
+                    a.mode + 1,
+                    a.frequency_hz
+                ),
+            ));
         }
         if b.frequency_hz < a.frequency_hz {
-            return Err(at(*later, format!(
-                "mode {} ({} Hz, line {l1}) is below mode {} ({} Hz, line {l0}): natural \
+            return Err(at(
+                *later,
+                format!(
+                    "mode {} ({} Hz, line {l1}) is below mode {} ({} Hz, line {l0}): natural \
                  frequencies increase with mode number (a swapped row or a typing slip?)",
-                b.mode + 1,
-                b.frequency_hz,
-                a.mode + 1,
-                a.frequency_hz
-            )));
+                    b.mode + 1,
+                    b.frequency_hz,
+                    a.mode + 1,
+                    a.frequency_hz
+                ),
+            ));
         }
     }
     Ok(())
@@ -307,12 +320,18 @@ mod tests {
 
     #[test]
     fn errors_name_the_line() {
-        assert_eq!(parse("").unwrap_err().to_string(), "1: empty file: expected the header `mode,frequency_hz[,std_hz]`");
+        assert_eq!(
+            parse("").unwrap_err().to_string(),
+            "1: empty file: expected the header `mode,frequency_hz[,std_hz]`"
+        );
         assert_eq!(
             parse("mode,freq\n1,2\n").unwrap_err().to_string(),
             "1: unknown column `freq`; the header must be `mode,frequency_hz[,std_hz]`"
         );
-        assert_eq!(parse("mode,frequency_hz\n1,abc\n").unwrap_err().to_string(), "2: frequency_hz `abc` is not a number");
+        assert_eq!(
+            parse("mode,frequency_hz\n1,abc\n").unwrap_err().to_string(),
+            "2: frequency_hz `abc` is not a number"
+        );
         assert_eq!(
             parse("mode,frequency_hz\n1,-3\n").unwrap_err().to_string(),
             "2: frequency_hz -3 must be a positive finite number"
@@ -333,7 +352,10 @@ mod tests {
             parse("mode,frequency_hz\n0,3\n").unwrap_err().to_string(),
             "2: mode `0` must be a whole number ≥ 1 (modes count from 1)"
         );
-        assert_eq!(parse("mode,frequency_hz\n1,3,4\n").unwrap_err().to_string(), "2: 3 fields, but the header has 2");
+        assert_eq!(
+            parse("mode,frequency_hz\n1,3,4\n").unwrap_err().to_string(),
+            "2: 3 fields, but the header has 2"
+        );
         assert_eq!(
             parse("frequency_hz\n3\n").unwrap_err().to_string(),
             "1: missing column `mode`; the header must be `mode,frequency_hz[,std_hz]`"
