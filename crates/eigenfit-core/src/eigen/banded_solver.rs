@@ -4,9 +4,10 @@
 
 use crate::eigen::lanczos::{self, pseudo_random, LanczosWork};
 use crate::eigen::small_eigen::symmetric_eigen;
+use crate::eigen::solver::request_tolerance;
 use crate::eigen::{
-    apply_sign_rule, check_count, drop_shapes, shifted_twice, DenseSolver, EigenSolver, ModeRequest, Modes,
-    SolveError, SolvedModes,
+    apply_sign_rule, check_count, shifted_twice, DenseSolver, EigenSolver, ModeRequest, Modes, SolveError,
+    SolvedModes,
 };
 use crate::matrix::{BandCholesky, BandedSymmetric, System};
 use nalgebra::{DMatrix, DVector};
@@ -70,7 +71,7 @@ impl Default for BandedSolver {
     fn default() -> Self {
         // 1e-12 on the shapes: a sensitivity φⱼ² at a stiff support, where φⱼ is small, then
         // agrees with the dense solver's to ~1e-12 (1e-10 left 6e-10 and costs 20 % less time on
-        // the paper rotor). Eigenvalue-only solves need √ of it (see `eigenvalue_tolerance`).
+        // the paper rotor). Eigenvalue-only solves need √ of it (see `request_tolerance`).
         Self { tolerance: 1e-12, max_iterations: 500 }
     }
 }
@@ -131,27 +132,17 @@ impl EigenSolver for BandedSolver {
     }
 
     /// The next eigenvalue's bound is the Sturm check's shift: no eigenvalue beyond the modes
-    /// returned lies below it, at no extra cost. Eigenvalues only: they are Rayleigh quotients
-    /// of the converged vectors, whose error is the square of the vectors', so the vectors are
-    /// iterated to √tolerance / 10 only.
+    /// returned lies below it, at no extra cost. Eigenvalues only are iterated less far
+    /// ([`request_tolerance`]).
     fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
-        let tolerance = if request.vectors { self.tolerance } else { self.eigenvalue_tolerance() };
-        match self.banded(system, request.count, tolerance)? {
-            Some((modes, next)) => Ok(SolvedModes {
-                modes: drop_shapes(modes, request.vectors),
-                next_eigenvalue: request.certificate.then_some(next),
-            }),
+        match self.banded(system, request.count, request_tolerance(request, self.tolerance))? {
+            Some((modes, next)) => Ok(SolvedModes::answering(request, modes, next)),
             None => DenseSolver.solve(system, request),
         }
     }
 }
 
 impl BandedSolver {
-    /// Inverse-residual tolerance of eigenvalue-only solves.
-    fn eigenvalue_tolerance(&self) -> f64 {
-        self.tolerance.max(0.1 * self.tolerance.sqrt())
-    }
-
     /// The lowest `count` modes with a lower bound on the next eigenvalue, or `None` for the
     /// dense solver: more than half the spectrum wanted, or a mode missed (see the type's
     /// documentation) in a system small enough for it.

@@ -130,15 +130,8 @@ fn inverted_solve(
     count: usize,
 ) -> Result<Modes, SolveError> {
     let l = chol.l();
-    let b = reduced_inverted(chol, m)?;
-    let eig = SymmetricEigen::try_new(b, f64::EPSILON, 0).ok_or(SolveError::Backend {
-        backend: "dense",
-        detail: "symmetric QR iteration did not converge".into(),
-    })?;
     // Largest μ first = lowest λ first.
-    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-    order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
-    order.truncate(count);
+    let (eig, order) = lowest_pairs(reduced_inverted(chol, m)?, count, |mu| -mu)?;
     if order.iter().any(|&i| eig.eigenvalues[i] <= 0.0) {
         return Err(SolveError::Backend {
             backend: "dense",
@@ -160,18 +153,28 @@ fn mass_reduction(k: &DMatrix<f64>, m: &DMatrix<f64>, count: usize) -> Result<Mo
     let l = chol.l();
     let x = l.solve_lower_triangular(k).ok_or_else(|| not_pd("zero pivot in L"))?;
     let a = l.solve_lower_triangular(&x.transpose()).ok_or_else(|| not_pd("zero pivot in L"))?;
-    let a = (&a + a.transpose()) * 0.5;
+    let (eig, order) = lowest_pairs((&a + a.transpose()) * 0.5, count, |lambda| lambda)?;
+    let eigenvalues = DVector::from_iterator(count, order.iter().map(|&i| eig.eigenvalues[i]));
+    let y = DMatrix::from_columns(&order.iter().map(|&i| eig.eigenvectors.column(i)).collect::<Vec<_>>());
+    let shapes = l.transpose().solve_upper_triangular(&y).ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
+    finish(eigenvalues, shapes)
+}
+
+/// The eigen-decomposition of the symmetric `a` and the indices of its `count` eigenpairs with
+/// the lowest `key(eigenvalue)`, in that order.
+fn lowest_pairs(
+    a: DMatrix<f64>,
+    count: usize,
+    key: impl Fn(f64) -> f64,
+) -> Result<(SymmetricEigen<f64, nalgebra::Dyn>, Vec<usize>), SolveError> {
     let eig = SymmetricEigen::try_new(a, f64::EPSILON, 0).ok_or(SolveError::Backend {
         backend: "dense",
         detail: "symmetric QR iteration did not converge".into(),
     })?;
     let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    order.sort_by(|&i, &j| key(eig.eigenvalues[i]).total_cmp(&key(eig.eigenvalues[j])));
     order.truncate(count);
-    let eigenvalues = DVector::from_iterator(count, order.iter().map(|&i| eig.eigenvalues[i]));
-    let y = DMatrix::from_columns(&order.iter().map(|&i| eig.eigenvectors.column(i)).collect::<Vec<_>>());
-    let shapes = l.transpose().solve_upper_triangular(&y).ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
-    finish(eigenvalues, shapes)
+    Ok((eig, order))
 }
 
 /// Rejects non-finite results and applies the sign rule.

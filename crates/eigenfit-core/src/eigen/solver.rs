@@ -165,6 +165,27 @@ pub fn with_next_by_one_more_mode(
     Ok(SolvedModes { modes, next_eigenvalue: Some(next) })
 }
 
+impl SolvedModes {
+    /// What `request` asked for from `modes` and a backend's bound `next` on the next eigenvalue.
+    pub fn answering(request: ModeRequest, modes: Modes, next: f64) -> Self {
+        Self {
+            modes: drop_shapes(modes, request.vectors),
+            next_eigenvalue: request.certificate.then_some(next),
+        }
+    }
+}
+
+/// The convergence tolerance of an iterative backend for `request`: `tolerance` with shapes; for
+/// eigenvalues only, √tolerance / 10 (when larger), since Rayleigh-quotient eigenvalues are
+/// accurate to the square of the vectors' error.
+pub(crate) fn request_tolerance(request: ModeRequest, tolerance: f64) -> f64 {
+    if request.vectors {
+        tolerance
+    } else {
+        tolerance.max(0.1 * tolerance.sqrt())
+    }
+}
+
 /// `modes` as a request for `vectors` wants them: without shape columns when it asked for
 /// eigenvalues only.
 pub fn drop_shapes(modes: Modes, vectors: bool) -> Modes {

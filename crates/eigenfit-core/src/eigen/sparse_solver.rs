@@ -4,10 +4,10 @@
 //! inertia of the sparse LDLᵀ of K − σ′M) proving that no mode below the highest one returned
 //! was missed.
 
+use crate::eigen::solver::request_tolerance;
 use crate::eigen::{
-    apply_sign_rule, check_count, drop_shapes, lanczos, lanczos::LanczosWork, lanczos::Locked,
-    lanczos::ShiftInvert, shifted_twice, DenseSolver, EigenSolver, ModeRequest, Modes, SolveError,
-    SolvedModes,
+    apply_sign_rule, check_count, lanczos, lanczos::LanczosWork, lanczos::Locked, lanczos::ShiftInvert,
+    shifted_twice, DenseSolver, EigenSolver, ModeRequest, Modes, SolveError, SolvedModes,
 };
 use crate::matrix::{CscSymmetric, System};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -261,24 +261,16 @@ impl EigenSolver for SparseSolver {
         "sparse"
     }
 
-    /// The next eigenvalue's bound is the Sturm count's shift. Eigenvalues only: they are
-    /// Rayleigh quotients of the converged vectors, accurate to the square of the vectors'
-    /// error, so the vectors are iterated to √tolerance / 10 only.
+    /// The next eigenvalue's bound is the Sturm count's shift. Eigenvalues only are iterated
+    /// less far ([`request_tolerance`]).
     fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
-        let tolerance = if request.vectors { self.tolerance } else { self.eigenvalue_tolerance() };
+        let tolerance = request_tolerance(request, self.tolerance);
         let (modes, next) = self.solve_with_tolerance(system, request.count, tolerance)?;
-        Ok(SolvedModes {
-            modes: drop_shapes(modes, request.vectors),
-            next_eigenvalue: request.certificate.then_some(next),
-        })
+        Ok(SolvedModes::answering(request, modes, next))
     }
 }
 
 impl SparseSolver {
-    fn eigenvalue_tolerance(&self) -> f64 {
-        self.tolerance.max(0.1 * self.tolerance.sqrt())
-    }
-
     fn solve_with_tolerance(
         &self,
         system: &System,

@@ -9,7 +9,6 @@ use thiserror::Error;
 /// Why a model's own frequencies could not be made into a measurement; the message is the
 /// failing step's own.
 #[derive(Debug, Clone, PartialEq, Error)]
-#[non_exhaustive]
 pub enum SynthesisError {
     /// The model could not be assembled at the parameters given.
     #[error(transparent)]
