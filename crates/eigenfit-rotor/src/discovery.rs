@@ -8,7 +8,7 @@ use crate::model::Rotor;
 use crate::RotorError;
 use eigenfit_core::analysis::chi2_upper_tail;
 use eigenfit_core::discovery::{
-    discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect,
+    discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect, Place,
 };
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::measurement::Measurement;
@@ -115,7 +115,11 @@ fn search<S: EigenSolver>(
     if let Ok(mut fine_base) = fine_base {
         coarse_result.report.evaluations += fine_base.evaluations;
         fine_base.evaluations = coarse_result.report.evaluations;
-        if !fine_base.disagreement_significant {
+        // The refined mesh is held to the test a named effect must pass (what is left is a misfit
+        // noise can explain, P(χ²) ≥ min_after_p_value), not to the detection level: at 5 %,
+        // one draw in twenty of data the refined mesh fits exactly would be refused.
+        let left = chi2_upper_tail(fine_base.chi2_before, fine_base.dof_before);
+        if left >= options.min_after_p_value {
             let gain = final_aicc(&coarse_result.report) - fine_base.aicc_before;
             if gain > -options.ambiguity_aicc {
                 return Ok(mesh_explains(coarse_result, fine_base, gain, options));
@@ -183,11 +187,7 @@ fn mesh_explains(
             .effects
             .iter()
             .map(|e| Alternative {
-                label: e.label.clone(),
-                kind: e.kind.clone(),
-                location: e.location,
-                position_m: e.position_m,
-                elements: e.elements,
+                place: e.place.clone(),
                 value: e.value,
                 unit: e.unit.clone(),
                 delta_aicc: gain,
@@ -212,11 +212,7 @@ fn mesh_explains(
 
 fn mesh_effect(gain: f64, ambiguous_with: Vec<Alternative>) -> NamedEffect {
     NamedEffect {
-        label: "mesh-refinement".into(),
-        kind: "mesh-refinement".into(),
-        location: None,
-        position_m: None,
-        elements: None,
+        place: Place::new("mesh-refinement", None, None, None),
         value: Some(REFINEMENT as f64),
         interval: None,
         unit: "sub-elements per element".into(),
@@ -226,7 +222,8 @@ fn mesh_effect(gain: f64, ambiguous_with: Vec<Alternative>) -> NamedEffect {
     }
 }
 
-/// AICc of what a run ends with: its named effects, or the calibrated base.
+/// AICc of what a run ends with: its named effects (with the charge for choosing their places,
+/// [`eigenfit_core::discovery::Fit::score`]), or the calibrated base.
 fn final_aicc(r: &DiscoveryReport) -> f64 {
-    r.selected.as_ref().map_or(r.aicc_before, |s| s.aicc.min(r.aicc_before))
+    r.selected.as_ref().map_or(r.aicc_before, |s| s.score().min(r.aicc_before))
 }

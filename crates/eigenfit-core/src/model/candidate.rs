@@ -142,16 +142,22 @@ impl Candidate {
 
     /// `kind@location` (or `kind@first-last`, `kind@x=…m`), or `kind` without a location.
     pub fn label(&self) -> String {
-        match (self.elements, self.position_m, self.location) {
-            (Some([a, b]), _, _) if a != b => format!("{}@{a}-{b}", self.kind),
-            (_, Some(x), _) => format!("{}@{x:.4}m", self.kind),
-            (_, _, Some(l)) => format!("{}@{l}", self.kind),
-            _ => self.kind.clone(),
-        }
+        label_of(&self.kind, self.location, self.position_m, self.elements)
     }
 
     /// Unit of the value (empty for a switch).
     pub fn unit(&self) -> &str {
         self.parameter.as_ref().map_or("", |p| p.unit.as_str())
+    }
+}
+
+/// The label of an effect of `kind` placed so: `kind@first-last` for a run of elements,
+/// `kind@x.xxxxm` by position, `kind@location`, or `kind` alone.
+pub fn label_of(kind: &str, location: Option<usize>, position_m: Option<f64>, elements: Option<[usize; 2]>) -> String {
+    match (elements, position_m, location) {
+        (Some([a, b]), _, _) if a != b => format!("{kind}@{a}-{b}"),
+        (_, Some(x), _) => format!("{kind}@{x:.4}m"),
+        (_, _, Some(l)) => format!("{kind}@{l}"),
+        _ => kind.to_string(),
     }
 }
