@@ -154,7 +154,8 @@ fn discover_refuses_to_write_a_named_pedestal_with_exit_2() {
     let data = dir.join("pedestal.csv");
     std::fs::write(&data, format!("mode,frequency_hz,std_hz\n{csv}")).unwrap();
     let target = dir.join("pedestal-model.toml");
-    let (code, v) = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data.to_str().unwrap(), "--json"]);
+    let (code, v) =
+        eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data.to_str().unwrap(), "--json"]);
     assert_eq!(code, 0);
     assert_eq!(v["missing_effect"]["kind"], "pedestal", "{v}");
     let out = Command::new(env!("CARGO_BIN_EXE_eigenfit"))

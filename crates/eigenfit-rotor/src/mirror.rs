@@ -99,7 +99,8 @@ impl Mirror {
             return None;
         }
         Some(Alternative {
-            place: Place::new(&effect.kind, place.0, place.1, place.2),
+            place: Place::new(&effect.kind, place.0, place.1, place.2)
+                .tapered_to(effect.taper_to.map(|t| self.elements - 1 - t)),
             value: effect.value,
             unit: effect.unit.clone(),
             delta_aicc: 0.0,

@@ -129,18 +129,34 @@ pub struct Place {
     /// First and last element, for an effect over a run of elements.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
+    /// For a taper over `elements`, the element where the value applies in full (the change
+    /// falls linearly to nothing at the run's other end).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub taper_to: Option<usize>,
 }
 
 impl Place {
     /// An effect of `kind` placed so, labelled as a candidate would be.
-    pub fn new(kind: &str, location: Option<usize>, position_m: Option<f64>, elements: Option<[usize; 2]>) -> Self {
-        let label = crate::model::candidate::label_of(kind, location, position_m, elements);
-        Self { label, kind: kind.to_string(), location, position_m, elements }
+    pub fn new(
+        kind: &str,
+        location: Option<usize>,
+        position_m: Option<f64>,
+        elements: Option<[usize; 2]>,
+    ) -> Self {
+        let label = crate::model::candidate::label_of(kind, location, position_m, elements, None);
+        Self { label, kind: kind.to_string(), location, position_m, elements, taper_to: None }
+    }
+
+    /// The same place as a taper whose value applies in full at element `e` (`None`: uniform).
+    pub fn tapered_to(self, e: Option<usize>) -> Self {
+        let label =
+            crate::model::candidate::label_of(&self.kind, self.location, self.position_m, self.elements, e);
+        Self { label, taper_to: e, ..self }
     }
 
     /// The place of candidate `c`.
     pub fn of(c: &Candidate) -> Self {
-        Self::new(&c.kind, c.location, c.position_m, c.elements)
+        Self::new(&c.kind, c.location, c.position_m, c.elements).tapered_to(c.taper_to)
     }
 }
 

@@ -5,7 +5,7 @@
 
 #![allow(dead_code)]
 
-use eigenfit_core::discovery::{DiscoveryOptions, NamedEffect};
+use eigenfit_core::discovery::{DiscoveryOptions, NamedEffect, Place};
 use eigenfit_core::eigen::{BandedSolver, EigenSolver, Modes, SolveError};
 use eigenfit_core::matrix::System;
 use eigenfit_core::measurement::{MeasuredMode, Measurement};
@@ -86,26 +86,21 @@ fn parse(text: &str) -> Fixtures {
     toml::from_str(text).expect("the committed fixtures parse")
 }
 
-/// Does the named effect (or alternative) `kind`/place match `e`? Positions match within a
-/// quarter of the element they fall in (the candidate grid's spacing).
-fn matches(
-    e: &Expected,
-    kind: &str,
-    location: Option<usize>,
-    position_m: Option<f64>,
-    elements: Option<[usize; 2]>,
-) -> bool {
-    if e.kind != kind {
+/// Does the named effect (or alternative) at `place` match `e`? Positions match within a
+/// quarter of the element they fall in (the candidate grid's spacing). A uniform section change
+/// is not matched by a taper; a taper (`within`) by any section change inside its run.
+fn matches(e: &Expected, place: &Place) -> bool {
+    if e.kind != place.kind {
         return false;
     }
     if let Some(x) = e.position_m {
-        return position_m.is_some_and(|p| (p - x).abs() <= 0.0125);
+        return place.position_m.is_some_and(|p| (p - x).abs() <= 0.0125);
     }
     if let Some([a, b]) = e.elements {
-        let run = elements.unwrap_or([location.unwrap_or(usize::MAX); 2]);
-        return if e.within { a <= run[0] && run[1] <= b } else { run == [a, b] };
+        let run = place.elements.unwrap_or([place.location.unwrap_or(usize::MAX); 2]);
+        return if e.within { a <= run[0] && run[1] <= b } else { run == [a, b] && place.taper_to.is_none() };
     }
-    e.location.is_none() || e.location == location
+    e.location.is_none() || e.location == place.location
 }
 
 /// Scores the named effects against the expected ones; also says whether every expected value
@@ -120,7 +115,7 @@ pub fn score(expected: &[Expected], named: &[NamedEffect]) -> (Outcome, bool) {
     let mut ambiguous = false;
     let mut covered = true;
     for e in expected {
-        let direct = named.iter().find(|n| matches(e, &n.kind, n.location, n.position_m, n.elements));
+        let direct = named.iter().find(|n| matches(e, n));
         match direct {
             Some(n) => {
                 if let (Some(v), Some(iv)) = (e.value, n.interval) {
@@ -128,9 +123,7 @@ pub fn score(expected: &[Expected], named: &[NamedEffect]) -> (Outcome, bool) {
                 }
             }
             None => {
-                let alt = named.iter().any(|n| {
-                    n.ambiguous_with.iter().any(|a| matches(e, &a.kind, a.location, a.position_m, a.elements))
-                });
+                let alt = named.iter().any(|n| n.ambiguous_with.iter().any(|a| matches(e, a)));
                 if !alt {
                     return (Outcome::Wrong, covered);
                 }
@@ -139,12 +132,9 @@ pub fn score(expected: &[Expected], named: &[NamedEffect]) -> (Outcome, bool) {
         }
     }
     // Every named effect must be one of the expected ones (or ambiguous with one).
-    let extra = named.iter().any(|n| {
-        !expected.iter().any(|e| {
-            matches(e, &n.kind, n.location, n.position_m, n.elements)
-                || n.ambiguous_with.iter().any(|a| matches(e, &a.kind, a.location, a.position_m, a.elements))
-        })
-    });
+    let extra = named
+        .iter()
+        .any(|n| !expected.iter().any(|e| matches(e, n) || n.ambiguous_with.iter().any(|a| matches(e, a))));
     if extra {
         return (Outcome::Wrong, covered);
     }
