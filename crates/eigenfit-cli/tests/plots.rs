@@ -17,13 +17,6 @@ fn json(out: &Output) -> Value {
     serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}: {stdout}"))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("eigenfit-plots-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 fn example(name: &str) -> String {
     format!("{}/../../examples/{name}", env!("CARGO_MANIFEST_DIR"))
 }
@@ -64,7 +57,8 @@ fn check_plot(dir: &Path, stem: &str, expected: &[&str]) {
 
 #[test]
 fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
-    let dir = temp_dir("simulate");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let out = eigenfit(&[
         "simulate",
         "--preset",
@@ -111,7 +105,8 @@ fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
 
 #[test]
 fn a_model_file_gets_no_table_1_overlay() {
-    let dir = temp_dir("simulate-file");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let out = eigenfit(&[
         "simulate",
         "--model",
@@ -131,7 +126,8 @@ fn a_model_file_gets_no_table_1_overlay() {
 
 #[test]
 fn estimate_plots_its_convergence_history() {
-    let dir = temp_dir("estimate");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let csv = dir.join("m.csv");
     std::fs::write(&csv, "mode,frequency_hz\n1,36.107\n2,84.066\n").unwrap();
     let more = ["--plot", dir.to_str().unwrap(), "--json"];
@@ -158,7 +154,8 @@ fn estimate_plots_its_convergence_history() {
 
 #[test]
 fn compare_plots_convergence_and_iteration_maps() {
-    let dir = temp_dir("compare");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let out = eigenfit(&[
         "compare",
         "--preset",
@@ -201,7 +198,8 @@ fn compare_plots_convergence_and_iteration_maps() {
 
 #[test]
 fn discover_plots_the_residual_before_and_after_with_the_noise_band() {
-    let dir = temp_dir("discover");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let out = eigenfit(&[
         "discover",
         "--preset",
@@ -237,7 +235,8 @@ fn discover_plots_the_residual_before_and_after_with_the_noise_band() {
 
 #[test]
 fn demo_writes_every_plot_kind_and_reports() {
-    let dir = temp_dir("demo");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let out_dir = dir.join("report");
     let out = eigenfit(&["demo", "--out", out_dir.to_str().unwrap(), "--grid", "4"]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
@@ -269,7 +268,8 @@ fn demo_writes_every_plot_kind_and_reports() {
 
 #[test]
 fn demo_json_lists_the_results_and_the_plots() {
-    let dir = temp_dir("demo-json");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let out = eigenfit(&["demo", "--out", dir.to_str().unwrap(), "--grid", "3", "--json"]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let v = json(&out);

@@ -22,12 +22,6 @@ fn json(args: &[&str]) -> (i32, Value) {
     (code, serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out} {err}")))
 }
 
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("eigenfit-test-data-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
 fn truth() -> [f64; 2] {
     let j: Value =
         serde_json::from_str(&std::fs::read_to_string(data("symmetric_rotor.json")).unwrap()).unwrap();
@@ -76,7 +70,8 @@ fn a_universal_file_estimates_a_symmetric_rotor_on_the_right_sides() {
 
 #[test]
 fn simulated_modes_round_trip_through_a_universal_file() {
-    let file = temp("round-trip.unv");
+    let scratch = common::scratch();
+    let file = scratch.path().join("round-trip.unv");
     let file = file.to_str().unwrap();
     let model = data("symmetric_rotor.toml");
     let (code, out, err) =
@@ -94,6 +89,7 @@ fn simulated_modes_round_trip_through_a_universal_file() {
 
 #[test]
 fn shapes_in_csv_estimate_the_right_sides_too() {
+    let scratch = common::scratch();
     // The fixture's frequencies and y shapes, as a test engineer would type them.
     let j: Value =
         serde_json::from_str(&std::fs::read_to_string(data("symmetric_rotor.json")).unwrap()).unwrap();
@@ -107,7 +103,7 @@ fn shapes_in_csv_estimate_the_right_sides_too() {
             shapes += &format!("{k},{n},y,{y}\n");
         }
     }
-    let (f, s) = (temp("freq.csv"), temp("shapes.csv"));
+    let (f, s) = (scratch.path().join("freq.csv"), scratch.path().join("shapes.csv"));
     std::fs::write(&f, freq).unwrap();
     std::fs::write(&s, shapes).unwrap();
     let (code, v) = json(&[
@@ -132,16 +128,17 @@ fn shapes_in_csv_estimate_the_right_sides_too() {
 
 #[test]
 fn bad_test_data_is_named() {
+    let scratch = common::scratch();
     let model = data("symmetric_rotor.toml");
     let text = std::fs::read_to_string(data("symmetric_rotor.unv")).unwrap();
     // Node 103 moved 10 mm off the shaft's nodes.
-    let moved = temp("moved.unv");
+    let moved = scratch.path().join("moved.unv");
     std::fs::write(&moved, text.replacen("2.5000000000000000e+02", "2.6000000000000000e+02", 1)).unwrap();
     let (code, _, err) = run(&["estimate", "--model", &model, "--measured", moved.to_str().unwrap()]);
     assert_eq!(code, 2);
     assert!(err.contains("node 103 at (0, 0, 0.26) m") && err.contains("nearest model node 5"), "{err}");
     // A broken number names the file and line.
-    let broken = temp("broken.unv");
+    let broken = scratch.path().join("broken.unv");
     let mut lines: Vec<&str> = text.lines().collect();
     let at = lines.iter().position(|l| l.trim() == "55").unwrap() + 9;
     lines[at] = "       abc";
@@ -170,7 +167,8 @@ fn bad_test_data_is_named() {
 
 #[test]
 fn plot_writes_the_mac_heatmap() {
-    let dir = temp("plots");
+    let scratch = common::scratch();
+    let dir = scratch.path().join("plots");
     let (code, out, err) = run(&[
         "estimate",
         "--model",
@@ -189,7 +187,8 @@ fn plot_writes_the_mac_heatmap() {
 
 #[test]
 fn the_written_model_round_trips_and_fix_holds_a_parameter() {
-    let out = temp("updated.toml");
+    let scratch = common::scratch();
+    let out = scratch.path().join("updated.toml");
     let (code, v) = json(&[
         "estimate",
         "--model",
@@ -257,11 +256,12 @@ fn the_written_model_round_trips_and_fix_holds_a_parameter() {
 /// other values, and written back into the model.
 #[test]
 fn a_declared_disk_mass_is_estimated_and_written_back() {
+    let scratch = common::scratch();
     let base = std::fs::read_to_string(data("symmetric_rotor.toml")).unwrap();
     // The "test rig": a heavier drive-end disk and other bearings.
-    let rig = temp("rig.toml");
+    let rig = scratch.path().join("rig.toml");
     std::fs::write(&rig, base.replacen("mass = 1.0", "mass = 1.3", 1)).unwrap();
-    let file = temp("rig.unv");
+    let file = scratch.path().join("rig.unv");
     let (code, out, err) = run(&[
         "simulate",
         "--model",
@@ -274,9 +274,9 @@ fn a_declared_disk_mass_is_estimated_and_written_back() {
         file.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{out}{err}");
-    let model = temp("with-disk-mass.toml");
+    let model = scratch.path().join("with-disk-mass.toml");
     std::fs::write(&model, format!("{base}\n[[parameter]]\nkind = \"disk-mass\"\nindex = 0\n")).unwrap();
-    let updated = temp("with-disk-mass-updated.toml");
+    let updated = scratch.path().join("with-disk-mass-updated.toml");
     let (code, v) = json(&[
         "estimate",
         "--model",
@@ -319,7 +319,8 @@ fn a_declared_disk_mass_is_estimated_and_written_back() {
 /// alone put the bearings on the right sides.
 #[test]
 fn a_campaign_with_a_test_mass_tells_the_sides_apart_from_frequencies() {
-    let dir = temp("campaign");
+    let scratch = common::scratch();
+    let dir = scratch.path().join("campaign");
     std::fs::create_dir_all(&dir).unwrap();
     let base = std::fs::read_to_string(data("symmetric_rotor.toml")).unwrap();
     std::fs::write(dir.join("rotor.toml"), &base).unwrap();
@@ -377,7 +378,8 @@ fn a_campaign_with_a_test_mass_tells_the_sides_apart_from_frequencies() {
 
 #[test]
 fn a_sensor_map_ties_sensors_like_coordinates_do() {
-    let map = temp("map.csv");
+    let scratch = common::scratch();
+    let map = scratch.path().join("map.csv");
     std::fs::write(
         &map,
         "node,model_node,direction,sign\n101,0,y,1\n102,2,y,1\n103,5,2,1\n104,8,y,1\n105,10,y,1\n",
@@ -415,10 +417,11 @@ fn a_sensor_map_ties_sensors_like_coordinates_do() {
 
 #[test]
 fn millimetres_without_a_units_dataset_are_recognised_and_said() {
+    let scratch = common::scratch();
     let text = std::fs::read_to_string(data("symmetric_rotor.unv")).unwrap();
     // Drop dataset 164 (the first dataset): coordinates stay in mm with nothing saying so.
     let start = text.match_indices("    -1\n").nth(2).unwrap().0;
-    let file = temp("no-units.unv");
+    let file = scratch.path().join("no-units.unv");
     std::fs::write(&file, &text[start..]).unwrap();
     let (code, v) = json(&[
         "estimate",

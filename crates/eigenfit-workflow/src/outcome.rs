@@ -27,3 +27,21 @@ impl Outcome {
         }
     }
 }
+
+/// Model evaluations allowed and spent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct BudgetReport {
+    /// The limit.
+    pub limit: usize,
+    /// Spent.
+    pub used: usize,
+    /// Whether it ran out.
+    pub exhausted: bool,
+}
+
+impl BudgetReport {
+    /// What `budget` allowed and what was spent of it.
+    pub fn of(budget: &eigenfit_core::update::Budget) -> Self {
+        Self { limit: budget.limit(), used: budget.used(), exhausted: budget.exhausted() }
+    }
+}

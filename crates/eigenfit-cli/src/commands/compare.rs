@@ -46,6 +46,10 @@ pub struct CompareArgs {
     /// Iteration limit per run.
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) each run may spend on its fit and intervals; a run
+    /// that hits it ends `budget-exhausted` (counted per target and strategy in the summary).
+    #[arg(long, value_name = "N", default_value_t = eigenfit_core::update::DEFAULT_EVALUATIONS)]
+    pub budget: usize,
     /// Also print a convergence map per target and strategy (grid runs with two parameters).
     #[arg(long)]
     pub maps: bool,
@@ -78,6 +82,7 @@ fn request(args: &CompareArgs) -> CompareRequest {
         std_hz: args.std_hz,
         modes: args.modes,
         max_iterations: args.max_iterations,
+        budget: args.budget,
         timing: args.timing,
     }
 }
@@ -143,6 +148,13 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             );
         }
         println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged damped runs whose data also fit another solution, - where not checked)");
+        let cut: usize = report.summary.iter().map(|s| s.budget_exhausted).sum();
+        if cut > 0 {
+            println!(
+                "{cut} run(s) ran out of their evaluation budget ({} model evaluations each): their results are incomplete; raise it with --budget",
+                args.budget
+            );
+        }
         if args.maps && np == 2 {
             print_maps(&report.raw, &plan.targets, &plan.strategies);
         }

@@ -27,3 +27,16 @@ pub fn paper_estimate<'a>(
     args.extend_from_slice(more);
     args
 }
+
+/// A fresh folder under the system's temporary folder, removed with everything in it when the
+/// value is dropped (also when the test fails).
+pub fn scratch() -> tempfile::TempDir {
+    tempfile::Builder::new().prefix("eigenfit-test-").tempdir().expect("a temporary folder")
+}
+
+/// Writes `text` to `name` in `dir`; returns the file's path.
+pub fn write_in(dir: &tempfile::TempDir, name: &str, text: &str) -> std::path::PathBuf {
+    let path = dir.path().join(name);
+    std::fs::write(&path, text).expect("a file in the temporary folder");
+    path
+}

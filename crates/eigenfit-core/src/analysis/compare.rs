@@ -1,12 +1,12 @@
 //! Strategy comparison: targets × initial guesses × strategies on reference data synthesised
 //! from the model itself (the paper's Tables 2–5 and convergence maps).
 
-use crate::analysis::{alternatives_among, local_solutions, uncertainty, Identifiability};
+use crate::analysis::{alternatives_among, local_solutions, uncertainty_within, Identifiability};
 use crate::eigen::EigenSolver;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::problem::{Linearisation, Objective, Problem};
-use crate::update::{Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
+use crate::update::{Budget, Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
@@ -26,6 +26,9 @@ pub struct CompareSettings {
     pub std_hz: Option<f64>,
     /// Iteration limit per run.
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) one run may spend on its fit and, for a damped run,
+    /// its intervals ([`Budget`]); a run that hits it ends `budget-exhausted`.
+    pub budget: usize,
 }
 
 /// One run of the comparison. Serialises as the `compare` report's run (the fields a report
@@ -61,6 +64,10 @@ pub struct CompareRun {
     /// empty, the data cannot choose between them and the estimate.
     #[serde(skip)]
     pub alternatives: Vec<Vec<f64>>,
+    /// True when the run's budget ([`CompareSettings::budget`]) ran out: its fit or its
+    /// identifiability flags are incomplete. Written only when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub budget_exhausted: bool,
 }
 
 /// Reference data: the lowest `modes` frequencies of `model` at `target`, optionally rounded.
@@ -143,14 +150,20 @@ where
         }
         _ => strategy.build(),
     };
-    let outcome =
-        Driver { max_iterations: settings.max_iterations }.run(problem, s.as_mut(), initial, &mut []);
+    let budget = Budget::new(settings.budget);
+    let outcome = Driver { max_iterations: settings.max_iterations }.run_within(
+        problem,
+        s.as_mut(),
+        initial,
+        &mut [],
+        &budget,
+    );
     let seconds = start.elapsed().as_secs_f64();
     match outcome {
         Ok(est) => {
             let converged = est.termination.is_converged();
             let identifiability = (converged && strategy == StrategyKind::LevenbergMarquardt)
-                .then(|| uncertainty(problem, &est.last, problem.measured.has_std()))
+                .then(|| uncertainty_within(problem, &est.last, problem.measured.has_std(), &budget))
                 .flatten()
                 .map(|u| u.identifiability);
             let alternatives = if converged && strategy == StrategyKind::LevenbergMarquardt {
@@ -171,6 +184,7 @@ where
                 estimate: est.parameters,
                 seconds,
                 identifiability,
+                budget_exhausted: budget.exhausted(),
             }
         }
         Err(e) => CompareRun {
@@ -186,6 +200,7 @@ where
             seconds,
             identifiability: None,
             alternatives: Vec::new(),
+            budget_exhausted: budget.exhausted(),
         },
     }
 }
@@ -311,7 +326,13 @@ mod tests {
         let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
         let strategies = StrategyKind::ALL;
         let settings =
-            CompareSettings { modes: 3, decimals: Some(3), std_hz: Some(0.01), max_iterations: 100 };
+            CompareSettings {
+                modes: 3,
+                decimals: Some(3),
+                std_hz: Some(0.01),
+                max_iterations: 100,
+                budget: crate::update::DEFAULT_EVALUATIONS,
+            };
         let mut seen = 0;
         let par = run_grid(&chain, &DenseSolver, &targets, &initials, &strategies, &settings, |_| seen += 1)
             .unwrap();
