@@ -46,7 +46,11 @@ fn ross_example_matches_ross() {
 #[test]
 fn estimate_reports_parameters_frequencies_and_intervals() {
     let scratch = common::scratch();
-    let csv = common::write_in(&scratch, "m.csv", "mode,frequency_hz,std_hz\n1,36.107,0.036\n2,84.066,0.084\n3,305.649,0.3\n");
+    let csv = common::write_in(
+        &scratch,
+        "m.csv",
+        "mode,frequency_hz,std_hz\n1,36.107,0.036\n2,84.066,0.084\n3,305.649,0.3\n",
+    );
     let (code, v) =
         eigenfit(&common::paper_estimate(csv.to_str().unwrap(), "damped", "1e2,1e2", &["--json"]));
     assert_eq!(code, 0);
@@ -99,10 +103,15 @@ fn compare_prints_one_run_per_cell() {
     }
 }
 
+/// `discover --preset paper-rotor --measured examples/NAME --json`.
+fn discover_example(name: &str) -> (i32, Value) {
+    let data = format!("{}/../../examples/{name}", env!("CARGO_MANIFEST_DIR"));
+    eigenfit(&["discover", "--preset", "paper-rotor", "--measured", &data, "--json"])
+}
+
 #[test]
 fn discover_names_the_hidden_effect_of_the_example_data() {
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_hidden_effect.csv");
-    let (code, v) = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data, "--json"]);
+    let (code, v) = discover_example("measured_hidden_effect.csv");
     assert_eq!(code, 0);
     assert_eq!(v["disagreement_significant"], true);
     // The data were made with disk-rotary-inertia@0 = 1e-3 kg·m² (docs/discovery.md).
@@ -117,8 +126,7 @@ fn discover_names_the_hidden_effect_of_the_example_data() {
 
 #[test]
 fn discover_adds_nothing_to_a_model_that_fits() {
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_no_effect.csv");
-    let (code, v) = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data, "--json"]);
+    let (code, v) = discover_example("measured_no_effect.csv");
     assert_eq!(code, 0);
     assert_eq!(v["disagreement_significant"], false);
     assert!(v["missing_effect"].is_null());

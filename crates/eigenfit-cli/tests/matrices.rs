@@ -241,20 +241,11 @@ fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
         std::fs::write(&file, uff::write("plate campaign", nodes, &uff_modes)).unwrap();
         let measured = file.to_str().unwrap();
         let model = plate("model.toml");
-        eigenfit(&[
-            "estimate",
-            "--model",
+        eigenfit(&common::estimate_with(
             &model,
-            "--measured",
             measured,
-            "--alternative-starts",
-            "0",
-            "--fix",
-            "zone3=1.1",
-            "--fix",
-            "zone4=0.9",
-            "--json",
-        ])
+            &["--alternative-starts", "0", "--fix", "zone3=1.1", "--fix", "zone4=0.9", "--json"],
+        ))
     };
     let (code, v, err) = estimate(&nodes);
     assert_eq!(code, 0, "{err}\n{v}");

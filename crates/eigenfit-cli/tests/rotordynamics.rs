@@ -131,16 +131,11 @@ fn estimate_with_cross_coupled_and_damping_parameters_and_verdicts() {
     let measured = data("runup_truth.csv");
     let truth: Value =
         serde_json::from_str(&std::fs::read_to_string(data("runup_truth.json")).unwrap()).unwrap();
-    let out = run(&[
-        "estimate",
-        "--model",
+    let out = run(&common::estimate_with(
         &model,
-        "--measured",
         &measured,
-        "--parameters",
-        "kxx,kyy,kxy,kyx,cxx,cyy",
-        "--json",
-    ]);
+        &["--parameters", "kxx,kyy,kxy,kyx,cxx,cyy", "--json"],
+    ));
     let v = json(&out);
     assert_eq!(v["verdict"], "converged");
     assert_eq!(v["acceptable"], true);

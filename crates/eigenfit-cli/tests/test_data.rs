@@ -4,22 +4,28 @@
 mod common;
 
 use serde_json::Value;
-use std::path::PathBuf;
+
 use std::process::Command;
 
 fn data(name: &str) -> String {
     common::data_file("../../tests/data/uff", name)
 }
 
-fn run(args: &[&str]) -> (i32, String, String) {
+fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs");
     let text = |b: Vec<u8>| String::from_utf8(b).expect("utf-8");
     (out.status.code().unwrap_or(-1), text(out.stdout), text(out.stderr))
 }
 
-fn json(args: &[&str]) -> (i32, Value) {
+fn json<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> (i32, Value) {
     let (code, out, err) = run(args);
     (code, serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out} {err}")))
+}
+
+/// `estimate` of the symmetric rotor from its universal file, then `more`.
+fn symmetric(more: &[&str]) -> Vec<String> {
+    let (model, unv) = (data("symmetric_rotor.toml"), data("symmetric_rotor.unv"));
+    common::estimate_with(&model, &unv, more).into_iter().map(String::from).collect()
 }
 
 fn truth() -> [f64; 2] {
@@ -32,15 +38,7 @@ fn truth() -> [f64; 2] {
 /// estimate is on the right sides (the truth inside, the mirror outside both intervals).
 #[test]
 fn a_universal_file_estimates_a_symmetric_rotor_on_the_right_sides() {
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--json",
-        "--quiet",
-    ]);
+    let (code, v) = json(&symmetric(&["--json", "--quiet"]));
     assert_eq!(code, 0, "{v}");
     let truth = truth();
     for (i, name) in ["k_drive_end", "k_free_end"].iter().enumerate() {
@@ -106,19 +104,11 @@ fn shapes_in_csv_estimate_the_right_sides_too() {
     let (f, s) = (scratch.path().join("freq.csv"), scratch.path().join("shapes.csv"));
     std::fs::write(&f, freq).unwrap();
     std::fs::write(&s, shapes).unwrap();
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
+    let (code, v) = json(&common::estimate_with(
         &data("symmetric_rotor.toml"),
-        "--measured",
         f.to_str().unwrap(),
-        "--shapes",
-        s.to_str().unwrap(),
-        "--initial",
-        "9e4,2e5",
-        "--json",
-        "--quiet",
-    ]);
+        &["--shapes", s.to_str().unwrap(), "--initial", "9e4,2e5", "--json", "--quiet"],
+    ));
     assert_eq!(code, 0, "{v}");
     let truth = truth();
     let k =
@@ -150,17 +140,11 @@ fn bad_test_data_is_named() {
         "{err}"
     );
     // The MAC threshold: no measured mode can be paired at MAC ≥ 1 with noisy shapes → exit 3.
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
+    let (code, v) = json(&common::estimate_with(
         &model,
-        "--measured",
         &data("symmetric_rotor.unv"),
-        "--mac-threshold",
-        "1",
-        "--json",
-        "--quiet",
-    ]);
+        &["--mac-threshold", "1", "--json", "--quiet"],
+    ));
     assert_eq!(code, 3);
     assert_eq!(v["unpaired"], serde_json::json!([1, 2, 3]));
 }
@@ -169,16 +153,7 @@ fn bad_test_data_is_named() {
 fn plot_writes_the_mac_heatmap() {
     let scratch = common::scratch();
     let dir = scratch.path().join("plots");
-    let (code, out, err) = run(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--plot",
-        dir.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let (code, out, err) = run(&symmetric(&["--plot", dir.to_str().unwrap(), "--quiet"]));
     assert_eq!(code, 0, "{out}{err}");
     let svg = std::fs::read_to_string(dir.join("mac.svg")).unwrap();
     assert!(svg.contains("MAC, measured against model modes"));
@@ -189,17 +164,7 @@ fn plot_writes_the_mac_heatmap() {
 fn the_written_model_round_trips_and_fix_holds_a_parameter() {
     let scratch = common::scratch();
     let out = scratch.path().join("updated.toml");
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--write-model",
-        out.to_str().unwrap(),
-        "--json",
-        "--quiet",
-    ]);
+    let (code, v) = json(&symmetric(&["--write-model", out.to_str().unwrap(), "--json", "--quiet"]));
     assert_eq!(code, 0, "{v}");
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.starts_with("# Updated by eigenfit estimate (damped strategy, converged) on "), "{text}");
@@ -207,15 +172,11 @@ fn the_written_model_round_trips_and_fix_holds_a_parameter() {
         text.contains("symmetric_rotor.unv") && text.contains("# chi2 = ") && text.contains("95% interval [")
     );
     // Read back through --model: the estimate is the new nominal, and estimating again stays there.
-    let (code, again) = json(&[
-        "estimate",
-        "--model",
+    let (code, again) = json(&common::estimate_with(
         out.to_str().unwrap(),
-        "--measured",
         &data("symmetric_rotor.unv"),
-        "--json",
-        "--quiet",
-    ]);
+        &["--json", "--quiet"],
+    ));
     assert_eq!(code, 0);
     for name in ["k_drive_end", "k_free_end"] {
         assert_eq!(again["initial"][name], v["parameters"][name]);
@@ -223,31 +184,13 @@ fn the_written_model_round_trips_and_fix_holds_a_parameter() {
         assert!((a / b - 1.0).abs() < 1e-6, "{name}: {a} vs {b}");
     }
     // --fix holds one bearing: only the other is estimated, and reported.
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--fix",
-        "k_free_end=8e4",
-        "--json",
-        "--quiet",
-    ]);
+    let (code, v) = json(&symmetric(&["--fix", "k_free_end=8e4", "--json", "--quiet"]));
     assert_eq!(code, 0, "{v}");
     assert_eq!(v["fixed"], serde_json::json!({"k_free_end": 8e4}));
     assert_eq!(v["parameters"].as_object().unwrap().len(), 1);
     let k = v["parameters"]["k_drive_end"].as_f64().unwrap();
     assert!((k / truth()[0] - 1.0).abs() < 0.02, "{k}");
-    let (code, _, err) = run(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--fix",
-        "k_nope=1",
-    ]);
+    let (code, _, err) = run(&symmetric(&["--fix", "k_nope=1"]));
     assert_eq!(code, 2);
     assert!(err.contains("--fix") && err.contains("k_nope"), "{err}");
 }
@@ -277,17 +220,11 @@ fn a_declared_disk_mass_is_estimated_and_written_back() {
     let model = scratch.path().join("with-disk-mass.toml");
     std::fs::write(&model, format!("{base}\n[[parameter]]\nkind = \"disk-mass\"\nindex = 0\n")).unwrap();
     let updated = scratch.path().join("with-disk-mass-updated.toml");
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
+    let (code, v) = json(&common::estimate_with(
         model.to_str().unwrap(),
-        "--measured",
         file.to_str().unwrap(),
-        "--write-model",
-        updated.to_str().unwrap(),
-        "--json",
-        "--quiet",
-    ]);
+        &["--write-model", updated.to_str().unwrap(), "--json", "--quiet"],
+    ));
     assert_eq!(code, 0, "{v}");
     for (name, want) in [("k_drive_end", 2e5), ("k_free_end", 1.5e5), ("m_disk_0", 1.3)] {
         let got = v["parameters"][name].as_f64().unwrap();
@@ -423,15 +360,11 @@ fn millimetres_without_a_units_dataset_are_recognised_and_said() {
     let start = text.match_indices("    -1\n").nth(2).unwrap().0;
     let file = scratch.path().join("no-units.unv");
     std::fs::write(&file, &text[start..]).unwrap();
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
+    let (code, v) = json(&common::estimate_with(
         &data("symmetric_rotor.toml"),
-        "--measured",
         file.to_str().unwrap(),
-        "--json",
-        "--quiet",
-    ]);
+        &["--json", "--quiet"],
+    ));
     assert_eq!(code, 0, "{v}");
     assert!(v["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains("read as mm")), "{v}");
     assert_eq!(v["sensors"].as_array().unwrap().len(), 5);

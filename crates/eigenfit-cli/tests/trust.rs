@@ -91,6 +91,35 @@ fn the_stiff_rotor_reports_chi2_and_stays_within_its_budget() {
 }
 
 #[test]
+fn discover_stays_within_the_budget_it_is_given_and_says_when_it_ran_out() {
+    let measured = "../../../../examples/measured_hidden_effect.csv";
+    for budget in [300u64, 1000, 100_000] {
+        let b = budget.to_string();
+        let out = eigenfit(&[
+            "discover",
+            "--preset",
+            "paper-rotor",
+            "--measured",
+            measured,
+            "--budget",
+            &b,
+            "--json",
+        ]);
+        let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        let used = v["evaluations"].as_u64().unwrap();
+        assert!(used <= budget, "{used} evaluations for a budget of {budget}");
+        assert_eq!(v["budget_limit"], budget);
+        // Exit 3 exactly when the search was cut short.
+        let cut = v["budget_exhausted"].as_bool().unwrap();
+        assert_eq!(out.status.code(), Some(if cut { 3 } else { 0 }), "budget {budget}: {v}");
+        // Enough budget: the effect is found without running out.
+        if budget == 100_000 {
+            assert!(!cut && v["missing_effect"]["kind"] == "disk-rotary-inertia", "{v}");
+        }
+    }
+}
+
+#[test]
 fn discover_reports_the_stiffnesses_refitted_with_the_effect() {
     let measured = "../../../../examples/measured_hidden_effect.csv";
     let out = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", measured, "--json"]);
@@ -119,20 +148,8 @@ fn stream_appends_and_the_other_run_is_refused() {
     let scratch = tempfile::tempdir().expect("a temporary folder");
     let dir = scratch.path();
     let file = dir.join("runs.jsonl");
-    let _ = std::fs::remove_file(&file);
-    let path = file.to_str().unwrap();
-    let args = [
-        "compare",
-        "--preset",
-        "paper-rotor",
-        "--targets",
-        "2e5:5e4",
-        "--initials",
-        "1e5:1e5",
-        "--quiet",
-        "--stream",
-        path,
-    ];
+    let one_run = "compare --preset paper-rotor --targets 2e5:5e4 --initials 1e5:1e5 --quiet --stream";
+    let args: Vec<&str> = one_run.split(' ').chain([file.to_str().unwrap()]).collect();
     assert_eq!(eigenfit(&args).status.code(), Some(0));
     let first = std::fs::read_to_string(&file).unwrap();
     assert_eq!(eigenfit(&args).status.code(), Some(0));
@@ -140,7 +157,7 @@ fn stream_appends_and_the_other_run_is_refused() {
     assert_eq!(both.lines().count(), 2 * first.lines().count());
     assert!(both.starts_with(&first));
     // A run refused by validation after the file name was given loses nothing.
-    let mut bad = args.to_vec();
+    let mut bad = args.clone();
     bad.extend(["--decimals", "400"]);
     assert_eq!(eigenfit(&bad).status.code(), Some(2));
     assert_eq!(std::fs::read_to_string(&file).unwrap(), both);

@@ -6,7 +6,9 @@ use crate::model::AnyModel;
 use crate::named::Named;
 use crate::progress::Progress;
 use eigenfit_core::analysis::verdict::check_reachable;
-use eigenfit_core::discovery::{discover, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
+use eigenfit_core::discovery::{
+    discover, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect,
+};
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::Problem;

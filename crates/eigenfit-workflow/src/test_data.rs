@@ -223,7 +223,9 @@ impl<'a> Fit<'a> {
             Fit::Frequencies(p) => {
                 (eigenfit_core::analysis::uncertainty_observed(p, at, has_std, budget, observers), None)
             }
-            Fit::Shapes(s) => s.uncertainty_within(at, budget).map_or((None, None), |(u, sc)| (Some(u), Some(sc))),
+            Fit::Shapes(s) => {
+                s.uncertainty_within(at, budget).map_or((None, None), |(u, sc)| (Some(u), Some(sc)))
+            }
         }
     }
 

@@ -1,6 +1,6 @@
 //! `eigenfit compare`: strategies × targets × a grid of initial guesses on reference data.
 
-use crate::error::CliError;
+use crate::error::{CliError, EXIT_NOT_CONVERGED, EXIT_OK};
 use crate::output::Stream;
 use crate::plot::compare_map::{CompareMaps, MapKind};
 use crate::source::ModelArgs;
@@ -87,8 +87,9 @@ fn request(args: &CompareArgs) -> CompareRequest {
     }
 }
 
-/// Runs `compare`.
-pub fn run(args: &CompareArgs) -> Result<(), CliError> {
+/// Runs `compare`; returns the exit code (3 when a run ran out of its evaluation budget: the
+/// comparison is incomplete).
+pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
     let np = model.parameters().len();
@@ -112,6 +113,9 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
+    let cut: usize = report.summary.iter().map(|s| s.budget_exhausted).sum();
+    let code = if cut > 0 { EXIT_NOT_CONVERGED } else { EXIT_OK };
+    crate::error::set_exit_on_closed_pipe(code);
     crate::output::report(args.report.json, &report, |report| {
         println!(
             "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",
@@ -148,7 +152,6 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             );
         }
         println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged damped runs whose data also fit another solution, - where not checked)");
-        let cut: usize = report.summary.iter().map(|s| s.budget_exhausted).sum();
         if cut > 0 {
             println!(
                 "{cut} run(s) ran out of their evaluation budget ({} model evaluations each): their results are incomplete; raise it with --budget",
@@ -161,7 +164,8 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     });
     // A write failure ends the command non-zero after the results are printed.
-    stream.map_or(Ok(()), |w| w.finish(report.runs.len()))
+    stream.map_or(Ok(()), |w| w.finish(report.runs.len()))?;
+    Ok(code)
 }
 
 /// Writes the convergence and iteration maps; a note on stderr (and nothing written) unless the

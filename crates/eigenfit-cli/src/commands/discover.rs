@@ -114,6 +114,16 @@ fn print_report(
     }
     match (found.effects.is_empty(), r.disagreement_significant) {
         (_, false) => println!("no significant disagreement: nothing added."),
+        // Cut short, the search has not shown that nothing explains the data.
+        (true, true) if r.budget_exhausted => {
+            println!("no candidate effect confirmed before the budget ran out.");
+            if let Some(best) = r.fits.iter().find(|f| f.plausible) {
+                println!(
+                    "  best partial explanation so far: {} (χ² {:.2} → {:.2})",
+                    best.label, r.chi2_before, best.chi2
+                );
+            }
+        }
         (true, true) => {
             println!(
                 "no candidate effect, alone or with others, explains the disagreement down to the noise."

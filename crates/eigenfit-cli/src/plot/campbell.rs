@@ -29,10 +29,6 @@ impl Figure for CampbellPlot<'_> {
         (1000, 680)
     }
 
-    fn supersample(&self) -> u32 {
-        super::SUPERSAMPLE
-    }
-
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let c = self.campbell;
         let (s0, s1) = (c.speeds_rpm[0], c.speeds_rpm[c.speeds_rpm.len() - 1].max(c.speeds_rpm[0] + 1.0));
@@ -78,7 +74,9 @@ impl Figure for CampbellPlot<'_> {
                 .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
                 .map_err(err)?
                 .label(format!("{name} whirl"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + pxi(24), y)], colour.stroke_width(px(3))));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + pxi(24), y)], colour.stroke_width(px(3)))
+                });
         }
         chart
             .draw_series(DashedLineSeries::new(
@@ -92,7 +90,9 @@ impl Figure for CampbellPlot<'_> {
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + pxi(24), y)], INK.stroke_width(px(2))));
         chart
             .draw_series(
-                c.critical_speeds.iter().map(|k| Circle::new((k.rpm, k.rpm / 60.0), px(7), INK.stroke_width(px(2)))),
+                c.critical_speeds
+                    .iter()
+                    .map(|k| Circle::new((k.rpm, k.rpm / 60.0), px(7), INK.stroke_width(px(2)))),
             )
             .map_err(err)?
             .label("critical speed")
@@ -100,4 +100,6 @@ impl Figure for CampbellPlot<'_> {
         style::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         Ok(())
     }
+
+    const SUPERSAMPLE: u32 = super::SUPERSAMPLE;
 }

@@ -90,10 +90,6 @@ impl Figure for CriticalSpeedMap {
         (1000, 680)
     }
 
-    fn supersample(&self) -> u32 {
-        super::SUPERSAMPLE
-    }
-
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let modes = self.mode_count();
         let x_range = self.stiffness[0]..self.stiffness[self.stiffness.len() - 1];
@@ -127,7 +123,9 @@ impl Figure for CriticalSpeedMap {
                 ))
                 .map_err(err)?
                 .label(format!("model, mode {}", m + 1))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + pxi(24), y)], c.stroke_width(px(3))));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + pxi(24), y)], c.stroke_width(px(3)))
+                });
         }
         if !self.reference.is_empty() {
             chart
@@ -144,4 +142,6 @@ impl Figure for CriticalSpeedMap {
         style::legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         Ok(())
     }
+
+    const SUPERSAMPLE: u32 = super::SUPERSAMPLE;
 }

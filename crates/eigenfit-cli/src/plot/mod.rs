@@ -39,11 +39,9 @@ pub trait Figure {
     fn size(&self) -> (u32, u32);
     /// Draws the whole figure on `root` (already filled white).
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult;
-    /// Drawn pixels per PNG pixel in each direction (1: drawn as is). A figure returning more
-    /// gives every pixel size through [`style::px`] / [`style::pxi`].
-    fn supersample(&self) -> u32 {
-        1
-    }
+    /// Drawn pixels per PNG pixel in each direction (1: drawn as is). A figure with more gives
+    /// every pixel size through [`style::px`] / [`style::pxi`].
+    const SUPERSAMPLE: u32 = 1;
 }
 
 /// The supersampling of figures with curves: 4 × 4 drawn pixels per PNG pixel, so a curve's
@@ -51,10 +49,10 @@ pub trait Figure {
 pub const SUPERSAMPLE: u32 = 4;
 
 /// Renders `figure` into RGB pixels (row-major, 3 bytes each) at its [`Figure::size`]: drawn at
-/// [`Figure::supersample`] times the size and averaged down block by block (a box filter).
+/// [`Figure::SUPERSAMPLE`] times the size and averaged down block by block (a box filter).
 pub fn to_rgb<F: Figure>(figure: &F) -> Result<Vec<u8>, String> {
     style::register_font();
-    let s = figure.supersample().max(1);
+    let s = F::SUPERSAMPLE.max(1);
     let (w, h) = figure.size();
     let (sw, sh) = (w * s, h * s);
     let mut big = vec![0u8; sw as usize * sh as usize * 3];
@@ -145,20 +143,18 @@ mod tests {
     use super::style::px;
     use super::*;
 
-    /// A slowly varying sine across the whole figure, drawn as a 3 px line of many points.
-    struct Sine {
-        supersample: u32,
-    }
+    /// A slowly varying sine across the whole figure, drawn as a 3 px line of many points,
+    /// `S` × `S` drawn pixels per pixel.
+    struct Sine<const S: u32>;
 
-    impl Figure for Sine {
+    impl<const S: u32> Figure for Sine<S> {
+        const SUPERSAMPLE: u32 = S;
         fn size(&self) -> (u32, u32) {
             (600, 300)
         }
-        fn supersample(&self) -> u32 {
-            self.supersample
-        }
         fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
-            let mut chart = ChartBuilder::on(root).margin(px(10)).build_cartesian_2d(0.0..1.0, -1.0..1.0).map_err(err)?;
+            let mut chart =
+                ChartBuilder::on(root).margin(px(10)).build_cartesian_2d(0.0..1.0, -1.0..1.0).map_err(err)?;
             let curve = (0..=400).map(|i| {
                 let x = f64::from(i) / 400.0;
                 (x, 0.4 * (std::f64::consts::TAU * x).sin() + 0.1 * x)
@@ -185,8 +181,8 @@ mod tests {
 
     /// Largest |second difference| of the centre row along the curve (px): the true curve's is
     /// below 0.01 px, so what is left is the rounding of the drawing.
-    fn wobble(supersample: u32) -> f64 {
-        let figure = Sine { supersample };
+    fn wobble<const S: u32>() -> f64 {
+        let figure = Sine::<S>;
         let (w, h) = figure.size();
         let rows = centre_rows(&to_rgb(&figure).unwrap(), w as usize, h as usize);
         rows.windows(3).map(|t| (t[0] - 2.0 * t[1] + t[2]).abs()).fold(0.0, f64::max)
@@ -194,8 +190,8 @@ mod tests {
 
     #[test]
     fn supersampled_curves_are_smooth_where_pixel_rounding_is_not() {
-        let plain = wobble(1);
-        let smooth = wobble(SUPERSAMPLE);
+        let plain = wobble::<1>();
+        let smooth = wobble::<SUPERSAMPLE>();
         // Drawn at whole pixels the centre line jumps by a pixel where the rounding steps.
         assert!(plain > 0.9, "whole-pixel drawing wobbles by {plain} px");
         assert!(smooth < 0.3, "supersampled drawing still wobbles by {smooth} px (whole pixels: {plain} px)");
@@ -204,7 +200,10 @@ mod tests {
     #[test]
     fn box_downsampling_averages_each_block() {
         // 2 × 1 output from a 4 × 2 input: left block black and white, right block all white.
-        let big = [0, 0, 0, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 0, 0, 0, 255, 255, 255, 255, 255, 255];
+        let big = [
+            0, 0, 0, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 0, 0, 0, 255, 255, 255, 255,
+            255, 255,
+        ];
         let small = box_downsample(&big, 2, 1, 2);
         assert_eq!(small, vec![128, 128, 128, 255, 255, 255]);
     }

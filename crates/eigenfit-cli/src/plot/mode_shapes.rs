@@ -116,10 +116,6 @@ impl Figure for ModeShapes {
         (1000, 720)
     }
 
-    fn supersample(&self) -> u32 {
-        super::SUPERSAMPLE
-    }
-
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let (x0, x1) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
         let pad = (x1 - x0) * 0.04;
@@ -147,7 +143,9 @@ impl Figure for ModeShapes {
         drop(mesh);
         // The shaft axis and the nodes.
         chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], INK.stroke_width(px(2)))).map_err(err)?;
-        chart.draw_series(self.nodes.iter().map(|&x| Circle::new((x, 0.0), px(3), INK.filled()))).map_err(err)?;
+        chart
+            .draw_series(self.nodes.iter().map(|&x| Circle::new((x, 0.0), px(3), INK.filled())))
+            .map_err(err)?;
         // Disks: a tall bar across the shaft and the mass above.
         for d in &self.masses {
             chart
@@ -187,11 +185,15 @@ impl Figure for ModeShapes {
                 .draw_series(LineSeries::new(s.curve.iter().copied(), c.stroke_width(px(3))))
                 .map_err(err)?
                 .label(format!("mode {}: {} Hz", k + 1, format_hz(s.frequency_hz)))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + pxi(24), y)], c.stroke_width(px(3))));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + pxi(24), y)], c.stroke_width(px(3)))
+                });
         }
         style::legend(&mut chart, SeriesLabelPosition::UpperMiddle)?;
         Ok(())
     }
+
+    const SUPERSAMPLE: u32 = super::SUPERSAMPLE;
 }
 
 /// A frequency with four significant digits or more.

@@ -33,7 +33,7 @@ thread_local! {
 }
 
 /// `n` pixels of the finished figure, in the pixels being drawn. A figure drawn supersampled
-/// ([`super::Figure::supersample`]) gives every size, margin and offset through this, so that it
+/// ([`super::Figure::SUPERSAMPLE`]) gives every size, margin and offset through this, so that it
 /// looks the same at any scale.
 pub fn px(n: u32) -> u32 {
     n * SCALE.with(Cell::get)
@@ -264,11 +264,13 @@ fn swatch<DB: DrawingBackend>(
     match swatch {
         Swatch::Box(c) => {
             area.draw(&Rectangle::new([(x, y + p(3)), (x + p(16), y + p(17))], c.filled())).map_err(e)?;
-            area.draw(&Rectangle::new([(x, y + p(3)), (x + p(16), y + p(17))], GUIDE.stroke_width(px(1)))).map_err(e)?;
+            area.draw(&Rectangle::new([(x, y + p(3)), (x + p(16), y + p(17))], GUIDE.stroke_width(px(1))))
+                .map_err(e)?;
             Ok(p(24))
         }
         Swatch::Line(c) => {
-            area.draw(&PathElement::new(vec![(x, mid), (x + p(26), mid)], c.stroke_width(px(3)))).map_err(e)?;
+            area.draw(&PathElement::new(vec![(x, mid), (x + p(26), mid)], c.stroke_width(px(3))))
+                .map_err(e)?;
             Ok(p(34))
         }
         Swatch::Dashed(c) => {
@@ -361,7 +363,8 @@ pub fn grid<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
     mesh: &'m mut MeshStyle<'a, 'b, X, Y, DB>,
     minor_alpha: f64,
 ) -> &'m mut MeshStyle<'a, 'b, X, Y, DB> {
-    mesh.light_line_style(LIGHT.mix(minor_alpha).stroke_width(px(1))).bold_line_style(LIGHT.stroke_width(px(1)))
+    mesh.light_line_style(LIGHT.mix(minor_alpha).stroke_width(px(1)))
+        .bold_line_style(LIGHT.stroke_width(px(1)))
 }
 
 /// Draws the series legend at `position` in the shared look (legend font, a light box).

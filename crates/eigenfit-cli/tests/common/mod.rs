@@ -40,3 +40,10 @@ pub fn write_in(dir: &tempfile::TempDir, name: &str, text: &str) -> std::path::P
     std::fs::write(&path, text).expect("a file in the temporary folder");
     path
 }
+
+/// `estimate --model MODEL --measured MEASURED`, then `more`.
+pub fn estimate_with<'a>(model: &'a str, measured: &'a str, more: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["estimate", "--model", model, "--measured", measured];
+    args.extend_from_slice(more);
+    args
+}

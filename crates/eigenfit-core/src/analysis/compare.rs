@@ -325,14 +325,13 @@ mod tests {
         let targets = vec![vec![3e4, 1e4, 2e4], vec![1e3, 5e4, 1e4]];
         let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
         let strategies = StrategyKind::ALL;
-        let settings =
-            CompareSettings {
-                modes: 3,
-                decimals: Some(3),
-                std_hz: Some(0.01),
-                max_iterations: 100,
-                budget: crate::update::DEFAULT_EVALUATIONS,
-            };
+        let settings = CompareSettings {
+            modes: 3,
+            decimals: Some(3),
+            std_hz: Some(0.01),
+            max_iterations: 100,
+            budget: crate::update::DEFAULT_EVALUATIONS,
+        };
         let mut seen = 0;
         let par = run_grid(&chain, &DenseSolver, &targets, &initials, &strategies, &settings, |_| seen += 1)
             .unwrap();
