@@ -145,7 +145,13 @@ fn compare_grid(c: &mut Criterion) {
     let targets = vec![vec![1e5, 1e5]];
     let initials = tensor_grid(&log_space(1e1, 1e9, 5), 2);
     let strategies = StrategyKind::ALL;
-    let settings = CompareSettings { modes: 2, decimals: None, std_hz: None, max_iterations: 1000 };
+    let settings = CompareSettings {
+        modes: 2,
+        decimals: None,
+        std_hz: None,
+        max_iterations: 1000,
+        budget: eigenfit::core::update::DEFAULT_EVALUATIONS,
+    };
     let solver = BandedSolver::default();
     let runs = targets.len() * initials.len() * strategies.len();
     g.bench_function(format!("{runs}_runs_parallel"), |b| {

@@ -124,8 +124,8 @@ fn compare_runs_strategies_on_a_matrices_model() {
 
 #[test]
 fn a_bad_matrix_file_is_bad_input_naming_it() {
-    let dir = std::env::temp_dir().join(format!("eigenfit-cli-matrices-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = common::scratch();
+    let dir = scratch.path();
     std::fs::write(dir.join("K.mtx"), "%%MatrixMarket matrix coordinate real general\n2 2 2\n1 2 1\n2 1 3\n")
         .unwrap();
     std::fs::write(dir.join("M.mtx"), "%%MatrixMarket matrix coordinate real general\n2 2 2\n1 1 1\n2 2 1\n")
@@ -142,8 +142,8 @@ fn discover_names_a_user_supplied_candidate_matrix() {
     // The plate with 3 kg added at DOF 33 (w of node 17): the "measured" frequencies come from
     // eigenfit itself with the mass as a parameter; discover starts from the plate without it
     // and must pick the candidate from the model file's [[candidate]] tables.
-    let dir = std::env::temp_dir().join(format!("eigenfit-cli-discover-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = common::scratch();
+    let dir = scratch.path();
     for f in ["K0.mtx", "K1.mtx", "K2.mtx", "K3.mtx", "K4.mtx", "M0.mtx"] {
         std::fs::copy(plate(f), dir.join(f)).unwrap();
     }
@@ -231,8 +231,8 @@ fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
             line: 0,
         })
         .collect();
-    let dir = std::env::temp_dir().join(format!("eigenfit-cli-matrices-shapes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = common::scratch();
+    let dir = scratch.path();
     let file = dir.join("campaign.unv");
     // No search for other solutions, two zones held at their true values: every shape
     // linearisation takes a dense n×n LU per mode and parameter (Nelson's method), minutes for
@@ -241,20 +241,11 @@ fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
         std::fs::write(&file, uff::write("plate campaign", nodes, &uff_modes)).unwrap();
         let measured = file.to_str().unwrap();
         let model = plate("model.toml");
-        eigenfit(&[
-            "estimate",
-            "--model",
+        eigenfit(&common::estimate_with(
             &model,
-            "--measured",
             measured,
-            "--alternative-starts",
-            "0",
-            "--fix",
-            "zone3=1.1",
-            "--fix",
-            "zone4=0.9",
-            "--json",
-        ])
+            &["--alternative-starts", "0", "--fix", "zone3=1.1", "--fix", "zone4=0.9", "--json"],
+        ))
     };
     let (code, v, err) = estimate(&nodes);
     assert_eq!(code, 0, "{err}\n{v}");

@@ -125,6 +125,9 @@ impl<S: EigenSolver> Request<'_, S> {
         // answer — said instead of a physical effect, or beside one that fits about as well.
         let fine_base =
             discover(&fine_rotor, solver, measured, &[], initial, &left(coarse_result.report.evaluations));
+        if let Err(DiscoveryError::BudgetExhausted(_)) = fine_base {
+            coarse_result.report.budget_exhausted = true;
+        }
         if let Ok(mut fine_base) = fine_base {
             coarse_result.report.evaluations += fine_base.evaluations;
             fine_base.evaluations = coarse_result.report.evaluations;
@@ -153,7 +156,13 @@ impl<S: EigenSolver> Request<'_, S> {
             initial,
             &left(coarse_result.report.evaluations),
         );
-        let Ok(mut fine) = fine else { return Ok(coarse_result) };
+        let mut fine = match fine {
+            Ok(fine) => fine,
+            Err(e) => {
+                coarse_result.report.budget_exhausted |= matches!(e, DiscoveryError::BudgetExhausted(_));
+                return Ok(coarse_result);
+            }
+        };
         coarse_result.report.evaluations += fine.evaluations;
         coarse_result.report.budget_exhausted |= fine.budget_exhausted;
         fine.evaluations = coarse_result.report.evaluations;

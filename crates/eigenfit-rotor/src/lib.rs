@@ -71,6 +71,7 @@ pub mod updatable;
 
 pub use builder::RotorBuilder;
 pub use error::RotorError;
+pub use file::MAX_TABLES;
 pub use model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
 pub use spec::{
     BearingSpec, Disk, EffectSpec, Material, ParameterSpec, PointMass, RotorSpec, Section, ShaftSpec,

@@ -160,9 +160,15 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
         }
     }
     // 2. Table 3 case 1 with all three strategies.
-    let settings = CompareSettings { modes: 2, decimals: Some(3), std_hz: None, max_iterations: 1000 };
-    let measured = reference_measurement(&rotor, &solver, &TARGET, &settings)
-        .map_err(|e| WorkflowError::Failure(e.to_string()))?;
+    let settings = CompareSettings {
+        modes: 2,
+        decimals: Some(3),
+        std_hz: None,
+        max_iterations: 1000,
+        budget: eigenfit_core::update::DEFAULT_EVALUATIONS,
+    };
+    let measured =
+        reference_measurement(&rotor, &solver, &TARGET, &settings).map_err(|e| WorkflowError::Failure(e.to_string()))?;
     let reference_hz: Vec<f64> = measured.modes().iter().map(|m| m.frequency_hz).collect();
     let problem = Problem::new(&rotor, &solver, measured);
     let mut estimates = Vec::new();

@@ -56,16 +56,7 @@ pub struct EstimateRequest {
     pub bearing_parameters: Option<String>,
 }
 
-/// Model evaluations allowed and spent.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub struct BudgetReport {
-    /// The limit.
-    pub limit: usize,
-    /// Spent.
-    pub used: usize,
-    /// Whether it ran out.
-    pub exhausted: bool,
-}
+pub use crate::outcome::BudgetReport;
 
 /// Another equally good parameter vector.
 #[derive(Debug, Clone, PartialEq, Serialize)]

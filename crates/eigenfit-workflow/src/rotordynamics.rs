@@ -17,6 +17,8 @@ use std::path::Path;
 /// The model file if it is a ROSS rotor (judged by its content: tables `ShaftElement_…`).
 pub fn ross_model(path: Option<&Path>) -> Option<&Path> {
     let path = path?;
+    // A FIFO or device is not read here (it would block): the model loader refuses it.
+    crate::model::check_model_file(path).ok()?;
     let text = std::fs::read_to_string(path).ok()?;
     ross_file::looks_like_ross(&text).then_some(path)
 }
@@ -30,6 +32,7 @@ fn to_workflow(e: RotorDynError) -> WorkflowError {
 
 /// Loads a ROSS rotor, errors naming the file.
 pub fn load(path: &Path) -> Result<Rotor, WorkflowError> {
+    crate::model::check_model_file(path)?;
     ross_file::read(path).map_err(to_workflow)
 }
 

@@ -211,7 +211,7 @@ impl<'a> Fit<'a> {
 
     /// Intervals and the residual scatter they were scaled by: the frequency fit's as the
     /// statistics module gives them (within `budget`, bounds done reported to `observers`), the
-    /// shape fit's from [`ShapeFit::uncertainty`].
+    /// shape fit's from [`ShapeFit::uncertainty_within`] (within `budget`).
     pub fn uncertainty_within(
         &mut self,
         at: &Linearisation,
@@ -223,7 +223,9 @@ impl<'a> Fit<'a> {
             Fit::Frequencies(p) => {
                 (eigenfit_core::analysis::uncertainty_observed(p, at, has_std, budget, observers), None)
             }
-            Fit::Shapes(s) => s.uncertainty(at).map_or((None, None), |(u, sc)| (Some(u), Some(sc))),
+            Fit::Shapes(s) => {
+                s.uncertainty_within(at, budget).map_or((None, None), |(u, sc)| (Some(u), Some(sc)))
+            }
         }
     }
 

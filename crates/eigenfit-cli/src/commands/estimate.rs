@@ -88,12 +88,11 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             crate::output::report(args.report.json, &*report, crate::rotordynamics::print_estimate);
             return Ok(code);
         }
+        // No result to print: an error with exit code 3 (also through the Python package).
         EstimateOutcome::BudgetExhaustedBeforeFit { limit } => {
-            crate::error::set_exit_on_closed_pipe(EXIT_NOT_CONVERGED);
-            eprintln!(
-                "eigenfit: budget-exhausted: the budget of {limit} model evaluations ran out before the fit could start (raise it with --budget)"
-            );
-            return Ok(EXIT_NOT_CONVERGED);
+            return Err(CliError::BudgetExhausted(format!(
+                "the budget of {limit} model evaluations ran out before the fit could start (raise it with --budget)"
+            )));
         }
         EstimateOutcome::Done(est) => est,
     };

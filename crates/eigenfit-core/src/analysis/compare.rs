@@ -1,13 +1,13 @@
 //! Strategy comparison: targets × initial guesses × strategies on reference data synthesised
 //! from the model itself (the paper's Tables 2–5 and convergence maps).
 
-use crate::analysis::{alternatives_among, local_solutions, uncertainty, Identifiability};
+use crate::analysis::{alternatives_among, local_solutions, uncertainty_within, Identifiability};
 use crate::eigen::EigenSolver;
 use crate::measurement::synthetic::SynthesisError;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::problem::{Linearisation, Objective, Problem};
-use crate::update::{Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
+use crate::update::{Budget, Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
@@ -28,6 +28,9 @@ pub struct CompareSettings {
     pub std_hz: Option<f64>,
     /// Iteration limit per run.
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) one run may spend on its fit and, for a damped run,
+    /// its intervals ([`Budget`]); a run that hits it ends `budget-exhausted`.
+    pub budget: usize,
 }
 
 /// One run of the comparison. Serialises as the `compare` report's run (the fields a report
@@ -63,6 +66,10 @@ pub struct CompareRun {
     /// empty, the data cannot choose between them and the estimate.
     #[serde(skip)]
     pub alternatives: Vec<Vec<f64>>,
+    /// True when the run's budget ([`CompareSettings::budget`]) ran out: its fit or its
+    /// identifiability flags are incomplete. Written only when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub budget_exhausted: bool,
 }
 
 /// Why a comparison grid could not be run.
@@ -156,13 +163,15 @@ where
         }
         _ => strategy.build(),
     };
-    let outcome = Driver { max_iterations: settings.max_iterations }.run(problem, s.as_mut(), initial);
+    let budget = Budget::new(settings.budget);
+    let outcome =
+        Driver { max_iterations: settings.max_iterations }.run_within(problem, s.as_mut(), initial, &budget);
     let seconds = start.elapsed().as_secs_f64();
     match outcome {
         Ok(est) => {
             let converged = est.termination.is_converged();
             let identifiability = (converged && strategy == StrategyKind::LevenbergMarquardt)
-                .then(|| uncertainty(problem, &est.last, problem.measured.has_std()))
+                .then(|| uncertainty_within(problem, &est.last, problem.measured.has_std(), &budget))
                 .flatten()
                 .map(|u| u.identifiability);
             let alternatives = if converged && strategy == StrategyKind::LevenbergMarquardt {
@@ -183,6 +192,7 @@ where
                 estimate: est.parameters,
                 seconds,
                 identifiability,
+                budget_exhausted: budget.exhausted(),
             }
         }
         Err(e) => CompareRun {
@@ -198,6 +208,7 @@ where
             seconds,
             identifiability: None,
             alternatives: Vec::new(),
+            budget_exhausted: budget.exhausted(),
         },
     }
 }
@@ -322,8 +333,13 @@ mod tests {
         let targets = vec![vec![3e4, 1e4, 2e4], vec![1e3, 5e4, 1e4]];
         let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
         let strategies = StrategyKind::ALL;
-        let settings =
-            CompareSettings { modes: 3, decimals: Some(3), std_hz: Some(0.01), max_iterations: 100 };
+        let settings = CompareSettings {
+            modes: 3,
+            decimals: Some(3),
+            std_hz: Some(0.01),
+            max_iterations: 100,
+            budget: crate::update::DEFAULT_EVALUATIONS,
+        };
         let mut seen = 0;
         let par = run_grid(&chain, &DenseSolver, &targets, &initials, &strategies, &settings, |_| seen += 1)
             .unwrap();

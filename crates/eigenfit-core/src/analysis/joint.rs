@@ -3,11 +3,12 @@
 //! every run); one that appears in one configuration only (a bearing changed for that run) is
 //! estimated from that configuration's data alone. Rows are stacked as in [`crate::problem::multi`].
 
-use crate::analysis::statistics::scatter_uncertainty;
+use crate::analysis::statistics::{scatter_uncertainty, UNCERTAINTY_EVALUATIONS};
 use crate::analysis::Uncertainty;
 use crate::model::{Parameter, ParameterError, ParameterSet};
 use crate::problem::multi::stack;
 use crate::problem::{Linearisation, Objective, ResidualError};
+use crate::update::Budget;
 use nalgebra::DMatrix;
 use thiserror::Error;
 
@@ -95,7 +96,18 @@ impl<'a> Joint<'a> {
     /// 95 % intervals at `at`: from the weights when `has_std`, else from the residual scatter
     /// σ̂ = √(‖r‖²/dof) as in [`ShapeFit::uncertainty`](super::ShapeFit::uncertainty).
     pub fn uncertainty(&mut self, at: &Linearisation, has_std: bool) -> Option<(Uncertainty, f64)> {
-        scatter_uncertainty(self, |joint| &mut joint.scale, at, has_std)
+        self.uncertainty_within(at, has_std, &Budget::new(UNCERTAINTY_EVALUATIONS))
+    }
+
+    /// [`Joint::uncertainty`] charging every profile refit to `budget` (shared with the fit, so
+    /// one limit bounds the whole campaign).
+    pub fn uncertainty_within(
+        &mut self,
+        at: &Linearisation,
+        has_std: bool,
+        budget: &Budget,
+    ) -> Option<(Uncertainty, f64)> {
+        scatter_uncertainty(self, |joint| &mut joint.scale, at, has_std, budget)
     }
 }
 

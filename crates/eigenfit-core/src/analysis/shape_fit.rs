@@ -62,8 +62,19 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     /// only set how frequencies and shapes count against each other; `None` when there are no
     /// more rows than parameters. Returns the intervals and σ̂ (1 with given std).
     pub fn uncertainty(&mut self, at: &Linearisation) -> Option<(crate::analysis::Uncertainty, f64)> {
+        let budget = crate::update::Budget::new(crate::analysis::statistics::UNCERTAINTY_EVALUATIONS);
+        self.uncertainty_within(at, &budget)
+    }
+
+    /// [`ShapeFit::uncertainty`] charging every profile refit to `budget` (shared with the fit,
+    /// so one limit bounds the whole task).
+    pub fn uncertainty_within(
+        &mut self,
+        at: &Linearisation,
+        budget: &crate::update::Budget,
+    ) -> Option<(crate::analysis::Uncertainty, f64)> {
         let has_std = self.problem.measured.has_std();
-        crate::analysis::statistics::scatter_uncertainty(self, |fit| &mut fit.scale, at, has_std)
+        crate::analysis::statistics::scatter_uncertainty(self, |fit| &mut fit.scale, at, has_std, budget)
     }
 
     /// Modes solved: as many as MAC pairing considers.

@@ -82,17 +82,18 @@ pub fn uncertainty_within(
 
 /// 95 % intervals at `at`: from the weights when `has_std`; without, from the residual scatter:
 /// every row is divided by σ̂ = √(‖r‖²/dof) (through `scale`, the objective's row divisor), the
-/// usual regression estimate. `None` when there are no more rows than parameters. Returns the
-/// intervals and σ̂ (1 with given std). Shared by [`ShapeFit`](super::ShapeFit) and
+/// usual regression estimate. `None` when there are no more rows than parameters. Profile refits
+/// are charged to `budget`. Returns the intervals and σ̂ (1 with given std). Shared by [`ShapeFit`](super::ShapeFit) and
 /// [`Joint`](super::Joint).
 pub(crate) fn scatter_uncertainty<P: Objective>(
     problem: &mut P,
     scale: fn(&mut P) -> &mut f64,
     at: &Linearisation,
     has_std: bool,
+    budget: &Budget,
 ) -> Option<(Uncertainty, f64)> {
     if has_std {
-        return uncertainty(problem, at, true).map(|u| (u, 1.0));
+        return uncertainty_within(problem, at, true, budget).map(|u| (u, 1.0));
     }
     let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
     let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
@@ -104,7 +105,7 @@ pub(crate) fn scatter_uncertainty<P: Objective>(
     let result = problem
         .linearise(&at.parameters)
         .ok()
-        .and_then(|lin| uncertainty(problem, &lin, true))
+        .and_then(|lin| uncertainty_within(problem, &lin, true, budget))
         .map(|u| (u, scatter));
     *scale(problem) = old;
     result

@@ -32,6 +32,10 @@ pub enum DiscoveryError {
     /// The base calibration failed.
     #[error("calibrating the nominal parameters failed: {0}")]
     Calibration(String),
+    /// The evaluation budget ([`DiscoveryOptions::max_evaluations`]) ran out before the
+    /// calibration finished: there is no misfit to judge yet.
+    #[error("the budget of {0} model evaluations ran out before the calibration finished")]
+    BudgetExhausted(usize),
 }
 
 /// Settings of the workflow.
@@ -409,7 +413,14 @@ where
     // (a) calibrate
     let est = Driver::default()
         .run_within(&base, &mut LevenbergMarquardt::default(), initial, &budget)
-        .map_err(|e| DiscoveryError::Calibration(e.to_string()))?;
+        .map_err(|e| match budget.exhausted() {
+            true => DiscoveryError::BudgetExhausted(options.max_evaluations),
+            false => DiscoveryError::Calibration(e.to_string()),
+        })?;
+    // A calibration cut short has no χ² to judge: saying "explained by the noise" would be a guess.
+    if matches!(est.termination, Termination::BudgetExhausted { .. }) {
+        return Err(DiscoveryError::BudgetExhausted(options.max_evaluations));
+    }
     let base_lin = est.last;
     let chi2_before = 2.0 * base_lin.cost();
     let dof_before = n - nb;
@@ -436,6 +447,7 @@ where
     };
     if !disagreement_significant {
         report.evaluations = budget.used();
+        report.budget_exhausted = budget.exhausted();
         return Ok(report);
     }
     // (b) forward selection: each round screens the candidates not yet chosen against the model

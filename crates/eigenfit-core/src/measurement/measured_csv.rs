@@ -129,8 +129,22 @@ pub fn shown_number(v: f64) -> String {
     }
 }
 
+/// Most lines a measured file may have: a modal test gives tens to hundreds of modes, so a file
+/// this long is a wrong file (a time series, a log), refused before it is parsed.
+pub const MAX_LINES: usize = 100_000;
+
 /// [`parse`] with the notes for the user (ignored columns), each starting with `LINE: `.
 pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), CsvError> {
+    let lines = text.lines().count();
+    if lines > MAX_LINES {
+        return Err(at(
+            MAX_LINES + 1,
+            format!(
+                "the file has {lines} lines, more than the {MAX_LINES} a measured file may have \
+                 (a modal test gives tens to hundreds of modes)"
+            ),
+        ));
+    }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
@@ -316,6 +330,17 @@ mod tests {
         assert_eq!(m.modes()[1].mode, 1);
         assert_eq!(m.modes()[1].frequency_hz, 84.517);
         assert_eq!(m.modes()[0].std_hz, Some(0.04));
+    }
+
+    #[test]
+    fn a_file_beyond_any_modal_test_is_refused_before_parsing() {
+        let mut text = String::from("mode,frequency_hz\n");
+        (1..=super::MAX_LINES).for_each(|k| text.push_str(&format!("{k},{}\n", 10 + k)));
+        let err = parse(&text).unwrap_err().to_string();
+        assert!(err.starts_with("100001: the file has 100001 lines, more than the 100000"), "{err}");
+        // One line fewer is parsed (and accepted: distinct increasing frequencies).
+        let shorter = &text[..text.rfind("100000,").unwrap()];
+        assert_eq!(parse(shorter).unwrap().len(), super::MAX_LINES - 1);
     }
 
     #[test]
