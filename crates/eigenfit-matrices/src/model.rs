@@ -245,6 +245,24 @@ impl MatricesModel {
         self.layout.as_ref()
     }
 
+    /// Permutations π of the parameters under which the model may be symmetric: parameter i
+    /// exchanged with π\[i\] keeps every trace and Frobenius inner product of the matrices
+    /// (see the `symmetry` module), among parameters of the same unit, scale and limits. The
+    /// frequencies at p and at p permuted are then expected equal; confirm by one solve.
+    /// Empty for an asymmetric structure. O(np² · nnz).
+    pub fn parameter_symmetries(&self) -> Vec<Vec<usize>> {
+        let terms: Vec<_> = self
+            .derivatives
+            .iter()
+            .map(|(k, m)| (k.as_ref().map(|t| &t.matrix), m.as_ref().map(|t| &t.matrix)))
+            .collect();
+        let params = self.params.as_slice();
+        crate::symmetry::invariant_permutations(&self.stiffness.matrix, &self.mass.matrix, &terms, |i, j| {
+            let (a, b) = (&params[i], &params[j]);
+            a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper
+        })
+    }
+
     /// `base + Σ pᵢ·termᵢ` on the common pattern.
     fn combine<'a>(&self, base: &Term, terms: impl Iterator<Item = (f64, Option<&'a Term>)>) -> CscSymmetric {
         let mut out = self.pattern.clone();
