@@ -133,24 +133,21 @@ def build(dofs, zx, zy, layout="off-centre"):
     rhoAs = RHO * STIFFENER_W * STIFFENER_H
     rhoIps = RHO * STIFFENER_W * STIFFENER_H * (STIFFENER_W**2 + STIFFENER_H**2) / 12.0
     K0 = sp.csr_matrix((n_all, n_all))
+
+    def stiffener(K0, M, a, b, L, bend, twist):
+        """K0, M with a stiffener's beams a[e]–b[e] added: bending on (w, θ_bend), torsion on θ_twist."""
+        kb_s, mb_s, kt_s, mt_s = beam_blocks(np.full(len(a), L), EIs, GJs, rhoAs, rhoIps)
+        bdofs = np.stack([3 * a, 3 * a + bend, 3 * b, 3 * b + bend], -1)
+        tdofs = np.stack([3 * a + twist, 3 * b + twist], -1)
+        K0 = K0 + scatter(bdofs, kb_s, n_all) + scatter(tdofs, kt_s, n_all)
+        return K0, M + scatter(bdofs, mb_s, n_all) + scatter(tdofs, mt_s, n_all)
+
     along_x, along_y = STIFFENERS[layout]
     for frac in along_x:
-        j = round(frac * (ny - 1))
-        sel = np.arange(nx - 1) * ny + j
-        a, b = ax[sel], bx[sel]
-        kb_s, mb_s, kt_s, mt_s = beam_blocks(np.full(len(a), hx), EIs, GJs, rhoAs, rhoIps)
-        K0 = K0 + scatter(np.stack([3 * a, 3 * a + 2, 3 * b, 3 * b + 2], -1), kb_s, n_all)
-        K0 = K0 + scatter(np.stack([3 * a + 1, 3 * b + 1], -1), kt_s, n_all)
-        M = M + scatter(np.stack([3 * a, 3 * a + 2, 3 * b, 3 * b + 2], -1), mb_s, n_all)
-        M = M + scatter(np.stack([3 * a + 1, 3 * b + 1], -1), mt_s, n_all)
-    i = round(along_y * (nx - 1))
-    sel = i * (ny - 1) + np.arange(ny - 1)
-    a, b = ay[sel], by[sel]
-    kb_s, mb_s, kt_s, mt_s = beam_blocks(np.full(len(a), hy), EIs, GJs, rhoAs, rhoIps)
-    K0 = K0 + scatter(np.stack([3 * a, 3 * a + 1, 3 * b, 3 * b + 1], -1), kb_s, n_all)
-    K0 = K0 + scatter(np.stack([3 * a + 2, 3 * b + 2], -1), kt_s, n_all)
-    M = M + scatter(np.stack([3 * a, 3 * a + 1, 3 * b, 3 * b + 1], -1), mb_s, n_all)
-    M = M + scatter(np.stack([3 * a + 2, 3 * b + 2], -1), mt_s, n_all)
+        sel = np.arange(nx - 1) * ny + round(frac * (ny - 1))
+        K0, M = stiffener(K0, M, ax[sel], bx[sel], hx, 2, 1)
+    sel = round(along_y * (nx - 1)) * (ny - 1) + np.arange(ny - 1)
+    K0, M = stiffener(K0, M, ay[sel], by[sel], hy, 1, 2)
     # Simply supported edges: w = 0 on the boundary nodes.
     ix, jy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     edge = ((ix == 0) | (ix == nx - 1) | (jy == 0) | (jy == ny - 1)).ravel()

@@ -178,7 +178,12 @@ impl MatricesModel {
             None => None,
         };
         let name = file.name.unwrap_or_else(|| path.display().to_string());
-        Ok(Self::assemble_terms(name, params, k0, m0, derivative_matrices, candidates, dofs))
+        let mut model = Self::assemble_terms(name, params, k0, m0, derivative_matrices);
+        // A map that fails here was refused above already.
+        model.layout = dofs.as_deref().and_then(|d| DofLayout::new(d).ok());
+        model.dofs = dofs;
+        model.candidates = candidates;
+        Ok(model)
     }
 
     /// A model from matrices already in memory: K₀, M₀ and, per parameter, (∂K/∂pᵢ, ∂M/∂pᵢ).
@@ -194,17 +199,16 @@ impl MatricesModel {
         derivatives: Vec<(Option<CscSymmetric>, Option<CscSymmetric>)>,
     ) -> Self {
         assert_eq!(derivatives.len(), params.len(), "one derivative pair per parameter");
-        Self::assemble_terms(name.into(), params, stiffness, mass, derivatives, Vec::new(), None)
+        Self::assemble_terms(name.into(), params, stiffness, mass, derivatives)
     }
 
+    /// The model without candidates or DOF map, its matrices mapped onto their common pattern.
     fn assemble_terms(
         name: String,
         params: ParameterSet,
         k0: CscSymmetric,
         m0: CscSymmetric,
         derivatives: Vec<(Option<CscSymmetric>, Option<CscSymmetric>)>,
-        candidates: Vec<Candidate>,
-        dofs: Option<Vec<Dof>>,
     ) -> Self {
         let n = k0.dim();
         // The common pattern: every matrix's entries, zero-valued.
@@ -219,9 +223,17 @@ impl MatricesModel {
         let stiffness = term(k0);
         let mass = term(m0);
         let derivatives = derivatives.into_iter().map(|(k, m)| (k.map(term), m.map(term))).collect();
-        // A map that fails here was refused by `from_toml_file` already.
-        let layout = dofs.as_deref().and_then(|d| DofLayout::new(d).ok());
-        Self { name, params, pattern, stiffness, mass, derivatives, candidates, dofs, layout }
+        Self {
+            name,
+            params,
+            pattern,
+            stiffness,
+            mass,
+            derivatives,
+            candidates: Vec::new(),
+            dofs: None,
+            layout: None,
+        }
     }
 
     /// The model's name (the `name` key, or the file's path).

@@ -26,6 +26,10 @@ use std::path::PathBuf;
 /// value moved to π\[i\]) when it is a mirror solution.
 type Alternative = (Vec<f64>, Option<Vec<usize>>);
 
+/// Most DOFs of a model updated from measured shapes: their derivatives (Nelson's method) take
+/// a dense factorisation per mode and iteration, seconds each at this size and O(n³) beyond.
+pub const SHAPE_DOF_LIMIT: usize = 2000;
+
 /// Restart-grid points refitted locally when searching for other equally good solutions.
 pub const ALTERNATIVE_STARTS: usize = 6;
 
@@ -280,6 +284,15 @@ pub fn run(
     let solver = request.source.solver()?;
     let options = &request.test_data;
     let data = test_data::read(&request.measured, any.layout(), options)?;
+    if data.sensors.is_some() && any.dofs() > SHAPE_DOF_LIMIT {
+        return Err(input(format!(
+            "{}: measured shapes need the shapes' derivatives, computed here by Nelson's method on \
+             dense matrices (O(n³) per mode and iteration): the model has {} DOFs, more than the {SHAPE_DOF_LIMIT} \
+             this is done for; estimate from the frequencies alone (a CSV of mode,frequency_hz)",
+            request.measured.display(),
+            any.dofs()
+        )));
+    }
     notes.extend(data.file_notes.iter().cloned());
     let measurement = data.measurement.clone();
     let strategy_kind = StrategyKind::from_name(&request.strategy).ok_or_else(|| {
