@@ -258,9 +258,12 @@ fn measured_shapes_find_a_matrices_models_dofs_through_its_dof_map() {
     };
     let (code, v, err) = estimate(&nodes);
     assert_eq!(code, 0, "{err}\n{v}");
+    // The universal file keeps 6 significant digits (E13.5) of every frequency and shape value:
+    // rounding of up to 5e-6 relative. The parameters are held to 1e-5 (the off-centre plate of
+    // the regenerated fixture ends 3.4e-6 off; the old symmetric one happened to end under 1e-6).
     for (i, name) in ["zone1", "zone2"].iter().enumerate() {
         let a = v["parameters"][name].as_f64().unwrap();
-        assert!((a / truth[i] - 1.0).abs() < 1e-6, "{name}: estimated {a}, true {}", truth[i]);
+        assert!((a / truth[i] - 1.0).abs() < 1e-5, "{name}: estimated {a}, true {}", truth[i]);
     }
     let mac = v["mac"].as_array().expect("a MAC report");
     for (k, row) in mac.iter().enumerate() {
