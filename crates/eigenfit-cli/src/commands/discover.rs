@@ -38,6 +38,17 @@ pub struct DiscoverArgs {
 
 /// Runs `discover`.
 pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
+    // Two-plane rotors saved by ROSS, against a run-up CSV: the rotordynamics workflow.
+    if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
+        if args.write_model.is_some() || args.plot.is_some() {
+            return Err(crate::error::input(
+                "--write-model and --plot are not available for ROSS rotors (the report names the effects)",
+            ));
+        }
+        let report = eigenfit_workflow::rotordynamics::discover(path, &args.measured, args.assumed_std)?;
+        crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
+        return Ok(());
+    }
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
     let mut notes = Vec::new();
