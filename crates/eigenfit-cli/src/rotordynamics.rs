@@ -56,12 +56,12 @@ pub fn print_estimate(r: &RunupEstimateReport) {
             p.model_whirl
         );
     }
-    if let (Some(chi2), Some(p)) = (r.chi2, r.p_value) {
-        println!("chi² = {chi2:.4} with {} degrees of freedom, p = {p:.3}", r.dof);
+    if let (Some(chi2), Some(p)) = (r.fit.chi2, r.fit.p_value) {
+        println!("chi² = {chi2:.4} with {} degrees of freedom, p = {p:.3}", r.fit.dof);
     }
-    if !r.disagreeing_modes.is_empty() {
+    if !r.fit.disagreeing_modes.is_empty() {
         let list: Vec<String> =
-            r.disagreeing_modes.iter().map(|d| format!("{} rpm mode {}", d.speed_rpm, d.mode)).collect();
+            r.fit.disagreeing_modes.iter().map(|d| format!("{} rpm mode {}", d.speed_rpm, d.mode)).collect();
         println!("disagreeing by more than 3σ: {}", list.join(", "));
     }
     if !r.identifiable {

@@ -3,7 +3,7 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::Outcome;
+use crate::outcome::{FitQualityReport, Outcome};
 use crate::overrides::{fixed, parameter_vector};
 use crate::progress::{Progress, StepsObserver};
 use crate::rotordynamics::{self, RunupEstimateReport};
@@ -163,18 +163,9 @@ pub struct EstimateReport {
     pub acceptable: bool,
     /// The verdict in words.
     pub verdict: String,
-    /// `acceptable`, `poor-fit` or `not-judged`.
-    pub fit_quality: &'static str,
-    /// χ² (with std).
-    pub chi2: Option<f64>,
-    /// Degrees of freedom.
-    pub dof: usize,
-    /// P(χ² this large from noise alone).
-    pub p_value: Option<f64>,
-    /// √(mean relative residual²).
-    pub relative_rms_residual: f64,
-    /// Measured mode numbers that disagree by more than 3σ.
-    pub disagreeing_modes: Vec<usize>,
+    /// χ², dof, p-value, relative RMS and the measured mode numbers that disagree by > 3σ.
+    #[serde(flatten)]
+    pub fit: FitQualityReport<usize>,
     /// The evaluation budget.
     pub budget: BudgetReport,
     /// Evaluations spent in each phase reached: reachability, fit, intervals,
@@ -471,12 +462,7 @@ pub fn run(
         outcome: Outcome::of(&estimate, converged),
         acceptable,
         verdict: verdict.to_string(),
-        fit_quality: quality.verdict.label(),
-        chi2: quality.chi2,
-        dof: quality.dof,
-        p_value: quality.p_value,
-        relative_rms_residual: quality.relative_rms,
-        disagreeing_modes: quality.disagreeing.iter().map(|&k| mode_numbers[k]).collect(),
+        fit: FitQualityReport::of(&quality, |k| mode_numbers[k]),
         budget: BudgetReport { limit: budget.limit(), used: budget.used(), exhausted: budget_spent },
         evaluations_by_phase: phase_counts(&phases),
         initial: Named::new(&names, initial.iter().copied()),

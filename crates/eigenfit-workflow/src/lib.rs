@@ -40,6 +40,6 @@ pub mod test_data;
 pub use error::WorkflowError;
 pub use model::{AnyModel, Updatable};
 pub use named::Named;
-pub use outcome::Outcome;
+pub use outcome::{FitQualityReport, Outcome};
 pub use progress::{NoProgress, Progress};
 pub use source::ModelSource;

@@ -27,3 +27,36 @@ impl Outcome {
         }
     }
 }
+
+/// `fit_quality`, `chi2`, `dof`, `p_value`, `relative_rms_residual`, `disagreeing_modes`: core's
+/// [`FitQuality`](eigenfit_core::analysis::verdict::FitQuality) as every estimating report states it,
+/// flattened into it. `D` names a disagreeing mode (a mode number, or a run-up point).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitQualityReport<D> {
+    /// `acceptable`, `poor-fit` or `not-judged`.
+    pub fit_quality: &'static str,
+    /// χ² = Σ (residual/σ)² (with std only).
+    pub chi2: Option<f64>,
+    /// Degrees of freedom: measured values − free parameters.
+    pub dof: usize,
+    /// P(χ²_dof > χ²): the probability that noise alone gives a misfit this large (with std only).
+    pub p_value: Option<f64>,
+    /// √(mean((f_model − f_measured)/f_measured)²).
+    pub relative_rms_residual: f64,
+    /// The measured values that miss by more than 3σ, worst first.
+    pub disagreeing_modes: Vec<D>,
+}
+
+impl<D> FitQualityReport<D> {
+    /// The report of `quality`, naming the k-th measured value `name(k)`.
+    pub fn of(quality: &eigenfit_core::analysis::verdict::FitQuality, name: impl Fn(usize) -> D) -> Self {
+        Self {
+            fit_quality: quality.verdict.label(),
+            chi2: quality.chi2,
+            dof: quality.dof,
+            p_value: quality.p_value,
+            relative_rms_residual: quality.relative_rms,
+            disagreeing_modes: quality.disagreeing.iter().map(|&k| name(k)).collect(),
+        }
+    }
+}

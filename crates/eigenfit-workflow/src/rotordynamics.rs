@@ -3,7 +3,7 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::Outcome;
+use crate::outcome::{FitQualityReport, Outcome};
 use eigenfit_core::analysis::verdict::{judge, FitQuality, FitVerdict};
 use eigenfit_core::problem::Linearisation;
 use eigenfit_rotordynamics::identify::{
@@ -128,18 +128,9 @@ pub struct RunupEstimateReport {
     pub acceptable: bool,
     /// `converged`, `poor-fit`, `not-converged` or converged with the quality not judged.
     pub verdict: &'static str,
-    /// Core's fit-quality label: `acceptable`, `poor-fit` or `not-judged`.
-    pub fit_quality: &'static str,
-    /// χ² (with std only).
-    pub chi2: Option<f64>,
-    /// Degrees of freedom: measured frequencies − parameters.
-    pub dof: usize,
-    /// P(χ²_dof > χ²) (with std only).
-    pub p_value: Option<f64>,
-    /// √(mean((f_model − f_measured)/f_measured)²).
-    pub relative_rms_residual: f64,
-    /// The points that miss by more than 3σ, worst first.
-    pub disagreeing_modes: Vec<RunupPointId>,
+    /// χ², dof, p-value, relative RMS and the run-up points that miss by more than 3σ.
+    #[serde(flatten)]
+    pub fit: FitQualityReport<RunupPointId>,
     /// The speed the coefficients are reported at (the lowest measured, rpm).
     pub reference_speed_rpm: f64,
     /// Nominal coefficients (N/m or N·s/m).
@@ -273,16 +264,10 @@ pub fn estimate(
         },
         acceptable,
         verdict,
-        fit_quality: quality.verdict.label(),
-        chi2: quality.chi2,
-        dof: quality.dof,
-        p_value: quality.p_value,
-        relative_rms_residual: quality.relative_rms,
-        disagreeing_modes: quality
-            .disagreeing
-            .iter()
-            .map(|&k| RunupPointId { speed_rpm: points[k].speed_rpm, mode: points[k].mode })
-            .collect(),
+        fit: FitQualityReport::of(&quality, |k| RunupPointId {
+            speed_rpm: points[k].speed_rpm,
+            mode: points[k].mode,
+        }),
         reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
         initial: Named::new(&names, nominal.iter().copied()),
         parameters: Named::new(&names, value.iter().copied()),

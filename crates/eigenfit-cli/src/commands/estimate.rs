@@ -152,10 +152,10 @@ fn print_report(est: &Estimation) {
     for (k, (m, f)) in r.measured_hz.iter().zip(&r.frequencies_hz).enumerate() {
         println!("{:>6}{m:>16.6}{f:>16.6}{:>14.2e}", est.mode_numbers[k], f - m);
     }
-    match (est.quality.verdict, r.chi2) {
+    match (est.quality.verdict, r.fit.chi2) {
         (FitVerdict::NotJudged, _) => println!(
             "fit quality: cannot be judged without std_hz; relative RMS residual {:.3e}",
-            r.relative_rms_residual
+            r.fit.relative_rms_residual
         ),
         (v, Some(chi2)) => println!(
             "fit quality: {} (χ² = {}, {} dof, p = {}){}",
@@ -165,12 +165,12 @@ fn print_report(est: &Estimation) {
                 "acceptable"
             },
             significant(chi2),
-            r.dof,
-            r.p_value.map_or("n/a (no dof)".to_string(), significant),
-            if r.disagreeing_modes.is_empty() {
+            r.fit.dof,
+            r.fit.p_value.map_or("n/a (no dof)".to_string(), significant),
+            if r.fit.disagreeing_modes.is_empty() {
                 String::new()
             } else {
-                format!("; modes disagreeing by more than 3σ: {}", join(&r.disagreeing_modes))
+                format!("; modes disagreeing by more than 3σ: {}", join(&r.fit.disagreeing_modes))
             }
         ),
         _ => {}
