@@ -344,13 +344,13 @@ fn pair_by_whirl(measured: &[&RunupPoint], modes: &[Mode]) -> Option<Vec<usize>>
     for (j, mode) in modes.iter().enumerate() {
         let f = mode.frequency_hz();
         let before = best.clone();
-        for mask in 0..=full {
-            if !before[mask].is_finite() {
+        for (mask, &from) in before.iter().enumerate() {
+            if !from.is_finite() {
                 continue;
             }
             for (i, p) in measured.iter().enumerate().filter(|(i, _)| mask & (1 << i) == 0) {
                 let mismatch = if p.whirl == Some(mode.whirl) { 0.0 } else { WHIRL_MISMATCH };
-                let c = before[mask] + (p.frequency_hz / f).ln().powi(2) + mismatch;
+                let c = from + (p.frequency_hz / f).ln().powi(2) + mismatch;
                 let next = mask | (1 << i);
                 if c < best[next] {
                     best[next] = c;
