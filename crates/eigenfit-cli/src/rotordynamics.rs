@@ -1,7 +1,7 @@
-//! Two-plane rotors (files written by ROSS `Rotor.save`) in `simulate` and `estimate`: the
+//! Two-plane rotors (files written by ROSS `Rotor.save`) in `simulate`, `estimate` and `discover`: the
 //! tables of the rotordynamics workflow's reports.
 
-use eigenfit_workflow::rotordynamics::{RunupEstimateReport, SpeedReport};
+use eigenfit_workflow::rotordynamics::{RunupDiscoverReport, RunupEstimateReport, SpeedReport};
 
 /// `simulate --model ROSS-FILE`: damped modes at one speed.
 pub fn print_speed(r: &SpeedReport) {
@@ -70,4 +70,45 @@ pub fn print_estimate(r: &RunupEstimateReport) {
              (an isotropic rotor's kxx and kyy act alike); no intervals"
         );
     }
+}
+
+/// `discover --model ROSS-FILE --measured RUNUP.csv`: the calibration, the misfit test and the
+/// named effects.
+pub fn print_discovery(r: &RunupDiscoverReport) {
+    let d = &r.discovery;
+    println!("{}: calibrated the bearings (at {} rpm):", d.model, r.reference_speed_rpm);
+    for (n, v) in d.calibrated_parameters.iter() {
+        println!("  {n} = {v:.6e} N/m");
+    }
+    println!(
+        "misfit: χ² = {:.2} on {} degrees of freedom, p = {:.3e} → {}",
+        d.chi2_before,
+        d.dof_before,
+        d.p_value,
+        if d.disagreement_significant {
+            "significant: the model misses something"
+        } else {
+            "explained by the noise"
+        }
+    );
+    if !d.disagreement_significant {
+        println!("no significant disagreement: nothing added.");
+    } else if d.missing_effects.is_empty() {
+        println!("no candidate effect, alone or with others, explains the disagreement down to the noise.");
+    }
+    for e in &d.missing_effects {
+        let interval = e.interval.map_or(String::new(), |[a, b]| format!(" (95 %: {a:.4e} … {b:.4e})"));
+        println!(
+            "missing effect: {} at {} = {:.4e} {}{interval}, AICc gain {:.1}",
+            e.kind,
+            e.location.map_or("-".into(), |l| l.to_string()),
+            e.value.unwrap_or(1.0),
+            e.unit,
+            e.delta_aicc
+        );
+    }
+    println!(
+        "RMS residual {:.4} Hz → {:.4} Hz; {} eigen-solve rounds",
+        d.rms_residual_before_hz, d.rms_residual_after_hz, d.evaluations
+    );
 }

@@ -8,9 +8,10 @@
 //! eigen-solve is the symmetric (undamped) problem with sorted real eigenvalues, while here a
 //! "mode" is a damped complex eigenpair at one of many speeds.
 
+use crate::effects::Effect;
 use crate::error::RotorDynError;
 use crate::interpolation::Coefficient;
-use crate::modal::Whirl;
+use crate::modal::{Mode, Whirl};
 use crate::rotor::Rotor;
 use crate::rpm_to_rad;
 use crate::sensitivity::{eigenvalue_derivatives, MatrixDerivative};
@@ -264,17 +265,51 @@ pub fn evaluate(
     scales: &[f64],
     points: &[RunupPoint],
 ) -> Result<Evaluation, RotorDynError> {
+    evaluate_with(rotor, params, scales, &[], points)
+}
+
+/// [`evaluate`] with candidate effects added at the given values; the Jacobian's columns are
+/// d f/d ln s for the parameters, then d f/d value for the effects.
+pub fn evaluate_with(
+    rotor: &Rotor,
+    params: &[Parameter],
+    scales: &[f64],
+    effects: &[(&Effect, f64)],
+    points: &[RunupPoint],
+) -> Result<Evaluation, RotorDynError> {
     let r = scaled_rotor(rotor, params, scales);
     let mut speeds: Vec<f64> = points.iter().map(|p| p.speed_rpm).collect();
     speeds.sort_by(f64::total_cmp);
     speeds.dedup();
+    let columns = params.len() + effects.len();
     let mut freqs = vec![0.0; points.len()];
     let mut whirl = vec![Whirl::Mixed; points.len()];
-    let mut jac = DMatrix::zeros(points.len(), params.len());
+    let mut jac = DMatrix::zeros(points.len(), columns);
     for &rpm in &speeds {
         let w = rpm_to_rad(rpm);
-        let mats = r.matrices(w);
-        let modes = r.modes_of(&mats, true)?;
+        let mut mats = r.matrices(w);
+        for (effect, value) in effects {
+            effect.add_to(&r, &mut mats, w, *value);
+        }
+        let here: Vec<usize> = (0..points.len()).filter(|&i| points[i].speed_rpm == rpm).collect();
+        let by_whirl = here.iter().all(|&i| points[i].whirl.is_some());
+        let highest = here.iter().map(|&i| points[i].mode).max().unwrap_or(0);
+        // By order: one more than the highest measured mode (its whirl partner, should they
+        // coincide). By whirl: spares among which to find the measured ones.
+        let needed = if by_whirl { 2 * highest + 6 } else { highest + 1 };
+        let modes = r.lowest_modes_of(&mats, needed)?;
+        let pairs: Vec<usize> = if by_whirl {
+            let measured: Vec<&RunupPoint> = here.iter().map(|&i| &points[i]).collect();
+            pair_by_whirl(&measured, &modes).ok_or_else(|| {
+                RotorDynError::Data(format!(
+                    "{} modes measured at {rpm} rpm but the model has only {} oscillating modes there",
+                    here.len(),
+                    modes.len()
+                ))
+            })?
+        } else {
+            here.iter().map(|&i| points[i].mode - 1).collect()
+        };
         let derivs: Vec<MatrixDerivative> = params
             .iter()
             .map(|p| {
@@ -289,24 +324,86 @@ pub fn evaluate(
                     MatrixDerivative { d: Some(a), ..Default::default() }
                 }
             })
+            .chain(effects.iter().map(|(effect, _)| effect.unit(&r, w)))
             .collect();
         let d = eigenvalue_derivatives(&mats, &modes, &derivs);
-        for (i, p) in points.iter().enumerate().filter(|(_, p)| p.speed_rpm == rpm) {
-            let Some(m) = modes.get(p.mode - 1) else {
+        for (&i, &k) in here.iter().zip(&pairs) {
+            let Some(m) = modes.get(k) else {
                 return Err(RotorDynError::Data(format!(
                     "mode {} measured at {rpm} rpm but the model has only {} oscillating modes there",
-                    p.mode,
+                    points[i].mode,
                     modes.len()
                 )));
             };
             freqs[i] = m.frequency_hz();
             whirl[i] = m.whirl;
-            for j in 0..params.len() {
-                jac[(i, j)] = d[p.mode - 1][j].im / (2.0 * PI);
+            for j in 0..columns {
+                jac[(i, j)] = d[k][j].im / (2.0 * PI);
             }
         }
     }
     Ok(Evaluation { frequencies_hz: freqs, whirl, jacobian: jac })
+}
+
+/// What a whirl mismatch costs in the pairing, in units of ln²(f_measured/f_model): as much as
+/// a 10 % frequency difference. Forward and backward modes of a pair are a few per cent apart
+/// and trade places when kxx and kyy are swapped (the mirror model, whose frequencies are the
+/// same): the whirl tells them apart where the frequencies cannot.
+const WHIRL_MISMATCH: f64 = 0.009_084; // ln²(1.1)
+
+/// Pairs the measured modes of one speed (each with a whirl) with computed modes: the
+/// assignment minimising Σ ln²(f_measured/f_model) + [`WHIRL_MISMATCH`] per whirl that differs,
+/// each model mode used once (so modes the run-up did not show — heavily damped ones — are
+/// skipped). Exact, by dynamic programming over the subsets of measured modes.
+/// `None` when there are more measured than computed modes.
+fn pair_by_whirl(measured: &[&RunupPoint], modes: &[Mode]) -> Option<Vec<usize>> {
+    let (a, b) = (measured.len(), modes.len());
+    if a > b || a > 20 {
+        return None;
+    }
+    let full = (1usize << a) - 1;
+    // best[mask]: least cost with the measured modes in `mask` paired among the model modes
+    // seen so far; choice[j][mask]: the measured mode model mode j took (or none).
+    let mut best = vec![f64::INFINITY; full + 1];
+    best[0] = 0.0;
+    let mut choice = vec![vec![usize::MAX; full + 1]; b];
+    for (j, mode) in modes.iter().enumerate() {
+        let f = mode.frequency_hz();
+        let before = best.clone();
+        for (mask, &from) in before.iter().enumerate() {
+            if !from.is_finite() {
+                continue;
+            }
+            for (i, p) in measured.iter().enumerate().filter(|(i, _)| mask & (1 << i) == 0) {
+                let mismatch = if p.whirl == Some(mode.whirl) { 0.0 } else { WHIRL_MISMATCH };
+                let c = from + (p.frequency_hz / f).ln().powi(2) + mismatch;
+                let next = mask | (1 << i);
+                if c < best[next] {
+                    best[next] = c;
+                    choice[j][next] = i;
+                }
+            }
+        }
+        // A cost improved at model mode j came from it; the rest stay as they were.
+        for mask in 0..=full {
+            if best[mask] == before[mask] {
+                choice[j][mask] = usize::MAX;
+            }
+        }
+    }
+    if !best[full].is_finite() {
+        return None;
+    }
+    let mut out = vec![0; a];
+    let mut mask = full;
+    for j in (0..b).rev() {
+        let i = choice[j][mask];
+        if i != usize::MAX {
+            out[i] = j;
+            mask &= !(1 << i);
+        }
+    }
+    Some(out)
 }
 
 /// Result of an identification.

@@ -8,11 +8,13 @@
 //! from whirl frequencies measured over a run-up with analytic eigenvalue sensitivities.
 
 pub mod campbell;
+pub mod effects;
 pub mod elements;
 pub mod error;
 pub mod identify;
 pub mod interpolation;
 pub mod modal;
+pub mod objective;
 pub mod ross_file;
 pub mod rotor;
 pub mod sensitivity;

@@ -213,6 +213,12 @@ impl Rotor {
         modal::solve(mats.m.as_ref(), mats.d.as_ref(), mats.k.as_ref(), &self.translation_pairs(), with_left)
     }
 
+    /// The `count` lowest modes of already assembled matrices with left vectors (for
+    /// sensitivities), by the fastest exact route for the size.
+    pub fn lowest_modes_of(&self, mats: &Matrices, count: usize) -> Result<Vec<Mode>, RotorDynError> {
+        modal::solve_lowest_with_left(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count)
+    }
+
     /// The `count` lowest modes at speed Ω (rad/s), by the fastest exact route for the size.
     pub fn lowest_modes(&self, speed: f64, count: usize) -> Result<Vec<Mode>, RotorDynError> {
         let mats = self.matrices(speed);

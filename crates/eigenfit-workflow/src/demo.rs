@@ -167,8 +167,8 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
         max_iterations: 1000,
         budget: eigenfit_core::update::DEFAULT_EVALUATIONS,
     };
-    let measured =
-        reference_measurement(&rotor, &solver, &TARGET, &settings).map_err(|e| WorkflowError::Failure(e.to_string()))?;
+    let measured = reference_measurement(&rotor, &solver, &TARGET, &settings)
+        .map_err(|e| WorkflowError::Failure(e.to_string()))?;
     let reference_hz: Vec<f64> = measured.modes().iter().map(|m| m.frequency_hz).collect();
     let problem = Problem::new(&rotor, &solver, measured);
     let mut estimates = Vec::new();

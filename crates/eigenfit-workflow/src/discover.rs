@@ -164,20 +164,33 @@ pub fn run(
     })?;
     found.report.evaluations += check.used();
     let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
-    let r = &found.report;
-    let report = DiscoverReport {
+    let report = report_of(label, &found.report, &found.effects, found.mesh_factor, &names, budget);
+    Ok(Discovery { found, report })
+}
+
+/// The `discover` report of a discovery run: `effects` the named ones, `names` the model's own
+/// parameters (the first of every fit). Shared by the planar, matrices and two-plane models.
+pub(crate) fn report_of(
+    label: &str,
+    r: &DiscoveryReport,
+    effects: &[NamedEffect],
+    mesh_refinement: usize,
+    names: &[String],
+    budget: usize,
+) -> DiscoverReport {
+    DiscoverReport {
         model: label.to_string(),
         disagreement_significant: r.disagreement_significant,
-        missing_effect: found.effects.first().cloned(),
-        missing_effects: found.effects.clone(),
-        mesh_refinement: found.mesh_factor,
+        missing_effect: effects.first().cloned(),
+        missing_effects: effects.to_vec(),
+        mesh_refinement,
         rms_residual_before_hz: r.rms_before_hz,
         rms_residual_after_hz: r.rms_after_hz,
         chi2_before: r.chi2_before,
         dof_before: r.dof_before,
         p_value: r.p_value,
-        calibrated_parameters: Named::new(&names, r.base_parameters.iter().copied()),
-        refitted_parameters: refitted(r, &names),
+        calibrated_parameters: Named::new(names, r.base_parameters.iter().copied()),
+        refitted_parameters: refitted(r, names),
         runner_up: r.runner_up.clone(),
         candidates_refitted: r.fits.clone(),
         modes: r
@@ -195,8 +208,7 @@ pub fn run(
         evaluations: r.evaluations,
         budget_limit: budget,
         budget_exhausted: r.budget_exhausted,
-    };
-    Ok(Discovery { found, report })
+    }
 }
 
 /// The augmented model (calibrated stiffnesses and the named effects) as rotor TOML; a

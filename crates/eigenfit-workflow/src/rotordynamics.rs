@@ -294,6 +294,106 @@ pub fn estimate(
     })
 }
 
+/// One run-up point before and after the discovered effects.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunupDiscoveryPoint {
+    /// Speed (rpm).
+    pub speed_rpm: f64,
+    /// Mode number as measured.
+    pub mode: usize,
+    /// Measured frequency (Hz).
+    pub measured_hz: f64,
+    /// Its standard deviation (Hz; assumed where the file gives none).
+    pub std_hz: f64,
+    /// Calibrated model without the effects (Hz).
+    pub before_hz: f64,
+    /// With the named effects (Hz).
+    pub after_hz: f64,
+}
+
+/// `discover` on a two-plane rotor: the planar report's keys (`missing_effect`, `chi2_before`,
+/// `calibrated_parameters` — the bearings' kxx and kyy in N/m at `reference_speed_rpm` —, …),
+/// and each run-up point by speed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunupDiscoverReport {
+    /// The report every model gives.
+    #[serde(flatten)]
+    pub discovery: crate::discover::DiscoverReport,
+    /// The speed the coefficients are given at (the lowest measured, rpm).
+    pub reference_speed_rpm: f64,
+    /// Each run-up point, before and after.
+    pub points: Vec<RunupDiscoveryPoint>,
+}
+
+/// `discover --model ROSS-FILE --measured RUNUP.csv`: calibrate the bearings' kxx and kyy, test
+/// the misfit against the noise and, when it is significant, name the effects (a mass, a
+/// diametral or polar inertia at a node, cross-coupling at a bearing, a stiffness loss in a
+/// shaft element) that explain it, by core's forward selection.
+pub fn discover(
+    path: &Path,
+    measured: &Path,
+    assumed_std: f64,
+) -> Result<RunupDiscoverReport, WorkflowError> {
+    use eigenfit_core::discovery::{discover_effects, DiscoveryOptions};
+    use eigenfit_rotordynamics::effects::candidates;
+    use eigenfit_rotordynamics::objective::{RunupObjective, RunupSearch};
+    if !(assumed_std.is_finite() && assumed_std > 0.0) {
+        return Err(input(format!("--assumed-std {assumed_std}: must be a positive number")));
+    }
+    let rotor = load(path)?;
+    let points = read_runup(measured).map_err(to_workflow)?;
+    let params = bearing_parameters(&rotor, &DEFAULT_COEFFICIENTS).map_err(to_workflow)?;
+    if params.is_empty() {
+        return Err(input(format!("{}: the rotor has no bearings to calibrate", path.display())));
+    }
+    let base =
+        RunupObjective::new(&rotor, params.clone(), &points, Some(assumed_std)).map_err(to_workflow)?;
+    let filled: Vec<RunupPoint> = base.points().to_vec();
+    let effects = candidates(&rotor);
+    let search = RunupSearch::new(base, &effects);
+    let options = DiscoveryOptions { assumed_relative_std: assumed_std, ..Default::default() };
+    let r = discover_effects(&search, &search.candidates(), &vec![1.0; params.len()], &options)
+        .map_err(|e| input(format!("{}: {e}", measured.display())))?;
+    let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
+    let mut report = crate::discover::report_of(
+        &path.display().to_string(),
+        &r,
+        &r.effects,
+        1,
+        &names,
+        options.max_evaluations,
+    );
+    // Factors → N/m at the lowest measured speed, as `estimate` reports them.
+    let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
+    let nominal: Vec<f64> = params.iter().map(|p| p.nominal(&rotor, w0)).collect();
+    for ((_, v), k) in report.calibrated_parameters.0.iter_mut().zip(&nominal) {
+        *v *= k;
+    }
+    if let Some(refitted) = report.refitted_parameters.as_mut() {
+        for ((_, v), k) in refitted.0.iter_mut().zip(&nominal) {
+            v.value *= k;
+            v.interval = v.interval.map(|[a, b]| [a * k, b * k]);
+        }
+    }
+    let points = filled
+        .iter()
+        .zip(&r.modes)
+        .map(|(p, m)| RunupDiscoveryPoint {
+            speed_rpm: p.speed_rpm,
+            mode: p.mode,
+            measured_hz: p.frequency_hz,
+            std_hz: m.std_hz,
+            before_hz: m.before_hz,
+            after_hz: m.after_hz,
+        })
+        .collect();
+    Ok(RunupDiscoverReport {
+        discovery: report,
+        reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
+        points,
+    })
+}
+
 /// Parses `FROM:TO:COUNT` (rpm, linear).
 pub fn parse_speeds(text: &str) -> Result<Vec<f64>, WorkflowError> {
     let bad = |why: &str| {

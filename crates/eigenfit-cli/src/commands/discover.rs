@@ -43,6 +43,17 @@ pub struct DiscoverArgs {
 
 /// Runs `discover`; returns the exit code (3 when the budget ran out before the search ended).
 pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
+    // Two-plane rotors saved by ROSS, against a run-up CSV: the rotordynamics workflow.
+    if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
+        if args.write_model.is_some() || args.plot.is_some() {
+            return Err(crate::error::input(
+                "--write-model and --plot are not available for ROSS rotors (the report names the effects)",
+            ));
+        }
+        let report = eigenfit_workflow::rotordynamics::discover(path, &args.measured, args.assumed_std)?;
+        crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
+        return Ok(0);
+    }
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
     let mut notes = Vec::new();

@@ -398,21 +398,110 @@ where
         .map(|(_, m)| with_std(m, options.assumed_relative_std))
         .collect::<Result<_, _>>()?;
     let models: Vec<&M> = configurations.iter().map(|&(m, _)| m).collect();
-    let n: usize = measured.iter().map(Measurement::len).sum();
-    let nb = model.parameters().len();
+    let search = ModelSearch { models, solver, measured };
+    if search.models.iter().any(|m| m.parameters() != model.parameters()) {
+        return Err(DiscoveryError::Data("the configurations' parameters differ".into()));
+    }
+    discover_effects(&search, candidates, initial, options)
+}
+
+/// One measured value of the data discovery explains, with the standard deviation it is
+/// weighed by.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredRow {
+    /// Test configuration (or, on a run-up, the speed's index).
+    pub configuration: usize,
+    /// 0-based mode number.
+    pub mode: usize,
+    /// Measured frequency, Hz.
+    pub frequency_hz: f64,
+    /// Its standard deviation, Hz.
+    pub std_hz: f64,
+}
+
+/// What discovery searches: a base least-squares problem, and the same problem with candidate
+/// effects added. [`discover_configurations`] builds one from [`StructuralModel`]s (effects as
+/// symmetric ΔK, ΔM through [`Augmented`]); a plugin whose effects are not of that form (the
+/// two-plane rotor at speed: gyroscopic and cross-coupled terms) implements it over its own
+/// [`Objective`] and runs the same selection with [`discover_effects`].
+pub trait EffectSearch {
+    /// Runs `f` on the objective with the effects `set` added, their values after the base
+    /// parameters in order; `None` when it cannot be built.
+    fn with_effects<T>(&self, set: &[&Candidate], f: impl FnOnce(&dyn Objective) -> Option<T>) -> Option<T>;
+
+    /// Runs `f` on the base objective, for the calibration (by default with no effect added).
+    fn with_base<T>(&self, f: impl FnOnce(&dyn Objective) -> Option<T>) -> Option<T> {
+        self.with_effects(&[], f)
+    }
+
+    /// The measured rows, in the objective's residual order.
+    fn rows(&self) -> Vec<MeasuredRow>;
+}
+
+/// Discovery over structural models: each configuration's model with the effects added to its
+/// K and M.
+struct ModelSearch<'a, M, S> {
+    models: Vec<&'a M>,
+    solver: &'a S,
+    measured: Vec<Measurement>,
+}
+
+impl<M: StructuralModel, S: EigenSolver> EffectSearch for ModelSearch<'_, M, S> {
+    fn with_effects<T>(&self, set: &[&Candidate], f: impl FnOnce(&dyn Objective) -> Option<T>) -> Option<T> {
+        with_augmented(&self.models, self.solver, &self.measured, set, f)
+    }
+
+    fn with_base<T>(&self, f: impl FnOnce(&dyn Objective) -> Option<T>) -> Option<T> {
+        let problems: Vec<Problem<&M, &S>> = self
+            .models
+            .iter()
+            .zip(&self.measured)
+            .map(|(&m, d)| Problem::new(m, self.solver, d.clone()))
+            .collect();
+        let base = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect())?;
+        f(&base)
+    }
+
+    fn rows(&self) -> Vec<MeasuredRow> {
+        self.measured
+            .iter()
+            .enumerate()
+            .flat_map(|(c, m)| m.modes().iter().map(move |mode| (c, mode)))
+            .map(|(configuration, m)| MeasuredRow {
+                configuration,
+                mode: m.mode,
+                frequency_hz: m.frequency_hz,
+                std_hz: m.std_hz.unwrap_or(f64::NAN),
+            })
+            .collect()
+    }
+}
+
+/// The discovery workflow (calibrate, detect, forward selection of `candidates`) on any
+/// [`EffectSearch`], starting the calibration from `initial`.
+pub fn discover_effects<E: EffectSearch>(
+    search: &E,
+    candidates: &[Candidate],
+    initial: &[f64],
+    options: &DiscoveryOptions,
+) -> Result<DiscoveryReport, DiscoveryError> {
+    let rows = search.rows();
+    let n = rows.len();
+    let nb = search
+        .with_base(|base| Some(base.parameters().len()))
+        .ok_or_else(|| DiscoveryError::Data("the base problem could not be built".into()))?;
     if n <= nb {
         return Err(DiscoveryError::Data(format!(
             "{n} measured modes for {nb} parameters: detecting a missing effect needs more modes than parameters"
         )));
     }
-    let problems: Vec<Problem<&M, &S>> =
-        models.iter().zip(&measured).map(|(&m, d)| Problem::new(m, solver, d.clone())).collect();
-    let base = Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect())
-        .ok_or_else(|| DiscoveryError::Data("the configurations' parameters differ".into()))?;
     let budget = Budget::new(options.max_evaluations);
     // (a) calibrate
-    let est = Driver::default()
-        .run_within(&base, &mut LevenbergMarquardt::default(), initial, &budget)
+    let est = search
+        .with_base(|base| {
+            Some(Driver::default().run_within(base, &mut LevenbergMarquardt::default(), initial, &budget))
+        })
+        .ok_or_else(|| DiscoveryError::Data("the base problem could not be built".into()))?
         .map_err(|e| match budget.exhausted() {
             true => DiscoveryError::BudgetExhausted(options.max_evaluations),
             false => DiscoveryError::Calibration(e.to_string()),
@@ -439,7 +528,7 @@ where
         selected: None,
         runner_up: None,
         effects: Vec::new(),
-        modes: compare_modes(&measured, &base_lin, &base_lin),
+        modes: compare_modes(&rows, &base_lin, &base_lin),
         rms_before_hz: rms_diff(&base_lin),
         rms_after_hz: rms_diff(&base_lin),
         evaluations: 0,
@@ -467,8 +556,8 @@ where
         }
         let chosen_refs: Vec<&Candidate> = chosen.iter().map(|&i| &candidates[i]).collect();
         let open = |i: usize| !chosen.iter().any(|&c| same_place(&candidates[c], &candidates[i]));
-        let mut scored: Vec<(usize, f64)> =
-            with_augmented(&models, solver, &measured, &chosen_refs, |problem| {
+        let mut scored: Vec<(usize, f64)> = search
+            .with_effects(&chosen_refs, |problem| {
                 let lin = budget.wrap(problem).linearise(&current.parameters).ok()?;
                 let projector = Projector::new(problem, &lin);
                 Some(
@@ -477,8 +566,7 @@ where
                         .enumerate()
                         .filter(|&(i, c)| !c.needs_refit() && open(i))
                         .filter_map(|(i, c)| {
-                            screen(&models, solver, &measured, &chosen_refs, c, (&lin, &projector), &budget)
-                                .map(|s| (i, s))
+                            screen(search, &chosen_refs, c, (&lin, &projector), &budget).map(|s| (i, s))
                         })
                         .collect(),
                 )
@@ -513,7 +601,7 @@ where
             .filter_map(|i| {
                 let mut set = chosen_refs.clone();
                 set.push(&candidates[i]);
-                let mut fit = refit(&models, solver, &measured, &set, &current.parameters, &budget)?;
+                let mut fit = refit(search, n, &set, &current.parameters, &budget)?;
                 fit.place_charge = current.place_charge + charges[i];
                 Some((i, fit))
             })
@@ -623,21 +711,14 @@ fn with_std(measured: &Measurement, relative: f64) -> Result<Measurement, Discov
     Measurement::new(modes).map_err(|e| DiscoveryError::Data(e.to_string()))
 }
 
-fn compare_modes(
-    measured: &[Measurement],
-    before: &Linearisation,
-    after: &Linearisation,
-) -> Vec<ModeComparison> {
-    measured
-        .iter()
+fn compare_modes(rows: &[MeasuredRow], before: &Linearisation, after: &Linearisation) -> Vec<ModeComparison> {
+    rows.iter()
         .enumerate()
-        .flat_map(|(c, m)| m.modes().iter().map(move |mode| (c, mode)))
-        .enumerate()
-        .map(|(k, (configuration, m))| ModeComparison {
-            configuration,
-            mode: m.mode,
-            measured_hz: m.frequency_hz,
-            std_hz: m.std_hz.unwrap_or(f64::NAN),
+        .map(|(k, r)| ModeComparison {
+            configuration: r.configuration,
+            mode: r.mode,
+            measured_hz: r.frequency_hz,
+            std_hz: r.std_hz,
             before_hz: before.frequencies_hz[k],
             after_hz: after.frequencies_hz[k],
         })
@@ -698,10 +779,8 @@ where
 
 /// Predicted χ² reduction of fitting the candidate's value alone, after the current parameters
 /// have absorbed what they can; 0 when the fit would need a value outside the bounds' sign.
-fn screen<M: StructuralModel, S: EigenSolver>(
-    models: &[&M],
-    solver: &S,
-    measured: &[Measurement],
+fn screen<E: EffectSearch>(
+    search: &E,
     chosen: &[&Candidate],
     candidate: &Candidate,
     (current, projector): (&Linearisation, &Projector),
@@ -712,8 +791,7 @@ fn screen<M: StructuralModel, S: EigenSolver>(
     p.push(par.nominal);
     let mut set = chosen.to_vec();
     set.push(candidate);
-    let lin =
-        with_augmented(models, solver, measured, &set, |problem| budget.wrap(problem).linearise(&p).ok())?;
+    let lin = search.with_effects(&set, |problem| budget.wrap(problem).linearise(&p).ok())?;
     let j = projector.apply(&lin.jacobian.column(lin.jacobian.ncols() - 1).into_owned());
     let r = projector.apply(&lin.residual);
     let jj = j.norm_squared();
@@ -728,10 +806,9 @@ fn screen<M: StructuralModel, S: EigenSolver>(
 
 /// Refits the current parameters with the candidate set `set` (the chosen ones, then the new
 /// one, last); intervals are the covariance ones (cheap: no profile per candidate).
-fn refit<M: StructuralModel, S: EigenSolver>(
-    models: &[&M],
-    solver: &S,
-    measured: &[Measurement],
+fn refit<E: EffectSearch>(
+    search: &E,
+    n: usize,
     set: &[&Candidate],
     current: &[f64],
     budget: &Budget,
@@ -739,8 +816,7 @@ fn refit<M: StructuralModel, S: EigenSolver>(
     let candidate = *set.last()?;
     let mut start = current.to_vec();
     start.extend(candidate.parameters().map(|p| p.nominal));
-    let n: usize = measured.iter().map(Measurement::len).sum();
-    with_augmented(models, solver, measured, set, |problem| {
+    search.with_effects(set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
         let est = Driver { max_iterations: 60 }

@@ -1,0 +1,165 @@
+//! The run-up as core's least-squares [`Objective`]: the bearing coefficient factors (and any
+//! candidate effects' values) as core parameters, the measured whirl frequencies as residual
+//! rows. Through it core's intervals (profile likelihood, one-sided bounds) and its discovery
+//! ([`EffectSearch`]) run on two-plane rotors at speed as they do on the planar model.
+
+use crate::effects::Effect;
+use crate::error::RotorDynError;
+use crate::identify::{evaluate_with, Parameter as Factor, RunupPoint};
+use crate::rotor::Rotor;
+use eigenfit_core::discovery::{EffectSearch, MeasuredRow};
+use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale};
+use eigenfit_core::problem::{Linearisation, Objective, ResidualError};
+use eigenfit_core::sensitivity::SensitivityError;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+
+/// Widest factor range searched on a coefficient curve: three decades either way.
+const FACTOR_RANGE: (f64, f64) = (1e-3, 1e3);
+
+/// Run-up frequencies of a rotor whose chosen bearing coefficient curves are scaled by factors
+/// (parameters 0…, dimensionless, log scale), with effects added at the values that follow.
+pub struct RunupObjective<'a> {
+    rotor: &'a Rotor,
+    factors: Vec<Factor>,
+    effects: Vec<&'a Effect>,
+    points: Vec<RunupPoint>,
+    parameters: ParameterSet,
+}
+
+impl<'a> RunupObjective<'a> {
+    /// The objective of `factors` on `rotor` against `points`. `assumed_relative_std`, when
+    /// given, becomes the std of every point without one (discovery weighs every row).
+    pub fn new(
+        rotor: &'a Rotor,
+        factors: Vec<Factor>,
+        points: &[RunupPoint],
+        assumed_relative_std: Option<f64>,
+    ) -> Result<Self, RotorDynError> {
+        let list: Vec<Parameter> = factors
+            .iter()
+            .map(|f| {
+                Parameter::new(f.name.clone(), "factor", 1.0)
+                    .with_bounds(FACTOR_RANGE.0, FACTOR_RANGE.1)
+                    .with_scale(Scale::Log)
+            })
+            .collect();
+        let parameters = ParameterSet::new(list).map_err(|e| RotorDynError::Data(e.to_string()))?;
+        let points = points
+            .iter()
+            .map(|p| RunupPoint {
+                std_hz: p.std_hz.or(assumed_relative_std.map(|r| r * p.frequency_hz)),
+                ..p.clone()
+            })
+            .collect();
+        Ok(Self { rotor, factors, effects: Vec::new(), points, parameters })
+    }
+
+    /// The same objective with `effects` added, their values after the factors.
+    pub fn with_effects(&self, effects: &[&'a Effect]) -> Result<Self, RotorDynError> {
+        let mut list = self.parameters.as_slice().to_vec();
+        list.extend(effects.iter().filter_map(|e| e.candidate.parameter.clone()));
+        Ok(Self {
+            rotor: self.rotor,
+            factors: self.factors.clone(),
+            effects: effects.to_vec(),
+            points: self.points.clone(),
+            parameters: ParameterSet::new(list).map_err(|e| RotorDynError::Data(e.to_string()))?,
+        })
+    }
+
+    /// The run-up points (with the assumed std filled in).
+    pub fn points(&self) -> &[RunupPoint] {
+        &self.points
+    }
+}
+
+impl Objective for RunupObjective<'_> {
+    fn parameters(&self) -> &ParameterSet {
+        &self.parameters
+    }
+
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        self.parameters.check(p).map_err(|e| SensitivityError::Model(e.into()))?;
+        let nf = self.factors.len();
+        let effects: Vec<(&Effect, f64)> =
+            self.effects.iter().copied().zip(p[nf..].iter().copied()).collect();
+        let e = evaluate_with(self.rotor, &self.factors, &p[..nf], &effects, &self.points)
+            .map_err(|e| SensitivityError::Model(ModelError::Invalid(e.to_string())))?;
+        let (m, np) = (self.points.len(), p.len());
+        let has_std = self.points.iter().all(|q| q.std_hz.is_some());
+        // Weighted by std_hz, or relative (σ = the measured frequency) without.
+        let sigma: Vec<f64> = self.points.iter().map(|q| q.std_hz.unwrap_or(q.frequency_hz)).collect();
+        // d f/d p: the factors' columns are d f/d ln s, so divide by s; effects' are d f/d v.
+        let df = DMatrix::from_fn(
+            m,
+            np,
+            |i, j| if j < nf { e.jacobian[(i, j)] / p[j] } else { e.jacobian[(i, j)] },
+        );
+        let omega = |f: f64| 2.0 * PI * f;
+        Ok(Linearisation {
+            parameters: p.to_vec(),
+            paired_modes: self.points.iter().map(|q| q.mode - 1).collect(),
+            model_eigenvalues: DVector::from_iterator(m, e.frequencies_hz.iter().map(|&f| omega(f).powi(2))),
+            measured_eigenvalues: DVector::from_iterator(
+                m,
+                self.points.iter().map(|q| omega(q.frequency_hz).powi(2)),
+            ),
+            // dλ/dp with λ = ω²: 2ω · 2π d f/d p.
+            eigenvalue_jacobian: DMatrix::from_fn(m, np, |i, j| {
+                2.0 * omega(e.frequencies_hz[i]) * 2.0 * PI * df[(i, j)]
+            }),
+            frequencies_hz: e.frequencies_hz.clone(),
+            measured_hz: self.points.iter().map(|q| q.frequency_hz).collect(),
+            residual: DVector::from_fn(m, |i, _| {
+                (self.points[i].frequency_hz - e.frequencies_hz[i]) / sigma[i]
+            }),
+            jacobian: DMatrix::from_fn(m, np, |i, j| df[(i, j)] / sigma[i]),
+            has_std,
+        })
+    }
+}
+
+/// Discovery on a run-up: the base objective and the rotor's candidate effects by label.
+pub struct RunupSearch<'a> {
+    base: RunupObjective<'a>,
+    effects: &'a [Effect],
+}
+
+impl<'a> RunupSearch<'a> {
+    /// Discovery of `effects` (from [`crate::effects::candidates`]) on `base`.
+    pub fn new(base: RunupObjective<'a>, effects: &'a [Effect]) -> Self {
+        Self { base, effects }
+    }
+
+    /// The candidates in core's form, in the order of the effects.
+    pub fn candidates(&self) -> Vec<Candidate> {
+        self.effects.iter().map(|e| e.candidate.clone()).collect()
+    }
+}
+
+impl EffectSearch for RunupSearch<'_> {
+    fn with_effects<T>(&self, set: &[&Candidate], f: impl FnOnce(&dyn Objective) -> Option<T>) -> Option<T> {
+        // Core hands back the candidates it was given: find each one's effect.
+        let chosen: Option<Vec<&Effect>> =
+            set.iter().map(|c| self.effects.iter().find(|e| e.candidate == **c)).collect();
+        let objective = self.base.with_effects(&chosen?).ok()?;
+        f(&objective)
+    }
+
+    fn rows(&self) -> Vec<MeasuredRow> {
+        let mut speeds: Vec<f64> = self.base.points.iter().map(|p| p.speed_rpm).collect();
+        speeds.sort_by(f64::total_cmp);
+        speeds.dedup();
+        self.base
+            .points
+            .iter()
+            .map(|p| MeasuredRow {
+                configuration: speeds.iter().position(|&s| s == p.speed_rpm).unwrap_or(0),
+                mode: p.mode - 1,
+                frequency_hz: p.frequency_hz,
+                std_hz: p.std_hz.unwrap_or(f64::NAN),
+            })
+            .collect()
+    }
+}
