@@ -133,6 +133,47 @@ fn discover_adds_nothing_to_a_model_that_fits() {
     assert_eq!(v["rms_residual_before_hz"], v["rms_residual_after_hz"]);
 }
 
+/// A pedestal (a bearing on its own mass and spring) adds a degree of freedom a rotor model file
+/// cannot hold: `--write-model` is refused as a request that cannot be met (exit 2, saying why),
+/// not as an internal failure, and nothing is written.
+#[test]
+fn discover_refuses_to_write_a_named_pedestal_with_exit_2() {
+    // The independent generator's rotor with K2 on a 0.5 kg / 2e6 N/m pedestal, exact (std 0.05 %).
+    let fixtures = include_str!("../../eigenfit-rotor/tests/fixtures/discovery/independent.toml");
+    let case = fixtures.split("[[case]]").find(|c| c.contains("name = \"pedestal\"")).expect("pedestal case");
+    let line = case.lines().find(|l| l.starts_with("exact_hz = [")).expect("exact_hz");
+    let csv: String = line["exact_hz = [".len()..line.len() - 1]
+        .split(", ")
+        .enumerate()
+        .map(|(m, f)| {
+            let f: f64 = f.parse().unwrap();
+            format!("{},{f},{}\n", m + 1, 5e-4 * f)
+        })
+        .collect();
+    // Its own folder (the other tests share `temp_file`'s), removed at the end.
+    let dir = std::env::temp_dir().join(format!("eigenfit-pedestal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let data = dir.join("pedestal.csv");
+    std::fs::write(&data, format!("mode,frequency_hz,std_hz\n{csv}")).unwrap();
+    let target = dir.join("pedestal-model.toml");
+    let (code, v) =
+        eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0);
+    assert_eq!(v["missing_effect"]["kind"], "pedestal", "{v}");
+    let out = Command::new(env!("CARGO_BIN_EXE_eigenfit"))
+        .args(["discover", "--preset", "paper-rotor", "--measured", data.to_str().unwrap(), "--quiet"])
+        .arg("--write-model")
+        .arg(&target)
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    let written = target.exists();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("pedestal") && stderr.contains("--write-model"), "{stderr}");
+    assert!(!written);
+}
+
 #[cfg(feature = "lapack")]
 #[test]
 fn lapack_and_dense_backends_agree_on_the_paper_rotor() {

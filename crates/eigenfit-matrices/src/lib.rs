@@ -30,7 +30,7 @@ pub mod market;
 mod model;
 
 pub use error::MatricesError;
-pub use layout::{Dof, DofLayout};
+pub use layout::{Dof, DofLayout, DofLayoutError};
 pub use model::MatricesModel;
 
 /// Whether the TOML text declares `kind = "matrices"` (cheap, for routing a `--model` file).

@@ -24,12 +24,21 @@ const SYMMETRY_TOLERANCE: f64 = 1e-10;
 pub fn read_symmetric(path: &Path, expected: Option<usize>) -> Result<CscSymmetric, MatricesError> {
     let text = std::fs::read_to_string(path).map_err(|e| MatricesError::io(path, e))?;
     parse_symmetric(&text, expected)
-        .map_err(|detail| MatricesError::Matrix { path: path.to_path_buf(), detail })
+        .map_err(|e| MatricesError::Matrix { path: path.to_path_buf(), detail: e.detail })
 }
 
-/// [`read_symmetric`] on the file's text; the error names the entry (1-based, as in the file).
-pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetric, String> {
-    parse_with(text, expected, text.len() >= LARGE_FILE_BYTES)
+/// Text that is not a symmetric real Matrix Market matrix. `detail` says what is wrong and
+/// where: the header, the size line, or the entry or line (1-based, as in the file).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{detail}")]
+pub struct MarketError {
+    /// What is wrong, and where.
+    pub detail: String,
+}
+
+/// [`read_symmetric`] on the file's text.
+pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetric, MarketError> {
+    parse_with(text, expected, text.len() >= LARGE_FILE_BYTES).map_err(|detail| MarketError { detail })
 }
 
 /// [`parse_symmetric`] with the entries read by [`read_entries_streaming`] or by the kept reader.

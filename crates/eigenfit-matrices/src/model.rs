@@ -172,7 +172,7 @@ impl MatricesModel {
         let dofs = match &file.dofs {
             Some(p) => {
                 let map = read_dof_map(&at(p), n)?;
-                DofLayout::new(&map).map_err(|e| MatricesError::invalid(&at(p), e))?;
+                DofLayout::new(&map).map_err(|e| MatricesError::invalid(&at(p), e.to_string()))?;
                 Some(map)
             }
             None => None,

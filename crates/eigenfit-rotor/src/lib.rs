@@ -76,4 +76,4 @@ pub use model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STI
 pub use spec::{
     BearingSpec, Disk, EffectSpec, Material, ParameterSpec, PointMass, RotorSpec, Section, ShaftSpec,
 };
-pub use updatable::UpdatableRotor;
+pub use updatable::{UpdatableError, UpdatableRotor};

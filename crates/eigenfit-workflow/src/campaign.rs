@@ -104,7 +104,7 @@ pub struct CampaignReport {
 
 /// Estimates a campaign jointly.
 pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<CampaignReport, WorkflowError> {
-    let campaign = Campaign::from_toml_file(&request.campaign).map_err(input)?;
+    let campaign = Campaign::from_toml_file(&request.campaign).map_err(|e| input(e.to_string()))?;
     let solver: Box<dyn EigenSolver> = match request.solver.as_str() {
         "banded" | "auto" => Box::new(BandedSolver::default()),
         "dense" => Box::new(DenseSolver),
@@ -160,7 +160,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     }
     let budget = Budget::new(request.budget);
     let estimate = Driver { max_iterations: request.max_iterations }
-        .run_within(&joint, strategy.as_mut(), &initial, &mut [], &budget)
+        .run_within(&joint, strategy.as_mut(), &initial, &budget)
         .map_err(|e| match budget.exhausted() {
             true => WorkflowError::BudgetExhausted(format!(
                 "the budget of {} model evaluations ran out before the fit could start (raise it with --budget)",

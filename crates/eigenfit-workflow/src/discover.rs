@@ -200,8 +200,17 @@ pub fn run(
 }
 
 /// The augmented model (calibrated stiffnesses and the named effects) as rotor TOML; a
-/// matrices model has no file form for its effects and says so.
+/// matrices model has no file form for its effects and says so, and neither has a pedestal
+/// (an input error: the request cannot be met, nothing broke).
 pub fn augmented_model_toml(found: &RotorDiscovery, model: &AnyModel) -> Result<String, WorkflowError> {
+    if let Some(p) = found.effects.iter().find(|e| e.kind == eigenfit_rotor::pedestal::KIND) {
+        return Err(input(format!(
+            "--write-model: the named `{}` adds a degree of freedom (the pedestal's mass on its own spring), \
+             which a rotor model file cannot describe yet; its mass and stiffness are in the report \
+             (run without --write-model to see it)",
+            p.label
+        )));
+    }
     let augmented = found.augmented_model(model.rotor("--write-model")?).map_err(failure)?;
     augmented.to_toml_string().map_err(failure)
 }

@@ -343,7 +343,7 @@ pub fn run(
     let mut strategy = strategy_kind.build();
     progress.begin(&format!("estimating ({})", strategy_kind.name()), None);
     let estimate = Driver { max_iterations: request.max_iterations }
-        .run_within(&fit, strategy.as_mut(), &start, &mut [], &budget)
+        .run_within(&fit, strategy.as_mut(), &start, &budget)
         .map_err(|e| input(e.to_string()));
     progress.end();
     let estimate = match estimate {

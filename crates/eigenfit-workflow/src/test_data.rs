@@ -376,7 +376,7 @@ pub fn updated_model_toml(
             "--write-model applies to rotor models only, not to a `kind = \"matrices\"` model",
         ));
     };
-    let updated = rotor.with_values(&full).map_err(WorkflowError::Failure)?;
+    let updated = rotor.with_values(&full).map_err(|e| WorkflowError::Failure(e.to_string()))?;
     let toml = updated.to_toml_string().map_err(failure)?;
     let mut head = format!(
         "# Updated by eigenfit estimate ({} strategy, {}) on {} from {}\n\

@@ -3,6 +3,7 @@
 
 use crate::analysis::{alternatives_among, local_solutions, uncertainty_within, Identifiability};
 use crate::eigen::EigenSolver;
+use crate::measurement::synthetic::SynthesisError;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::problem::{Linearisation, Objective, Problem};
@@ -10,6 +11,7 @@ use crate::update::{Budget, Driver, LevenbergMarquardt, StrategyKind, UpdateStra
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
+use thiserror::Error;
 
 /// Local fits tried when looking for other solutions of a damped run.
 const ALTERNATIVE_STARTS: usize = 6;
@@ -70,19 +72,30 @@ pub struct CompareRun {
     pub budget_exhausted: bool,
 }
 
+/// Why a comparison grid could not be run.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum CompareError {
+    /// The reference data of a target could not be computed.
+    #[error(transparent)]
+    Reference(#[from] SynthesisError),
+    /// A worker thread panicked (a bug; the other runs are lost with it).
+    #[error("a comparison run panicked")]
+    RunPanicked,
+}
+
 /// Reference data: the lowest `modes` frequencies of `model` at `target`, optionally rounded.
 pub fn reference_measurement<M, S>(
     model: &M,
     solver: &S,
     target: &[f64],
     settings: &CompareSettings,
-) -> Result<Measurement, String>
+) -> Result<Measurement, SynthesisError>
 where
     M: StructuralModel + ?Sized,
     S: EigenSolver + ?Sized,
 {
-    let system = model.assemble(target).map_err(|e| e.to_string())?;
-    let modes = solver.lowest(&system, settings.modes).map_err(|e| e.to_string())?;
+    let modes = solver.lowest(&model.assemble(target)?, settings.modes)?;
     let round = |f: f64| match settings.decimals {
         Some(d) => (f * 10f64.powi(d)).round() / 10f64.powi(d),
         None => f,
@@ -93,7 +106,7 @@ where
         .enumerate()
         .map(|(k, f)| MeasuredMode { mode: k, frequency_hz: round(f), std_hz: settings.std_hz, shape: None })
         .collect();
-    Measurement::new(measured).map_err(|e| e.to_string())
+    Ok(Measurement::new(measured)?)
 }
 
 /// What every damped run on the same reference data shares, computed once: the coarse grid of
@@ -151,13 +164,8 @@ where
         _ => strategy.build(),
     };
     let budget = Budget::new(settings.budget);
-    let outcome = Driver { max_iterations: settings.max_iterations }.run_within(
-        problem,
-        s.as_mut(),
-        initial,
-        &mut [],
-        &budget,
-    );
+    let outcome =
+        Driver { max_iterations: settings.max_iterations }.run_within(problem, s.as_mut(), initial, &budget);
     let seconds = start.elapsed().as_secs_f64();
     match outcome {
         Ok(est) => {
@@ -217,7 +225,7 @@ pub fn run_grid<M, S>(
     strategies: &[StrategyKind],
     settings: &CompareSettings,
     mut on_run: impl FnMut(&CompareRun),
-) -> Result<Vec<CompareRun>, String>
+) -> Result<Vec<CompareRun>, CompareError>
 where
     M: StructuralModel + Sync,
     S: EigenSolver + Sync,
@@ -227,7 +235,7 @@ where
         .map(|target| {
             Ok(Problem::new(model, solver, reference_measurement(model, solver, target, settings)?))
         })
-        .collect::<Result<Vec<_>, String>>()?;
+        .collect::<Result<Vec<_>, CompareError>>()?;
     let shared: Vec<SharedData> = problems.iter().map(|p| SharedData::for_runs(p, strategies)).collect();
     let cases: Vec<(usize, &Vec<f64>, StrategyKind)> = (0..targets.len())
         .flat_map(|t| initials.iter().flat_map(move |i| strategies.iter().map(move |&s| (t, i, s))))
@@ -248,7 +256,7 @@ where
         for run in receiver {
             on_run(&run);
         }
-        worker.join().map_err(|_| "a comparison run panicked".to_string())
+        worker.join().map_err(|_| CompareError::RunPanicked)
     })
 }
 
@@ -261,7 +269,7 @@ pub fn run_grid_serial<M, S>(
     strategies: &[StrategyKind],
     settings: &CompareSettings,
     mut on_run: impl FnMut(&CompareRun),
-) -> Result<Vec<CompareRun>, String>
+) -> Result<Vec<CompareRun>, CompareError>
 where
     M: StructuralModel,
     S: EigenSolver,

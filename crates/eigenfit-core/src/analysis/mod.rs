@@ -14,7 +14,7 @@ pub(crate) mod statistics;
 pub mod verdict;
 
 pub use chi2::chi2_upper_tail;
-pub use joint::Joint;
+pub use joint::{Joint, JointError};
 pub use shape_fit::{ShapeFit, DEFAULT_FREQUENCY_STD_REL, DEFAULT_SHAPE_STD};
 pub use statistics::{
     alternative_solutions, alternative_solutions_within, alternatives_among, local_solutions,

@@ -2,7 +2,7 @@
 //! parameters the data cannot determine (with the one-sided bound they do support).
 
 use crate::problem::{Linearisation, Objective};
-use crate::update::{Budget, Driver, LevenbergMarquardt, Observer};
+use crate::update::{Budget, Driver, LevenbergMarquardt, LevenbergMarquardtSettings, Observer};
 use nalgebra::DMatrix;
 
 /// χ² quantile of one degree of freedom at 95%: the profile-likelihood threshold.
@@ -235,7 +235,6 @@ impl Profile<'_> {
             self.problem,
             &mut local,
             &p,
-            &mut [],
             self.budget,
         );
         if self.budget.exhausted() {
@@ -343,7 +342,7 @@ pub fn local_solutions(problem: &dyn Objective, starts: usize) -> Vec<Linearisat
         .take(starts)
         .filter_map(|seed| {
             let mut local = LevenbergMarquardt::default().with_max_restarts(0);
-            let est = (Driver { max_iterations: 100 }).run(problem, &mut local, &seed, &mut []).ok()?;
+            let est = (Driver { max_iterations: 100 }).run(problem, &mut local, &seed).ok()?;
             est.termination.is_converged().then_some(est.last)
         })
         .collect()
@@ -428,7 +427,7 @@ fn scaled_distance(problem: &dyn Objective, a: &[f64], b: &[f64]) -> f64 {
 /// `lin` fits as well as `at`: an exact fit (to the damped strategy's tolerance, or ten times
 /// `at`'s misfit), or with std within the 95% χ² threshold of one degree of freedom.
 fn fits_as_well(at: &Linearisation, lin: &Linearisation) -> bool {
-    let tol = LevenbergMarquardt::default().residual_tolerance;
+    let tol = LevenbergMarquardtSettings::default().residual_tolerance;
     // Equal frequencies are an equal fit only when frequencies are the whole residual: with
     // shape rows (testdata::shapes) a mirror matches every frequency and still misfits.
     let frequencies_only = lin.residual.len() == lin.frequencies_hz.len();
