@@ -28,6 +28,7 @@ mod error;
 mod layout;
 pub mod market;
 mod model;
+mod symmetry;
 
 pub use error::MatricesError;
 pub use layout::{Dof, DofLayout, DofLayoutError};

@@ -228,8 +228,7 @@ mod tests {
 
     #[test]
     fn every_storage_of_one_matrix_reads_the_same() {
-        for streaming in [false, true] {
-            let parse = |t: &str, e: Option<usize>| parse_with(t, e, streaming);
+        with_both_readers(|parse| {
             let lower_sym =
             "%%MatrixMarket matrix coordinate real symmetric\n3 3 5\n1 1 4\n2 1 -1\n2 2 3\n3 2 0.5\n3 3 2\n";
             let upper_sym =
@@ -241,13 +240,12 @@ mod tests {
                 assert_eq!(dense(&parse(text, Some(3)).unwrap()), FULL, "{text}");
             }
             assert_eq!(parse(integer, None).unwrap().nnz(), 3);
-        }
+        });
     }
 
     #[test]
     fn bad_files_are_refused_naming_the_entry() {
-        for streaming in [false, true] {
-            let parse = |t: &str, e: Option<usize>| parse_with(t, e, streaming);
+        with_both_readers(|parse| {
             let disagree =
                 "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 4\n1 2 -1\n2 1 -1.5\n3 3 1\n";
             let e = parse(disagree, None).unwrap_err();
@@ -278,6 +276,13 @@ mod tests {
             ] {
                 assert!(parse(short, None).is_err(), "{short}");
             }
+        });
+    }
+
+    /// Runs `check` with the kept reader and with the streaming one: both must agree on every file.
+    fn with_both_readers(check: impl Fn(&dyn Fn(&str, Option<usize>) -> Result<CscSymmetric, String>)) {
+        for streaming in [false, true] {
+            check(&|t, e| parse_with(t, e, streaming));
         }
     }
 

@@ -91,6 +91,16 @@ impl AnyModel {
         }
     }
 
+    /// Permutations of the parameters under which the model's matrices may be symmetric (a
+    /// matrices model's mirrored zones, [`MatricesModel::parameter_symmetries`]); exchanges of
+    /// one pair of like parameters are checked for every model anyway. Empty for a rotor.
+    pub fn parameter_symmetries(&self) -> Vec<Vec<usize>> {
+        match self {
+            AnyModel::Rotor(_) => Vec::new(),
+            AnyModel::Matrices(m) => m.parameter_symmetries(),
+        }
+    }
+
     /// The rotor with its `[[parameter]]` tables resolved (docs/rotor-model.md), or the
     /// matrices model as it is; errors name `label`.
     pub fn updatable(&self, label: &str) -> Result<Updatable<'_>, WorkflowError> {

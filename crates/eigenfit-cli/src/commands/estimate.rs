@@ -192,6 +192,21 @@ fn print_report(est: &Estimation) {
                 "equally good mirror solution ({i} ↔ {j} exchanged, a symmetric model): {}",
                 values.join(", ")
             ),
+            None if !a.exchanged.is_empty() => {
+                let cycles: Vec<String> = a
+                    .exchanged
+                    .iter()
+                    .map(|c| match c.as_slice() {
+                        [i, j] => format!("{i} ↔ {j}"),
+                        _ => format!("{} → {}", c.join(" → "), c[0]),
+                    })
+                    .collect();
+                println!(
+                    "equally good mirror solution ({} exchanged, a symmetric model): {}",
+                    cycles.join(", "),
+                    values.join(", ")
+                )
+            }
             None => println!("equally good other solution: {}", values.join(", ")),
         }
     }

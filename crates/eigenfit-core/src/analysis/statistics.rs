@@ -388,23 +388,47 @@ pub fn mirror_solutions(
     budget: &Budget,
 ) -> Vec<(usize, usize, Vec<f64>)> {
     let params = problem.parameters().as_slice();
-    let budgeted = budget.wrap(problem);
-    let mut found = Vec::new();
+    let mut pairs = Vec::new();
     for i in 0..params.len() {
         for j in i + 1..params.len() {
             let (a, b) = (&params[i], &params[j]);
-            if a.unit != b.unit || a.scale != b.scale || a.lower != b.lower || a.upper != b.upper {
-                continue;
+            if a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper {
+                let mut swap: Vec<usize> = (0..params.len()).collect();
+                swap.swap(i, j);
+                pairs.push((i, j, swap));
             }
-            let mut p = at.parameters.clone();
-            p.swap(i, j);
-            if scaled_distance(problem, &p, &at.parameters) <= MIRROR_DISTANCE {
-                continue; // (nearly) equal values: the exchange is the same point, not another solution
-            }
-            if let Ok(lin) = budgeted.linearise(&p) {
-                if fits_as_well(at, &lin) {
-                    found.push((i, j, p));
-                }
+        }
+    }
+    let swaps: Vec<Vec<usize>> = pairs.iter().map(|(_, _, s)| s.clone()).collect();
+    permuted_solutions(problem, at, &swaps, budget)
+        .into_iter()
+        .map(|(k, p)| (pairs[k].0, pairs[k].1, p))
+        .collect()
+}
+
+/// The solutions a model's symmetries give: for each permutation π of `permutations` (parameter
+/// i's value moves to π\[i\]; e.g. a structure's mirror exchanging two pairs of zones at once)
+/// whose permuted vector differs from `at` and fits the data as well, its index and the vector.
+/// Costs one evaluation per permutation, charged to `budget`.
+pub fn permuted_solutions(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    permutations: &[Vec<usize>],
+    budget: &Budget,
+) -> Vec<(usize, Vec<f64>)> {
+    let budgeted = budget.wrap(problem);
+    let mut found = Vec::new();
+    for (k, perm) in permutations.iter().enumerate() {
+        let mut p = at.parameters.clone();
+        for (i, &j) in perm.iter().enumerate() {
+            p[j] = at.parameters[i];
+        }
+        if scaled_distance(problem, &p, &at.parameters) <= MIRROR_DISTANCE {
+            continue; // (nearly) equal values: the exchange is the same point, not another solution
+        }
+        if let Ok(lin) = budgeted.linearise(&p) {
+            if fits_as_well(at, &lin) {
+                found.push((k, p));
             }
         }
     }

@@ -28,6 +28,9 @@ pub struct LevenbergMarquardt {
     shared_seeds: Option<Arc<Vec<Vec<f64>>>>,
     far_checked: bool,
     best: Option<Linearisation>,
+    /// Points this run started from (the initial point, then each restart seed), in scaled
+    /// units: a seed at one of them would only repeat that run.
+    started_from: Vec<Vec<f64>>,
     restarts: usize,
     stuck_for: usize,
     recent_cost: f64,
@@ -106,6 +109,9 @@ fn seeds_per_axis(free: usize) -> usize {
 const MAX_SEEDS: usize = 243;
 /// Relative frequency misfit above which a run starts from the best coarse-grid point.
 const FAR_START: f64 = 0.2;
+/// Scaled distance within which a restart seed counts as a point already started from (the
+/// nominal point is the middle of every odd grid axis, so the best seed is often the start).
+const SAME_START: f64 = 1e-6;
 
 impl LevenbergMarquardt {
     /// The strategy with `settings` already checked.
@@ -119,6 +125,7 @@ impl LevenbergMarquardt {
             shared_seeds: None,
             far_checked: false,
             best: None,
+            started_from: Vec::new(),
             restarts: 0,
             stuck_for: 0,
             recent_cost: f64::INFINITY,
@@ -172,6 +179,17 @@ impl LevenbergMarquardt {
         self.restarts
     }
 
+    /// Records `p` as a starting point; false when the run already started there.
+    fn first_start_from(&mut self, params: &ParameterSet, p: &[f64]) -> bool {
+        let s: Vec<f64> = params.iter().zip(p).map(|(q, &v)| q.to_scaled(v)).collect();
+        let seen =
+            self.started_from.iter().any(|t| t.iter().zip(&s).all(|(a, b)| (a - b).abs() <= SAME_START));
+        if !seen {
+            self.started_from.push(s);
+        }
+        !seen
+    }
+
     fn is_free(&self, i: usize) -> bool {
         !self.fixed.get(i).copied().unwrap_or(false)
     }
@@ -201,6 +219,9 @@ impl LevenbergMarquardt {
             let Some(p) = self.seeds.as_mut().and_then(|s| (!s.is_empty()).then(|| s.remove(0))) else {
                 break;
             };
+            if !self.first_start_from(problem.parameters(), &p) {
+                continue;
+            }
             if let Ok(next) = problem.linearise(&p) {
                 self.restarts += 1;
                 self.mu = 1e-3;
@@ -279,6 +300,8 @@ impl UpdateStrategy for LevenbergMarquardt {
         self.seeds = None;
         self.far_checked = false;
         self.best = None;
+        self.started_from.clear();
+        self.first_start_from(problem.parameters(), &initial.parameters);
         self.restarts = 0;
         self.stuck_for = 0;
         self.recent_cost = initial.cost();
@@ -303,6 +326,7 @@ impl UpdateStrategy for LevenbergMarquardt {
                 (!seeds.is_empty()).then(|| seeds.remove(0)).map(|p| problem.linearise(&p))
             {
                 if next.cost() < current.cost() {
+                    self.first_start_from(problem.parameters(), &next.parameters);
                     self.remember(current);
                     self.recent_cost = next.cost();
                     return Ok(Step { next, status: StepStatus::Continue });
