@@ -76,7 +76,7 @@ fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
     assert_eq!(v["frequencies_hz"].as_array().unwrap().len(), 3, "the JSON contract is unchanged");
     assert_eq!(v["plots"].as_array().unwrap().len(), 4);
     check_plot(
-        &dir,
+        dir,
         "critical-speed-map",
         &[
             "paper-rotor: critical speed map",
@@ -88,7 +88,7 @@ fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
         ],
     );
     check_plot(
-        &dir,
+        dir,
         "mode-shapes",
         &[
             "position along the shaft x [m]",
@@ -109,7 +109,7 @@ fn a_model_file_gets_no_table_1_overlay() {
     let dir = scratch.path();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("f1 [Hz]") && stdout.contains("wrote "), "{stdout}");
-    check_plot(&dir, "critical-speed-map", &["support stiffness k [N/m]", "model, mode 1"]);
+    check_plot(dir, "critical-speed-map", &["support stiffness k [N/m]", "model, mode 1"]);
     let svg = std::fs::read_to_string(dir.join("critical-speed-map.svg")).unwrap();
     assert!(!svg.contains("Table 1"));
 }
@@ -162,7 +162,7 @@ fn compare_plots_convergence_and_iteration_maps() {
     assert!(stdout.contains("target [N/m]") && stdout.contains("it. med"), "{stdout}");
     for stem in ["compare-convergence", "compare-iterations"] {
         check_plot(
-            &dir,
+            dir,
             stem,
             &[
                 "initial k_K1 [N/m]",
@@ -200,7 +200,7 @@ fn discover_plots_the_residual_before_and_after_with_the_noise_band() {
             && written.iter().any(|w| w.ends_with("discovery.png"))
     );
     check_plot(
-        &dir,
+        dir,
         "discovery",
         &[
             "residual per mode before and after discovery",
