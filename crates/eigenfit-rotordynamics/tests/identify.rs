@@ -154,8 +154,9 @@ fn compressor_bearings_come_back_from_a_start_forty_percent_off() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data");
     let r = ross_file::read(&dir.join("compressor_start.toml")).unwrap();
     let points = parse_runup(&std::fs::read_to_string(dir.join("compressor_runup.csv")).unwrap()).unwrap();
-    let params = bearing_parameters(&r, &["kxx_Bearing 0", "kyy_Bearing 0", "kxx_Bearing 13", "kyy_Bearing 13"])
-        .unwrap();
+    let params =
+        bearing_parameters(&r, &["kxx_Bearing 0", "kyy_Bearing 0", "kxx_Bearing 13", "kyy_Bearing 13"])
+            .unwrap();
     let start: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("realistic_runups.json")).unwrap()).unwrap();
     let id = identify(&r, &params, &points, &[1.0; 4], 100).unwrap();
@@ -167,6 +168,10 @@ fn compressor_bearings_come_back_from_a_start_forty_percent_off() {
         let (coef, tag) = p.name.split_once('_').unwrap();
         let truth = 1.0 / start["compressor_start_factors"][tag][coef].as_f64().unwrap();
         assert!((id.scales[k] - truth).abs() < 1e-4 * truth, "{}: {} vs {truth}", p.name, id.scales[k]);
-        assert!((id.scales[k].ln() - truth.ln()).abs() < 1.96 * sd[k], "{}: truth outside the interval", p.name);
+        assert!(
+            (id.scales[k].ln() - truth.ln()).abs() < 1.96 * sd[k],
+            "{}: truth outside the interval",
+            p.name
+        );
     }
 }
