@@ -114,7 +114,7 @@ fn estimation(c: &mut Criterion) {
         g.bench_function(kind.name(), |b| {
             b.iter(|| {
                 let mut s = kind.build();
-                Driver::default().run(&problem, s.as_mut(), black_box(&[1e2, 1e2]), &mut []).unwrap()
+                Driver::default().run(&problem, s.as_mut(), black_box(&[1e2, 1e2])).unwrap()
             })
         });
     }
@@ -122,14 +122,14 @@ fn estimation(c: &mut Criterion) {
     g.bench_function("damped_local", |b| {
         b.iter(|| {
             let mut s = LevenbergMarquardt::default().with_max_restarts(0);
-            Driver::default().run(&problem, &mut s, black_box(&[1e2, 1e2]), &mut []).unwrap()
+            Driver::default().run(&problem, &mut s, black_box(&[1e2, 1e2])).unwrap()
         })
     });
     let dense = paper_problem(DenseSolver);
     g.bench_function("damped_dense_solver", |b| {
         b.iter(|| {
             let mut s = LevenbergMarquardt::default();
-            Driver::default().run(&dense, &mut s, black_box(&[1e2, 1e2]), &mut []).unwrap()
+            Driver::default().run(&dense, &mut s, black_box(&[1e2, 1e2])).unwrap()
         })
     });
     g.bench_function("linearise", |b| b.iter(|| problem.linearise(black_box(&[1e3, 2e4])).unwrap()));
@@ -145,7 +145,13 @@ fn compare_grid(c: &mut Criterion) {
     let targets = vec![vec![1e5, 1e5]];
     let initials = tensor_grid(&log_space(1e1, 1e9, 5), 2);
     let strategies = StrategyKind::ALL;
-    let settings = CompareSettings { modes: 2, decimals: None, std_hz: None, max_iterations: 1000 };
+    let settings = CompareSettings {
+        modes: 2,
+        decimals: None,
+        std_hz: None,
+        max_iterations: 1000,
+        budget: eigenfit::core::update::DEFAULT_EVALUATIONS,
+    };
     let solver = BandedSolver::default();
     let runs = targets.len() * initials.len() * strategies.len();
     g.bench_function(format!("{runs}_runs_parallel"), |b| {

@@ -75,7 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         } else {
             LevenbergMarquardt::default().with_max_restarts(0)
         };
-        Driver::default().run(&problem, &mut damped, &[1e2, 1e2], &mut [])
+        Driver::default().run(&problem, &mut damped, &[1e2, 1e2])
     };
     let estimate = run(true)?;
     println!(

@@ -190,11 +190,11 @@ pub fn update_all(problems: &[Problem<ShearBuilding, DenseSolver>]) -> Vec<Run> 
                 if strategy == StrategyKind::LevenbergMarquardt { &all } else { &problems[0] };
             let mut s: Box<dyn UpdateStrategy> = match strategy {
                 // The paper's 0.01 Hz suits a 40–200 Hz rotor; a 2–14 Hz building needs finer.
-                StrategyKind::Newton => Box::new(Newton { tolerance_hz: 1e-4 }),
-                StrategyKind::PStep => Box::new(PStep::new(1e-4, 0.5, 5)),
+                StrategyKind::Newton => Box::new(Newton::new(1e-4).expect("valid tolerance")),
+                StrategyKind::PStep => Box::new(PStep::new(1e-4, 0.5, 5).expect("valid settings")),
                 StrategyKind::LevenbergMarquardt => strategy.build(),
             };
-            let estimate = Driver::default().run(data, s.as_mut(), &DESIGN, &mut []).expect("runs");
+            let estimate = Driver::default().run(data, s.as_mut(), &DESIGN).expect("runs");
             let intervals = (strategy == StrategyKind::LevenbergMarquardt)
                 .then(|| uncertainty(data, &estimate.last, true))
                 .flatten()

@@ -76,7 +76,7 @@ fn main() {
         let stacked =
             Stacked::new(problems.iter().map(|p| p as &dyn Objective).collect()).expect("same parameters");
         let e = Driver::default()
-            .run(&stacked, &mut LevenbergMarquardt::default(), &start, &mut [])
+            .run(&stacked, &mut LevenbergMarquardt::default(), &start)
             .expect("calibration runs");
         let rel: Vec<f64> =
             e.last.frequencies_hz.iter().zip(&e.last.measured_hz).map(|(a, b)| (a / b - 1.0).abs()).collect();

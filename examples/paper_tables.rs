@@ -82,7 +82,13 @@ fn main() {
     for (title, target, cases) in &tables {
         println!("### {title}\n");
         for decimals in [Some(3), None] {
-            let settings = CompareSettings { modes: 2, decimals, std_hz: None, max_iterations: 1000 };
+            let settings = CompareSettings {
+                modes: 2,
+                decimals,
+                std_hz: None,
+                max_iterations: 1000,
+                budget: eigenfit::core::update::DEFAULT_EVALUATIONS,
+            };
             let measured =
                 reference_measurement(&rotor, &DenseSolver, target, &settings).expect("reference data");
             let freqs: Vec<String> = measured.modes().iter().map(|m| format!("{}", m.frequency_hz)).collect();

@@ -18,7 +18,7 @@ fn profile(
     p[i] = value;
     let fixed = (0..p.len()).map(|j| j == i).collect();
     let mut local = LevenbergMarquardt::default().with_fixed(fixed).with_max_restarts(0);
-    let est = Driver::default().run(problem, &mut local, &p, &mut []).unwrap();
+    let est = Driver::default().run(problem, &mut local, &p).unwrap();
     2.0 * est.last.cost()
 }
 
@@ -28,8 +28,7 @@ fn stiff_support_gets_a_one_sided_profile_bound() {
     let data = [(59.029, 0.06), (203.444, 0.2), (670.711, 0.6)];
     let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
     let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est =
-        Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut []).unwrap();
+    let est = Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
     assert!(est.termination.is_converged());
     let u = uncertainty(&problem, &est.last, true).unwrap();
     let Identifiability::LowerBoundOnly { lower } = u.identifiability[1] else {
@@ -52,8 +51,7 @@ fn soft_supports_are_determined_with_tight_intervals() {
     let data = [(36.107, 0.036), (84.066, 0.084), (305.649, 0.31)];
     let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
     let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est =
-        Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut []).unwrap();
+    let est = Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
     let u = uncertainty(&problem, &est.last, true).unwrap();
     assert!(u.identifiability.iter().all(Identifiability::is_determined), "{:?}", u.identifiability);
     for iv in &u.intervals {
@@ -77,8 +75,7 @@ fn the_interval_phase_reports_bounds_done_to_its_observers() {
     let data = [(59.029, 0.06), (203.444, 0.2), (670.711, 0.6)];
     let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
     let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est =
-        Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut []).unwrap();
+    let est = Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
     let mut steps = Steps::default();
     let budget = eigenfit::core::update::Budget::new(eigenfit::core::analysis::UNCERTAINTY_EVALUATIONS);
     let observed =

@@ -15,13 +15,15 @@ fuzz_target!(|data: &[u8]| {
     // `measured::read_with_notes` rejects non-UTF-8 files before parsing (tested in the CLI corpus).
     let Ok(text) = std::str::from_utf8(data) else { return };
     match measured::parse(text) {
-        Err(message) => {
+        Err(error) => {
+            let message = error.to_string();
             let (line, _) = message.split_once(": ").unwrap_or_else(|| panic!("no `LINE: ` in {message:?}"));
             let line: usize = line.parse().unwrap_or_else(|_| panic!("no line number in {message:?}"));
             assert!(
                 line >= 1 && line <= text.lines().count().max(1),
                 "line {line} out of range: {message:?}"
             );
+            assert_eq!(line, error.line, "{message:?}");
         }
         Ok(m) => {
             assert!(!m.is_empty());

@@ -39,10 +39,11 @@ def run(args: Sequence[str], result_class: Type[R]) -> R:
 
     This is what every function here calls; use it for CLI options that have no keyword yet.
     Raises :class:`EigenfitError` with the CLI's message and exit code on failure; exit code 3
-    (not converged or not acceptable) returns the result.
+    (not converged or not acceptable) returns the result, unless there is none (a budget spent
+    before the fit could start): then it raises with exit code 3.
     """
     code, text = _native.run_json([os.fspath(a) for a in args])
-    if code in (0, EXIT_NOT_CONVERGED):
+    if code == 0 or (code == EXIT_NOT_CONVERGED and text.startswith("{")):
         return result_class.from_json(text, code)  # type: ignore[return-value]
     raise EigenfitError(text, code)
 

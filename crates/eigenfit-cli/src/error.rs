@@ -20,6 +20,9 @@ pub enum CliError {
     /// eigenfit failed on valid input.
     #[error("{0}")]
     Failure(String),
+    /// The evaluation budget ran out before any result (exit code 3, like a fit cut short).
+    #[error("budget-exhausted: {0}")]
+    BudgetExhausted(String),
 }
 
 impl CliError {
@@ -28,6 +31,7 @@ impl CliError {
         match self {
             CliError::Input(_) => EXIT_BAD_INPUT,
             CliError::Failure(_) => EXIT_FAILURE,
+            CliError::BudgetExhausted(_) => EXIT_NOT_CONVERGED,
         }
     }
 }
@@ -37,6 +41,7 @@ impl From<eigenfit_workflow::WorkflowError> for CliError {
         match e {
             eigenfit_workflow::WorkflowError::Input(m) => CliError::Input(m),
             eigenfit_workflow::WorkflowError::Failure(m) => CliError::Failure(m),
+            eigenfit_workflow::WorkflowError::BudgetExhausted(m) => CliError::BudgetExhausted(m),
         }
     }
 }

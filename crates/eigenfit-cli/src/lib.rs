@@ -54,8 +54,8 @@ pub fn run(cli: &Cli) -> Result<u8, CliError> {
         Command::Simulate(a) => commands::simulate::run(a).map(|()| error::EXIT_OK),
         Command::Estimate(a) => commands::estimate::run(a),
         Command::Campaign(a) => commands::campaign::run(a),
-        Command::Compare(a) => commands::compare::run(a).map(|()| error::EXIT_OK),
-        Command::Discover(a) => commands::discover::run(a).map(|()| error::EXIT_OK),
+        Command::Compare(a) => commands::compare::run(a),
+        Command::Discover(a) => commands::discover::run(a),
         Command::Demo(a) => commands::demo::run(a).map(|()| error::EXIT_OK),
         Command::Campbell(a) => commands::campbell::run(a).map(|()| error::EXIT_OK),
     }

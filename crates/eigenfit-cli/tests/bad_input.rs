@@ -236,8 +236,8 @@ fn every_command_reports_a_bad_model_the_same_way() {
 /// and byte patterns not worth keeping as files.
 #[test]
 fn generated_garbage_never_panics() {
-    let dir = std::env::temp_dir().join(format!("eigenfit-bad-input-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scratch = tempfile::tempdir().expect("a temporary folder");
+    let dir = scratch.path();
     // A cheap deterministic byte generator (xorshift), so that failures reproduce.
     let mut state = 0x9e37_79b9_7f4a_7c15_u64;
     let mut next = move || {
@@ -264,5 +264,4 @@ fn generated_garbage_never_panics() {
             assert!(stderr.starts_with("eigenfit: ") && stderr.contains(&path), "{path}: {stderr}");
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
 }

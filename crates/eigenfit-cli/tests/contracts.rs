@@ -12,14 +12,6 @@ fn eigenfit(args: &[&str]) -> (i32, Value) {
     (out.status.code().unwrap_or(-1), json)
 }
 
-fn temp_file(name: &str, text: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("eigenfit-contracts-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
 #[test]
 fn simulate_prints_ascending_frequencies() {
     let (code, v) = eigenfit(&[
@@ -53,7 +45,12 @@ fn ross_example_matches_ross() {
 
 #[test]
 fn estimate_reports_parameters_frequencies_and_intervals() {
-    let csv = temp_file("m.csv", "mode,frequency_hz,std_hz\n1,36.107,0.036\n2,84.066,0.084\n3,305.649,0.3\n");
+    let scratch = common::scratch();
+    let csv = common::write_in(
+        &scratch,
+        "m.csv",
+        "mode,frequency_hz,std_hz\n1,36.107,0.036\n2,84.066,0.084\n3,305.649,0.3\n",
+    );
     let (code, v) =
         eigenfit(&common::paper_estimate(csv.to_str().unwrap(), "damped", "1e2,1e2", &["--json"]));
     assert_eq!(code, 0);
@@ -68,7 +65,8 @@ fn estimate_reports_parameters_frequencies_and_intervals() {
 
 #[test]
 fn estimate_that_does_not_converge_exits_with_3_and_still_reports() {
-    let csv = temp_file("far.csv", "mode,frequency_hz\n1,36.107\n2,84.066\n");
+    let scratch = common::scratch();
+    let csv = common::write_in(&scratch, "far.csv", "mode,frequency_hz\n1,36.107\n2,84.066\n");
     let (code, v) =
         eigenfit(&common::paper_estimate(csv.to_str().unwrap(), "newton", "1e8,1e8", &["--json"]));
     assert_eq!(code, 3);
@@ -105,10 +103,15 @@ fn compare_prints_one_run_per_cell() {
     }
 }
 
+/// `discover --preset paper-rotor --measured examples/NAME --json`.
+fn discover_example(name: &str) -> (i32, Value) {
+    let data = format!("{}/../../examples/{name}", env!("CARGO_MANIFEST_DIR"));
+    eigenfit(&["discover", "--preset", "paper-rotor", "--measured", &data, "--json"])
+}
+
 #[test]
 fn discover_names_the_hidden_effect_of_the_example_data() {
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_hidden_effect.csv");
-    let (code, v) = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data, "--json"]);
+    let (code, v) = discover_example("measured_hidden_effect.csv");
     assert_eq!(code, 0);
     assert_eq!(v["disagreement_significant"], true);
     // The data were made with disk-rotary-inertia@0 = 1e-3 kg·m² (docs/discovery.md).
@@ -123,12 +126,52 @@ fn discover_names_the_hidden_effect_of_the_example_data() {
 
 #[test]
 fn discover_adds_nothing_to_a_model_that_fits() {
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_no_effect.csv");
-    let (code, v) = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data, "--json"]);
+    let (code, v) = discover_example("measured_no_effect.csv");
     assert_eq!(code, 0);
     assert_eq!(v["disagreement_significant"], false);
     assert!(v["missing_effect"].is_null());
     assert_eq!(v["rms_residual_before_hz"], v["rms_residual_after_hz"]);
+}
+
+/// A pedestal (a bearing on its own mass and spring) adds a degree of freedom a rotor model file
+/// cannot hold: `--write-model` is refused as a request that cannot be met (exit 2, saying why),
+/// not as an internal failure, and nothing is written.
+#[test]
+fn discover_refuses_to_write_a_named_pedestal_with_exit_2() {
+    // The independent generator's rotor with K2 on a 0.5 kg / 2e6 N/m pedestal, exact (std 0.05 %).
+    let fixtures = include_str!("../../eigenfit-rotor/tests/fixtures/discovery/independent.toml");
+    let case = fixtures.split("[[case]]").find(|c| c.contains("name = \"pedestal\"")).expect("pedestal case");
+    let line = case.lines().find(|l| l.starts_with("exact_hz = [")).expect("exact_hz");
+    let csv: String = line["exact_hz = [".len()..line.len() - 1]
+        .split(", ")
+        .enumerate()
+        .map(|(m, f)| {
+            let f: f64 = f.parse().unwrap();
+            format!("{},{f},{}\n", m + 1, 5e-4 * f)
+        })
+        .collect();
+    // Its own folder (the other tests share `temp_file`'s), removed at the end.
+    let dir = std::env::temp_dir().join(format!("eigenfit-pedestal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let data = dir.join("pedestal.csv");
+    std::fs::write(&data, format!("mode,frequency_hz,std_hz\n{csv}")).unwrap();
+    let target = dir.join("pedestal-model.toml");
+    let (code, v) =
+        eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0);
+    assert_eq!(v["missing_effect"]["kind"], "pedestal", "{v}");
+    let out = Command::new(env!("CARGO_BIN_EXE_eigenfit"))
+        .args(["discover", "--preset", "paper-rotor", "--measured", data.to_str().unwrap(), "--quiet"])
+        .arg("--write-model")
+        .arg(&target)
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    let written = target.exists();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("pedestal") && stderr.contains("--write-model"), "{stderr}");
+    assert!(!written);
 }
 
 #[cfg(feature = "lapack")]
@@ -213,7 +256,8 @@ fn the_same_input_gives_byte_for_byte_the_same_output() {
 
 #[test]
 fn compare_streams_every_finished_run() {
-    let path = temp_file("runs.jsonl", "");
+    let scratch = common::scratch();
+    let path = common::write_in(&scratch, "runs.jsonl", "");
     let (code, v) = eigenfit(&[
         "compare",
         "--preset",

@@ -5,7 +5,7 @@
 mod common;
 
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn eigenfit(args: &[&str]) -> Output {
@@ -17,11 +17,16 @@ fn json(out: &Output) -> Value {
     serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}: {stdout}"))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("eigenfit-plots-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// Runs `eigenfit ARGS… --plot DIR` with DIR a fresh folder (removed when the first value is
+/// dropped); checks the run ended with exit code 0.
+fn plotted(args: &[&str]) -> (tempfile::TempDir, Output) {
+    let scratch = common::scratch();
+    let dir = scratch.path().to_str().expect("a UTF-8 temporary path").to_string();
+    let mut all = args.to_vec();
+    all.extend(["--plot", dir.as_str()]);
+    let out = eigenfit(&all);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    (scratch, out)
 }
 
 fn example(name: &str) -> String {
@@ -64,20 +69,9 @@ fn check_plot(dir: &Path, stem: &str, expected: &[&str]) {
 
 #[test]
 fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
-    let dir = temp_dir("simulate");
-    let out = eigenfit(&[
-        "simulate",
-        "--preset",
-        "paper-rotor",
-        "--stiffness",
-        "1e5,1e5",
-        "--modes",
-        "3",
-        "--plot",
-        dir.to_str().unwrap(),
-        "--json",
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let (scratch, out) =
+        plotted(&["simulate", "--preset", "paper-rotor", "--stiffness", "1e5,1e5", "--modes", "3", "--json"]);
+    let dir = scratch.path();
     let v = json(&out);
     assert_eq!(v["frequencies_hz"].as_array().unwrap().len(), 3, "the JSON contract is unchanged");
     assert_eq!(v["plots"].as_array().unwrap().len(), 4);
@@ -111,17 +105,8 @@ fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
 
 #[test]
 fn a_model_file_gets_no_table_1_overlay() {
-    let dir = temp_dir("simulate-file");
-    let out = eigenfit(&[
-        "simulate",
-        "--model",
-        &example("rotor.toml"),
-        "--sweep",
-        "1e3:1e8:6",
-        "--plot",
-        dir.to_str().unwrap(),
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let (scratch, out) = plotted(&["simulate", "--model", &example("rotor.toml"), "--sweep", "1e3:1e8:6"]);
+    let dir = scratch.path();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("f1 [Hz]") && stdout.contains("wrote "), "{stdout}");
     check_plot(&dir, "critical-speed-map", &["support stiffness k [N/m]", "model, mode 1"]);
@@ -131,7 +116,8 @@ fn a_model_file_gets_no_table_1_overlay() {
 
 #[test]
 fn estimate_plots_its_convergence_history() {
-    let dir = temp_dir("estimate");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let csv = dir.join("m.csv");
     std::fs::write(&csv, "mode,frequency_hz\n1,36.107\n2,84.066\n").unwrap();
     let more = ["--plot", dir.to_str().unwrap(), "--json"];
@@ -158,8 +144,7 @@ fn estimate_plots_its_convergence_history() {
 
 #[test]
 fn compare_plots_convergence_and_iteration_maps() {
-    let dir = temp_dir("compare");
-    let out = eigenfit(&[
+    let (scratch, out) = plotted(&[
         "compare",
         "--preset",
         "paper-rotor",
@@ -169,10 +154,8 @@ fn compare_plots_convergence_and_iteration_maps() {
         "4",
         "--strategies",
         "newton,damped",
-        "--plot",
-        dir.to_str().unwrap(),
     ]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let dir = scratch.path();
     // Not a terminal: no progress bar on stderr.
     assert!(out.stderr.is_empty(), "stderr: {}", String::from_utf8_lossy(&out.stderr));
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -201,18 +184,15 @@ fn compare_plots_convergence_and_iteration_maps() {
 
 #[test]
 fn discover_plots_the_residual_before_and_after_with_the_noise_band() {
-    let dir = temp_dir("discover");
-    let out = eigenfit(&[
+    let (scratch, out) = plotted(&[
         "discover",
         "--preset",
         "paper-rotor",
         "--measured",
         &example("measured_hidden_effect.csv"),
-        "--plot",
-        dir.to_str().unwrap(),
         "--json",
     ]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let dir = scratch.path();
     let v = json(&out);
     let written: Vec<&str> = v["written"].as_array().unwrap().iter().map(|w| w.as_str().unwrap()).collect();
     assert!(
@@ -237,7 +217,8 @@ fn discover_plots_the_residual_before_and_after_with_the_noise_band() {
 
 #[test]
 fn demo_writes_every_plot_kind_and_reports() {
-    let dir = temp_dir("demo");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let out_dir = dir.join("report");
     let out = eigenfit(&["demo", "--out", out_dir.to_str().unwrap(), "--grid", "4"]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
@@ -269,7 +250,8 @@ fn demo_writes_every_plot_kind_and_reports() {
 
 #[test]
 fn demo_json_lists_the_results_and_the_plots() {
-    let dir = temp_dir("demo-json");
+    let scratch = common::scratch();
+    let dir = scratch.path().to_path_buf();
     let out = eigenfit(&["demo", "--out", dir.to_str().unwrap(), "--grid", "3", "--json"]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let v = json(&out);

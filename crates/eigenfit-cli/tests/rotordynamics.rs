@@ -68,8 +68,8 @@ fn estimate_recovers_bearing_stiffnesses_from_a_runup() {
     let text = std::fs::read_to_string(&model).unwrap();
     let stiffer = text.replace("kxx = [ 1000000.0,]", "kxx = [ 1200000.0,]");
     assert_ne!(text, stiffer, "fixture layout changed");
-    let dir = std::env::temp_dir().join(format!("eigenfit-rotordyn-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = common::scratch();
+    let dir = scratch.path();
     let truth = dir.join("truth.toml");
     std::fs::write(&truth, stiffer).unwrap();
     let mut csv = String::from("speed_rpm,mode,frequency_hz,std_hz\n");
@@ -108,7 +108,6 @@ fn estimate_recovers_bearing_stiffnesses_from_a_runup() {
         .map(|p| (p["model_hz"].as_f64().unwrap() - p["measured_hz"].as_f64().unwrap()).abs())
         .fold(0.0, f64::max);
     assert!(mismatch < 1e-3, "largest frequency mismatch {mismatch} Hz");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -132,16 +131,11 @@ fn estimate_with_cross_coupled_and_damping_parameters_and_verdicts() {
     let measured = data("runup_truth.csv");
     let truth: Value =
         serde_json::from_str(&std::fs::read_to_string(data("runup_truth.json")).unwrap()).unwrap();
-    let out = run(&[
-        "estimate",
-        "--model",
+    let out = run(&common::estimate_with(
         &model,
-        "--measured",
         &measured,
-        "--parameters",
-        "kxx,kyy,kxy,kyx,cxx,cyy",
-        "--json",
-    ]);
+        &["--parameters", "kxx,kyy,kxy,kyx,cxx,cyy", "--json"],
+    ));
     let v = json(&out);
     assert_eq!(v["verdict"], "converged");
     assert_eq!(v["acceptable"], true);

@@ -4,28 +4,28 @@
 mod common;
 
 use serde_json::Value;
-use std::path::PathBuf;
+
 use std::process::Command;
 
 fn data(name: &str) -> String {
     common::data_file("../../tests/data/uff", name)
 }
 
-fn run(args: &[&str]) -> (i32, String, String) {
+fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs");
     let text = |b: Vec<u8>| String::from_utf8(b).expect("utf-8");
     (out.status.code().unwrap_or(-1), text(out.stdout), text(out.stderr))
 }
 
-fn json(args: &[&str]) -> (i32, Value) {
+fn json<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> (i32, Value) {
     let (code, out, err) = run(args);
     (code, serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out} {err}")))
 }
 
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("eigenfit-test-data-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+/// `estimate` of the symmetric rotor from its universal file, then `more`.
+fn symmetric(more: &[&str]) -> Vec<String> {
+    let (model, unv) = (data("symmetric_rotor.toml"), data("symmetric_rotor.unv"));
+    common::estimate_with(&model, &unv, more).into_iter().map(String::from).collect()
 }
 
 fn truth() -> [f64; 2] {
@@ -38,15 +38,7 @@ fn truth() -> [f64; 2] {
 /// estimate is on the right sides (the truth inside, the mirror outside both intervals).
 #[test]
 fn a_universal_file_estimates_a_symmetric_rotor_on_the_right_sides() {
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--json",
-        "--quiet",
-    ]);
+    let (code, v) = json(&symmetric(&["--json", "--quiet"]));
     assert_eq!(code, 0, "{v}");
     let truth = truth();
     for (i, name) in ["k_drive_end", "k_free_end"].iter().enumerate() {
@@ -76,7 +68,8 @@ fn a_universal_file_estimates_a_symmetric_rotor_on_the_right_sides() {
 
 #[test]
 fn simulated_modes_round_trip_through_a_universal_file() {
-    let file = temp("round-trip.unv");
+    let scratch = common::scratch();
+    let file = scratch.path().join("round-trip.unv");
     let file = file.to_str().unwrap();
     let model = data("symmetric_rotor.toml");
     let (code, out, err) =
@@ -94,6 +87,7 @@ fn simulated_modes_round_trip_through_a_universal_file() {
 
 #[test]
 fn shapes_in_csv_estimate_the_right_sides_too() {
+    let scratch = common::scratch();
     // The fixture's frequencies and y shapes, as a test engineer would type them.
     let j: Value =
         serde_json::from_str(&std::fs::read_to_string(data("symmetric_rotor.json")).unwrap()).unwrap();
@@ -107,22 +101,14 @@ fn shapes_in_csv_estimate_the_right_sides_too() {
             shapes += &format!("{k},{n},y,{y}\n");
         }
     }
-    let (f, s) = (temp("freq.csv"), temp("shapes.csv"));
+    let (f, s) = (scratch.path().join("freq.csv"), scratch.path().join("shapes.csv"));
     std::fs::write(&f, freq).unwrap();
     std::fs::write(&s, shapes).unwrap();
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
+    let (code, v) = json(&common::estimate_with(
         &data("symmetric_rotor.toml"),
-        "--measured",
         f.to_str().unwrap(),
-        "--shapes",
-        s.to_str().unwrap(),
-        "--initial",
-        "9e4,2e5",
-        "--json",
-        "--quiet",
-    ]);
+        &["--shapes", s.to_str().unwrap(), "--initial", "9e4,2e5", "--json", "--quiet"],
+    ));
     assert_eq!(code, 0, "{v}");
     let truth = truth();
     let k =
@@ -132,16 +118,17 @@ fn shapes_in_csv_estimate_the_right_sides_too() {
 
 #[test]
 fn bad_test_data_is_named() {
+    let scratch = common::scratch();
     let model = data("symmetric_rotor.toml");
     let text = std::fs::read_to_string(data("symmetric_rotor.unv")).unwrap();
     // Node 103 moved 10 mm off the shaft's nodes.
-    let moved = temp("moved.unv");
+    let moved = scratch.path().join("moved.unv");
     std::fs::write(&moved, text.replacen("2.5000000000000000e+02", "2.6000000000000000e+02", 1)).unwrap();
     let (code, _, err) = run(&["estimate", "--model", &model, "--measured", moved.to_str().unwrap()]);
     assert_eq!(code, 2);
     assert!(err.contains("node 103 at (0, 0, 0.26) m") && err.contains("nearest model node 5"), "{err}");
     // A broken number names the file and line.
-    let broken = temp("broken.unv");
+    let broken = scratch.path().join("broken.unv");
     let mut lines: Vec<&str> = text.lines().collect();
     let at = lines.iter().position(|l| l.trim() == "55").unwrap() + 9;
     lines[at] = "       abc";
@@ -153,34 +140,20 @@ fn bad_test_data_is_named() {
         "{err}"
     );
     // The MAC threshold: no measured mode can be paired at MAC ≥ 1 with noisy shapes → exit 3.
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
+    let (code, v) = json(&common::estimate_with(
         &model,
-        "--measured",
         &data("symmetric_rotor.unv"),
-        "--mac-threshold",
-        "1",
-        "--json",
-        "--quiet",
-    ]);
+        &["--mac-threshold", "1", "--json", "--quiet"],
+    ));
     assert_eq!(code, 3);
     assert_eq!(v["unpaired"], serde_json::json!([1, 2, 3]));
 }
 
 #[test]
 fn plot_writes_the_mac_heatmap() {
-    let dir = temp("plots");
-    let (code, out, err) = run(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--plot",
-        dir.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let scratch = common::scratch();
+    let dir = scratch.path().join("plots");
+    let (code, out, err) = run(&symmetric(&["--plot", dir.to_str().unwrap(), "--quiet"]));
     assert_eq!(code, 0, "{out}{err}");
     let svg = std::fs::read_to_string(dir.join("mac.svg")).unwrap();
     assert!(svg.contains("MAC, measured against model modes"));
@@ -189,18 +162,9 @@ fn plot_writes_the_mac_heatmap() {
 
 #[test]
 fn the_written_model_round_trips_and_fix_holds_a_parameter() {
-    let out = temp("updated.toml");
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--write-model",
-        out.to_str().unwrap(),
-        "--json",
-        "--quiet",
-    ]);
+    let scratch = common::scratch();
+    let out = scratch.path().join("updated.toml");
+    let (code, v) = json(&symmetric(&["--write-model", out.to_str().unwrap(), "--json", "--quiet"]));
     assert_eq!(code, 0, "{v}");
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.starts_with("# Updated by eigenfit estimate (damped strategy, converged) on "), "{text}");
@@ -208,15 +172,11 @@ fn the_written_model_round_trips_and_fix_holds_a_parameter() {
         text.contains("symmetric_rotor.unv") && text.contains("# chi2 = ") && text.contains("95% interval [")
     );
     // Read back through --model: the estimate is the new nominal, and estimating again stays there.
-    let (code, again) = json(&[
-        "estimate",
-        "--model",
+    let (code, again) = json(&common::estimate_with(
         out.to_str().unwrap(),
-        "--measured",
         &data("symmetric_rotor.unv"),
-        "--json",
-        "--quiet",
-    ]);
+        &["--json", "--quiet"],
+    ));
     assert_eq!(code, 0);
     for name in ["k_drive_end", "k_free_end"] {
         assert_eq!(again["initial"][name], v["parameters"][name]);
@@ -224,31 +184,13 @@ fn the_written_model_round_trips_and_fix_holds_a_parameter() {
         assert!((a / b - 1.0).abs() < 1e-6, "{name}: {a} vs {b}");
     }
     // --fix holds one bearing: only the other is estimated, and reported.
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--fix",
-        "k_free_end=8e4",
-        "--json",
-        "--quiet",
-    ]);
+    let (code, v) = json(&symmetric(&["--fix", "k_free_end=8e4", "--json", "--quiet"]));
     assert_eq!(code, 0, "{v}");
     assert_eq!(v["fixed"], serde_json::json!({"k_free_end": 8e4}));
     assert_eq!(v["parameters"].as_object().unwrap().len(), 1);
     let k = v["parameters"]["k_drive_end"].as_f64().unwrap();
     assert!((k / truth()[0] - 1.0).abs() < 0.02, "{k}");
-    let (code, _, err) = run(&[
-        "estimate",
-        "--model",
-        &data("symmetric_rotor.toml"),
-        "--measured",
-        &data("symmetric_rotor.unv"),
-        "--fix",
-        "k_nope=1",
-    ]);
+    let (code, _, err) = run(&symmetric(&["--fix", "k_nope=1"]));
     assert_eq!(code, 2);
     assert!(err.contains("--fix") && err.contains("k_nope"), "{err}");
 }
@@ -257,11 +199,12 @@ fn the_written_model_round_trips_and_fix_holds_a_parameter() {
 /// other values, and written back into the model.
 #[test]
 fn a_declared_disk_mass_is_estimated_and_written_back() {
+    let scratch = common::scratch();
     let base = std::fs::read_to_string(data("symmetric_rotor.toml")).unwrap();
     // The "test rig": a heavier drive-end disk and other bearings.
-    let rig = temp("rig.toml");
+    let rig = scratch.path().join("rig.toml");
     std::fs::write(&rig, base.replacen("mass = 1.0", "mass = 1.3", 1)).unwrap();
-    let file = temp("rig.unv");
+    let file = scratch.path().join("rig.unv");
     let (code, out, err) = run(&[
         "simulate",
         "--model",
@@ -274,20 +217,14 @@ fn a_declared_disk_mass_is_estimated_and_written_back() {
         file.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{out}{err}");
-    let model = temp("with-disk-mass.toml");
+    let model = scratch.path().join("with-disk-mass.toml");
     std::fs::write(&model, format!("{base}\n[[parameter]]\nkind = \"disk-mass\"\nindex = 0\n")).unwrap();
-    let updated = temp("with-disk-mass-updated.toml");
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
+    let updated = scratch.path().join("with-disk-mass-updated.toml");
+    let (code, v) = json(&common::estimate_with(
         model.to_str().unwrap(),
-        "--measured",
         file.to_str().unwrap(),
-        "--write-model",
-        updated.to_str().unwrap(),
-        "--json",
-        "--quiet",
-    ]);
+        &["--write-model", updated.to_str().unwrap(), "--json", "--quiet"],
+    ));
     assert_eq!(code, 0, "{v}");
     for (name, want) in [("k_drive_end", 2e5), ("k_free_end", 1.5e5), ("m_disk_0", 1.3)] {
         let got = v["parameters"][name].as_f64().unwrap();
@@ -319,7 +256,8 @@ fn a_declared_disk_mass_is_estimated_and_written_back() {
 /// alone put the bearings on the right sides.
 #[test]
 fn a_campaign_with_a_test_mass_tells_the_sides_apart_from_frequencies() {
-    let dir = temp("campaign");
+    let scratch = common::scratch();
+    let dir = scratch.path().join("campaign");
     std::fs::create_dir_all(&dir).unwrap();
     let base = std::fs::read_to_string(data("symmetric_rotor.toml")).unwrap();
     std::fs::write(dir.join("rotor.toml"), &base).unwrap();
@@ -377,7 +315,8 @@ fn a_campaign_with_a_test_mass_tells_the_sides_apart_from_frequencies() {
 
 #[test]
 fn a_sensor_map_ties_sensors_like_coordinates_do() {
-    let map = temp("map.csv");
+    let scratch = common::scratch();
+    let map = scratch.path().join("map.csv");
     std::fs::write(
         &map,
         "node,model_node,direction,sign\n101,0,y,1\n102,2,y,1\n103,5,2,1\n104,8,y,1\n105,10,y,1\n",
@@ -415,20 +354,17 @@ fn a_sensor_map_ties_sensors_like_coordinates_do() {
 
 #[test]
 fn millimetres_without_a_units_dataset_are_recognised_and_said() {
+    let scratch = common::scratch();
     let text = std::fs::read_to_string(data("symmetric_rotor.unv")).unwrap();
     // Drop dataset 164 (the first dataset): coordinates stay in mm with nothing saying so.
     let start = text.match_indices("    -1\n").nth(2).unwrap().0;
-    let file = temp("no-units.unv");
+    let file = scratch.path().join("no-units.unv");
     std::fs::write(&file, &text[start..]).unwrap();
-    let (code, v) = json(&[
-        "estimate",
-        "--model",
+    let (code, v) = json(&common::estimate_with(
         &data("symmetric_rotor.toml"),
-        "--measured",
         file.to_str().unwrap(),
-        "--json",
-        "--quiet",
-    ]);
+        &["--json", "--quiet"],
+    ));
     assert_eq!(code, 0, "{v}");
     assert!(v["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains("read as mm")), "{v}");
     assert_eq!(v["sensors"].as_array().unwrap().len(), 5);

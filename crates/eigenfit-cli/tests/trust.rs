@@ -22,235 +22,38 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
-/// One case: arguments, expected exit code, fragments stdout+stderr must contain.
+/// One case of `trust_corpus/cases.toml`: arguments, expected exit code, fragments
+/// stdout+stderr must contain.
+#[derive(serde::Deserialize)]
 struct Case {
-    args: &'static [&'static str],
+    args: Vec<String>,
     exit: i32,
-    says: &'static [&'static str],
+    says: Vec<String>,
+}
+
+#[derive(serde::Deserialize)]
+struct Corpus {
+    case: Vec<Case>,
 }
 
 const ROTOR: &str = "three_disk_rotor.toml";
 
-const CASES: &[Case] = &[
-    // The stiff-bearing symmetric rotor with two modes and std: an exact fit whose upper sides the
-    // data do not bound, and the mirror solution named.
-    Case {
-        args: &[
-            "estimate",
-            "--model",
-            ROTOR,
-            "--measured",
-            "stiff_two_modes_std.csv",
-            "--initial",
-            "1e6,1e6",
-        ],
-        exit: 0,
-        says: &["not identifiable: ≥", "mirror solution (k_DE ↔ k_NDE exchanged", "χ² ="],
-    },
-    // The same from the mirror side, without std: the fit cannot be judged, the mirror is named.
-    Case {
-        args: &["estimate", "--model", ROTOR, "--measured", "stiff_two_modes.csv", "--initial", "1e8,1e7"],
-        exit: 0,
-        says: &["cannot be judged without std_hz", "relative RMS residual", "mirror solution"],
-    },
-    // Issue: `--initial 1e-6,1e15` is inside the documented bounds.
-    Case {
-        args: &[
-            "estimate",
-            "--model",
-            ROTOR,
-            "--measured",
-            "stiff_two_modes_std.csv",
-            "--initial",
-            "1e-6,1e15",
-        ],
-        exit: 0,
-        says: &["mirror solution"],
-    },
-    // Frequencies a little above anything the supports can give: the fit runs to the 1e15 N/m
-    // limit, which is reported as such, never as an estimate.
-    Case {
-        args: &["estimate", "--preset", "paper-rotor", "--measured", "at_limit.csv"],
-        exit: 3,
-        says: &[
-            "not identifiable: at its upper limit",
-            "at a parameter limit (the data cannot determine it): k_K1, k_K2",
-        ],
-    },
-    Case {
-        args: &["estimate", "--preset", "paper-rotor", "--measured", "at_limit_std.csv"],
-        exit: 3,
-        says: &["not identifiable: ≥ ", "fit quality: POOR", "modes disagreeing by more than 3σ: 1, 2"],
-    },
-    // A mesh whose lowest eigenvalues are lost to round-off, and an extreme value.
-    Case {
-        args: &["simulate", "--preset", "uniform-rotor", "--elements", "10000"],
-        exit: 2,
-        says: &["mode 1 cannot be trusted: round-off in the matrices"],
-    },
-    // Finer still, the solver itself fails (a missed mode): the same refusal, exit 2, not 1.
-    Case {
-        args: &["simulate", "--preset", "uniform-rotor", "--elements", "20000"],
-        exit: 2,
-        says: &["mode 1 cannot be trusted: round-off in the matrices (≈ "],
-    },
-    Case {
-        args: &["simulate", "--preset", "paper-rotor", "--effect", "point-mass@0=1e50"],
-        exit: 2,
-        says: &["cannot be trusted: round-off in the matrices"],
-    },
-    Case {
-        args: &["simulate", "--preset", "paper-rotor", "--effect", "bearing-rotational-stiffness@0=1e50"],
-        exit: 2,
-        says: &["cannot be trusted: round-off in the matrices"],
-    },
-    // A decimal slip in examples/measured_hidden_effect.csv (mode 8 = 38889.557).
-    Case {
-        args: &["estimate", "--preset", "paper-rotor", "--measured", "decimal_slip.csv"],
-        exit: 2,
-        says: &["decimal_slip.csv: no stiffness within the limits can produce mode 8 at 38889.557 Hz"],
-    },
-    // discover runs estimate's sanity check (the same library function).
-    Case {
-        args: &["discover", "--preset", "paper-rotor", "--measured", "decimal_slip.csv"],
-        exit: 2,
-        says: &["decimal_slip.csv: no stiffness within the limits can produce mode 8 at 38889.557 Hz"],
-    },
-    // A value that overflows in assembly is blamed on its file field.
-    Case {
-        args: &["simulate", "--model", "huge_diameter.toml"],
-        exit: 2,
-        says: &["huge_diameter.toml: line 12: element 0: diameter = 1e300 gives a second moment of area"],
-    },
-    Case {
-        args: &["estimate", "--preset", "ross-example", "--measured", "decreasing.csv"],
-        exit: 2,
-        says: &["decreasing.csv:3: mode 2 (36.1 Hz, line 3) is below mode 1 (84.5 Hz, line 2)"],
-    },
-    Case {
-        args: &["estimate", "--preset", "ross-example", "--measured", "equal.csv"],
-        exit: 2,
-        says: &["equal.csv:3: mode 2 has the same frequency as mode 1"],
-    },
-    Case {
-        args: &["estimate", "--preset", "ross-example", "--measured", "outlier.csv"],
-        exit: 2,
-        says: &["outlier.csv: no stiffness within the limits can produce mode 3 at 3029.4 Hz"],
-    },
-    Case {
-        args: &["estimate", "--preset", "ross-example", "--measured", "huge.csv"],
-        exit: 2,
-        says: &["mode 3 at 1e300 Hz"],
-    },
-    // Data the model cannot fit within the noise (the hidden effect): a poor fit, modes named.
-    Case {
-        args: &[
-            "estimate",
-            "--preset",
-            "paper-rotor",
-            "--measured",
-            "../../../../examples/measured_hidden_effect.csv",
-        ],
-        exit: 3,
-        says: &["fit quality: POOR", "modes disagreeing by more than 3σ: 6, 7"],
-    },
-    Case {
-        args: &[
-            "estimate",
-            "--preset",
-            "paper-rotor",
-            "--measured",
-            "../../../../examples/measured_no_effect.csv",
-        ],
-        exit: 0,
-        says: &["fit quality: acceptable (χ² = ", "6 dof, p = "],
-    },
-    // A budget too small for the fit: said, exit 3 (and before the fit could start).
-    Case {
-        args: &[
-            "estimate",
-            "--preset",
-            "paper-rotor",
-            "--measured",
-            "../../../../examples/measured_no_effect.csv",
-            "--budget",
-            "3",
-        ],
-        exit: 3,
-        says: &["budget-exhausted", "before the fit could start"],
-    },
-    Case {
-        args: &[
-            "estimate",
-            "--preset",
-            "paper-rotor",
-            "--measured",
-            "../../../../examples/measured_no_effect.csv",
-            "--budget",
-            "5",
-        ],
-        exit: 3,
-        says: &["budget-exhausted", "raise it with --budget"],
-    },
-    Case {
-        args: &["estimate", "--preset", "ross-example", "--measured", "extra_column.csv"],
-        exit: 0,
-        says: &["column `damping_ratio` is not used by eigenfit and is ignored", "cannot be judged"],
-    },
-    Case {
-        args: &["estimate", "--preset", "ross-example", "--measured", "invisible_header.csv"],
-        exit: 2,
-        says: &["unknown column `mode\\u{200b}`"],
-    },
-    Case {
-        args: &["compare", "--preset", "paper-rotor", "--targets", "2e5:5e4", "--grid", "10000"],
-        exit: 2,
-        says: &["--grid 10000: 10000^2 initial guesses, more than the 1000000 runs compare accepts"],
-    },
-    Case {
-        args: &["simulate", "--preset", "paper-rotor", "--sweep", "1e2:1e9:1000000000"],
-        exit: 2,
-        says: &["1000000000 points, more than the 100000 a sweep accepts"],
-    },
-    Case {
-        args: &[
-            "compare",
-            "--preset",
-            "paper-rotor",
-            "--targets",
-            "2e5:5e4",
-            "--initials",
-            "1e5:1e5",
-            "--decimals",
-            "400",
-        ],
-        exit: 2,
-        says: &["--decimals 400: must be between -15 and 15"],
-    },
-    Case {
-        args: &[
-            "compare",
-            "--preset",
-            "paper-rotor",
-            "--targets",
-            "2e5:5e4",
-            "--initials",
-            "1e5:1e5",
-            "--stream",
-            "/dev/null",
-        ],
-        exit: 2,
-        says: &["/dev/null: --stream needs a regular file"],
-    },
-];
+fn cases() -> Vec<Case> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/trust_corpus/cases.toml");
+    let text = std::fs::read_to_string(&path).expect("the corpus's cases.toml");
+    toml::from_str::<Corpus>(&text).expect("cases.toml parses").case
+}
 
 #[test]
 fn every_case_of_the_issue_ends_with_its_verdict() {
-    for case in CASES {
-        let out = eigenfit(case.args);
+    let cases = cases();
+    assert!(cases.len() >= 26, "cases.toml lost cases: {}", cases.len());
+    for case in &cases {
+        let args: Vec<&str> = case.args.iter().map(String::as_str).collect();
+        let out = eigenfit(&args);
         let all = text(&out.stdout) + &text(&out.stderr);
         assert_eq!(out.status.code(), Some(case.exit), "{:?}:\n{all}", case.args);
-        for fragment in case.says {
+        for fragment in &case.says {
             assert!(all.contains(fragment), "{:?}: no `{fragment}` in\n{all}", case.args);
         }
         assert!(!all.contains("panicked") && !all.contains("internal error"), "{:?}:\n{all}", case.args);
@@ -288,6 +91,35 @@ fn the_stiff_rotor_reports_chi2_and_stays_within_its_budget() {
 }
 
 #[test]
+fn discover_stays_within_the_budget_it_is_given_and_says_when_it_ran_out() {
+    let measured = "../../../../examples/measured_hidden_effect.csv";
+    for budget in [300u64, 1000, 100_000] {
+        let b = budget.to_string();
+        let out = eigenfit(&[
+            "discover",
+            "--preset",
+            "paper-rotor",
+            "--measured",
+            measured,
+            "--budget",
+            &b,
+            "--json",
+        ]);
+        let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        let used = v["evaluations"].as_u64().unwrap();
+        assert!(used <= budget, "{used} evaluations for a budget of {budget}");
+        assert_eq!(v["budget_limit"], budget);
+        // Exit 3 exactly when the search was cut short.
+        let cut = v["budget_exhausted"].as_bool().unwrap();
+        assert_eq!(out.status.code(), Some(if cut { 3 } else { 0 }), "budget {budget}: {v}");
+        // Enough budget: the effect is found without running out.
+        if budget == 100_000 {
+            assert!(!cut && v["missing_effect"]["kind"] == "disk-rotary-inertia", "{v}");
+        }
+    }
+}
+
+#[test]
 fn discover_reports_the_stiffnesses_refitted_with_the_effect() {
     let measured = "../../../../examples/measured_hidden_effect.csv";
     let out = eigenfit(&["discover", "--preset", "paper-rotor", "--measured", measured, "--json"]);
@@ -313,23 +145,11 @@ fn discover_reports_the_stiffnesses_refitted_with_the_effect() {
 
 #[test]
 fn stream_appends_and_the_other_run_is_refused() {
-    let dir = std::env::temp_dir().join(format!("eigenfit-trust-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = tempfile::tempdir().expect("a temporary folder");
+    let dir = scratch.path();
     let file = dir.join("runs.jsonl");
-    let _ = std::fs::remove_file(&file);
-    let path = file.to_str().unwrap();
-    let args = [
-        "compare",
-        "--preset",
-        "paper-rotor",
-        "--targets",
-        "2e5:5e4",
-        "--initials",
-        "1e5:1e5",
-        "--quiet",
-        "--stream",
-        path,
-    ];
+    let one_run = "compare --preset paper-rotor --targets 2e5:5e4 --initials 1e5:1e5 --quiet --stream";
+    let args: Vec<&str> = one_run.split(' ').chain([file.to_str().unwrap()]).collect();
     assert_eq!(eigenfit(&args).status.code(), Some(0));
     let first = std::fs::read_to_string(&file).unwrap();
     assert_eq!(eigenfit(&args).status.code(), Some(0));
@@ -337,7 +157,7 @@ fn stream_appends_and_the_other_run_is_refused() {
     assert_eq!(both.lines().count(), 2 * first.lines().count());
     assert!(both.starts_with(&first));
     // A run refused by validation after the file name was given loses nothing.
-    let mut bad = args.to_vec();
+    let mut bad = args.clone();
     bad.extend(["--decimals", "400"]);
     assert_eq!(eigenfit(&bad).status.code(), Some(2));
     assert_eq!(std::fs::read_to_string(&file).unwrap(), both);
@@ -348,7 +168,6 @@ fn stream_appends_and_the_other_run_is_refused() {
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("another eigenfit run is streaming into this file"));
     drop(holder);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -399,8 +218,8 @@ proptest! {
     /// never a panic, and within the budget.
     #[test]
     fn any_measured_file_ends_within_the_budget(csv in measured_file()) {
-        let dir = std::env::temp_dir().join(format!("eigenfit-trust-prop-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().expect("a temporary folder");
+        let dir = scratch.path();
         let file = dir.join("m.csv");
         std::fs::write(&file, &csv).unwrap();
         let out = eigenfit(&["estimate", "--preset", "ross-example", "--measured", file.to_str().unwrap(), "--json", "--quiet", "--budget", "3000"]);

@@ -218,26 +218,44 @@ pub fn eigenvector_derivative_nelson(
     k: usize,
     d: &SystemDerivative,
 ) -> Result<DVector<f64>, SensitivityError> {
+    let mut one = eigenvector_derivatives_nelson(system, modes, k, std::slice::from_ref(d))?;
+    Ok(one.remove(0))
+}
+
+/// [`eigenvector_derivative_nelson`] for several parameters' derivatives at once: the dense
+/// O(n³) factorisation of K − λₖM is done once for all of them.
+pub fn eigenvector_derivatives_nelson(
+    system: &System,
+    modes: &Modes,
+    k: usize,
+    derivatives: &[SystemDerivative],
+) -> Result<Vec<DVector<f64>>, SensitivityError> {
     check_distinct(modes, k, DEFAULT_REPEATED_TOLERANCE, rigid_body_tolerance(system))?;
     let lk = modes.eigenvalues[k];
     let phi = DVector::from_column_slice(modes.shape(k));
-    let dlk = eigenvalue_derivative(modes, k, d);
     let m_phi = system.mass() * &phi;
-    let mut rhs = &m_phi * dlk;
-    d.stiffness.mul_add(-1.0, phi.as_slice(), rhs.as_mut_slice());
-    d.mass.mul_add(lk, phi.as_slice(), rhs.as_mut_slice());
     let mut a = system.stiffness() - system.mass() * lk;
     let pivot = phi.iamax();
     a.row_mut(pivot).fill(0.0);
     a.column_mut(pivot).fill(0.0);
     a[(pivot, pivot)] = 1.0;
-    rhs[pivot] = 0.0;
-    let v = a.lu().solve(&rhs).ok_or(SensitivityError::Singular { mode: k })?;
-    if v.iter().any(|x| !x.is_finite()) {
-        return Err(SensitivityError::Singular { mode: k });
-    }
-    let c = -m_phi.dot(&v) - 0.5 * d.mass.bilinear(phi.as_slice(), phi.as_slice());
-    Ok(v + phi * c)
+    let lu = a.lu();
+    derivatives
+        .iter()
+        .map(|d| {
+            let dlk = eigenvalue_derivative(modes, k, d);
+            let mut rhs = &m_phi * dlk;
+            d.stiffness.mul_add(-1.0, phi.as_slice(), rhs.as_mut_slice());
+            d.mass.mul_add(lk, phi.as_slice(), rhs.as_mut_slice());
+            rhs[pivot] = 0.0;
+            let v = lu.solve(&rhs).ok_or(SensitivityError::Singular { mode: k })?;
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(SensitivityError::Singular { mode: k });
+            }
+            let c = -m_phi.dot(&v) - 0.5 * d.mass.bilinear(phi.as_slice(), phi.as_slice());
+            Ok(v + &phi * c)
+        })
+        .collect()
 }
 
 #[cfg(test)]

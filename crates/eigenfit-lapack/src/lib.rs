@@ -51,7 +51,10 @@ extern crate openblas_src;
 
 mod driver;
 
-use eigenfit_core::eigen::{apply_sign_rule, check_count, shifted_twice, EigenSolver, Modes, SolveError};
+use eigenfit_core::eigen::{
+    apply_sign_rule, check_count, shifted_twice, with_next_by_one_more_mode, EigenSolver, ModeRequest, Modes,
+    SolveError, SolvedModes,
+};
 use eigenfit_core::matrix::System;
 use nalgebra::{DMatrix, DVector};
 
@@ -147,10 +150,14 @@ impl EigenSolver for LapackSolver {
         BACKEND
     }
 
-    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
-        check_count(system, count)?;
-        let n = system.dofs();
-        solve(system.stiffness(), system.mass(), count, self.method.resolve(n, count))
+    /// Its certificate is the next eigenvalue itself, from a solve of one mode more; eigenvalues
+    /// only are the full solve's.
+    fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
+        with_next_by_one_more_mode(system, request, |count, _| {
+            check_count(system, count)?;
+            let n = system.dofs();
+            solve(system.stiffness(), system.mass(), count, self.method.resolve(n, count))
+        })
     }
 }
 

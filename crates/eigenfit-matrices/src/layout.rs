@@ -41,19 +41,34 @@ fn direction(label: &str) -> Option<u8> {
         .or_else(|| label.parse::<u8>().ok().filter(|d| (1..=6).contains(d)))
 }
 
+/// A DOF map entry that cannot be part of a layout: the DOF (from 1) and what is wrong;
+/// shown as `dof DOF: MESSAGE`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("dof {dof}: {message}")]
+pub struct DofLayoutError {
+    /// The DOF, counted from 1.
+    pub dof: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+fn dof_error(index: usize, message: String) -> DofLayoutError {
+    DofLayoutError { dof: index + 1, message }
+}
+
 impl DofLayout {
     /// The layout of `dofs` (entry i describes DOF i). Refused, naming the DOF (from 1): an
     /// unknown direction, a node given two positions, a (node, direction) given to two DOFs.
-    pub fn new(dofs: &[Dof]) -> Result<Self, String> {
+    pub fn new(dofs: &[Dof]) -> Result<Self, DofLayoutError> {
         let mut index: HashMap<u64, usize> = HashMap::new();
         let mut layout = Self { labels: Vec::new(), coordinates: Vec::new(), dof_of: HashMap::new() };
         for (i, d) in dofs.iter().enumerate() {
             let at = [d.x, d.y, d.z];
             if at.iter().any(|c| !c.is_finite()) {
-                return Err(format!("dof {}: node {} has a non-finite coordinate", i + 1, d.node));
+                return Err(dof_error(i, format!("node {} has a non-finite coordinate", d.node)));
             }
             let dir = direction(&d.direction).ok_or_else(|| {
-                format!("dof {}: direction `{}` is none of x, y, z, rx, ry, rz (or 1–6)", i + 1, d.direction)
+                dof_error(i, format!("direction `{}` is none of x, y, z, rx, ry, rz (or 1–6)", d.direction))
             })?;
             let node = *index.entry(d.node).or_insert_with(|| {
                 layout.labels.push(d.node);
@@ -64,25 +79,23 @@ impl DofLayout {
             let first = layout.coordinates[node];
             let scale = first.iter().chain(&at).fold(1.0_f64, |m, c| m.max(c.abs()));
             if first.iter().zip(&at).any(|(a, b)| (a - b).abs() > 1e-5 * scale) {
-                return Err(format!(
-                    "dof {}: node {} at ({}, {}, {}) but an earlier DOF puts it at ({}, {}, {})",
-                    i + 1,
-                    d.node,
-                    at[0],
-                    at[1],
-                    at[2],
-                    first[0],
-                    first[1],
-                    first[2]
+                return Err(dof_error(
+                    i,
+                    format!(
+                        "node {} at ({}, {}, {}) but an earlier DOF puts it at ({}, {}, {})",
+                        d.node, at[0], at[1], at[2], first[0], first[1], first[2]
+                    ),
                 ));
             }
             if let Some(other) = layout.dof_of.insert((node, dir), i) {
-                return Err(format!(
-                    "dof {}: node {} direction {} is dof {} already",
-                    i + 1,
-                    d.node,
-                    DIRECTIONS[usize::from(dir) - 1],
-                    other + 1
+                return Err(dof_error(
+                    i,
+                    format!(
+                        "node {} direction {} is dof {} already",
+                        d.node,
+                        DIRECTIONS[usize::from(dir) - 1],
+                        other + 1
+                    ),
                 ));
             }
         }
@@ -136,11 +149,11 @@ mod tests {
 
     #[test]
     fn inconsistent_maps_are_refused_naming_the_dof() {
-        let e = DofLayout::new(&[dof(1, "z", 0.0), dof(1, "w", 0.0)]).unwrap_err();
+        let e = DofLayout::new(&[dof(1, "z", 0.0), dof(1, "w", 0.0)]).unwrap_err().to_string();
         assert!(e.starts_with("dof 2: direction `w`"), "{e}");
-        let e = DofLayout::new(&[dof(1, "z", 0.0), dof(1, "z", 0.0)]).unwrap_err();
+        let e = DofLayout::new(&[dof(1, "z", 0.0), dof(1, "z", 0.0)]).unwrap_err().to_string();
         assert!(e.contains("dof 2: node 1 direction z is dof 1 already"), "{e}");
-        let e = DofLayout::new(&[dof(1, "z", 0.0), dof(1, "rx", 0.2)]).unwrap_err();
+        let e = DofLayout::new(&[dof(1, "z", 0.0), dof(1, "rx", 0.2)]).unwrap_err().to_string();
         assert!(e.contains("dof 2: node 1 at (0.2, 0, 0)"), "{e}");
     }
 }

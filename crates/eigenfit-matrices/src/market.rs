@@ -24,12 +24,21 @@ const SYMMETRY_TOLERANCE: f64 = 1e-10;
 pub fn read_symmetric(path: &Path, expected: Option<usize>) -> Result<CscSymmetric, MatricesError> {
     let text = std::fs::read_to_string(path).map_err(|e| MatricesError::io(path, e))?;
     parse_symmetric(&text, expected)
-        .map_err(|detail| MatricesError::Matrix { path: path.to_path_buf(), detail })
+        .map_err(|e| MatricesError::Matrix { path: path.to_path_buf(), detail: e.detail })
 }
 
-/// [`read_symmetric`] on the file's text; the error names the entry (1-based, as in the file).
-pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetric, String> {
-    parse_with(text, expected, text.len() >= LARGE_FILE_BYTES)
+/// Text that is not a symmetric real Matrix Market matrix. `detail` says what is wrong and
+/// where: the header, the size line, or the entry or line (1-based, as in the file).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{detail}")]
+pub struct MarketError {
+    /// What is wrong, and where.
+    pub detail: String,
+}
+
+/// [`read_symmetric`] on the file's text.
+pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetric, MarketError> {
+    parse_with(text, expected, text.len() >= LARGE_FILE_BYTES).map_err(|detail| MarketError { detail })
 }
 
 /// [`parse_symmetric`] with the entries read by [`read_entries_streaming`] or by the kept reader.
@@ -219,8 +228,7 @@ mod tests {
 
     #[test]
     fn every_storage_of_one_matrix_reads_the_same() {
-        for streaming in [false, true] {
-            let parse = |t: &str, e: Option<usize>| parse_with(t, e, streaming);
+        with_both_readers(|parse| {
             let lower_sym =
             "%%MatrixMarket matrix coordinate real symmetric\n3 3 5\n1 1 4\n2 1 -1\n2 2 3\n3 2 0.5\n3 3 2\n";
             let upper_sym =
@@ -232,13 +240,12 @@ mod tests {
                 assert_eq!(dense(&parse(text, Some(3)).unwrap()), FULL, "{text}");
             }
             assert_eq!(parse(integer, None).unwrap().nnz(), 3);
-        }
+        });
     }
 
     #[test]
     fn bad_files_are_refused_naming_the_entry() {
-        for streaming in [false, true] {
-            let parse = |t: &str, e: Option<usize>| parse_with(t, e, streaming);
+        with_both_readers(|parse| {
             let disagree =
                 "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 4\n1 2 -1\n2 1 -1.5\n3 3 1\n";
             let e = parse(disagree, None).unwrap_err();
@@ -269,6 +276,13 @@ mod tests {
             ] {
                 assert!(parse(short, None).is_err(), "{short}");
             }
+        });
+    }
+
+    /// Runs `check` with the kept reader and with the streaming one: both must agree on every file.
+    fn with_both_readers(check: impl Fn(&dyn Fn(&str, Option<usize>) -> Result<CscSymmetric, String>)) {
+        for streaming in [false, true] {
+            check(&|t, e| parse_with(t, e, streaming));
         }
     }
 

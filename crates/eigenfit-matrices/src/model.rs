@@ -172,13 +172,18 @@ impl MatricesModel {
         let dofs = match &file.dofs {
             Some(p) => {
                 let map = read_dof_map(&at(p), n)?;
-                DofLayout::new(&map).map_err(|e| MatricesError::invalid(&at(p), e))?;
+                DofLayout::new(&map).map_err(|e| MatricesError::invalid(&at(p), e.to_string()))?;
                 Some(map)
             }
             None => None,
         };
         let name = file.name.unwrap_or_else(|| path.display().to_string());
-        Ok(Self::assemble_terms(name, params, k0, m0, derivative_matrices, candidates, dofs))
+        let mut model = Self::assemble_terms(name, params, k0, m0, derivative_matrices);
+        // A map that fails here was refused above already.
+        model.layout = dofs.as_deref().and_then(|d| DofLayout::new(d).ok());
+        model.dofs = dofs;
+        model.candidates = candidates;
+        Ok(model)
     }
 
     /// A model from matrices already in memory: K₀, M₀ and, per parameter, (∂K/∂pᵢ, ∂M/∂pᵢ).
@@ -194,17 +199,16 @@ impl MatricesModel {
         derivatives: Vec<(Option<CscSymmetric>, Option<CscSymmetric>)>,
     ) -> Self {
         assert_eq!(derivatives.len(), params.len(), "one derivative pair per parameter");
-        Self::assemble_terms(name.into(), params, stiffness, mass, derivatives, Vec::new(), None)
+        Self::assemble_terms(name.into(), params, stiffness, mass, derivatives)
     }
 
+    /// The model without candidates or DOF map, its matrices mapped onto their common pattern.
     fn assemble_terms(
         name: String,
         params: ParameterSet,
         k0: CscSymmetric,
         m0: CscSymmetric,
         derivatives: Vec<(Option<CscSymmetric>, Option<CscSymmetric>)>,
-        candidates: Vec<Candidate>,
-        dofs: Option<Vec<Dof>>,
     ) -> Self {
         let n = k0.dim();
         // The common pattern: every matrix's entries, zero-valued.
@@ -219,9 +223,17 @@ impl MatricesModel {
         let stiffness = term(k0);
         let mass = term(m0);
         let derivatives = derivatives.into_iter().map(|(k, m)| (k.map(term), m.map(term))).collect();
-        // A map that fails here was refused by `from_toml_file` already.
-        let layout = dofs.as_deref().and_then(|d| DofLayout::new(d).ok());
-        Self { name, params, pattern, stiffness, mass, derivatives, candidates, dofs, layout }
+        Self {
+            name,
+            params,
+            pattern,
+            stiffness,
+            mass,
+            derivatives,
+            candidates: Vec::new(),
+            dofs: None,
+            layout: None,
+        }
     }
 
     /// The model's name (the `name` key, or the file's path).
@@ -243,6 +255,24 @@ impl MatricesModel {
     /// the model file gives one.
     pub fn layout(&self) -> Option<&DofLayout> {
         self.layout.as_ref()
+    }
+
+    /// Permutations π of the parameters under which the model may be symmetric: parameter i
+    /// exchanged with π\[i\] keeps every trace and Frobenius inner product of the matrices
+    /// (see the `symmetry` module), among parameters of the same unit, scale and limits. The
+    /// frequencies at p and at p permuted are then expected equal; confirm by one solve.
+    /// Empty for an asymmetric structure. O(np² · nnz).
+    pub fn parameter_symmetries(&self) -> Vec<Vec<usize>> {
+        let terms: Vec<_> = self
+            .derivatives
+            .iter()
+            .map(|(k, m)| (k.as_ref().map(|t| &t.matrix), m.as_ref().map(|t| &t.matrix)))
+            .collect();
+        let params = self.params.as_slice();
+        crate::symmetry::invariant_permutations(&self.stiffness.matrix, &self.mass.matrix, &terms, |i, j| {
+            let (a, b) = (&params[i], &params[j]);
+            a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper
+        })
     }
 
     /// `base + Σ pᵢ·termᵢ` on the common pattern.

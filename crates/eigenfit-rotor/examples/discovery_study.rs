@@ -3,7 +3,9 @@
 //! scored per case and noise level, with the slowest run's wall time.
 //!
 //! cargo run --release -p eigenfit-rotor --example discovery_study
-//! (`STUDY_CASES=pedestal,clean` for some cases only, `STUDY_VERBOSE=1` for every answer)
+//! (`STUDY_CASES=pedestal,clean` for some cases only, `STUDY_VERBOSE=1` for every answer,
+//! `STUDY_SET=heldout` for the held-out draws of `generate.py --heldout` instead of the design
+//! draws)
 
 #[path = "../tests/common/study.rs"]
 mod study;
@@ -12,7 +14,9 @@ use std::time::Instant;
 use study::Outcome;
 
 fn main() {
-    let fixtures = study::load();
+    let heldout = std::env::var("STUDY_SET").is_ok_and(|s| s == "heldout");
+    let fixtures = if heldout { study::load_heldout() } else { study::load() };
+    println!("draws: {}\n", if heldout { "held-out (heldout.toml)" } else { "design (independent.toml)" });
     println!("| case | noise | named | ambiguous (honest) | nothing | wrong | truth in 95 % interval |");
     println!("|---|---|---|---|---|---|---|");
     let mut slowest = 0.0f64;

@@ -43,20 +43,48 @@ pub struct Configuration {
     pub sensor_map: Option<PathBuf>,
 }
 
+/// Why a campaign file could not be read; each names the file.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum CampaignError {
+    /// The file cannot be read.
+    #[error("{}: cannot read: {message}", .path.display())]
+    Unreadable {
+        /// The file.
+        path: PathBuf,
+        /// The system's reason.
+        message: String,
+    },
+    /// The text is not a valid campaign (TOML syntax or a missing or mistyped key).
+    #[error("{}{}: {message}", .path.display(), .line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Syntax {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line, where the parser knows it.
+        line: Option<usize>,
+        /// The parser's message.
+        message: String,
+    },
+    /// The file lists no `[[configuration]]`.
+    #[error("{}: no [[configuration]]", .path.display())]
+    NoConfiguration {
+        /// The file.
+        path: PathBuf,
+    },
+}
+
 impl Campaign {
     /// Reads a campaign file; errors name the file (and the line for syntax errors).
-    pub fn from_toml_file(path: &Path) -> Result<Self, String> {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-        let mut c: Campaign = toml::from_str(&text).map_err(|e| {
-            let line = e.span().map(|s| text[..s.start].matches('\n').count() + 1);
-            match line {
-                Some(l) => format!("{}:{l}: {}", path.display(), e.message()),
-                None => format!("{}: {}", path.display(), e.message()),
-            }
+    pub fn from_toml_file(path: &Path) -> Result<Self, CampaignError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CampaignError::Unreadable { path: path.into(), message: e.to_string() })?;
+        let mut c: Campaign = toml::from_str(&text).map_err(|e| CampaignError::Syntax {
+            path: path.into(),
+            line: e.span().map(|s| text[..s.start].matches('\n').count() + 1),
+            message: e.message().into(),
         })?;
         if c.configurations.is_empty() {
-            return Err(format!("{}: no [[configuration]]", path.display()));
+            return Err(CampaignError::NoConfiguration { path: path.into() });
         }
         let dir = path.parent().unwrap_or(Path::new("."));
         for (i, conf) in c.configurations.iter_mut().enumerate() {

@@ -8,7 +8,7 @@ use crate::model::Rotor;
 use crate::RotorError;
 use eigenfit_core::analysis::chi2_upper_tail;
 use eigenfit_core::discovery::{
-    discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect,
+    discover, Alternative, DiscoveryError, DiscoveryOptions, DiscoveryReport, NamedEffect, Place,
 };
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::measurement::Measurement;
@@ -49,6 +49,14 @@ impl RotorDiscovery {
                         .into(),
                 });
             }
+            if let (Some(run), Some(to)) = (e.elements, e.taper_to) {
+                // A taper is written as what it is on this mesh: each element's own section change.
+                for (element, share) in effects::taper_shares(rotor, run, to) {
+                    let value = share * e.value.unwrap_or(0.0);
+                    out = out.with_effect(EffectSpec::new(e.kind.clone(), Some(element), value))?;
+                }
+                continue;
+            }
             let mut spec = EffectSpec::new(e.kind.clone(), e.location, e.value.unwrap_or(1.0));
             spec.elements = e.elements.filter(|[a, b]| a != b);
             if e.kind == "point-mass" {
@@ -77,7 +85,7 @@ pub fn discover_rotor<S: EigenSolver>(
     initial: &[f64],
     options: &DiscoveryOptions,
 ) -> Result<RotorDiscovery, DiscoveryError> {
-    let mut found = search(rotor, solver, measured, initial, options)?;
+    let mut found = Request { rotor, solver, measured, initial, options }.search()?;
     // The mirror image of an effect on a symmetric rotor fits exactly as well: say so.
     crate::mirror::add_images(rotor, &mut found.effects);
     for e in &found.effects {
@@ -88,84 +96,105 @@ pub fn discover_rotor<S: EigenSolver>(
     Ok(found)
 }
 
-/// The search of [`discover_rotor`]: the user's mesh, then the refined mesh when needed.
-fn search<S: EigenSolver>(
-    rotor: &Rotor,
-    solver: &S,
-    measured: &Measurement,
-    initial: &[f64],
-    options: &DiscoveryOptions,
-) -> Result<RotorDiscovery, DiscoveryError> {
-    let coarse = discover(rotor, solver, measured, &effects::candidates(rotor), initial, options)?;
-    let mut coarse_result =
-        RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
-    if !coarse_result.report.disagreement_significant {
-        return Ok(coarse_result);
-    }
-    let Ok(fine_rotor) = mesh::refined(rotor, REFINEMENT) else { return Ok(coarse_result) };
-    // The refined-mesh runs share what the first run left of the evaluation budget.
-    let left = |spent: usize| DiscoveryOptions {
-        max_evaluations: options.max_evaluations.saturating_sub(spent),
-        ..options.clone()
-    };
-    // First the refined mesh alone (one calibration): if it explains the data, that is the
-    // answer — said instead of a physical effect, or beside one that fits about as well.
-    let fine_base =
-        discover(&fine_rotor, solver, measured, &[], initial, &left(coarse_result.report.evaluations));
-    if let Ok(mut fine_base) = fine_base {
-        coarse_result.report.evaluations += fine_base.evaluations;
-        fine_base.evaluations = coarse_result.report.evaluations;
-        if !fine_base.disagreement_significant {
-            let gain = final_aicc(&coarse_result.report) - fine_base.aicc_before;
-            if gain > -options.ambiguity_aicc {
-                return Ok(mesh_explains(coarse_result, fine_base, gain, options));
+/// What [`discover_rotor`] was asked, carried to each mesh it searches.
+struct Request<'a, S> {
+    rotor: &'a Rotor,
+    solver: &'a S,
+    measured: &'a Measurement,
+    initial: &'a [f64],
+    options: &'a DiscoveryOptions,
+}
+
+impl<S: EigenSolver> Request<'_, S> {
+    /// The search of [`discover_rotor`]: the user's mesh, then the refined mesh when needed.
+    fn search(&self) -> Result<RotorDiscovery, DiscoveryError> {
+        let Self { rotor, solver, measured, initial, options } = *self;
+        let coarse = discover(rotor, solver, measured, &effects::candidates(rotor), initial, options)?;
+        let mut coarse_result =
+            RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
+        if !coarse_result.report.disagreement_significant {
+            return Ok(coarse_result);
+        }
+        let Ok(fine_rotor) = mesh::refined(rotor, REFINEMENT) else { return Ok(coarse_result) };
+        // The refined-mesh runs share what the first run left of the evaluation budget.
+        let left = |spent: usize| DiscoveryOptions {
+            max_evaluations: options.max_evaluations.saturating_sub(spent),
+            ..options.clone()
+        };
+        // First the refined mesh alone (one calibration): if it explains the data, that is the
+        // answer — said instead of a physical effect, or beside one that fits about as well.
+        let fine_base =
+            discover(&fine_rotor, solver, measured, &[], initial, &left(coarse_result.report.evaluations));
+        if let Err(DiscoveryError::BudgetExhausted(_)) = fine_base {
+            coarse_result.report.budget_exhausted = true;
+        }
+        if let Ok(mut fine_base) = fine_base {
+            coarse_result.report.evaluations += fine_base.evaluations;
+            fine_base.evaluations = coarse_result.report.evaluations;
+            // The refined mesh is held to the test a named effect must pass (what is left is a misfit
+            // noise can explain, P(χ²) ≥ min_after_p_value), not to the detection level: at 5 %,
+            // one draw in twenty of data the refined mesh fits exactly would be refused.
+            let left = chi2_upper_tail(fine_base.chi2_before, fine_base.dof_before);
+            if left >= options.min_after_p_value {
+                let gain = final_aicc(&coarse_result.report) - fine_base.aicc_before;
+                if gain > -options.ambiguity_aicc {
+                    return Ok(mesh_explains(coarse_result, fine_base, gain, options));
+                }
             }
         }
+        // The full search on the refined mesh only when nothing explained the user's mesh: it costs
+        // a second, larger discovery run.
+        if coarse_result.report.selected.is_some() {
+            return Ok(coarse_result);
+        }
+        let candidates = effects::candidates_on(rotor, &fine_rotor, REFINEMENT);
+        let fine = discover(
+            &fine_rotor,
+            solver,
+            measured,
+            &candidates,
+            initial,
+            &left(coarse_result.report.evaluations),
+        );
+        let mut fine = match fine {
+            Ok(fine) => fine,
+            Err(e) => {
+                coarse_result.report.budget_exhausted |= matches!(e, DiscoveryError::BudgetExhausted(_));
+                return Ok(coarse_result);
+            }
+        };
+        coarse_result.report.evaluations += fine.evaluations;
+        coarse_result.report.budget_exhausted |= fine.budget_exhausted;
+        fine.evaluations = coarse_result.report.evaluations;
+        fine.budget_exhausted = coarse_result.report.budget_exhausted;
+        let gain = final_aicc(&coarse_result.report) - final_aicc(&fine);
+        // Like any effect, the refinement is named only if what is left is noise.
+        let (chi2, k) = fine
+            .selected
+            .as_ref()
+            .map_or((fine.chi2_before, initial.len()), |s| (s.chi2, s.parameters.len()));
+        let n = fine.modes.len();
+        let consistent = n > k && chi2_upper_tail(chi2, n - k) >= options.min_after_p_value;
+        if gain < options.min_aicc_gain || !consistent {
+            return Ok(coarse_result);
+        }
+        // Detection statistics and the "before" column stay those of the user's mesh.
+        let c = &coarse_result.report;
+        for (m, before) in fine.modes.iter_mut().zip(&c.modes) {
+            m.before_hz = before.before_hz;
+        }
+        let diffs: Vec<f64> = fine.modes.iter().map(|m| m.after_hz - m.measured_hz).collect();
+        fine.rms_after_hz = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
+        fine.rms_before_hz = c.rms_before_hz;
+        fine.chi2_before = c.chi2_before;
+        fine.p_value = c.p_value;
+        fine.aicc_before = c.aicc_before;
+        fine.disagreement_significant = c.disagreement_significant;
+        let mut named = fine.effects.clone();
+        named.push(mesh_effect(gain, Vec::new()));
+        named.sort_by(|a, b| b.delta_aicc.total_cmp(&a.delta_aicc));
+        Ok(RotorDiscovery { report: fine, effects: named, mesh_factor: REFINEMENT })
     }
-    // The full search on the refined mesh only when nothing explained the user's mesh: it costs
-    // a second, larger discovery run.
-    if coarse_result.report.selected.is_some() {
-        return Ok(coarse_result);
-    }
-    let candidates = effects::candidates_on(rotor, &fine_rotor, REFINEMENT);
-    let fine = discover(
-        &fine_rotor,
-        solver,
-        measured,
-        &candidates,
-        initial,
-        &left(coarse_result.report.evaluations),
-    );
-    let Ok(mut fine) = fine else { return Ok(coarse_result) };
-    coarse_result.report.evaluations += fine.evaluations;
-    coarse_result.report.budget_exhausted |= fine.budget_exhausted;
-    fine.evaluations = coarse_result.report.evaluations;
-    fine.budget_exhausted = coarse_result.report.budget_exhausted;
-    let gain = final_aicc(&coarse_result.report) - final_aicc(&fine);
-    // Like any effect, the refinement is named only if what is left is noise.
-    let (chi2, k) =
-        fine.selected.as_ref().map_or((fine.chi2_before, initial.len()), |s| (s.chi2, s.parameters.len()));
-    let n = fine.modes.len();
-    let consistent = n > k && chi2_upper_tail(chi2, n - k) >= options.min_after_p_value;
-    if gain < options.min_aicc_gain || !consistent {
-        return Ok(coarse_result);
-    }
-    // Detection statistics and the "before" column stay those of the user's mesh.
-    let c = &coarse_result.report;
-    for (m, before) in fine.modes.iter_mut().zip(&c.modes) {
-        m.before_hz = before.before_hz;
-    }
-    let diffs: Vec<f64> = fine.modes.iter().map(|m| m.after_hz - m.measured_hz).collect();
-    fine.rms_after_hz = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
-    fine.rms_before_hz = c.rms_before_hz;
-    fine.chi2_before = c.chi2_before;
-    fine.p_value = c.p_value;
-    fine.aicc_before = c.aicc_before;
-    fine.disagreement_significant = c.disagreement_significant;
-    let mut named = fine.effects.clone();
-    named.push(mesh_effect(gain, Vec::new()));
-    named.sort_by(|a, b| b.delta_aicc.total_cmp(&a.delta_aicc));
-    Ok(RotorDiscovery { report: fine, effects: named, mesh_factor: REFINEMENT })
 }
 
 /// The refined mesh alone explains the data (`fine`: its calibration, nothing named): name
@@ -183,11 +212,7 @@ fn mesh_explains(
             .effects
             .iter()
             .map(|e| Alternative {
-                label: e.label.clone(),
-                kind: e.kind.clone(),
-                location: e.location,
-                position_m: e.position_m,
-                elements: e.elements,
+                place: e.place.clone(),
                 value: e.value,
                 unit: e.unit.clone(),
                 delta_aicc: gain,
@@ -212,11 +237,7 @@ fn mesh_explains(
 
 fn mesh_effect(gain: f64, ambiguous_with: Vec<Alternative>) -> NamedEffect {
     NamedEffect {
-        label: "mesh-refinement".into(),
-        kind: "mesh-refinement".into(),
-        location: None,
-        position_m: None,
-        elements: None,
+        place: Place::new("mesh-refinement", None, None, None),
         value: Some(REFINEMENT as f64),
         interval: None,
         unit: "sub-elements per element".into(),
@@ -226,7 +247,8 @@ fn mesh_effect(gain: f64, ambiguous_with: Vec<Alternative>) -> NamedEffect {
     }
 }
 
-/// AICc of what a run ends with: its named effects, or the calibrated base.
+/// AICc of what a run ends with: its named effects (with the charge for choosing their places,
+/// [`eigenfit_core::discovery::Fit::score`]), or the calibrated base.
 fn final_aicc(r: &DiscoveryReport) -> f64 {
-    r.selected.as_ref().map_or(r.aicc_before, |s| s.aicc.min(r.aicc_before))
+    r.selected.as_ref().map_or(r.aicc_before, |s| s.score().min(r.aicc_before))
 }

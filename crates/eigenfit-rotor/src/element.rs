@@ -146,8 +146,42 @@ pub fn displacement_shape(xi: f64, l: f64) -> nalgebra::Vector4<f64> {
     )
 }
 
+/// Curvature shape functions at ξ = x/L: v''(x) = B·[v₁, θ₁, v₂, θ₂] (the second derivatives of
+/// [`displacement_shape`]). EI·BBᵀ integrated over the element gives [`stiffness`].
+pub fn curvature_shape(xi: f64, l: f64) -> nalgebra::Vector4<f64> {
+    nalgebra::Vector4::new(
+        (12.0 * xi - 6.0) / (l * l),
+        (6.0 * xi - 4.0) / l,
+        (6.0 - 12.0 * xi) / (l * l),
+        (6.0 * xi - 2.0) / l,
+    )
+}
+
+/// Five-point Gauss–Legendre points on [0, 1] and their weights (summing to 1): exact for
+/// polynomials up to degree 9 — a linear taper's EI(x)·BBᵀ (degree 6) and ρA(x)·NNᵀ (degree 8).
+pub const GAUSS_5: [(f64, f64); 5] = [
+    (0.046_910_077_030_668_0, 0.118_463_442_528_094_5),
+    (0.230_765_344_947_158_5, 0.239_314_335_249_683_2),
+    (0.5, 0.284_444_444_444_444_4),
+    (0.769_234_655_052_841_5, 0.239_314_335_249_683_2),
+    (0.953_089_922_969_332, 0.118_463_442_528_094_5),
+];
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn gauss_points_of_the_shape_functions_rebuild_the_element_matrices() {
+        let (ei, rho_a, l) = (2.1e11 * 1.9e-9, 7850.0 * 1.5e-4, 0.05);
+        let (mut k, mut m) = (nalgebra::Matrix4::zeros(), nalgebra::Matrix4::zeros());
+        for (xi, w) in GAUSS_5 {
+            let (b, n) = (curvature_shape(xi, l), displacement_shape(xi, l));
+            k += w * l * ei * b * b.transpose();
+            m += w * l * rho_a * n * n.transpose();
+        }
+        assert!((k - stiffness(ei, l)).amax() <= 1e-12 * stiffness(ei, l).amax());
+        assert!((m - consistent_mass(rho_a, l)).amax() <= 1e-12 * consistent_mass(rho_a, l).amax());
+    }
+
     #[test]
     fn timoshenko_masses_reduce_to_euler_bernoulli_and_keep_rigid_body_energy() {
         let (rho_a, rho_i, l) = (1.2, 3e-6, 0.07);

@@ -87,6 +87,14 @@ pub enum RotorError {
         /// [`MAX_ELEMENTS`](crate::MAX_ELEMENTS).
         max: usize,
     },
+    /// More `[[table]]`s of one kind than any rotor has ([`MAX_TABLES`](crate::MAX_TABLES)).
+    #[error("more than {max} [[{table}]] tables: a real rotor has a few; refused before parsing the file")]
+    TooManyTables {
+        /// The table's name (`bearing`, `material`, …).
+        table: String,
+        /// The most allowed.
+        max: usize,
+    },
     /// The shaft geometry is given twice or not at all.
     #[error("shaft: {0}")]
     ShaftLayout(&'static str),

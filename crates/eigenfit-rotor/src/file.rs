@@ -50,6 +50,38 @@ impl RotorSpec {
     }
 }
 
+/// Most tables of one kind (`[[bearing]]`, `[[material]]`, …) a rotor file may have. A real rotor
+/// has a few of each (a turbine-generator train some twenty bearings); a file with more is made
+/// by mistake, and refused before the TOML is parsed (10⁵ bearings took seconds to parse).
+pub const MAX_TABLES: usize = 10_000;
+
+/// Refuses more than [`MAX_TABLES`] `[[kind]]` headers of one kind, naming the line of the first
+/// one too many: a count of header lines, far cheaper than the parse it saves.
+fn check_table_counts(text: &str, path: Option<&Path>) -> Result<(), RotorError> {
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let Some(rest) = line.trim_start().strip_prefix("[[") else { continue };
+        let Some((name, _)) = rest.split_once("]]") else { continue };
+        let name = name.trim();
+        let count = match counts.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, c)) => c,
+            None => {
+                counts.push((name, 0));
+                &mut counts.last_mut().expect("just pushed").1
+            }
+        };
+        *count += 1;
+        if *count > MAX_TABLES {
+            return Err(RotorError::Located {
+                path: path.map(Path::to_path_buf),
+                line: i + 1,
+                error: Box::new(RotorError::TooManyTables { table: name.to_string(), max: MAX_TABLES }),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Parses and validates `text`; a validation error gets the line of the entry or key at fault.
 fn build(text: &str, path: Option<&Path>) -> Result<Rotor, RotorError> {
     parse(text, path)?.build_sited().map_err(|SitedError { error, site }| {
@@ -262,6 +294,7 @@ impl<'de> Deserialize<'de> for Plain {
 }
 
 fn parse(text: &str, path: Option<&Path>) -> Result<RotorBuilder, RotorError> {
+    check_table_counts(text, path)?;
     match toml::from_str::<RotorSpec>(text) {
         Ok(spec) => Ok(RotorBuilder::from_spec(spec)),
         Err(e) => {
@@ -300,5 +333,21 @@ mod tests {
         // 'é' is two bytes but one column.
         assert_eq!(line_column(text, 9), (2, 3));
         assert_eq!(line_column(text, 1000), (3, 1));
+    }
+
+    #[test]
+    fn more_tables_of_a_kind_than_any_rotor_has_are_refused_at_the_first_too_many() {
+        let table = "[[ bearing ]] # a support\nnode = 0\nstiffness = 1e6\n";
+        let text = format!("[shaft]\nlength = 1.0\nelements = 4\n{}", table.repeat(MAX_TABLES + 1));
+        let err = Rotor::from_toml_str(&text).unwrap_err();
+        // The header of bearing MAX_TABLES + 1: three lines of shaft, three per bearing.
+        let line = 3 + 3 * MAX_TABLES + 1;
+        assert_eq!(
+            err.to_string(),
+            format!("line {line}: more than {MAX_TABLES} [[bearing]] tables: a real rotor has a few; refused before parsing the file")
+        );
+        // Many tables of different kinds are each within the limit.
+        let mixed = "[[material]]\nname = \"m\"\n".repeat(MAX_TABLES) + &table.repeat(3);
+        assert!(check_table_counts(&mixed, None).is_ok());
     }
 }

@@ -71,8 +71,9 @@ pub mod updatable;
 
 pub use builder::RotorBuilder;
 pub use error::RotorError;
+pub use file::MAX_TABLES;
 pub use model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
 pub use spec::{
     BearingSpec, Disk, EffectSpec, Material, ParameterSpec, PointMass, RotorSpec, Section, ShaftSpec,
 };
-pub use updatable::UpdatableRotor;
+pub use updatable::{UpdatableError, UpdatableRotor};

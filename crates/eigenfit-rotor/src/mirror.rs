@@ -4,7 +4,7 @@
 //! both (`ambiguous_with`) instead of picking one silently.
 
 use crate::model::Rotor;
-use eigenfit_core::discovery::{Alternative, NamedEffect};
+use eigenfit_core::discovery::{Alternative, NamedEffect, Place};
 
 /// Index maps of a mirror-symmetric rotor onto itself.
 pub struct Mirror {
@@ -98,18 +98,9 @@ impl Mirror {
         if place == (effect.location, effect.position_m, effect.elements) {
             return None;
         }
-        let label = match (place.2, place.1, place.0) {
-            (Some([a, b]), _, _) if a != b => format!("{}@{a}-{b}", effect.kind),
-            (_, Some(x), _) => format!("{}@{x:.4}m", effect.kind),
-            (_, _, Some(l)) => format!("{}@{l}", effect.kind),
-            _ => effect.kind.clone(),
-        };
         Some(Alternative {
-            label,
-            kind: effect.kind.clone(),
-            location: place.0,
-            position_m: place.1,
-            elements: place.2,
+            place: Place::new(&effect.kind, place.0, place.1, place.2)
+                .tapered_to(effect.taper_to.map(|t| self.elements - 1 - t)),
             value: effect.value,
             unit: effect.unit.clone(),
             delta_aicc: 0.0,
@@ -140,7 +131,7 @@ pub fn add_images(rotor: &Rotor, effects: &mut [NamedEffect]) {
 mod tests {
     use super::Mirror;
     use crate::{presets, BearingSpec, Disk, EffectSpec, Material, Rotor};
-    use eigenfit_core::discovery::NamedEffect;
+    use eigenfit_core::discovery::{NamedEffect, Place};
     use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 
     fn symmetric() -> Rotor {
@@ -158,11 +149,7 @@ mod tests {
 
     fn effect(kind: &str, location: Option<usize>) -> NamedEffect {
         NamedEffect {
-            label: kind.into(),
-            kind: kind.into(),
-            location,
-            position_m: None,
-            elements: None,
+            place: Place::new(kind, location, None, None),
             value: Some(0.3),
             interval: None,
             unit: String::new(),

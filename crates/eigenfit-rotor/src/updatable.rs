@@ -10,11 +10,12 @@
 //! (f(v) − f(v₀))·(K₁, M₁) to it.
 
 use crate::element;
+use crate::error::RotorError;
 use crate::model::Rotor;
 use crate::spec::{Material, Section};
 use crate::RotorBuilder;
 use eigenfit_core::matrix::{SparseSymmetric, System, SystemDerivative};
-use eigenfit_core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
+use eigenfit_core::model::{ModelError, Parameter, ParameterError, ParameterSet, Scale, StructuralModel};
 
 // Defined with the other plain descriptions (a rotor's spec holds them); still reachable here.
 pub use crate::spec::ParameterSpec;
@@ -78,14 +79,37 @@ pub struct UpdatableRotor {
     parameters: ParameterSet,
 }
 
+/// Why a rotor's `[[parameter]]` tables could not be resolved, or a rotor not written at
+/// parameter values.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum UpdatableError {
+    /// A `[[parameter]]` table is invalid.
+    #[error("parameter {table} ({kind}): {why}")]
+    Table {
+        /// The table's index (0-based, in file order).
+        table: usize,
+        /// The table's `kind`.
+        kind: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// The parameter list or a parameter vector is invalid.
+    #[error(transparent)]
+    Parameters(#[from] ParameterError),
+    /// The rotor at these values is invalid.
+    #[error(transparent)]
+    Rotor(#[from] RotorError),
+}
+
 impl UpdatableRotor {
     /// Resolves the rotor's `[[parameter]]` tables; errors name the table (`parameter 2`).
-    pub fn new(rotor: Rotor) -> Result<Self, String> {
+    pub fn new(rotor: Rotor) -> Result<Self, UpdatableError> {
         let specs = rotor.spec().parameters.clone();
         let mut params: Vec<Parameter> = rotor.parameters().iter().cloned().collect();
         let mut extras = Vec::with_capacity(specs.len());
         for (i, s) in specs.iter().enumerate() {
-            let at = |why: String| format!("parameter {i} ({}): {why}", s.kind);
+            let at = |why: String| UpdatableError::Table { table: i, kind: s.kind.clone(), why };
             let (extra, name, unit) = resolve(&rotor, s).map_err(at)?;
             let scale_kind = matches!(extra.kind, Kind::ModulusScale | Kind::DiameterScale);
             let v = extra.nominal;
@@ -118,7 +142,7 @@ impl UpdatableRotor {
             params.push(Parameter::new(name, unit, v).with_bounds(lo, hi).with_scale(Scale::Log));
             extras.push(extra);
         }
-        let parameters = ParameterSet::new(params).map_err(|e| e.to_string())?;
+        let parameters = ParameterSet::new(params)?;
         Ok(Self { rotor, extras, parameters })
     }
 
@@ -131,8 +155,8 @@ impl UpdatableRotor {
     /// back (through TOML) as a plain rotor at these values: bearing and disk values replaced,
     /// a scaled section's modulus as a new material `<material>_<parameter name>`, a scaled
     /// section's diameters multiplied.
-    pub fn with_values(&self, p: &[f64]) -> Result<Rotor, String> {
-        self.parameters.check(p).map_err(|e| e.to_string())?;
+    pub fn with_values(&self, p: &[f64]) -> Result<Rotor, UpdatableError> {
+        self.parameters.check(p)?;
         let nb = self.rotor.bearings().len();
         let mut spec = self.rotor.spec().clone();
         // A modulus scale adds a material: the shaft's default may then no longer be implied.
@@ -179,7 +203,7 @@ impl UpdatableRotor {
                 }
             }
         }
-        RotorBuilder::from_spec(spec).build().map_err(|e| e.to_string())
+        Ok(RotorBuilder::from_spec(spec).build()?)
     }
 
     /// Element ranges of a section parameter: the section's, or one per element (whole shaft)

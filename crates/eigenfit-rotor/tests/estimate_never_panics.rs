@@ -142,7 +142,7 @@ proptest! {
         let solver: Box<dyn EigenSolver> = if banded { Box::new(BandedSolver::default()) } else { Box::new(DenseSolver) };
         let problem = Problem::new(&rotor, solver.as_ref(), measurement);
         let mut strategy = strategy.build();
-        match (Driver { max_iterations: 40 }).run(&problem, strategy.as_mut(), &initial, &mut []) {
+        match (Driver { max_iterations: 40 }).run(&problem, strategy.as_mut(), &initial) {
             Err(e) => prop_assert!(!e.to_string().is_empty()),
             Ok(estimate) => {
                 prop_assert!(!estimate.history.is_empty());
@@ -175,7 +175,7 @@ fn zero_parameters_newton_does_not_panic() {
     let measurement = Measurement::new(vec![MeasuredMode::new(2, 100.0)]).expect("valid data");
     for kind in [StrategyKind::Newton, StrategyKind::PStep] {
         let problem = Problem::new(&rotor, DenseSolver, measurement.clone());
-        let result = Driver { max_iterations: 40 }.run(&problem, kind.build().as_mut(), &[], &mut []);
+        let result = Driver { max_iterations: 40 }.run(&problem, kind.build().as_mut(), &[]);
         assert!(result.is_err(), "{kind:?}: nothing to estimate, expected a typed error: {result:?}");
     }
 }

@@ -47,6 +47,7 @@ fn names_every_in_list_effect_of_independent_data() {
         "thin-element",
         "thin-run",
         "two-effects",
+        "taper",
     ] {
         let o = outcomes(case, 2);
         assert_eq!(hits(&o), o.len(), "{case}: {o:?}");
@@ -77,6 +78,32 @@ fn pedestal_candidate_reproduces_the_independent_pedestal_rotor() {
         for (m, (a, b)) in f.iter().zip(exact).enumerate() {
             assert!((a - b).abs() <= 1e-8 * b, "{case} mode {m}: {a} vs numpy {b}");
         }
+    }
+}
+
+/// The taper candidate at the generator's truth (Ø14 → Ø11 mm linearly over elements 5–7) gives
+/// the generator's frequencies: numpy integrated its tapered elements on its own.
+#[test]
+fn taper_candidate_reproduces_the_independent_taper_rotor() {
+    let rotor = presets::paper_rotor();
+    let fixtures = study::load();
+    let exact = &fixtures.case.iter().find(|c| c.name == "taper").unwrap().exact_hz;
+    let candidates = eigenfit_rotor::effects::candidates(&rotor);
+    let taper = candidates.iter().find(|c| c.label() == "section-change@5-7~7").expect("the taper");
+    let model = Augmented::new(&rotor, taper).unwrap();
+    let system = model.assemble(&[2e5, 5e4, 11.0 / 14.0 - 1.0]).unwrap();
+    let f = BandedSolver::default().lowest(&system, exact.len()).unwrap().frequencies_hz();
+    for (m, (a, b)) in f.iter().zip(exact).enumerate() {
+        assert!((a - b).abs() <= 1e-8 * b, "taper mode {m}: {a} vs numpy {b}");
+    }
+    // Its derivative (a sum of graded parts) matches finite differences.
+    let p = [2e5, 5e4, -0.2];
+    let exact = model.derivative(&p, 2).unwrap();
+    let fd = finite_difference_derivative(&model, &p, 2).unwrap();
+    for (a, b) in [(&exact.stiffness, &fd.stiffness), (&exact.mass, &fd.mass)] {
+        let (a, b) = (a.to_dense(), b.to_dense());
+        let scale = a.amax();
+        assert!((a - b).amax() <= 1e-6 * scale, "taper: analytic vs finite-difference derivative");
     }
 }
 

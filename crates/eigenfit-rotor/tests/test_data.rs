@@ -112,7 +112,7 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
         .map(|m| eigenfit_core::measurement::MeasuredMode { shape: None, ..m.clone() })
         .collect();
     let freq_only = Problem::new(&rotor, DenseSolver, Measurement::new(without_shapes).unwrap());
-    let est = Driver::default().run(&freq_only, &mut LevenbergMarquardt::default(), &start, &mut []).unwrap();
+    let est = Driver::default().run(&freq_only, &mut LevenbergMarquardt::default(), &start).unwrap();
     let p = &est.parameters;
     let swapped = [p[1], p[0]];
     let (c1, c2) = (freq_only.cost(p).unwrap(), freq_only.cost(&swapped).unwrap());
@@ -124,7 +124,7 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
         0.05,
     );
     let mut damped = LevenbergMarquardt::default();
-    let est = Driver::default().run(&fit, &mut damped as &mut dyn UpdateStrategy, &start, &mut []).unwrap();
+    let est = Driver::default().run(&fit, &mut damped as &mut dyn UpdateStrategy, &start).unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
     let u = uncertainty(&fit, &est.last, true).unwrap();
     for (i, name) in ["drive_end", "free_end"].iter().enumerate() {

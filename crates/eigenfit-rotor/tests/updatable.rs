@@ -139,7 +139,7 @@ fn a_disk_mass_is_estimated() {
     let f = DenseSolver.lowest(&m.assemble(&truth).unwrap(), 4).unwrap().frequencies_hz();
     let problem = Problem::new(&m, DenseSolver, Measurement::from_frequencies(&f).unwrap());
     let est = Driver::default()
-        .run(&problem, &mut LevenbergMarquardt::default(), &m.parameters().nominal_values(), &mut [])
+        .run(&problem, &mut LevenbergMarquardt::default(), &m.parameters().nominal_values())
         .unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
     for (a, b) in est.parameters.iter().zip(truth) {
@@ -155,6 +155,7 @@ fn bad_declarations_are_named() {
                 .unwrap(),
         )
         .unwrap_err()
+        .to_string()
     };
     assert_eq!(
         bad("[[parameter]]\nkind = \"disk-mass\"\nindex = 3\n"),

@@ -49,23 +49,44 @@ pub fn is_runup_header(text: &str) -> bool {
         .is_some_and(|l| l.split(',').next().map(str::trim) == Some("speed_rpm"))
 }
 
+/// An invalid run-up CSV: the line (where one is at fault) and what is wrong; shown as
+/// `line LINE: MESSAGE`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}{message}", .line.map(|l| format!("line {l}: ")).unwrap_or_default())]
+pub struct RunupError {
+    /// The 1-based line, `None` for a fault of the whole file (no data rows).
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub message: String,
+}
+
+fn line_error(line: usize, message: String) -> RunupError {
+    RunupError { line: Some(line), message }
+}
+
 /// Parses run-up CSV text (see [`read_runup`]); `#` lines are comments.
-pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, String> {
+pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, RunupError> {
     let mut lines =
         text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let (_, header) =
-        lines.next().ok_or("empty file: expected header speed_rpm,mode,frequency_hz[,std_hz][,whirl]")?;
+    let (_, header) = lines.next().ok_or_else(|| RunupError {
+        line: None,
+        message: "empty file: expected header speed_rpm,mode,frequency_hz[,std_hz][,whirl]".into(),
+    })?;
     let cols: Vec<&str> = header.split(',').map(str::trim).collect();
     let col = |name: &str| cols.iter().position(|c| *c == name);
     let (Some(cs), Some(cm), Some(cf)) = (col("speed_rpm"), col("mode"), col("frequency_hz")) else {
-        return Err(format!(
-            "line 1: header `{header}` must name speed_rpm, mode and frequency_hz (optional std_hz, whirl)"
+        return Err(line_error(
+            1,
+            format!("header `{header}` must name speed_rpm, mode and frequency_hz (optional std_hz, whirl)"),
         ));
     };
     if let Some(bad) =
         cols.iter().find(|c| !["speed_rpm", "mode", "frequency_hz", "std_hz", "whirl"].contains(c))
     {
-        return Err(format!("line 1: unknown column `{bad}` (speed_rpm, mode, frequency_hz, std_hz, whirl)"));
+        return Err(line_error(
+            1,
+            format!("unknown column `{bad}` (speed_rpm, mode, frequency_hz, std_hz, whirl)"),
+        ));
     }
     let (cstd, cw) = (col("std_hz"), col("whirl"));
     let mut out = Vec::new();
@@ -73,34 +94,36 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, String> {
         let at = i + 1;
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
         if f.len() != cols.len() {
-            return Err(format!("line {at}: {} fields, the header has {}", f.len(), cols.len()));
+            return Err(line_error(at, format!("{} fields, the header has {}", f.len(), cols.len())));
         }
-        let num = |c: usize, name: &str| -> Result<f64, String> {
-            let v: f64 = f[c].parse().map_err(|_| format!("line {at}: {name} `{}` is not a number", f[c]))?;
+        let num = |c: usize, name: &str| -> Result<f64, RunupError> {
+            let v: f64 =
+                f[c].parse().map_err(|_| line_error(at, format!("{name} `{}` is not a number", f[c])))?;
             if v.is_finite() {
                 Ok(v)
             } else {
-                Err(format!("line {at}: {name} `{}` is not finite", f[c]))
+                Err(line_error(at, format!("{name} `{}` is not finite", f[c])))
             }
         };
         let speed_rpm = num(cs, "speed_rpm")?;
         if speed_rpm < 0.0 {
-            return Err(format!("line {at}: speed_rpm {speed_rpm} must be ≥ 0"));
+            return Err(line_error(at, format!("speed_rpm {speed_rpm} must be ≥ 0")));
         }
-        let mode: usize =
-            f[cm].parse().map_err(|_| format!("line {at}: mode `{}` is not a whole number ≥ 1", f[cm]))?;
+        let mode: usize = f[cm]
+            .parse()
+            .map_err(|_| line_error(at, format!("mode `{}` is not a whole number ≥ 1", f[cm])))?;
         if mode == 0 {
-            return Err(format!("line {at}: mode counts from 1"));
+            return Err(line_error(at, "mode counts from 1".into()));
         }
         let frequency_hz = num(cf, "frequency_hz")?;
         if frequency_hz <= 0.0 {
-            return Err(format!("line {at}: frequency_hz {frequency_hz} must be > 0"));
+            return Err(line_error(at, format!("frequency_hz {frequency_hz} must be > 0")));
         }
         let std_hz = match cstd {
             Some(c) if !f[c].is_empty() => {
                 let s = num(c, "std_hz")?;
                 if s <= 0.0 {
-                    return Err(format!("line {at}: std_hz {s} must be > 0"));
+                    return Err(line_error(at, format!("std_hz {s} must be > 0")));
                 }
                 Some(s)
             }
@@ -113,20 +136,23 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, String> {
                 "forward" => Whirl::Forward,
                 "backward" => Whirl::Backward,
                 "mixed" => Whirl::Mixed,
-                _ => return Err(format!("line {at}: whirl `{w}` is not forward, backward or mixed")),
+                _ => return Err(line_error(at, format!("whirl `{w}` is not forward, backward or mixed"))),
             }),
         };
         if out.iter().any(|p: &RunupPoint| p.speed_rpm == speed_rpm && p.mode == mode) {
-            return Err(format!("line {at}: mode {mode} at {speed_rpm} rpm appears twice"));
+            return Err(line_error(at, format!("mode {mode} at {speed_rpm} rpm appears twice")));
         }
         out.push(RunupPoint { speed_rpm, mode, frequency_hz, std_hz, whirl });
     }
     if out.is_empty() {
-        return Err("no data rows".into());
+        return Err(RunupError { line: None, message: "no data rows".into() });
     }
     let with_std = out.iter().filter(|p| p.std_hz.is_some()).count();
     if with_std != 0 && with_std != out.len() {
-        return Err("std_hz must be given on every row or on none".into());
+        return Err(RunupError {
+            line: None,
+            message: "std_hz must be given on every row or on none".into(),
+        });
     }
     Ok(out)
 }

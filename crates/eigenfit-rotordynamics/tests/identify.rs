@@ -93,7 +93,7 @@ fn runup_csv_errors_name_the_line() {
         ("speed_rpm,mode,frequency_hz\n1000,1,20\n1000,1,21\n", "twice"),
         ("speed_rpm,mode,frequency_hz,std_hz\n1000,1,20,0.1\n1000,2,21,\n", "every row"),
     ] {
-        let e = parse_runup(text).unwrap_err();
+        let e = parse_runup(text).unwrap_err().to_string();
         assert!(e.contains(needle), "{text:?}: {e}");
     }
 }

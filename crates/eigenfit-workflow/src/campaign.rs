@@ -4,14 +4,14 @@
 use crate::error::{failure, input, WorkflowError};
 use crate::model::Updatable;
 use crate::named::Named;
-use crate::outcome::Outcome;
+use crate::outcome::{BudgetReport, Outcome};
 use crate::overrides::fixed;
 use crate::progress::Progress;
 use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDataOptions};
 use eigenfit_core::analysis::Joint;
 use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
-use eigenfit_core::update::{Driver, StrategyKind};
+use eigenfit_core::update::{Budget, Driver, StrategyKind};
 use eigenfit_rotor::campaign::Campaign;
 use eigenfit_rotor::{Rotor, UpdatableRotor};
 use serde::Serialize;
@@ -28,6 +28,8 @@ pub struct CampaignRequest {
     pub solver: String,
     /// Iteration limit.
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) the joint fit and its intervals may spend together.
+    pub budget: usize,
     /// Node matching, shape weight and MAC threshold for every configuration.
     pub shape: ShapeOptions,
 }
@@ -70,6 +72,9 @@ pub struct CampaignReport {
     /// Converged (with every mode paired), why it stopped, iterations, evaluations.
     #[serde(flatten)]
     pub outcome: Outcome,
+    /// The evaluation budget: the limit, what the fit and its intervals spent, whether it ran out
+    /// (intervals cut short are incomplete).
+    pub budget: BudgetReport,
     /// Initial values.
     pub initial: Named<f64>,
     /// Estimated values.
@@ -99,7 +104,7 @@ pub struct CampaignReport {
 
 /// Estimates a campaign jointly.
 pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<CampaignReport, WorkflowError> {
-    let campaign = Campaign::from_toml_file(&request.campaign).map_err(input)?;
+    let campaign = Campaign::from_toml_file(&request.campaign).map_err(|e| input(e.to_string()))?;
     let solver: Box<dyn EigenSolver> = match request.solver.as_str() {
         "banded" | "auto" => Box::new(BandedSolver::default()),
         "dense" => Box::new(DenseSolver),
@@ -150,14 +155,26 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     let initial = joint.parameters().nominal_values();
     progress.begin(&format!("estimating the campaign ({})", strategy_kind.name()), None);
     let mut strategy = strategy_kind.build();
+    if request.budget == 0 {
+        return Err(input("--budget 0: at least one model evaluation is needed"));
+    }
+    let budget = Budget::new(request.budget);
     let estimate = Driver { max_iterations: request.max_iterations }
-        .run(&joint, strategy.as_mut(), &initial, &mut [])
-        .map_err(|e| input(e.to_string()));
+        .run_within(&joint, strategy.as_mut(), &initial, &budget)
+        .map_err(|e| match budget.exhausted() {
+            true => WorkflowError::BudgetExhausted(format!(
+                "the budget of {} model evaluations ran out before the fit could start (raise it with --budget)",
+                budget.limit()
+            )),
+            false => input(e.to_string()),
+        });
     progress.end();
     let estimate = estimate?;
     let p = estimate.parameters.clone();
     let (unc, scatter) = match estimate.termination.is_converged() {
-        true => joint.uncertainty(&estimate.last, has_std).map_or((None, None), |(u, s)| (Some(u), Some(s))),
+        true => joint
+            .uncertainty_within(&estimate.last, has_std, &budget)
+            .map_or((None, None), |(u, s)| (Some(u), Some(s))),
         false => (None, None),
     };
     let pnames: Vec<String> = joint.parameters().iter().map(|q| q.name.clone()).collect();
@@ -184,6 +201,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         campaign: request.campaign.display().to_string(),
         strategy: estimate.strategy,
         outcome: Outcome::of(&estimate, estimate.termination.is_converged() && !unpaired),
+        budget: BudgetReport::of(&budget),
         initial: Named::new(&pnames, initial.iter().copied()),
         parameters: Named::new(&pnames, p.iter().copied()),
         chi2: estimate.last.chi2(),

@@ -48,6 +48,8 @@ pub struct CompareRequest {
     pub modes: Option<usize>,
     /// Iteration limit per run.
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) one run may spend on its fit and intervals.
+    pub budget: usize,
     /// Include each run's wall-clock time.
     pub timing: bool,
 }
@@ -134,11 +136,15 @@ pub fn plan(request: &CompareRequest, np: usize) -> Result<ComparePlan, Workflow
             return Err(input(format!("--std-hz {s}: must be a positive finite number")));
         }
     }
+    if request.budget == 0 {
+        return Err(input("--budget 0: at least one model evaluation is needed"));
+    }
     let settings = CompareSettings {
         modes: request.modes.unwrap_or(np).max(np),
         decimals: request.decimals,
         std_hz: request.std_hz,
         max_iterations: request.max_iterations,
+        budget: request.budget,
     };
     Ok(ComparePlan { targets, initials, strategies, settings, timing: request.timing })
 }
@@ -227,6 +233,8 @@ pub struct Summary {
     pub max_iterations: Option<usize>,
     /// Largest relative error of the converged runs.
     pub max_relative_error: f64,
+    /// Runs cut short by their evaluation budget (`--budget`).
+    pub budget_exhausted: usize,
 }
 
 /// The summary of `runs` per target and strategy.
@@ -250,6 +258,7 @@ pub fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[Strate
                 median_iterations: (!iters.is_empty()).then(|| iters[iters.len() / 2]),
                 max_iterations: iters.last().copied(),
                 max_relative_error: conv.iter().map(|r| r.relative_error).fold(0.0, f64::max),
+                budget_exhausted: group.iter().filter(|r| r.budget_exhausted).count(),
             });
         }
     }

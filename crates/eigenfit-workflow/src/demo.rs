@@ -160,18 +160,22 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
         }
     }
     // 2. Table 3 case 1 with all three strategies.
-    let settings = CompareSettings { modes: 2, decimals: Some(3), std_hz: None, max_iterations: 1000 };
-    let measured =
-        reference_measurement(&rotor, &solver, &TARGET, &settings).map_err(WorkflowError::Failure)?;
+    let settings = CompareSettings {
+        modes: 2,
+        decimals: Some(3),
+        std_hz: None,
+        max_iterations: 1000,
+        budget: eigenfit_core::update::DEFAULT_EVALUATIONS,
+    };
+    let measured = reference_measurement(&rotor, &solver, &TARGET, &settings)
+        .map_err(|e| WorkflowError::Failure(e.to_string()))?;
     let reference_hz: Vec<f64> = measured.modes().iter().map(|m| m.frequency_hz).collect();
     let problem = Problem::new(&rotor, &solver, measured);
     let mut estimates = Vec::new();
     for kind in StrategyKind::ALL {
         let mut strategy = kind.build();
         estimates.push(
-            Driver { max_iterations: 1000 }
-                .run(&problem, strategy.as_mut(), &INITIAL, &mut [])
-                .map_err(failure)?,
+            Driver { max_iterations: 1000 }.run(&problem, strategy.as_mut(), &INITIAL).map_err(failure)?,
         );
     }
     // 3. Where each strategy converges from: a grid of initial guesses.
@@ -181,7 +185,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
     progress.begin("convergence map", Some((initials.len() * strategies.len()) as u64));
     let runs = run_grid(&rotor, &solver, &targets, &initials, &strategies, &settings, |_| progress.step());
     progress.end();
-    let runs = runs.map_err(WorkflowError::Failure)?;
+    let runs = runs.map_err(|e| WorkflowError::Failure(e.to_string()))?;
     // 4. Discovery of a hidden effect.
     let data = measured_csv::parse(HIDDEN_EFFECT_CSV)
         .map_err(|e| WorkflowError::Failure(format!("built-in dataset: line {e}")))?;

@@ -6,11 +6,13 @@ use crate::model::AnyModel;
 use crate::named::Named;
 use crate::progress::Progress;
 use eigenfit_core::analysis::verdict::check_reachable;
-use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect};
+use eigenfit_core::discovery::{
+    discover, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect,
+};
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::Problem;
-use eigenfit_core::update::{Budget, DEFAULT_EVALUATIONS};
+use eigenfit_core::update::Budget;
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde::Serialize;
 use std::path::Path;
@@ -66,8 +68,10 @@ pub struct DiscoverReport {
     pub modes: Vec<ModeReport>,
     /// Files written (the augmented model, plots).
     pub written: Vec<String>,
-    /// Eigen-solves the search spent (user's and refined mesh together).
+    /// Eigen-solves the run spent (the data check, the user's and the refined mesh together).
     pub evaluations: usize,
+    /// The evaluation budget the run was given (`--budget`).
+    pub budget_limit: usize,
     /// True when the search stopped at its budget of eigen-solves.
     pub budget_exhausted: bool,
 }
@@ -104,13 +108,17 @@ pub struct Discovery {
 }
 
 /// Runs the discovery on `model` against the measured CSV at `measured`, assuming a relative
-/// standard deviation `assumed_std` where the file gives none. Notes on the file go to `notes`.
+/// standard deviation `assumed_std` where the file gives none, spending at most `budget` model
+/// evaluations (eigen-solves) on the data check and the whole search together. Notes on the file
+/// go to `notes`.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     label: &str,
     model: &AnyModel,
     solver: &dyn EigenSolver,
     measured: &Path,
     assumed_std: f64,
+    budget: usize,
     notes: &mut Vec<String>,
     progress: &mut dyn Progress,
 ) -> Result<Discovery, WorkflowError> {
@@ -119,12 +127,26 @@ pub fn run(
     if !(assumed_std.is_finite() && assumed_std > 0.0) {
         return Err(input(format!("--assumed-std {assumed_std}: must be a positive number")));
     }
+    if budget == 0 {
+        return Err(input("--budget 0: at least one model evaluation is needed"));
+    }
     // Estimate's sanity check, so a typing slip ends here as it does there (exit 2, mode named).
     let mode_numbers: Vec<usize> = data.modes().iter().map(|m| m.mode + 1).collect();
     let problem = Problem::new(model, solver, data.clone());
-    check_reachable(&problem, &mode_numbers, &Budget::new(DEFAULT_EVALUATIONS))
-        .map_err(|e| input(format!("{}: {e}", measured.display())))?;
-    let options = DiscoveryOptions { assumed_relative_std: assumed_std, ..Default::default() };
+    let check = Budget::new(budget);
+    check_reachable(&problem, &mode_numbers, &check).map_err(|e| {
+        if check.exhausted() {
+            budget_error(budget)
+        } else {
+            input(format!("{}: {e}", measured.display()))
+        }
+    })?;
+    // The search gets what the check left, so `budget` bounds the whole run.
+    let options = DiscoveryOptions {
+        assumed_relative_std: assumed_std,
+        max_evaluations: check.remaining(),
+        ..Default::default()
+    };
     progress.begin("discovering: calibrate, detect, screen and refit candidates", None);
     let found = match model {
         AnyModel::Rotor(r) => discover_rotor(r, &solver, &data, &r.nominal_stiffnesses(), &options),
@@ -135,9 +157,14 @@ pub fn run(
         }
     };
     progress.end();
-    let found = found.map_err(|e| input(format!("{}: {e}", measured.display())))?;
+    // A calibration cut short by the budget is no input error: the user's budget was too small.
+    let mut found = found.map_err(|e| match e {
+        DiscoveryError::BudgetExhausted(_) => budget_error(budget),
+        e => input(format!("{}: {e}", measured.display())),
+    })?;
+    found.report.evaluations += check.used();
     let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
-    let report = report_of(label, &found.report, &found.effects, found.mesh_factor, &names);
+    let report = report_of(label, &found.report, &found.effects, found.mesh_factor, &names, budget);
     Ok(Discovery { found, report })
 }
 
@@ -149,6 +176,7 @@ pub(crate) fn report_of(
     effects: &[NamedEffect],
     mesh_refinement: usize,
     names: &[String],
+    budget_limit: usize,
 ) -> DiscoverReport {
     DiscoverReport {
         model: label.to_string(),
@@ -178,13 +206,30 @@ pub(crate) fn report_of(
             .collect(),
         written: Vec::new(),
         evaluations: r.evaluations,
+        budget_limit,
         budget_exhausted: r.budget_exhausted,
     }
 }
 
 /// The augmented model (calibrated stiffnesses and the named effects) as rotor TOML; a
-/// matrices model has no file form for its effects and says so.
+/// matrices model has no file form for its effects and says so, and neither has a pedestal
+/// (an input error: the request cannot be met, nothing broke).
 pub fn augmented_model_toml(found: &RotorDiscovery, model: &AnyModel) -> Result<String, WorkflowError> {
+    if let Some(p) = found.effects.iter().find(|e| e.kind == eigenfit_rotor::pedestal::KIND) {
+        return Err(input(format!(
+            "--write-model: the named `{}` adds a degree of freedom (the pedestal's mass on its own spring), \
+             which a rotor model file cannot describe yet; its mass and stiffness are in the report \
+             (run without --write-model to see it)",
+            p.label
+        )));
+    }
     let augmented = found.augmented_model(model.rotor("--write-model")?).map_err(failure)?;
     augmented.to_toml_string().map_err(failure)
+}
+
+/// The budget ran out before the calibration could finish: nothing to report but that.
+fn budget_error(budget: usize) -> WorkflowError {
+    WorkflowError::BudgetExhausted(format!(
+        "the budget of {budget} model evaluations ran out before the calibration finished (raise it with --budget)"
+    ))
 }

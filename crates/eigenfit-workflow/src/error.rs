@@ -1,5 +1,6 @@
-//! The one error type of the workflows: bad input (the user can fix it) or a failure inside
-//! eigenfit on valid input. The CLI maps them to exit codes 2 and 1.
+//! The one error type of the workflows: bad input (the user can fix it), a failure inside
+//! eigenfit on valid input, or a user budget too small to produce any result. The CLI maps them
+//! to exit codes 2, 1 and 3.
 
 use thiserror::Error;
 
@@ -12,6 +13,9 @@ pub enum WorkflowError {
     /// eigenfit failed on valid input (a solver that broke).
     #[error("{0}")]
     Failure(String),
+    /// The evaluation budget ran out before there was any result to report.
+    #[error("{0}")]
+    BudgetExhausted(String),
 }
 
 /// Shorthand for an input error.

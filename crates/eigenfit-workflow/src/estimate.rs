@@ -11,17 +11,24 @@ use crate::simulate::check_roundoff;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, judge, FitQuality, FitVerdict};
-use eigenfit_core::analysis::{alternative_solutions_within, mirror_solutions, Identifiability, Uncertainty};
+use eigenfit_core::analysis::{
+    alternative_solutions_within, mirror_solutions, permuted_solutions, Identifiability, Uncertainty,
+};
 use eigenfit_core::measurement::mac::MacReport;
 use eigenfit_core::measurement::measured_csv::shown;
-use eigenfit_core::model::StructuralModel;
+use eigenfit_core::model::{ParameterSet, StructuralModel};
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
 use eigenfit_core::update::{Budget, Driver, Estimate, LevenbergMarquardt, StrategyKind};
 use serde::Serialize;
 use std::path::PathBuf;
 
-/// Another equally good parameter vector, with the exchanged pair when it is a mirror solution.
-type Alternative = (Vec<f64>, Option<(usize, usize)>);
+/// Another equally good parameter vector, with the permutation of the parameters (parameter i's
+/// value moved to π\[i\]) when it is a mirror solution.
+type Alternative = (Vec<f64>, Option<Vec<usize>>);
+
+/// Most DOFs of a model updated from measured shapes: their derivatives (Nelson's method) take
+/// a dense factorisation per mode and iteration, seconds each at this size and O(n³) beyond.
+pub const SHAPE_DOF_LIMIT: usize = 2000;
 
 /// Restart-grid points refitted locally when searching for other equally good solutions.
 pub const ALTERNATIVE_STARTS: usize = 6;
@@ -56,24 +63,19 @@ pub struct EstimateRequest {
     pub bearing_parameters: Option<String>,
 }
 
-/// Model evaluations allowed and spent.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub struct BudgetReport {
-    /// The limit.
-    pub limit: usize,
-    /// Spent.
-    pub used: usize,
-    /// Whether it ran out.
-    pub exhausted: bool,
-}
+pub use crate::outcome::BudgetReport;
 
 /// Another equally good parameter vector.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AlternativeSolution {
     /// Its values.
     pub parameters: Named<f64>,
-    /// The exchanged pair when it is a mirror solution of a symmetric model.
+    /// The exchanged pair when it is a mirror solution of a symmetric model that exchanges one
+    /// pair of parameters (`None` for a symmetry exchanging more: see `exchanged`).
     pub mirror_of: Option<[String; 2]>,
+    /// A mirror solution's exchanged parameters as cycles (`[["zone1", "zone3"], ["zone2",
+    /// "zone4"]]`: a plate's zones mirrored about its centre line); empty for other solutions.
+    pub exchanged: Vec<Vec<String>>,
 }
 
 /// One iteration of the fit.
@@ -273,6 +275,15 @@ pub fn run(
     let solver = request.source.solver()?;
     let options = &request.test_data;
     let data = test_data::read(&request.measured, any.layout(), options)?;
+    if data.sensors.is_some() && any.dofs() > SHAPE_DOF_LIMIT {
+        return Err(input(format!(
+            "{}: measured shapes need the shapes' derivatives, computed here by Nelson's method on \
+             dense matrices (O(n³) per mode and iteration): the model has {} DOFs, more than the {SHAPE_DOF_LIMIT} \
+             this is done for; estimate from the frequencies alone (a CSV of mode,frequency_hz)",
+            request.measured.display(),
+            any.dofs()
+        )));
+    }
     notes.extend(data.file_notes.iter().cloned());
     let measurement = data.measurement.clone();
     let strategy_kind = StrategyKind::from_name(&request.strategy).ok_or_else(|| {
@@ -352,7 +363,7 @@ pub fn run(
     let mut strategy = strategy_kind.build();
     progress.begin(&format!("estimating ({})", strategy_kind.name()), None);
     let estimate = Driver { max_iterations: request.max_iterations }
-        .run_within(&fit, strategy.as_mut(), &start, &mut [], &budget)
+        .run_within(&fit, strategy.as_mut(), &start, &budget)
         .map_err(|e| input(e.to_string()));
     progress.end();
     let estimate = match estimate {
@@ -387,7 +398,16 @@ pub fn run(
     let mut alternatives: Vec<Alternative> = Vec::new();
     if converged && quality.verdict != FitVerdict::Poor {
         for (i, j, p) in mirror_solutions(&fit, &estimate.last, &budget) {
-            alternatives.push((p, Some((i, j))));
+            let mut swap: Vec<usize> = (0..np).collect();
+            swap.swap(i, j);
+            alternatives.push((p, Some(swap)));
+        }
+        // A structure's symmetries exchanging more than one pair (a matrices model's mirrored
+        // zones), on the parameters left free.
+        let symmetries =
+            free_permutations(&any.parameter_symmetries(), updatable.parameters(), model.parameters());
+        for (k, p) in permuted_solutions(&fit, &estimate.last, &symmetries, &budget) {
+            alternatives.push((p, Some(symmetries[k].clone())));
         }
         phases.push(("mirror_solutions", budget.used()));
         // Ranking the coarse grid alone costs an evaluation per point: skipped with no start.
@@ -471,9 +491,16 @@ pub fn run(
         at_limit: pinned,
         alternative_solutions: alternatives
             .iter()
-            .map(|(p, mirror)| AlternativeSolution {
-                parameters: Named::new(&names, p.iter().copied()),
-                mirror_of: mirror.map(|(i, j)| [names[i].clone(), names[j].clone()]),
+            .map(|(p, mirror)| {
+                let cycles = mirror.as_deref().map(cycles).unwrap_or_default();
+                AlternativeSolution {
+                    parameters: Named::new(&names, p.iter().copied()),
+                    mirror_of: match cycles.as_slice() {
+                        [pair] if pair.len() == 2 => Some([names[pair[0]].clone(), names[pair[1]].clone()]),
+                        _ => None,
+                    },
+                    exchanged: cycles.iter().map(|c| c.iter().map(|&i| names[i].clone()).collect()).collect(),
+                }
             })
             .collect(),
         frequencies_hz: estimate.last.frequencies_hz.clone(),
@@ -529,4 +556,49 @@ fn phase_counts(totals: &[(&str, usize)]) -> Named<usize> {
             })
             .collect(),
     )
+}
+
+/// The model's parameter permutations (over `all`, its parameters) that move more than one pair
+/// and keep every held parameter in place, over the free parameters `free` (matched by name);
+/// single exchanges are left to `mirror_solutions`, which checks every like pair.
+fn free_permutations(
+    permutations: &[Vec<usize>],
+    all: &ParameterSet,
+    free: &ParameterSet,
+) -> Vec<Vec<usize>> {
+    let index: Vec<Option<usize>> = all.iter().map(|p| free.iter().position(|q| q.name == p.name)).collect();
+    permutations
+        .iter()
+        .filter(|perm| perm.iter().enumerate().all(|(i, &j)| index[i].is_some() == index[j].is_some()))
+        .filter(|perm| perm.iter().enumerate().all(|(i, &j)| index[i].is_some() || i == j))
+        .map(|perm| {
+            let mut reduced = vec![0; free.len()];
+            for (i, &j) in perm.iter().enumerate() {
+                if let (Some(a), Some(b)) = (index[i], index[j]) {
+                    reduced[a] = b;
+                }
+            }
+            reduced
+        })
+        .filter(|perm| !matches!(cycles(perm).as_slice(), [pair] if pair.len() == 2))
+        .collect()
+}
+
+/// The cycles (two or more parameters each) of a permutation, each from its lowest index.
+fn cycles(perm: &[usize]) -> Vec<Vec<usize>> {
+    let mut seen = vec![false; perm.len()];
+    let mut out = Vec::new();
+    for start in 0..perm.len() {
+        let mut cycle = Vec::new();
+        let mut i = start;
+        while !seen[i] {
+            seen[i] = true;
+            cycle.push(i);
+            i = perm[i];
+        }
+        if cycle.len() > 1 {
+            out.push(cycle);
+        }
+    }
+    out
 }

@@ -91,6 +91,16 @@ impl AnyModel {
         }
     }
 
+    /// Permutations of the parameters under which the model's matrices may be symmetric (a
+    /// matrices model's mirrored zones, [`MatricesModel::parameter_symmetries`]); exchanges of
+    /// one pair of like parameters are checked for every model anyway. Empty for a rotor.
+    pub fn parameter_symmetries(&self) -> Vec<Vec<usize>> {
+        match self {
+            AnyModel::Rotor(_) => Vec::new(),
+            AnyModel::Matrices(m) => m.parameter_symmetries(),
+        }
+    }
+
     /// The rotor with its `[[parameter]]` tables resolved (docs/rotor-model.md), or the
     /// matrices model as it is; errors name `label`.
     pub fn updatable(&self, label: &str) -> Result<Updatable<'_>, WorkflowError> {
@@ -103,10 +113,37 @@ impl AnyModel {
     }
 }
 
-/// Whether the model file at `path` declares `kind = "matrices"` (unreadable files are left to
-/// the rotor reader, whose errors name them).
+/// Largest model file read (bytes): far above any rotor or matrices model file (their matrices
+/// live in separate files), small enough that a wrong path (a disk image) is refused at once.
+pub const MAX_MODEL_FILE_BYTES: u64 = 64 << 20;
+
+/// Refuses a model file that is not a regular file (a FIFO would block every reader, a device
+/// like /dev/zero never end) or is larger than [`MAX_MODEL_FILE_BYTES`], before anything reads it.
+pub fn check_model_file(path: &Path) -> Result<(), WorkflowError> {
+    // A missing or unreadable file is left to the readers, whose messages name it.
+    let Ok(meta) = std::fs::metadata(path) else { return Ok(()) };
+    if !meta.is_file() && !meta.is_dir() {
+        return Err(input(format!(
+            "{}: not a regular file (a FIFO, socket or device would block or never end)",
+            path.display()
+        )));
+    }
+    if meta.len() > MAX_MODEL_FILE_BYTES {
+        return Err(input(format!(
+            "{}: {} MB, larger than the {} MB a model file may have",
+            path.display(),
+            meta.len() >> 20,
+            MAX_MODEL_FILE_BYTES >> 20
+        )));
+    }
+    Ok(())
+}
+
+/// Whether the model file at `path` declares `kind = "matrices"` (unreadable files, and anything
+/// [`check_model_file`] refuses, are left to the readers, whose errors name them).
 pub fn is_matrices_file(path: &Path) -> bool {
-    std::fs::read_to_string(path).is_ok_and(|text| eigenfit_matrices::is_matrices_file(&text))
+    check_model_file(path).is_ok()
+        && std::fs::read_to_string(path).is_ok_and(|text| eigenfit_matrices::is_matrices_file(&text))
 }
 
 /// Loads a matrices model; every error is bad input naming the file.

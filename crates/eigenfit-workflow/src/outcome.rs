@@ -28,6 +28,24 @@ impl Outcome {
     }
 }
 
+/// Model evaluations allowed and spent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct BudgetReport {
+    /// The limit.
+    pub limit: usize,
+    /// Spent.
+    pub used: usize,
+    /// Whether it ran out.
+    pub exhausted: bool,
+}
+
+impl BudgetReport {
+    /// What `budget` allowed and what was spent of it.
+    pub fn of(budget: &eigenfit_core::update::Budget) -> Self {
+        Self { limit: budget.limit(), used: budget.used(), exhausted: budget.exhausted() }
+    }
+}
+
 /// `fit_quality`, `chi2`, `dof`, `p_value`, `relative_rms_residual`, `disagreeing_modes`: core's
 /// [`FitQuality`](eigenfit_core::analysis::verdict::FitQuality) as every estimating report states it,
 /// flattened into it. `D` names a disagreeing mode (a mode number, or a run-up point).

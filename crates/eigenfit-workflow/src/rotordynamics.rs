@@ -17,6 +17,8 @@ use std::path::Path;
 /// The model file if it is a ROSS rotor (judged by its content: tables `ShaftElement_…`).
 pub fn ross_model(path: Option<&Path>) -> Option<&Path> {
     let path = path?;
+    // A FIFO or device is not read here (it would block): the model loader refuses it.
+    crate::model::check_model_file(path).ok()?;
     let text = std::fs::read_to_string(path).ok()?;
     ross_file::looks_like_ross(&text).then_some(path)
 }
@@ -30,6 +32,7 @@ fn to_workflow(e: RotorDynError) -> WorkflowError {
 
 /// Loads a ROSS rotor, errors naming the file.
 pub fn load(path: &Path) -> Result<Rotor, WorkflowError> {
+    crate::model::check_model_file(path)?;
     ross_file::read(path).map_err(to_workflow)
 }
 
@@ -352,7 +355,14 @@ pub fn discover(
     let r = discover_effects(&search, &search.candidates(), &vec![1.0; params.len()], &options)
         .map_err(|e| input(format!("{}: {e}", measured.display())))?;
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
-    let mut report = crate::discover::report_of(&path.display().to_string(), &r, &r.effects, 1, &names);
+    let mut report = crate::discover::report_of(
+        &path.display().to_string(),
+        &r,
+        &r.effects,
+        1,
+        &names,
+        options.max_evaluations,
+    );
     // Factors → N/m at the lowest measured speed, as `estimate` reports them.
     let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
     let nominal: Vec<f64> = params.iter().map(|p| p.nominal(&rotor, w0)).collect();

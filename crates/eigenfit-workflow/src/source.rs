@@ -55,6 +55,9 @@ impl ModelSource {
 
     /// Loads a rotor or a matrices model (`kind = "matrices"`) and a label for reports.
     pub fn load_any(&self) -> Result<(AnyModel, String), WorkflowError> {
+        if let Some(path) = &self.model {
+            model::check_model_file(path)?;
+        }
         let Some(path) = self.model.as_ref().filter(|p| model::is_matrices_file(p)) else {
             return self.load().map(|(rotor, label)| (AnyModel::Rotor(rotor), label));
         };
@@ -80,6 +83,7 @@ impl ModelSource {
             }
         }
         if let Some(path) = &self.model {
+            model::check_model_file(path)?;
             let rotor = Rotor::from_toml_file(path).map_err(|e| match e {
                 // These already name the file (and the line where it could be placed).
                 RotorError::Io { .. }

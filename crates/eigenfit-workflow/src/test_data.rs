@@ -211,7 +211,7 @@ impl<'a> Fit<'a> {
 
     /// Intervals and the residual scatter they were scaled by: the frequency fit's as the
     /// statistics module gives them (within `budget`, bounds done reported to `observers`), the
-    /// shape fit's from [`ShapeFit::uncertainty`].
+    /// shape fit's from [`ShapeFit::uncertainty_within`] (within `budget`).
     pub fn uncertainty_within(
         &mut self,
         at: &Linearisation,
@@ -223,7 +223,9 @@ impl<'a> Fit<'a> {
             Fit::Frequencies(p) => {
                 (eigenfit_core::analysis::uncertainty_observed(p, at, has_std, budget, observers), None)
             }
-            Fit::Shapes(s) => s.uncertainty(at).map_or((None, None), |(u, sc)| (Some(u), Some(sc))),
+            Fit::Shapes(s) => {
+                s.uncertainty_within(at, budget).map_or((None, None), |(u, sc)| (Some(u), Some(sc)))
+            }
         }
     }
 
@@ -374,7 +376,7 @@ pub fn updated_model_toml(
             "--write-model applies to rotor models only, not to a `kind = \"matrices\"` model",
         ));
     };
-    let updated = rotor.with_values(&full).map_err(WorkflowError::Failure)?;
+    let updated = rotor.with_values(&full).map_err(|e| WorkflowError::Failure(e.to_string()))?;
     let toml = updated.to_toml_string().map_err(failure)?;
     let mut head = format!(
         "# Updated by eigenfit estimate ({} strategy, {}) on {} from {}\n\

@@ -68,6 +68,7 @@ fn a_comparison_too_large_is_refused_before_anything_is_built() {
         std_hz: None,
         modes: None,
         max_iterations: 10,
+        budget: eigenfit_core::update::DEFAULT_EVALUATIONS,
         timing: false,
     };
     let err = compare::plan(&request, 2).unwrap_err();

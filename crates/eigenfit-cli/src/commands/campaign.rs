@@ -22,6 +22,10 @@ pub struct CampaignArgs {
     /// Iteration limit.
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) the joint fit and its intervals may spend together;
+    /// when it runs out the run ends with exit code 3 and says so (as `estimate`'s `--budget`).
+    #[arg(long, value_name = "N", default_value_t = eigenfit_core::update::DEFAULT_EVALUATIONS)]
+    pub budget: usize,
     /// Node matching, shape weight and MAC threshold.
     #[command(flatten)]
     pub shape: crate::testdata::ShapeArgs,
@@ -37,10 +41,14 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         strategy: args.strategy.clone(),
         solver: args.solver.clone(),
         max_iterations: args.max_iterations,
+        budget: args.budget,
         shape: args.shape.options(),
     };
     let report = campaign::run(&request, &mut Bars::new(args.report.quiet))?;
     crate::commands::simulate::print_notes(&report.file_notes);
+    let done = report.outcome.converged && !report.budget.exhausted;
+    let code = if done { 0 } else { EXIT_NOT_CONVERGED };
+    crate::error::set_exit_on_closed_pipe(code);
     crate::output::report(args.report.json, &report, |report| {
         println!(
             "{}: {} configurations, {} strategy, {} after {} iterations",
@@ -76,6 +84,12 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         if let Some(s) = report.scatter.filter(|_| !report.has_std) {
             println!("intervals from the residual scatter (no std in the data): sigma_hat = {s:.3e}");
         }
+        if report.budget.exhausted {
+            println!(
+                "the evaluation budget ({} model evaluations) ran out: results are incomplete; raise it with --budget",
+                report.budget.limit
+            );
+        }
     });
-    Ok(if report.outcome.converged { 0 } else { EXIT_NOT_CONVERGED })
+    Ok(code)
 }

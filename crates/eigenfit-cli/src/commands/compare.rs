@@ -1,6 +1,6 @@
 //! `eigenfit compare`: strategies × targets × a grid of initial guesses on reference data.
 
-use crate::error::CliError;
+use crate::error::{CliError, EXIT_NOT_CONVERGED, EXIT_OK};
 use crate::output::Stream;
 use crate::plot::compare_map::{CompareMaps, MapKind};
 use crate::source::ModelArgs;
@@ -46,6 +46,10 @@ pub struct CompareArgs {
     /// Iteration limit per run.
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) each run may spend on its fit and intervals; a run
+    /// that hits it ends `budget-exhausted` (counted per target and strategy in the summary).
+    #[arg(long, value_name = "N", default_value_t = eigenfit_core::update::DEFAULT_EVALUATIONS)]
+    pub budget: usize,
     /// Also print a convergence map per target and strategy (grid runs with two parameters).
     #[arg(long)]
     pub maps: bool,
@@ -78,12 +82,14 @@ fn request(args: &CompareArgs) -> CompareRequest {
         std_hz: args.std_hz,
         modes: args.modes,
         max_iterations: args.max_iterations,
+        budget: args.budget,
         timing: args.timing,
     }
 }
 
-/// Runs `compare`.
-pub fn run(args: &CompareArgs) -> Result<(), CliError> {
+/// Runs `compare`; returns the exit code (3 when a run ran out of its evaluation budget: the
+/// comparison is incomplete).
+pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
     let np = model.parameters().len();
@@ -107,6 +113,9 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
+    let cut: usize = report.summary.iter().map(|s| s.budget_exhausted).sum();
+    let code = if cut > 0 { EXIT_NOT_CONVERGED } else { EXIT_OK };
+    crate::error::set_exit_on_closed_pipe(code);
     crate::output::report(args.report.json, &report, |report| {
         println!(
             "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",
@@ -143,13 +152,20 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             );
         }
         println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged damped runs whose data also fit another solution, - where not checked)");
+        if cut > 0 {
+            println!(
+                "{cut} run(s) ran out of their evaluation budget ({} model evaluations each): their results are incomplete; raise it with --budget",
+                args.budget
+            );
+        }
         if args.maps && np == 2 {
             print_maps(&report.raw, &plan.targets, &plan.strategies);
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     });
     // A write failure ends the command non-zero after the results are printed.
-    stream.map_or(Ok(()), |w| w.finish(report.runs.len()))
+    stream.map_or(Ok(()), |w| w.finish(report.runs.len()))?;
+    Ok(code)
 }
 
 /// Writes the convergence and iteration maps; a note on stderr (and nothing written) unless the

@@ -1,6 +1,6 @@
 //! `eigenfit discover`: find where model and measurement disagree, name the missing effect, add it.
 
-use crate::error::CliError;
+use crate::error::{CliError, EXIT_NOT_CONVERGED, EXIT_OK};
 use crate::output::write_atomically;
 use crate::plot;
 use crate::plot::discovery::DiscoveryPlot;
@@ -25,6 +25,11 @@ pub struct DiscoverArgs {
     /// Relative frequency standard deviation assumed where the file gives none.
     #[arg(long, default_value_t = 1e-3)]
     pub assumed_std: f64,
+    /// Most model evaluations (eigen-solves) the data check and the whole search may spend
+    /// together; when it runs out the search stops with what it has and the run ends with exit
+    /// code 3 (as `estimate`'s `--budget`).
+    #[arg(long, value_name = "N", default_value_t = eigenfit_core::discovery::DEFAULT_EVALUATIONS)]
+    pub budget: usize,
     /// Write the augmented model (calibrated stiffnesses + the named effect) to this TOML file.
     #[arg(long, value_name = "FILE.toml")]
     pub write_model: Option<PathBuf>,
@@ -36,8 +41,8 @@ pub struct DiscoverArgs {
     pub report: crate::output::ReportArgs,
 }
 
-/// Runs `discover`.
-pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
+/// Runs `discover`; returns the exit code (3 when the budget ran out before the search ended).
+pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
     // Two-plane rotors saved by ROSS, against a run-up CSV: the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
         if args.write_model.is_some() || args.plot.is_some() {
@@ -47,7 +52,7 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
         }
         let report = eigenfit_workflow::rotordynamics::discover(path, &args.measured, args.assumed_std)?;
         crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
-        return Ok(());
+        return Ok(crate::error::EXIT_OK);
     }
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
@@ -58,11 +63,14 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
         solver.as_ref(),
         &args.measured,
         args.assumed_std,
+        args.budget,
         &mut notes,
         &mut Bars::new(args.report.quiet),
     );
     crate::commands::simulate::print_notes(&notes);
     let Discovery { found, mut report } = found?;
+    let code = if report.budget_exhausted { EXIT_NOT_CONVERGED } else { EXIT_OK };
+    crate::error::set_exit_on_closed_pipe(code);
     if let Some(path) = &args.write_model {
         let text = discover::augmented_model_toml(&found, &model)?;
         write_atomically(path, text.as_bytes())?;
@@ -80,7 +88,7 @@ pub fn run(args: &DiscoverArgs) -> Result<(), CliError> {
             println!("wrote {w}");
         }
     });
-    Ok(())
+    Ok(code)
 }
 
 fn print_report(
@@ -117,6 +125,16 @@ fn print_report(
     }
     match (found.effects.is_empty(), r.disagreement_significant) {
         (_, false) => println!("no significant disagreement: nothing added."),
+        // Cut short, the search has not shown that nothing explains the data.
+        (true, true) if r.budget_exhausted => {
+            println!("no candidate effect confirmed before the budget ran out.");
+            if let Some(best) = r.fits.iter().find(|f| f.plausible) {
+                println!(
+                    "  best partial explanation so far: {} (χ² {:.2} → {:.2})",
+                    best.label, r.chi2_before, best.chi2
+                );
+            }
+        }
         (true, true) => {
             println!(
                 "no candidate effect, alone or with others, explains the disagreement down to the noise."
@@ -174,7 +192,7 @@ fn print_report(
     }
     if r.budget_exhausted {
         println!(
-            "note: the search stopped at its budget of eigen-solves ({} spent): effects it had not reached were not tried",
+            "the evaluation budget ({} model evaluations) ran out: the search stopped with what it had, effects it had not reached were not tried; raise it with --budget",
             r.evaluations
         );
     }

@@ -88,12 +88,11 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             crate::output::report(args.report.json, &*report, crate::rotordynamics::print_estimate);
             return Ok(code);
         }
+        // No result to print: an error with exit code 3 (also through the Python package).
         EstimateOutcome::BudgetExhaustedBeforeFit { limit } => {
-            crate::error::set_exit_on_closed_pipe(EXIT_NOT_CONVERGED);
-            eprintln!(
-                "eigenfit: budget-exhausted: the budget of {limit} model evaluations ran out before the fit could start (raise it with --budget)"
-            );
-            return Ok(EXIT_NOT_CONVERGED);
+            return Err(CliError::BudgetExhausted(format!(
+                "the budget of {limit} model evaluations ran out before the fit could start (raise it with --budget)"
+            )));
         }
         EstimateOutcome::Done(est) => est,
     };
@@ -193,6 +192,21 @@ fn print_report(est: &Estimation) {
                 "equally good mirror solution ({i} ↔ {j} exchanged, a symmetric model): {}",
                 values.join(", ")
             ),
+            None if !a.exchanged.is_empty() => {
+                let cycles: Vec<String> = a
+                    .exchanged
+                    .iter()
+                    .map(|c| match c.as_slice() {
+                        [i, j] => format!("{i} ↔ {j}"),
+                        _ => format!("{} → {}", c.join(" → "), c[0]),
+                    })
+                    .collect();
+                println!(
+                    "equally good mirror solution ({} exchanged, a symmetric model): {}",
+                    cycles.join(", "),
+                    values.join(", ")
+                )
+            }
             None => println!("equally good other solution: {}", values.join(", ")),
         }
     }

@@ -1,7 +1,7 @@
 //! Campbell diagram: damped frequencies of followed modes against speed (rpm), coloured by
 //! whirl, with the 1× line and the critical speeds on it.
 
-use super::style::{self, INK};
+use super::style::{self, px, pxi, INK};
 use super::{err, DrawResult, Figure};
 use eigenfit_rotordynamics::{Campbell, Whirl};
 use plotters::coord::Shift;
@@ -35,10 +35,10 @@ impl Figure for CampbellPlot<'_> {
         let f_max = c.frequencies_hz.iter().flatten().fold(0.0f64, |m, &f| m.max(f)) * 1.08;
         let body = style::title(root, &format!("{}: Campbell diagram", self.title), 50)?;
         let mut chart = ChartBuilder::on(&body)
-            .margin(20)
-            .margin_top(5)
-            .x_label_area_size(60)
-            .y_label_area_size(90)
+            .margin(px(20))
+            .margin_top(px(5))
+            .x_label_area_size(px(60))
+            .y_label_area_size(px(90))
             .build_cartesian_2d(s0..s1, 0.0..f_max.max(1.0))
             .map_err(err)?;
         style::grid(
@@ -55,7 +55,7 @@ impl Figure for CampbellPlot<'_> {
                     (c.speeds_rpm[k - 1], c.frequencies_hz[k - 1][i0]),
                     (c.speeds_rpm[k], c.frequencies_hz[k][i1]),
                 ];
-                chart.draw_series(LineSeries::new(points, colour.stroke_width(3))).map_err(err)?;
+                chart.draw_series(LineSeries::new(points, colour.stroke_width(px(3)))).map_err(err)?;
             }
         }
         // Every computed mode as a dot, so modes that enter the N lowest mid-range show too.
@@ -64,7 +64,7 @@ impl Figure for CampbellPlot<'_> {
                 c.frequencies_hz[k]
                     .iter()
                     .zip(&c.whirl[k])
-                    .map(move |(&f, &w)| Circle::new((rpm, f), 3, whirl_colour(w).filled()))
+                    .map(move |(&f, &w)| Circle::new((rpm, f), px(3), whirl_colour(w).filled()))
             }))
             .map_err(err)?;
         for (w, name) in [(Whirl::Forward, "forward"), (Whirl::Backward, "backward"), (Whirl::Mixed, "mixed")]
@@ -74,26 +74,32 @@ impl Figure for CampbellPlot<'_> {
                 .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
                 .map_err(err)?
                 .label(format!("{name} whirl"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + pxi(24), y)], colour.stroke_width(px(3)))
+                });
         }
         chart
             .draw_series(DashedLineSeries::new(
                 vec![(s0, s0 / 60.0), (s1, s1 / 60.0)],
-                8,
-                6,
-                INK.stroke_width(2),
+                px(8),
+                px(6),
+                INK.stroke_width(px(2)),
             ))
             .map_err(err)?
             .label("1× (synchronous)")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], INK.stroke_width(2)));
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + pxi(24), y)], INK.stroke_width(px(2))));
         chart
             .draw_series(
-                c.critical_speeds.iter().map(|k| Circle::new((k.rpm, k.rpm / 60.0), 7, INK.stroke_width(2))),
+                c.critical_speeds
+                    .iter()
+                    .map(|k| Circle::new((k.rpm, k.rpm / 60.0), px(7), INK.stroke_width(px(2)))),
             )
             .map_err(err)?
             .label("critical speed")
-            .legend(|(x, y)| Circle::new((x + 12, y), 6, INK.stroke_width(2)));
+            .legend(|(x, y)| Circle::new((x + pxi(12), y), px(6), INK.stroke_width(px(2))));
         style::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         Ok(())
     }
+
+    const SUPERSAMPLE: u32 = super::SUPERSAMPLE;
 }

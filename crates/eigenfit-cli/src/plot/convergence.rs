@@ -1,11 +1,37 @@
 //! (c) Convergence history of estimates: parameters (log) and the largest frequency difference
 //! per iteration, one colour per strategy.
 
-use super::style::{self, log_bounds, log_tick, strategy_colour, Swatch, INK};
+use super::style::{self, log_bounds, log_tick, px, pxi, strategy_colour, Swatch, INK};
 use super::{err, DrawResult, Figure};
 use eigenfit_core::update::Estimate;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+
+/// A panel of the figure on `area`: iterations 0…`x_end` across (whole numbers labelled), `y`
+/// on a log axis titled `y_title`, with `x_area` pixels for the x labels.
+fn panel<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    x_area: u32,
+    x_end: f64,
+    y: std::ops::Range<f64>,
+    y_title: &str,
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, LogCoord<f64>>>, String> {
+    let mut chart = ChartBuilder::on(area)
+        .margin(px(15))
+        .margin_left(px(20))
+        .x_label_area_size(px(x_area))
+        .y_label_area_size(px(90))
+        .build_cartesian_2d(0.0..x_end, y.log_scale())
+        .map_err(err)?;
+    let whole = |v: &f64| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() };
+    style::grid(style::axes(&mut chart.configure_mesh(), "iteration", y_title), 0.4)
+        .x_label_formatter(&whole)
+        .y_label_formatter(&log_tick)
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
+}
 
 /// Smallest |Δf| drawn on the log axis (exact convergence would be −∞).
 const FLOOR_HZ: f64 = 1e-9;
@@ -67,11 +93,10 @@ impl Figure for Convergence {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let max_it = self.runs.iter().filter_map(|r| r.history.last().map(|h| h.0)).max().unwrap_or(1).max(1);
         let body = style::title(root, &self.title, 60)?;
-        let (plots, legend) = body.split_horizontally(body.dim_in_pixel().0 - LEGEND_W);
+        let (plots, legend) = body.split_horizontally(body.dim_in_pixel().0 - px(LEGEND_W));
         let split = (plots.dim_in_pixel().1 as f64 * 0.56) as u32;
         let (top, bottom) = plots.split_vertically(split);
         let x_end = max_it as f64 + 0.3;
-        let x_fmt = |v: &f64| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() };
 
         // Top: the parameters.
         let p_range = log_bounds(
@@ -81,26 +106,17 @@ impl Figure for Convergence {
                 .chain(self.target.iter().flatten().copied()),
             2.0,
         );
-        let mut chart = ChartBuilder::on(&top)
-            .margin(15)
-            .margin_left(20)
-            .x_label_area_size(45)
-            .y_label_area_size(90)
-            .build_cartesian_2d(0.0..x_end, p_range.log_scale())
-            .map_err(err)?;
-        style::grid(
-            style::axes(&mut chart.configure_mesh(), "iteration", format!("parameter [{}]", self.unit)),
-            0.4,
-        )
-        .x_label_formatter(&x_fmt)
-        .y_label_formatter(&log_tick)
-        .draw()
-        .map_err(err)?;
+        let mut chart = panel(&top, 45, x_end, p_range, &format!("parameter [{}]", self.unit))?;
         let mut entries = Vec::new();
         if let Some(t) = &self.target {
             for &v in t {
                 chart
-                    .draw_series(DashedLineSeries::new([(0.0, v), (x_end, v)], 4, 5, INK.stroke_width(1)))
+                    .draw_series(DashedLineSeries::new(
+                        [(0.0, v), (x_end, v)],
+                        px(4),
+                        px(5),
+                        INK.stroke_width(px(1)),
+                    ))
                     .map_err(err)?;
             }
             entries.push((Swatch::Guide, "target".to_string()));
@@ -110,21 +126,28 @@ impl Figure for Convergence {
             for (j, name) in self.parameter_names.iter().enumerate() {
                 let points: Vec<(f64, f64)> = run.history.iter().map(|h| (h.0 as f64, h.1[j])).collect();
                 if j == 0 {
-                    chart.draw_series(LineSeries::new(points.clone(), c.stroke_width(3))).map_err(err)?;
-                    chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(err)?;
+                    chart.draw_series(LineSeries::new(points.clone(), c.stroke_width(px(3)))).map_err(err)?;
+                    chart
+                        .draw_series(points.iter().map(|&p| Circle::new(p, px(4), c.filled())))
+                        .map_err(err)?;
                     entries.push((Swatch::Line(c), format!("{} · {name}", run.strategy)));
                 } else {
                     chart
-                        .draw_series(DashedLineSeries::new(points.clone(), 8, 5, c.stroke_width(3)))
+                        .draw_series(DashedLineSeries::new(
+                            points.clone(),
+                            px(8),
+                            px(5),
+                            c.stroke_width(px(3)),
+                        ))
                         .map_err(err)?;
                     chart
-                        .draw_series(points.iter().map(|&p| TriangleMarker::new(p, 5, c.filled())))
+                        .draw_series(points.iter().map(|&p| TriangleMarker::new(p, px(5), c.filled())))
                         .map_err(err)?;
                     entries.push((Swatch::Dashed(c), format!("{} · {name}", run.strategy)));
                 }
             }
         }
-        style::legend_column(&legend, (0, 30), &entries)?;
+        style::legend_column(&legend, (0, pxi(30)), &entries)?;
 
         // Bottom: the largest frequency difference.
         let clamped = self.runs.iter().any(|r| r.history.iter().any(|h| h.2 < FLOOR_HZ));
@@ -136,22 +159,16 @@ impl Figure for Convergence {
                 .chain(self.sigma_hz),
             3.0,
         );
-        let mut chart = ChartBuilder::on(&bottom)
-            .margin(15)
-            .margin_left(20)
-            .x_label_area_size(50)
-            .y_label_area_size(90)
-            .build_cartesian_2d(0.0..x_end, d_range.log_scale())
-            .map_err(err)?;
-        style::grid(style::axes(&mut chart.configure_mesh(), "iteration", "max |f − f_measured| [Hz]"), 0.4)
-            .x_label_formatter(&x_fmt)
-            .y_label_formatter(&log_tick)
-            .draw()
-            .map_err(err)?;
+        let mut chart = panel(&bottom, 50, x_end, d_range, "max |f − f_measured| [Hz]")?;
         let mut entries = Vec::new();
         if let Some(tol) = self.tolerance_hz {
             chart
-                .draw_series(DashedLineSeries::new([(0.0, tol), (x_end, tol)], 4, 5, INK.stroke_width(1)))
+                .draw_series(DashedLineSeries::new(
+                    [(0.0, tol), (x_end, tol)],
+                    px(4),
+                    px(5),
+                    INK.stroke_width(px(1)),
+                ))
                 .map_err(err)?;
             entries.push((Swatch::Guide, format!("paper's tolerance, {tol} Hz")));
         }
@@ -159,9 +176,9 @@ impl Figure for Convergence {
             chart
                 .draw_series(DashedLineSeries::new(
                     [(0.0, sigma), (x_end, sigma)],
-                    10,
-                    4,
-                    INK.mix(0.6).stroke_width(2),
+                    px(10),
+                    px(4),
+                    INK.mix(0.6).stroke_width(px(2)),
                 ))
                 .map_err(err)?;
             entries.push((Swatch::Guide, format!("largest measurement σ, {} Hz", log_tick(&sigma))));
@@ -170,14 +187,16 @@ impl Figure for Convergence {
             let c = strategy_colour(&run.strategy);
             let points: Vec<(f64, f64)> =
                 run.history.iter().map(|h| (h.0 as f64, h.2.max(FLOOR_HZ))).collect();
-            chart.draw_series(LineSeries::new(points.clone(), c.stroke_width(3))).map_err(err)?;
-            chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(err)?;
+            chart.draw_series(LineSeries::new(points.clone(), c.stroke_width(px(3)))).map_err(err)?;
+            chart.draw_series(points.iter().map(|&p| Circle::new(p, px(4), c.filled()))).map_err(err)?;
             entries.push((Swatch::Line(c), format!("{} ({})", run.strategy, run.outcome)));
         }
         if clamped {
             entries.push((Swatch::None, format!("(below {} Hz: drawn at {0})", log_tick(&FLOOR_HZ))));
         }
-        style::legend_column(&legend, (0, split as i32 + 30), &entries)?;
+        style::legend_column(&legend, (0, split as i32 + pxi(30)), &entries)?;
         Ok(())
     }
+
+    const SUPERSAMPLE: u32 = super::SUPERSAMPLE;
 }

@@ -1,7 +1,7 @@
 //! (a) Critical speed map: natural frequencies against support stiffness (all bearings equal),
 //! log–log, with the paper's Table 1 overlaid for the paper rotor.
 
-use super::style::{self, log_bounds, log_tick, mode_colour, INK};
+use super::style::{self, log_bounds, log_tick, mode_colour, px, pxi, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
 use eigenfit_core::eigen::EigenSolver;
@@ -100,10 +100,10 @@ impl Figure for CriticalSpeedMap {
         let body =
             style::title(root, &format!("{}: critical speed map (all supports equal)", self.title), 50)?;
         let mut chart = ChartBuilder::on(&body)
-            .margin(20)
-            .margin_top(5)
-            .x_label_area_size(60)
-            .y_label_area_size(90)
+            .margin(px(20))
+            .margin_top(px(5))
+            .x_label_area_size(px(60))
+            .y_label_area_size(px(90))
             .build_cartesian_2d(x_range.log_scale(), y_range.log_scale())
             .map_err(err)?;
         style::grid(
@@ -119,25 +119,29 @@ impl Figure for CriticalSpeedMap {
             chart
                 .draw_series(LineSeries::new(
                     self.stiffness.iter().zip(&self.frequencies).map(|(&k, f)| (k, f[m])),
-                    c.stroke_width(3),
+                    c.stroke_width(px(3)),
                 ))
                 .map_err(err)?
                 .label(format!("model, mode {}", m + 1))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + pxi(24), y)], c.stroke_width(px(3)))
+                });
         }
         if !self.reference.is_empty() {
             chart
                 .draw_series(self.reference.iter().map(|r| {
                     let c = mode_colour(r.mode);
                     EmptyElement::at((r.stiffness, r.frequency_hz))
-                        + Circle::new((0, 0), 7, INK.stroke_width(2))
-                        + Cross::new((0, 0), 4, c.stroke_width(2))
+                        + Circle::new((0, 0), px(7), INK.stroke_width(px(2)))
+                        + Cross::new((0, 0), px(4), c.stroke_width(px(2)))
                 }))
                 .map_err(err)?
                 .label(self.reference_label.clone())
-                .legend(|(x, y)| Circle::new((x + 12, y), 6, INK.stroke_width(2)));
+                .legend(|(x, y)| Circle::new((x + pxi(12), y), px(6), INK.stroke_width(px(2))));
         }
         style::legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         Ok(())
     }
+
+    const SUPERSAMPLE: u32 = super::SUPERSAMPLE;
 }

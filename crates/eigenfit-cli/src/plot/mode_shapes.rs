@@ -1,6 +1,6 @@
 //! (b) Mode shapes of the lowest modes along the shaft, disks and bearings marked.
 
-use super::style::{self, mode_colour, short_sci, INK};
+use super::style::{self, mode_colour, px, pxi, short_sci, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
 use eigenfit_core::eigen::EigenSolver;
@@ -121,10 +121,10 @@ impl Figure for ModeShapes {
         let pad = (x1 - x0) * 0.04;
         let body = style::title(root, &self.title, 50)?;
         let mut chart = ChartBuilder::on(&body)
-            .margin(20)
-            .margin_top(5)
-            .x_label_area_size(60)
-            .y_label_area_size(80)
+            .margin(px(20))
+            .margin_top(px(5))
+            .x_label_area_size(px(60))
+            .y_label_area_size(px(80))
             .build_cartesian_2d(x0 - pad..x1 + pad, -1.75..2.15)
             .map_err(err)?;
         let mut mesh = chart.configure_mesh();
@@ -142,12 +142,14 @@ impl Figure for ModeShapes {
             .map_err(err)?;
         drop(mesh);
         // The shaft axis and the nodes.
-        chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], INK.stroke_width(2))).map_err(err)?;
-        chart.draw_series(self.nodes.iter().map(|&x| Circle::new((x, 0.0), 3, INK.filled()))).map_err(err)?;
+        chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], INK.stroke_width(px(2)))).map_err(err)?;
+        chart
+            .draw_series(self.nodes.iter().map(|&x| Circle::new((x, 0.0), px(3), INK.filled())))
+            .map_err(err)?;
         // Disks: a tall bar across the shaft and the mass above.
         for d in &self.masses {
             chart
-                .draw_series(LineSeries::new([(d.x, -1.15), (d.x, 1.15)], style::GUIDE.stroke_width(1)))
+                .draw_series(LineSeries::new([(d.x, -1.15), (d.x, 1.15)], style::GUIDE.stroke_width(px(1))))
                 .map_err(err)?;
             chart
                 .draw_series([Rectangle::new(
@@ -165,7 +167,7 @@ impl Figure for ModeShapes {
         }
         // Bearings: a triangle under the shaft and the name with its stiffness below.
         for b in &self.bearings {
-            chart.draw_series([TriangleMarker::new((b.x, -1.28), 11, INK.filled())]).map_err(err)?;
+            chart.draw_series([TriangleMarker::new((b.x, -1.28), px(11), INK.filled())]).map_err(err)?;
             chart
                 .draw_series([Text::new(
                     b.label.clone(),
@@ -180,14 +182,18 @@ impl Figure for ModeShapes {
         for (k, s) in self.shapes.iter().enumerate() {
             let c = mode_colour(k);
             chart
-                .draw_series(LineSeries::new(s.curve.iter().copied(), c.stroke_width(3)))
+                .draw_series(LineSeries::new(s.curve.iter().copied(), c.stroke_width(px(3))))
                 .map_err(err)?
                 .label(format!("mode {}: {} Hz", k + 1, format_hz(s.frequency_hz)))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + pxi(24), y)], c.stroke_width(px(3)))
+                });
         }
         style::legend(&mut chart, SeriesLabelPosition::UpperMiddle)?;
         Ok(())
     }
+
+    const SUPERSAMPLE: u32 = super::SUPERSAMPLE;
 }
 
 /// A frequency with four significant digits or more.

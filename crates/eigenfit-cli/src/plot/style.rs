@@ -6,6 +6,7 @@ use plotters::coord::CoordTranslate;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, RGBColor};
+use std::cell::Cell;
 use std::ops::Range;
 use std::sync::Once;
 
@@ -26,6 +27,31 @@ pub fn register_font() {
     });
 }
 
+thread_local! {
+    /// Drawn pixels per pixel of the finished figure: > 1 while a supersampled PNG is drawn.
+    static SCALE: Cell<u32> = const { Cell::new(1) };
+}
+
+/// `n` pixels of the finished figure, in the pixels being drawn. A figure drawn supersampled
+/// ([`super::Figure::SUPERSAMPLE`]) gives every size, margin and offset through this, so that it
+/// looks the same at any scale.
+pub fn px(n: u32) -> u32 {
+    n * SCALE.with(Cell::get)
+}
+
+/// [`px`] for signed offsets.
+pub fn pxi(n: i32) -> i32 {
+    n * SCALE.with(Cell::get) as i32
+}
+
+/// Runs `draw` with [`px`] scaling by `scale`, restoring the previous scale afterwards.
+pub(super) fn scaled<R>(scale: u32, draw: impl FnOnce() -> R) -> R {
+    let old = SCALE.with(|s| s.replace(scale.max(1)));
+    let out = draw();
+    SCALE.with(|s| s.set(old));
+    out
+}
+
 /// Figure title size (px).
 pub const TITLE: u32 = 24;
 /// Panel caption size (px).
@@ -39,7 +65,7 @@ pub const LEGEND: u32 = 15;
 
 /// The font at `size` px.
 pub fn font(size: u32) -> FontDesc<'static> {
-    (FAMILY, size).into_font()
+    (FAMILY, px(size)).into_font()
 }
 
 /// The font at `size` px in `colour`.
@@ -233,34 +259,37 @@ fn swatch<DB: DrawingBackend>(
     swatch: &Swatch,
 ) -> Result<i32, String> {
     let e = super::err;
-    let mid = y + 10;
+    let p = pxi;
+    let mid = y + p(10);
     match swatch {
         Swatch::Box(c) => {
-            area.draw(&Rectangle::new([(x, y + 3), (x + 16, y + 17)], c.filled())).map_err(e)?;
-            area.draw(&Rectangle::new([(x, y + 3), (x + 16, y + 17)], GUIDE.stroke_width(1))).map_err(e)?;
-            Ok(24)
+            area.draw(&Rectangle::new([(x, y + p(3)), (x + p(16), y + p(17))], c.filled())).map_err(e)?;
+            area.draw(&Rectangle::new([(x, y + p(3)), (x + p(16), y + p(17))], GUIDE.stroke_width(px(1))))
+                .map_err(e)?;
+            Ok(p(24))
         }
         Swatch::Line(c) => {
-            area.draw(&PathElement::new(vec![(x, mid), (x + 26, mid)], c.stroke_width(3))).map_err(e)?;
-            Ok(34)
+            area.draw(&PathElement::new(vec![(x, mid), (x + p(26), mid)], c.stroke_width(px(3))))
+                .map_err(e)?;
+            Ok(p(34))
         }
         Swatch::Dashed(c) => {
             for (a, b) in [(0, 8), (13, 26)] {
-                area.draw(&PathElement::new(vec![(x + a, mid), (x + b, mid)], c.stroke_width(3)))
+                area.draw(&PathElement::new(vec![(x + p(a), mid), (x + p(b), mid)], c.stroke_width(px(3))))
                     .map_err(e)?;
             }
-            Ok(34)
+            Ok(p(34))
         }
         Swatch::Guide => {
             for (a, b) in [(0, 4), (9, 13), (18, 22)] {
-                area.draw(&PathElement::new(vec![(x + a, mid), (x + b, mid)], INK.stroke_width(1)))
+                area.draw(&PathElement::new(vec![(x + p(a), mid), (x + p(b), mid)], INK.stroke_width(px(1))))
                     .map_err(e)?;
             }
-            Ok(34)
+            Ok(p(34))
         }
         Swatch::Target => {
-            area.draw(&Cross::new((x + 8, mid), 6, INK.stroke_width(3))).map_err(e)?;
-            Ok(24)
+            area.draw(&Cross::new((x + p(8), mid), p(6), INK.stroke_width(px(3)))).map_err(e)?;
+            Ok(p(24))
         }
         Swatch::None => Ok(0),
     }
@@ -275,9 +304,9 @@ pub fn legend_row<DB: DrawingBackend>(
     let style = text(LEGEND, INK);
     for (sw, label) in entries {
         x += swatch(area, (x, y), sw)?;
-        area.draw(&Text::new(label.clone(), (x, y + 2), style.clone())).map_err(super::err)?;
+        area.draw(&Text::new(label.clone(), (x, y + pxi(2)), style.clone())).map_err(super::err)?;
         let (w, _) = area.estimate_text_size(label, &style).map_err(super::err)?;
-        x += w as i32 + 26;
+        x += w as i32 + pxi(26);
     }
     Ok(x)
 }
@@ -291,8 +320,8 @@ pub fn legend_column<DB: DrawingBackend>(
     let style = text(LEGEND, INK);
     for (sw, label) in entries {
         let w = swatch(area, (x, y), sw)?;
-        area.draw(&Text::new(label.clone(), (x + w, y + 2), style.clone())).map_err(super::err)?;
-        y += 26;
+        area.draw(&Text::new(label.clone(), (x + w, y + pxi(2)), style.clone())).map_err(super::err)?;
+        y += pxi(26);
     }
     Ok(y)
 }
@@ -303,11 +332,11 @@ pub fn title<DB: DrawingBackend>(
     title: &str,
     height: u32,
 ) -> Result<DrawingArea<DB, plotters::coord::Shift>, String> {
-    let (head, rest) = area.split_vertically(height);
+    let (head, rest) = area.split_vertically(px(height));
     let (w, _) = head.dim_in_pixel();
     head.draw(&Text::new(
         title.to_string(),
-        (w as i32 / 2, 30),
+        (w as i32 / 2, pxi(30)),
         text(TITLE, INK).pos(Pos::new(HPos::Center, VPos::Center)),
     ))
     .map_err(super::err)?;
@@ -321,7 +350,12 @@ pub fn axes<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
     x: impl Into<String>,
     y: impl Into<String>,
 ) -> &'m mut MeshStyle<'a, 'b, X, Y, DB> {
-    mesh.x_desc(x).y_desc(y).axis_desc_style(font(AXIS)).label_style(font(TICK))
+    mesh.x_desc(x)
+        .y_desc(y)
+        .axis_desc_style(font(AXIS))
+        .label_style(font(TICK))
+        .axis_style(BLACK.stroke_width(px(1)))
+        .set_all_tick_mark_size(px(5))
 }
 
 /// Minor grid lines in the light grey at `minor_alpha`, major ones in the light grey.
@@ -329,7 +363,8 @@ pub fn grid<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
     mesh: &'m mut MeshStyle<'a, 'b, X, Y, DB>,
     minor_alpha: f64,
 ) -> &'m mut MeshStyle<'a, 'b, X, Y, DB> {
-    mesh.light_line_style(LIGHT.mix(minor_alpha)).bold_line_style(LIGHT)
+    mesh.light_line_style(LIGHT.mix(minor_alpha).stroke_width(px(1)))
+        .bold_line_style(LIGHT.stroke_width(px(1)))
 }
 
 /// Draws the series legend at `position` in the shared look (legend font, a light box).
@@ -342,8 +377,9 @@ pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .position(position)
         .label_font(font(LEGEND))
         .background_style(WHITE.mix(0.9))
-        .border_style(GUIDE)
-        .margin(12)
+        .border_style(GUIDE.stroke_width(px(1)))
+        .margin(px(12))
+        .legend_area_size(px(30))
         .draw()
         .map_err(super::err)
 }

@@ -27,3 +27,23 @@ pub fn paper_estimate<'a>(
     args.extend_from_slice(more);
     args
 }
+
+/// A fresh folder under the system's temporary folder, removed with everything in it when the
+/// value is dropped (also when the test fails).
+pub fn scratch() -> tempfile::TempDir {
+    tempfile::Builder::new().prefix("eigenfit-test-").tempdir().expect("a temporary folder")
+}
+
+/// Writes `text` to `name` in `dir`; returns the file's path.
+pub fn write_in(dir: &tempfile::TempDir, name: &str, text: &str) -> std::path::PathBuf {
+    let path = dir.path().join(name);
+    std::fs::write(&path, text).expect("a file in the temporary folder");
+    path
+}
+
+/// `estimate --model MODEL --measured MEASURED`, then `more`.
+pub fn estimate_with<'a>(model: &'a str, measured: &'a str, more: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["estimate", "--model", model, "--measured", measured];
+    args.extend_from_slice(more);
+    args
+}

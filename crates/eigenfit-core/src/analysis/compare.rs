@@ -1,15 +1,17 @@
 //! Strategy comparison: targets × initial guesses × strategies on reference data synthesised
 //! from the model itself (the paper's Tables 2–5 and convergence maps).
 
-use crate::analysis::{alternatives_among, local_solutions, uncertainty, Identifiability};
+use crate::analysis::{alternatives_among, local_solutions, uncertainty_within, Identifiability};
 use crate::eigen::EigenSolver;
+use crate::measurement::synthetic::SynthesisError;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::problem::{Linearisation, Objective, Problem};
-use crate::update::{Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
+use crate::update::{Budget, Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
+use thiserror::Error;
 
 /// Local fits tried when looking for other solutions of a damped run.
 const ALTERNATIVE_STARTS: usize = 6;
@@ -26,6 +28,9 @@ pub struct CompareSettings {
     pub std_hz: Option<f64>,
     /// Iteration limit per run.
     pub max_iterations: usize,
+    /// Most model evaluations (eigen-solves) one run may spend on its fit and, for a damped run,
+    /// its intervals ([`Budget`]); a run that hits it ends `budget-exhausted`.
+    pub budget: usize,
 }
 
 /// One run of the comparison. Serialises as the `compare` report's run (the fields a report
@@ -61,6 +66,22 @@ pub struct CompareRun {
     /// empty, the data cannot choose between them and the estimate.
     #[serde(skip)]
     pub alternatives: Vec<Vec<f64>>,
+    /// True when the run's budget ([`CompareSettings::budget`]) ran out: its fit or its
+    /// identifiability flags are incomplete. Written only when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub budget_exhausted: bool,
+}
+
+/// Why a comparison grid could not be run.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum CompareError {
+    /// The reference data of a target could not be computed.
+    #[error(transparent)]
+    Reference(#[from] SynthesisError),
+    /// A worker thread panicked (a bug; the other runs are lost with it).
+    #[error("a comparison run panicked")]
+    RunPanicked,
 }
 
 /// Reference data: the lowest `modes` frequencies of `model` at `target`, optionally rounded.
@@ -69,13 +90,12 @@ pub fn reference_measurement<M, S>(
     solver: &S,
     target: &[f64],
     settings: &CompareSettings,
-) -> Result<Measurement, String>
+) -> Result<Measurement, SynthesisError>
 where
     M: StructuralModel + ?Sized,
     S: EigenSolver + ?Sized,
 {
-    let system = model.assemble(target).map_err(|e| e.to_string())?;
-    let modes = solver.lowest(&system, settings.modes).map_err(|e| e.to_string())?;
+    let modes = solver.lowest(&model.assemble(target)?, settings.modes)?;
     let round = |f: f64| match settings.decimals {
         Some(d) => (f * 10f64.powi(d)).round() / 10f64.powi(d),
         None => f,
@@ -86,7 +106,7 @@ where
         .enumerate()
         .map(|(k, f)| MeasuredMode { mode: k, frequency_hz: round(f), std_hz: settings.std_hz, shape: None })
         .collect();
-    Measurement::new(measured).map_err(|e| e.to_string())
+    Ok(Measurement::new(measured)?)
 }
 
 /// What every damped run on the same reference data shares, computed once: the coarse grid of
@@ -143,14 +163,15 @@ where
         }
         _ => strategy.build(),
     };
+    let budget = Budget::new(settings.budget);
     let outcome =
-        Driver { max_iterations: settings.max_iterations }.run(problem, s.as_mut(), initial, &mut []);
+        Driver { max_iterations: settings.max_iterations }.run_within(problem, s.as_mut(), initial, &budget);
     let seconds = start.elapsed().as_secs_f64();
     match outcome {
         Ok(est) => {
             let converged = est.termination.is_converged();
             let identifiability = (converged && strategy == StrategyKind::LevenbergMarquardt)
-                .then(|| uncertainty(problem, &est.last, problem.measured.has_std()))
+                .then(|| uncertainty_within(problem, &est.last, problem.measured.has_std(), &budget))
                 .flatten()
                 .map(|u| u.identifiability);
             let alternatives = if converged && strategy == StrategyKind::LevenbergMarquardt {
@@ -171,6 +192,7 @@ where
                 estimate: est.parameters,
                 seconds,
                 identifiability,
+                budget_exhausted: budget.exhausted(),
             }
         }
         Err(e) => CompareRun {
@@ -186,6 +208,7 @@ where
             seconds,
             identifiability: None,
             alternatives: Vec::new(),
+            budget_exhausted: budget.exhausted(),
         },
     }
 }
@@ -202,7 +225,7 @@ pub fn run_grid<M, S>(
     strategies: &[StrategyKind],
     settings: &CompareSettings,
     mut on_run: impl FnMut(&CompareRun),
-) -> Result<Vec<CompareRun>, String>
+) -> Result<Vec<CompareRun>, CompareError>
 where
     M: StructuralModel + Sync,
     S: EigenSolver + Sync,
@@ -212,7 +235,7 @@ where
         .map(|target| {
             Ok(Problem::new(model, solver, reference_measurement(model, solver, target, settings)?))
         })
-        .collect::<Result<Vec<_>, String>>()?;
+        .collect::<Result<Vec<_>, CompareError>>()?;
     let shared: Vec<SharedData> = problems.iter().map(|p| SharedData::for_runs(p, strategies)).collect();
     let cases: Vec<(usize, &Vec<f64>, StrategyKind)> = (0..targets.len())
         .flat_map(|t| initials.iter().flat_map(move |i| strategies.iter().map(move |&s| (t, i, s))))
@@ -233,7 +256,7 @@ where
         for run in receiver {
             on_run(&run);
         }
-        worker.join().map_err(|_| "a comparison run panicked".to_string())
+        worker.join().map_err(|_| CompareError::RunPanicked)
     })
 }
 
@@ -246,7 +269,7 @@ pub fn run_grid_serial<M, S>(
     strategies: &[StrategyKind],
     settings: &CompareSettings,
     mut on_run: impl FnMut(&CompareRun),
-) -> Result<Vec<CompareRun>, String>
+) -> Result<Vec<CompareRun>, CompareError>
 where
     M: StructuralModel,
     S: EigenSolver,
@@ -310,8 +333,13 @@ mod tests {
         let targets = vec![vec![3e4, 1e4, 2e4], vec![1e3, 5e4, 1e4]];
         let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
         let strategies = StrategyKind::ALL;
-        let settings =
-            CompareSettings { modes: 3, decimals: Some(3), std_hz: Some(0.01), max_iterations: 100 };
+        let settings = CompareSettings {
+            modes: 3,
+            decimals: Some(3),
+            std_hz: Some(0.01),
+            max_iterations: 100,
+            budget: crate::update::DEFAULT_EVALUATIONS,
+        };
         let mut seen = 0;
         let par = run_grid(&chain, &DenseSolver, &targets, &initials, &strategies, &settings, |_| seen += 1)
             .unwrap();

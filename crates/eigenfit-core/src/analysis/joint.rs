@@ -3,12 +3,31 @@
 //! every run); one that appears in one configuration only (a bearing changed for that run) is
 //! estimated from that configuration's data alone. Rows are stacked as in [`crate::problem::multi`].
 
-use crate::analysis::statistics::scatter_uncertainty;
+use crate::analysis::statistics::{scatter_uncertainty, UNCERTAINTY_EVALUATIONS};
 use crate::analysis::Uncertainty;
-use crate::model::{Parameter, ParameterSet};
+use crate::model::{Parameter, ParameterError, ParameterSet};
 use crate::problem::multi::stack;
 use crate::problem::{Linearisation, Objective, ResidualError};
+use crate::update::Budget;
 use nalgebra::DMatrix;
+use thiserror::Error;
+
+/// Why configurations cannot be joined.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum JointError {
+    /// A shared parameter's unit, bounds or scale differ from the first configuration's.
+    #[error("configuration {configuration}: parameter `{name}` differs from the first configuration's (unit, bounds or scale)")]
+    ParameterDiffers {
+        /// The configuration (0-based) where it differs.
+        configuration: usize,
+        /// The parameter's name.
+        name: String,
+    },
+    /// The joint parameter list is invalid (e.g. empty).
+    #[error(transparent)]
+    Parameters(#[from] ParameterError),
+}
 
 /// Several configurations' objectives over the union of their parameters.
 pub struct Joint<'a> {
@@ -23,7 +42,7 @@ pub struct Joint<'a> {
 impl<'a> Joint<'a> {
     /// Joins `parts`; a shared name must have the same unit, bounds and scale everywhere (its
     /// nominal value is the first configuration's).
-    pub fn new(parts: Vec<&'a dyn Objective>) -> Result<Self, String> {
+    pub fn new(parts: Vec<&'a dyn Objective>) -> Result<Self, JointError> {
         let mut all: Vec<Parameter> = Vec::new();
         let mut maps = Vec::with_capacity(parts.len());
         for (k, part) in parts.iter().enumerate() {
@@ -35,10 +54,10 @@ impl<'a> Joint<'a> {
                         if (a.unit.as_str(), a.lower, a.upper, a.scale)
                             != (q.unit.as_str(), q.lower, q.upper, q.scale)
                         {
-                            return Err(format!(
-                                "configuration {k}: parameter `{}` differs from the first configuration's (unit, bounds or scale)",
-                                q.name
-                            ));
+                            return Err(JointError::ParameterDiffers {
+                                configuration: k,
+                                name: q.name.clone(),
+                            });
                         }
                         map.push(i);
                     }
@@ -50,7 +69,7 @@ impl<'a> Joint<'a> {
             }
             maps.push(map);
         }
-        let parameters = ParameterSet::new(all).map_err(|e| e.to_string())?;
+        let parameters = ParameterSet::new(all)?;
         Ok(Self { parts, maps, parameters, scale: 1.0 })
     }
 
@@ -77,7 +96,18 @@ impl<'a> Joint<'a> {
     /// 95 % intervals at `at`: from the weights when `has_std`, else from the residual scatter
     /// σ̂ = √(‖r‖²/dof) as in [`ShapeFit::uncertainty`](super::ShapeFit::uncertainty).
     pub fn uncertainty(&mut self, at: &Linearisation, has_std: bool) -> Option<(Uncertainty, f64)> {
-        scatter_uncertainty(self, |joint| &mut joint.scale, at, has_std)
+        self.uncertainty_within(at, has_std, &Budget::new(UNCERTAINTY_EVALUATIONS))
+    }
+
+    /// [`Joint::uncertainty`] charging every profile refit to `budget` (shared with the fit, so
+    /// one limit bounds the whole campaign).
+    pub fn uncertainty_within(
+        &mut self,
+        at: &Linearisation,
+        has_std: bool,
+        budget: &Budget,
+    ) -> Option<(Uncertainty, f64)> {
+        scatter_uncertainty(self, |joint| &mut joint.scale, at, has_std, budget)
     }
 }
 

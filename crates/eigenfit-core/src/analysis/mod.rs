@@ -14,10 +14,10 @@ pub(crate) mod statistics;
 pub mod verdict;
 
 pub use chi2::chi2_upper_tail;
-pub use joint::Joint;
+pub use joint::{Joint, JointError};
 pub use shape_fit::{ShapeFit, DEFAULT_FREQUENCY_STD_REL, DEFAULT_SHAPE_STD};
 pub use statistics::{
     alternative_solutions, alternative_solutions_within, alternatives_among, local_solutions,
-    mirror_solutions, uncertainty, uncertainty_observed, uncertainty_within, Identifiability, Uncertainty,
-    UNCERTAINTY_EVALUATIONS,
+    mirror_solutions, permuted_solutions, uncertainty, uncertainty_observed, uncertainty_within,
+    Identifiability, Uncertainty, UNCERTAINTY_EVALUATIONS,
 };

@@ -155,11 +155,12 @@ where
     let seed = trial_seed(settings.seed, index);
     let outcome = (|| {
         let mut noise = NoiseRng(seed);
-        let data = synthesise(model, solver, truth, settings.modes, settings.relative_std, Some(&mut noise))?;
+        let data = synthesise(model, solver, truth, settings.modes, settings.relative_std, Some(&mut noise))
+            .map_err(|e| e.to_string())?;
         let problem = Problem::new(model, solver, data);
         let driver = Driver { max_iterations: settings.max_iterations };
         let est = driver
-            .run(&problem, &mut LevenbergMarquardt::default(), &settings.initial, &mut [])
+            .run(&problem, &mut LevenbergMarquardt::default(), &settings.initial)
             .map_err(|e| e.to_string())?;
         let intervals = uncertainty(&problem, &est.last, true).map(|u| u.intervals);
         Ok(TrialEstimate {

@@ -10,7 +10,7 @@
 use crate::eigen::EigenSolver;
 use crate::model::{ParameterSet, StructuralModel};
 use crate::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
-use crate::sensitivity::{eigenvector_derivative_nelson, SensitivityError};
+use crate::sensitivity::{eigenvector_derivatives_nelson, SensitivityError};
 use nalgebra::{DMatrix, DVector};
 
 /// Default standard deviation of a unit-length measured shape's entries.
@@ -62,8 +62,19 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     /// only set how frequencies and shapes count against each other; `None` when there are no
     /// more rows than parameters. Returns the intervals and σ̂ (1 with given std).
     pub fn uncertainty(&mut self, at: &Linearisation) -> Option<(crate::analysis::Uncertainty, f64)> {
+        let budget = crate::update::Budget::new(crate::analysis::statistics::UNCERTAINTY_EVALUATIONS);
+        self.uncertainty_within(at, &budget)
+    }
+
+    /// [`ShapeFit::uncertainty`] charging every profile refit to `budget` (shared with the fit,
+    /// so one limit bounds the whole task).
+    pub fn uncertainty_within(
+        &mut self,
+        at: &Linearisation,
+        budget: &crate::update::Budget,
+    ) -> Option<(crate::analysis::Uncertainty, f64)> {
         let has_std = self.problem.measured.has_std();
-        crate::analysis::statistics::scatter_uncertainty(self, |fit| &mut fit.scale, at, has_std)
+        crate::analysis::statistics::scatter_uncertainty(self, |fit| &mut fit.scale, at, has_std, budget)
     }
 
     /// Modes solved: as many as MAC pairing considers.
@@ -119,8 +130,10 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
             let ud = &d * (sign / dn);
             let row0 = m + j * ns;
             residual.rows_mut(row0, ns).copy_from(&((ud - &u) * ws));
-            for (i, der) in derivatives.iter().enumerate() {
-                let dphi = eigenvector_derivative_nelson(&system, &modes, k, der)?;
+            // One factorisation of K − λₖM for every parameter.
+            for (i, dphi) in
+                eigenvector_derivatives_nelson(&system, &modes, k, &derivatives)?.iter().enumerate()
+            {
                 let ds = DVector::from_iterator(ns, sensor_dofs.iter().map(|&dof| dphi[dof]));
                 let du = (&ds - &u * u.dot(&ds)) / sn;
                 jacobian.view_mut((row0, i), (ns, 1)).copy_from(&(du * ws));

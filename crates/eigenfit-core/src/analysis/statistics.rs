@@ -2,7 +2,7 @@
 //! parameters the data cannot determine (with the one-sided bound they do support).
 
 use crate::problem::{Linearisation, Objective};
-use crate::update::{Budget, Driver, LevenbergMarquardt, Observer};
+use crate::update::{Budget, Driver, LevenbergMarquardt, LevenbergMarquardtSettings, Observer};
 use nalgebra::DMatrix;
 
 /// χ² quantile of one degree of freedom at 95%: the profile-likelihood threshold.
@@ -82,17 +82,18 @@ pub fn uncertainty_within(
 
 /// 95 % intervals at `at`: from the weights when `has_std`; without, from the residual scatter:
 /// every row is divided by σ̂ = √(‖r‖²/dof) (through `scale`, the objective's row divisor), the
-/// usual regression estimate. `None` when there are no more rows than parameters. Returns the
-/// intervals and σ̂ (1 with given std). Shared by [`ShapeFit`](super::ShapeFit) and
+/// usual regression estimate. `None` when there are no more rows than parameters. Profile refits
+/// are charged to `budget`. Returns the intervals and σ̂ (1 with given std). Shared by [`ShapeFit`](super::ShapeFit) and
 /// [`Joint`](super::Joint).
 pub(crate) fn scatter_uncertainty<P: Objective>(
     problem: &mut P,
     scale: fn(&mut P) -> &mut f64,
     at: &Linearisation,
     has_std: bool,
+    budget: &Budget,
 ) -> Option<(Uncertainty, f64)> {
     if has_std {
-        return uncertainty(problem, at, true).map(|u| (u, 1.0));
+        return uncertainty_within(problem, at, true, budget).map(|u| (u, 1.0));
     }
     let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
     let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
@@ -104,7 +105,7 @@ pub(crate) fn scatter_uncertainty<P: Objective>(
     let result = problem
         .linearise(&at.parameters)
         .ok()
-        .and_then(|lin| uncertainty(problem, &lin, true))
+        .and_then(|lin| uncertainty_within(problem, &lin, true, budget))
         .map(|u| (u, scatter));
     *scale(problem) = old;
     result
@@ -234,7 +235,6 @@ impl Profile<'_> {
             self.problem,
             &mut local,
             &p,
-            &mut [],
             self.budget,
         );
         if self.budget.exhausted() {
@@ -342,7 +342,7 @@ pub fn local_solutions(problem: &dyn Objective, starts: usize) -> Vec<Linearisat
         .take(starts)
         .filter_map(|seed| {
             let mut local = LevenbergMarquardt::default().with_max_restarts(0);
-            let est = (Driver { max_iterations: 100 }).run(problem, &mut local, &seed, &mut []).ok()?;
+            let est = (Driver { max_iterations: 100 }).run(problem, &mut local, &seed).ok()?;
             est.termination.is_converged().then_some(est.last)
         })
         .collect()
@@ -388,23 +388,47 @@ pub fn mirror_solutions(
     budget: &Budget,
 ) -> Vec<(usize, usize, Vec<f64>)> {
     let params = problem.parameters().as_slice();
-    let budgeted = budget.wrap(problem);
-    let mut found = Vec::new();
+    let mut pairs = Vec::new();
     for i in 0..params.len() {
         for j in i + 1..params.len() {
             let (a, b) = (&params[i], &params[j]);
-            if a.unit != b.unit || a.scale != b.scale || a.lower != b.lower || a.upper != b.upper {
-                continue;
+            if a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper {
+                let mut swap: Vec<usize> = (0..params.len()).collect();
+                swap.swap(i, j);
+                pairs.push((i, j, swap));
             }
-            let mut p = at.parameters.clone();
-            p.swap(i, j);
-            if scaled_distance(problem, &p, &at.parameters) <= MIRROR_DISTANCE {
-                continue; // (nearly) equal values: the exchange is the same point, not another solution
-            }
-            if let Ok(lin) = budgeted.linearise(&p) {
-                if fits_as_well(at, &lin) {
-                    found.push((i, j, p));
-                }
+        }
+    }
+    let swaps: Vec<Vec<usize>> = pairs.iter().map(|(_, _, s)| s.clone()).collect();
+    permuted_solutions(problem, at, &swaps, budget)
+        .into_iter()
+        .map(|(k, p)| (pairs[k].0, pairs[k].1, p))
+        .collect()
+}
+
+/// The solutions a model's symmetries give: for each permutation π of `permutations` (parameter
+/// i's value moves to π\[i\]; e.g. a structure's mirror exchanging two pairs of zones at once)
+/// whose permuted vector differs from `at` and fits the data as well, its index and the vector.
+/// Costs one evaluation per permutation, charged to `budget`.
+pub fn permuted_solutions(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    permutations: &[Vec<usize>],
+    budget: &Budget,
+) -> Vec<(usize, Vec<f64>)> {
+    let budgeted = budget.wrap(problem);
+    let mut found = Vec::new();
+    for (k, perm) in permutations.iter().enumerate() {
+        let mut p = at.parameters.clone();
+        for (i, &j) in perm.iter().enumerate() {
+            p[j] = at.parameters[i];
+        }
+        if scaled_distance(problem, &p, &at.parameters) <= MIRROR_DISTANCE {
+            continue; // (nearly) equal values: the exchange is the same point, not another solution
+        }
+        if let Ok(lin) = budgeted.linearise(&p) {
+            if fits_as_well(at, &lin) {
+                found.push((k, p));
             }
         }
     }
@@ -427,7 +451,7 @@ fn scaled_distance(problem: &dyn Objective, a: &[f64], b: &[f64]) -> f64 {
 /// `lin` fits as well as `at`: an exact fit (to the damped strategy's tolerance, or ten times
 /// `at`'s misfit), or with std within the 95% χ² threshold of one degree of freedom.
 fn fits_as_well(at: &Linearisation, lin: &Linearisation) -> bool {
-    let tol = LevenbergMarquardt::default().residual_tolerance;
+    let tol = LevenbergMarquardtSettings::default().residual_tolerance;
     // Equal frequencies are an equal fit only when frequencies are the whole residual: with
     // shape rows (testdata::shapes) a mirror matches every frequency and still misfits.
     let frequencies_only = lin.residual.len() == lin.frequencies_hz.len();

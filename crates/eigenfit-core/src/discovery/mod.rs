@@ -32,6 +32,10 @@ pub enum DiscoveryError {
     /// The base calibration failed.
     #[error("calibrating the nominal parameters failed: {0}")]
     Calibration(String),
+    /// The evaluation budget ([`DiscoveryOptions::max_evaluations`]) ran out before the
+    /// calibration finished: there is no misfit to judge yet.
+    #[error("the budget of {0} model evaluations ran out before the calibration finished")]
+    BudgetExhausted(usize),
 }
 
 /// Settings of the workflow.
@@ -112,10 +116,10 @@ impl ModeComparison {
     }
 }
 
-/// A refitted candidate. Serialises as a `discover` report's candidate (what, where, value,
-/// interval, χ², AICc, plausibility).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Fit {
+/// What an effect is and where: the part of a refitted candidate, an alternative and a named
+/// effect that identifies it (serialised flat into each).
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+pub struct Place {
     /// The candidate's label, `kind@location`.
     #[serde(skip)]
     pub label: String,
@@ -123,18 +127,69 @@ pub struct Fit {
     pub kind: String,
     /// Location.
     pub location: Option<usize>,
-    /// Fitted value (`None` for a switch).
-    pub value: Option<f64>,
-    /// Unit of the value.
-    pub unit: String,
-    /// 95% interval of the value.
-    pub interval: Option<[f64; 2]>,
     /// Position along the structure (m), for an effect placed by coordinate.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub position_m: Option<f64>,
     /// First and last element, for an effect over a run of elements.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
+    /// For a taper over `elements`, the element where the value applies in full (the change
+    /// falls linearly to nothing at the run's other end).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub taper_to: Option<usize>,
+}
+
+impl Place {
+    /// An effect of `kind` placed so, labelled as a candidate would be.
+    pub fn new(
+        kind: &str,
+        location: Option<usize>,
+        position_m: Option<f64>,
+        elements: Option<[usize; 2]>,
+    ) -> Self {
+        let label = crate::model::candidate::label_of(kind, location, position_m, elements, None);
+        Self { label, kind: kind.to_string(), location, position_m, elements, taper_to: None }
+    }
+
+    /// The same place as a taper whose value applies in full at element `e` (`None`: uniform).
+    pub fn tapered_to(self, e: Option<usize>) -> Self {
+        let label =
+            crate::model::candidate::label_of(&self.kind, self.location, self.position_m, self.elements, e);
+        Self { label, taper_to: e, ..self }
+    }
+
+    /// The place of candidate `c`.
+    pub fn of(c: &Candidate) -> Self {
+        Self::new(&c.kind, c.location, c.position_m, c.elements).tapered_to(c.taper_to)
+    }
+}
+
+/// Reads through to the place (`fit.kind`, `effect.location`): what every report reads first.
+macro_rules! reads_place {
+    ($($t:ty),*) => {$(
+        impl std::ops::Deref for $t {
+            type Target = Place;
+            fn deref(&self) -> &Place {
+                &self.place
+            }
+        }
+    )*};
+}
+reads_place!(Fit, Alternative, NamedEffect);
+
+/// A refitted candidate. Serialises as a `discover` report's candidate (what, where, value,
+/// interval, χ², AICc, plausibility).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Fit {
+    /// What was fitted and where.
+    #[serde(flatten)]
+    pub place: Place,
+    /// Fitted value (`None` for a switch).
+    pub value: Option<f64>,
+    /// Unit of the value.
+    pub unit: String,
+    /// 95% interval of the value.
+    pub interval: Option<[f64; 2]>,
     /// All fitted parameters: the base's, then the values of every effect in the fit.
     #[serde(skip)]
     pub parameters: Vec<f64>,
@@ -145,6 +200,9 @@ pub struct Fit {
     pub chi2: f64,
     /// AICc of the fit.
     pub aicc: f64,
+    /// What choosing its effects' places cost: 2·ln m per effect whose kind the search tried at
+    /// m places (see [`place_charges`]). Selection ranks by `aicc + place_charge`.
+    pub place_charge: f64,
     /// Is the value physically plausible (and, for a value, its interval clear of zero)?
     pub plausible: bool,
     /// Model frequencies of the measured modes, Hz.
@@ -153,21 +211,23 @@ pub struct Fit {
 }
 
 impl Fit {
+    /// What selection ranks by: AICc plus the charge for the places chosen.
+    pub fn score(&self) -> f64 {
+        self.aicc + self.place_charge
+    }
+
     /// The calibrated base model as a "fit" with no effect.
     fn base(lin: &Linearisation, aicc: f64) -> Self {
         Self {
-            label: String::new(),
-            kind: String::new(),
-            location: None,
+            place: Place::default(),
             value: None,
             unit: String::new(),
             interval: None,
-            position_m: None,
-            elements: None,
             parameters: lin.parameters.clone(),
             intervals: vec![None; lin.parameters.len()],
             chi2: 2.0 * lin.cost(),
             aicc,
+            place_charge: 0.0,
             plausible: true,
             frequencies_hz: lin.frequencies_hz.clone(),
         }
@@ -177,38 +237,24 @@ impl Fit {
 /// An alternative that explains the data about as well as a named effect.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Alternative {
-    /// `kind@location`.
-    #[serde(skip)]
-    pub label: String,
-    /// Kind.
-    pub kind: String,
-    /// Location.
-    pub location: Option<usize>,
-    /// Position along the structure (m), if placed by coordinate.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub position_m: Option<f64>,
-    /// Element run, if any.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub elements: Option<[usize; 2]>,
+    /// What and where.
+    #[serde(flatten)]
+    pub place: Place,
     /// Its fitted value.
     pub value: Option<f64>,
     /// Unit of the value.
     pub unit: String,
-    /// Its AICc minus the named effect's (≥ 0).
+    /// Its AICc minus the named effect's, each with its place charge ([`Fit::score`]; ≥ 0).
     pub delta_aicc: f64,
 }
 
 impl Alternative {
     fn new(c: &Candidate, fit: &Fit, named_aicc: f64) -> Self {
         Self {
-            label: c.label(),
-            kind: c.kind.clone(),
-            location: c.location,
-            position_m: c.position_m,
-            elements: c.elements,
+            place: Place::of(c),
             value: fit.value,
             unit: c.unit().to_string(),
-            delta_aicc: fit.aicc - named_aicc,
+            delta_aicc: fit.score() - named_aicc,
         }
     }
 }
@@ -216,19 +262,9 @@ impl Alternative {
 /// One effect named by forward selection, with its value from the final joint fit.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct NamedEffect {
-    /// `kind@location`.
-    #[serde(skip)]
-    pub label: String,
-    /// Kind.
-    pub kind: String,
-    /// Location.
-    pub location: Option<usize>,
-    /// Position along the structure (m), if placed by coordinate.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub position_m: Option<f64>,
-    /// Element run, if any.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub elements: Option<[usize; 2]>,
+    /// What and where.
+    #[serde(flatten)]
+    pub place: Place,
     /// Fitted value in the final joint fit (`None` for a switch, reported as 1: on).
     #[serde(serialize_with = "value_or_on")]
     pub value: Option<f64>,
@@ -236,7 +272,8 @@ pub struct NamedEffect {
     pub interval: Option<[f64; 2]>,
     /// Unit of the value.
     pub unit: String,
-    /// AICc gained when the effect was added.
+    /// AICc gained when the effect was added, less the charge for choosing its place
+    /// ([`Fit::score`]).
     pub delta_aicc: f64,
     /// Alternatives within [`DiscoveryOptions::ambiguity_aicc`] when it was chosen.
     pub ambiguous_with: Vec<Alternative>,
@@ -266,11 +303,7 @@ fn value_or_on<S: serde::Serializer>(value: &Option<f64>, s: S) -> Result<S::Ok,
 impl NamedEffect {
     fn new(c: &Candidate, delta_aicc: f64, ambiguous_with: Vec<Alternative>) -> Self {
         Self {
-            label: c.label(),
-            kind: c.kind.clone(),
-            location: c.location,
-            position_m: c.position_m,
-            elements: c.elements,
+            place: Place::of(c),
             value: None,
             interval: None,
             unit: c.unit().to_string(),
@@ -466,16 +499,17 @@ pub fn discover_effects<E: EffectSearch>(
     // (a) calibrate
     let est = search
         .with_base(|base| {
-            Some(Driver::default().run_within(
-                base,
-                &mut LevenbergMarquardt::default(),
-                initial,
-                &mut [],
-                &budget,
-            ))
+            Some(Driver::default().run_within(base, &mut LevenbergMarquardt::default(), initial, &budget))
         })
         .ok_or_else(|| DiscoveryError::Data("the base problem could not be built".into()))?
-        .map_err(|e| DiscoveryError::Calibration(e.to_string()))?;
+        .map_err(|e| match budget.exhausted() {
+            true => DiscoveryError::BudgetExhausted(options.max_evaluations),
+            false => DiscoveryError::Calibration(e.to_string()),
+        })?;
+    // A calibration cut short has no χ² to judge: saying "explained by the noise" would be a guess.
+    if matches!(est.termination, Termination::BudgetExhausted { .. }) {
+        return Err(DiscoveryError::BudgetExhausted(options.max_evaluations));
+    }
     let base_lin = est.last;
     let chi2_before = 2.0 * base_lin.cost();
     let dof_before = n - nb;
@@ -502,6 +536,7 @@ pub fn discover_effects<E: EffectSearch>(
     };
     if !disagreement_significant {
         report.evaluations = budget.used();
+        report.budget_exhausted = budget.exhausted();
         return Ok(report);
     }
     // (b) forward selection: each round screens the candidates not yet chosen against the model
@@ -510,6 +545,7 @@ pub fn discover_effects<E: EffectSearch>(
     // explains what is left.
     let mut chosen: Vec<usize> = Vec::new();
     let mut current = Fit::base(&base_lin, aicc_before);
+    let charges = place_charges(candidates);
     let mut named: Vec<NamedEffect> = Vec::new();
     for round in 0..options.max_effects {
         if budget.exhausted() {
@@ -565,16 +601,18 @@ pub fn discover_effects<E: EffectSearch>(
             .filter_map(|i| {
                 let mut set = chosen_refs.clone();
                 set.push(&candidates[i]);
-                refit(search, n, &set, &current.parameters, &budget).map(|f| (i, f))
+                let mut fit = refit(search, n, &set, &current.parameters, &budget)?;
+                fit.place_charge = current.place_charge + charges[i];
+                Some((i, fit))
             })
             .collect();
-        fits.sort_by(|a, b| a.1.aicc.total_cmp(&b.1.aicc));
+        fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
         if round == 0 {
             report.fits = fits.iter().map(|(_, f)| f.clone()).collect();
         }
         let mut plausible = fits.iter().filter(|(_, f)| f.plausible);
         let Some((best_i, best)) = plausible.next().cloned() else { break };
-        if current.aicc - best.aicc < options.min_aicc_gain {
+        if current.score() - best.score() < options.min_aicc_gain {
             break;
         }
         if round == 0 {
@@ -583,10 +621,10 @@ pub fn discover_effects<E: EffectSearch>(
         let ambiguous_with = fits
             .iter()
             .filter(|(i, _)| !same_place(&candidates[*i], &candidates[best_i]))
-            .filter(|(_, f)| f.plausible && f.aicc - best.aicc < options.ambiguity_aicc)
-            .map(|(i, f)| Alternative::new(&candidates[*i], f, best.aicc))
+            .filter(|(_, f)| f.plausible && f.score() - best.score() < options.ambiguity_aicc)
+            .map(|(i, f)| Alternative::new(&candidates[*i], f, best.score()))
             .collect();
-        named.push(NamedEffect::new(&candidates[best_i], current.aicc - best.aicc, ambiguous_with));
+        named.push(NamedEffect::new(&candidates[best_i], current.score() - best.score(), ambiguous_with));
         chosen.push(best_i);
         current = best;
     }
@@ -619,14 +657,10 @@ pub fn discover_effects<E: EffectSearch>(
     }
     let first = &named[0];
     let mut selected = current.clone();
-    selected.label = first.label.clone();
-    selected.kind = first.kind.clone();
-    selected.location = first.location;
+    selected.place = first.place.clone();
     selected.value = first.value;
     selected.unit = first.unit.clone();
     selected.interval = first.interval;
-    selected.position_m = first.position_m;
-    selected.elements = first.elements;
     for (m, f) in report.modes.iter_mut().zip(&selected.frequencies_hz) {
         m.after_hz = *f;
     }
@@ -635,6 +669,31 @@ pub fn discover_effects<E: EffectSearch>(
     report.selected = Some(selected);
     report.effects = named;
     Ok(report)
+}
+
+/// The charge for choosing each candidate's place: 2·ln m, m the number of places its kind is
+/// offered at. The best of m places fits noise better than one place given in advance (the
+/// look-elsewhere effect: the largest of m χ²₁ draws grows as 2·ln m), so a point mass picked
+/// among 41 positions must beat a switch with one place (the shaft's rotary inertia) by that much
+/// more before it is preferred — the charge of the risk-inflation criterion (Foster & George,
+/// Ann. Statist. 22, 1994) for choosing one of m candidate places.
+pub fn place_charges(candidates: &[Candidate]) -> Vec<f64> {
+    let mut places: Vec<(&str, Vec<Place>)> = Vec::new();
+    for c in candidates {
+        let place = Place::of(c);
+        match places.iter_mut().find(|(k, _)| *k == c.kind) {
+            Some((_, seen)) if !seen.contains(&place) => seen.push(place),
+            Some(_) => {}
+            None => places.push((&c.kind, vec![place])),
+        }
+    }
+    candidates
+        .iter()
+        .map(|c| {
+            let m = places.iter().find(|(k, _)| *k == c.kind).map_or(1, |(_, seen)| seen.len());
+            2.0 * (m as f64).ln()
+        })
+        .collect()
 }
 
 /// Two candidates that describe the same thing at the same place (never chosen twice).
@@ -761,7 +820,7 @@ fn refit<E: EffectSearch>(
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
         let est = Driver { max_iterations: 60 }
-            .run_within(problem, &mut LevenbergMarquardt::default(), &start, &mut [], budget)
+            .run_within(problem, &mut LevenbergMarquardt::default(), &start, budget)
             .ok()?;
         // A fit cut short by the budget is not a fit.
         if matches!(est.termination, Termination::BudgetExhausted { .. }) {
@@ -792,16 +851,13 @@ fn refit<E: EffectSearch>(
             (value, interval) = (None, None);
         }
         Some(Fit {
-            label: candidate.label(),
-            kind: candidate.kind.clone(),
-            location: candidate.location,
+            place: Place::of(candidate),
             value,
             unit: candidate.unit().to_string(),
             interval,
-            position_m: candidate.position_m,
-            elements: candidate.elements,
             chi2,
             aicc: aicc(chi2, n, k),
+            place_charge: 0.0,
             plausible,
             frequencies_hz: est.last.frequencies_hz.clone(),
             parameters: est.parameters,

@@ -4,8 +4,10 @@
 
 use crate::eigen::lanczos::{self, pseudo_random, LanczosWork};
 use crate::eigen::small_eigen::symmetric_eigen;
+use crate::eigen::solver::request_tolerance;
 use crate::eigen::{
-    apply_sign_rule, check_count, shifted_twice, DenseSolver, EigenSolver, Modes, SolveError,
+    apply_sign_rule, check_count, shifted_twice, DenseSolver, EigenSolver, ModeRequest, Modes, SolveError,
+    SolvedModes,
 };
 use crate::matrix::{BandCholesky, BandedSymmetric, System};
 use nalgebra::{DMatrix, DVector};
@@ -69,7 +71,7 @@ impl Default for BandedSolver {
     fn default() -> Self {
         // 1e-12 on the shapes: a sensitivity φⱼ² at a stiff support, where φⱼ is small, then
         // agrees with the dense solver's to ~1e-12 (1e-10 left 6e-10 and costs 20 % less time on
-        // the paper rotor). Eigenvalue-only solves need √ of it (see `eigenvalue_tolerance`).
+        // the paper rotor). Eigenvalue-only solves need √ of it (see `request_tolerance`).
         Self { tolerance: 1e-12, max_iterations: 500 }
     }
 }
@@ -129,49 +131,18 @@ impl EigenSolver for BandedSolver {
         "banded"
     }
 
-    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
-        match self.banded(system, count, self.tolerance)? {
-            Some((modes, _)) => Ok(modes),
-            None => DenseSolver.lowest(system, count),
-        }
-    }
-
     /// The next eigenvalue's bound is the Sturm check's shift: no eigenvalue beyond the modes
-    /// returned lies below it, at no extra cost.
-    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
-        match self.banded(system, count, self.tolerance)? {
-            Some(found) => Ok(found),
-            None => DenseSolver.lowest_with_next(system, count),
-        }
-    }
-
-    /// The eigenvalues are Rayleigh quotients of the converged vectors, whose error is the square
-    /// of the vectors': the vectors are iterated to √tolerance / 10 only.
-    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
-        match self.banded(system, count, self.eigenvalue_tolerance())? {
-            Some((modes, _)) => Ok(modes.eigenvalues),
-            None => DenseSolver.lowest_eigenvalues(system, count),
-        }
-    }
-
-    fn lowest_eigenvalues_with_next(
-        &self,
-        system: &System,
-        count: usize,
-    ) -> Result<(DVector<f64>, f64), SolveError> {
-        match self.banded(system, count, self.eigenvalue_tolerance())? {
-            Some((modes, next)) => Ok((modes.eigenvalues, next)),
-            None => DenseSolver.lowest_eigenvalues_with_next(system, count),
+    /// returned lies below it, at no extra cost. Eigenvalues only are iterated less far
+    /// ([`request_tolerance`]).
+    fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
+        match self.banded(system, request.count, request_tolerance(request, self.tolerance))? {
+            Some((modes, next)) => Ok(SolvedModes::answering(request, modes, next)),
+            None => DenseSolver.solve(system, request),
         }
     }
 }
 
 impl BandedSolver {
-    /// Inverse-residual tolerance of eigenvalue-only solves.
-    fn eigenvalue_tolerance(&self) -> f64 {
-        self.tolerance.max(0.1 * self.tolerance.sqrt())
-    }
-
     /// The lowest `count` modes with a lower bound on the next eigenvalue, or `None` for the
     /// dense solver: more than half the spectrum wanted, or a mode missed (see the type's
     /// documentation) in a system small enough for it.
@@ -199,7 +170,7 @@ impl BandedSolver {
         };
         let found = WORKSPACE.with(|ws| {
             let ws = &mut *ws.try_borrow_mut().map_err(|_| backend("workspace in use (re-entrant solve)"))?;
-            Self { tolerance, ..*self }.solve(k, m, count, ws)
+            Self { tolerance, ..*self }.solve_band(k, m, count, ws)
         })?;
         match found {
             Some(found) => Ok(Some(found)),
@@ -238,7 +209,7 @@ fn backend(detail: impl Into<String>) -> SolveError {
 impl BandedSolver {
     /// The lowest `count` modes and a lower bound on the next eigenvalue, or `None` when the
     /// Sturm check shows a missed mode.
-    fn solve(
+    fn solve_band(
         &self,
         k: &BandedSymmetric,
         m: &BandedSymmetric,

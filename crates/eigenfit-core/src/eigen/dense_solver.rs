@@ -1,6 +1,9 @@
 //! The default, pure-nalgebra eigen-solver: Cholesky reduction to a standard symmetric problem.
 
-use crate::eigen::{apply_sign_rule, check_count, shifted_twice, EigenSolver, Modes, SolveError};
+use crate::eigen::{
+    apply_sign_rule, check_count, shifted_twice, with_next_by_one_more_mode, EigenSolver, ModeRequest, Modes,
+    SolveError, SolvedModes,
+};
 use crate::matrix::System;
 use nalgebra::{Cholesky, DMatrix, DVector, SymmetricEigen};
 
@@ -28,7 +31,22 @@ impl EigenSolver for DenseSolver {
         "dense"
     }
 
-    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
+    /// Its certificate is the next eigenvalue itself, from a solve of one mode more.
+    fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
+        with_next_by_one_more_mode(system, request, |count, vectors| {
+            if vectors {
+                self.modes(system, count)
+            } else {
+                let eigenvalues = self.eigenvalues_only(system, count)?;
+                Ok(Modes { eigenvalues, shapes: DMatrix::zeros(system.dofs(), 0) })
+            }
+        })
+    }
+}
+
+impl DenseSolver {
+    /// The lowest `count` modes with their shapes.
+    fn modes(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
         check_count(system, count)?;
         let (k, m) = (system.stiffness(), system.mass());
         // M must be positive definite for the problem to be symmetric-definite at all.
@@ -46,13 +64,7 @@ impl EigenSolver for DenseSolver {
         shifted_twice(scale, |sigma| shifted(k, m, sigma, count))
     }
 
-    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
-        self.eigenvalues_only(system, count)
-    }
-}
-
-impl DenseSolver {
-    /// [`EigenSolver::lowest_eigenvalues`]: the same arithmetic as `lowest` on its common path
+    /// Eigenvalues only: the same arithmetic as `modes` on its common path
     /// (K positive definite, at most half the modes), without accumulating eigenvectors.
     fn eigenvalues_only(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
         check_count(system, count)?;
@@ -80,7 +92,7 @@ impl DenseSolver {
             }
         }
         // Rigid-body modes or most of the spectrum: the full solve.
-        self.lowest(system, count).map(|modes| modes.eigenvalues)
+        self.modes(system, count).map(|modes| modes.eigenvalues)
     }
 }
 
@@ -118,15 +130,8 @@ fn inverted_solve(
     count: usize,
 ) -> Result<Modes, SolveError> {
     let l = chol.l();
-    let b = reduced_inverted(chol, m)?;
-    let eig = SymmetricEigen::try_new(b, f64::EPSILON, 0).ok_or(SolveError::Backend {
-        backend: "dense",
-        detail: "symmetric QR iteration did not converge".into(),
-    })?;
     // Largest μ first = lowest λ first.
-    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-    order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
-    order.truncate(count);
+    let (eig, order) = lowest_pairs(reduced_inverted(chol, m)?, count, |mu| -mu)?;
     if order.iter().any(|&i| eig.eigenvalues[i] <= 0.0) {
         return Err(SolveError::Backend {
             backend: "dense",
@@ -148,18 +153,28 @@ fn mass_reduction(k: &DMatrix<f64>, m: &DMatrix<f64>, count: usize) -> Result<Mo
     let l = chol.l();
     let x = l.solve_lower_triangular(k).ok_or_else(|| not_pd("zero pivot in L"))?;
     let a = l.solve_lower_triangular(&x.transpose()).ok_or_else(|| not_pd("zero pivot in L"))?;
-    let a = (&a + a.transpose()) * 0.5;
+    let (eig, order) = lowest_pairs((&a + a.transpose()) * 0.5, count, |lambda| lambda)?;
+    let eigenvalues = DVector::from_iterator(count, order.iter().map(|&i| eig.eigenvalues[i]));
+    let y = DMatrix::from_columns(&order.iter().map(|&i| eig.eigenvectors.column(i)).collect::<Vec<_>>());
+    let shapes = l.transpose().solve_upper_triangular(&y).ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
+    finish(eigenvalues, shapes)
+}
+
+/// The eigen-decomposition of the symmetric `a` and the indices of its `count` eigenpairs with
+/// the lowest `key(eigenvalue)`, in that order.
+fn lowest_pairs(
+    a: DMatrix<f64>,
+    count: usize,
+    key: impl Fn(f64) -> f64,
+) -> Result<(SymmetricEigen<f64, nalgebra::Dyn>, Vec<usize>), SolveError> {
     let eig = SymmetricEigen::try_new(a, f64::EPSILON, 0).ok_or(SolveError::Backend {
         backend: "dense",
         detail: "symmetric QR iteration did not converge".into(),
     })?;
     let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    order.sort_by(|&i, &j| key(eig.eigenvalues[i]).total_cmp(&key(eig.eigenvalues[j])));
     order.truncate(count);
-    let eigenvalues = DVector::from_iterator(count, order.iter().map(|&i| eig.eigenvalues[i]));
-    let y = DMatrix::from_columns(&order.iter().map(|&i| eig.eigenvectors.column(i)).collect::<Vec<_>>());
-    let shapes = l.transpose().solve_upper_triangular(&y).ok_or_else(|| not_pd("zero pivot in Lᵀ"))?;
-    finish(eigenvalues, shapes)
+    Ok((eig, order))
 }
 
 /// Rejects non-finite results and applies the sign rule.
@@ -236,5 +251,26 @@ mod tests {
         let modes = DenseSolver.lowest(&sys, 2).unwrap();
         assert!(modes.eigenvalues[0].abs() < 1e-14);
         assert!((modes.eigenvalues[1] - 2.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn a_request_gets_what_it_asks_for() {
+        // Two unit masses, springs 1 (ground–1) and 1 (1–2): λ = (3 ∓ √5)/2.
+        let k = DMatrix::from_row_slice(2, 2, &[2.0, -1.0, -1.0, 1.0]);
+        let sys = System::new(k, DMatrix::identity(2, 2)).unwrap();
+        let (low, high) = ((3.0 - 5f64.sqrt()) / 2.0, (3.0 + 5f64.sqrt()) / 2.0);
+        let plain = DenseSolver.solve(&sys, ModeRequest::modes(1)).unwrap();
+        assert_eq!((plain.modes.shapes.shape(), plain.next_eigenvalue), ((2, 1), None));
+        let only = DenseSolver.solve(&sys, ModeRequest::eigenvalues(1).with_certificate()).unwrap();
+        assert_eq!(only.modes.shapes.shape(), (2, 0));
+        assert!((only.modes.eigenvalues[0] - low).abs() < 1e-14);
+        assert!((only.next_eigenvalue.unwrap() - high).abs() < 1e-14);
+        // No further mode: the certificate is ∞.
+        let all = DenseSolver.solve(&sys, ModeRequest::modes(2).with_certificate()).unwrap();
+        assert_eq!(all.next_eigenvalue, Some(f64::INFINITY));
+        assert_eq!(
+            DenseSolver.lowest_with_next(&sys, 1).unwrap().1,
+            DenseSolver.lowest(&sys, 2).unwrap().eigenvalues[1]
+        );
     }
 }

@@ -18,5 +18,8 @@ pub(crate) mod sparse_solver;
 pub use banded_solver::{subspace_size, BandedSolver};
 pub use dense_solver::{DenseSolver, DENSE_MAX_DOFS};
 pub use modes::{apply_sign_rule, Modes};
-pub use solver::{check_count, shifted_twice, EigenSolver, SolveError};
+pub use solver::{
+    check_count, drop_shapes, shifted_twice, with_next_by_one_more_mode, EigenSolver, ModeRequest,
+    SolveError, SolvedModes,
+};
 pub use sparse_solver::SparseSolver;

@@ -4,9 +4,10 @@
 //! inertia of the sparse LDLᵀ of K − σ′M) proving that no mode below the highest one returned
 //! was missed.
 
+use crate::eigen::solver::request_tolerance;
 use crate::eigen::{
     apply_sign_rule, check_count, lanczos, lanczos::LanczosWork, lanczos::Locked, lanczos::ShiftInvert,
-    shifted_twice, DenseSolver, EigenSolver, Modes, SolveError,
+    shifted_twice, DenseSolver, EigenSolver, ModeRequest, Modes, SolveError, SolvedModes,
 };
 use crate::matrix::{CscSymmetric, System};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -260,36 +261,22 @@ impl EigenSolver for SparseSolver {
         "sparse"
     }
 
-    fn lowest(&self, system: &System, count: usize) -> Result<Modes, SolveError> {
-        self.lowest_with_next(system, count).map(|(m, _)| m)
-    }
-
-    /// The next eigenvalue's bound is the Sturm count's shift.
-    fn lowest_with_next(&self, system: &System, count: usize) -> Result<(Modes, f64), SolveError> {
-        self.solve(system, count, self.tolerance)
-    }
-
-    /// The eigenvalues are Rayleigh quotients of the converged vectors, accurate to the square
-    /// of the vectors' error: the vectors are iterated to √tolerance / 10 only.
-    fn lowest_eigenvalues(&self, system: &System, count: usize) -> Result<DVector<f64>, SolveError> {
-        self.solve(system, count, self.eigenvalue_tolerance()).map(|(m, _)| m.eigenvalues)
-    }
-
-    fn lowest_eigenvalues_with_next(
-        &self,
-        system: &System,
-        count: usize,
-    ) -> Result<(DVector<f64>, f64), SolveError> {
-        self.solve(system, count, self.eigenvalue_tolerance()).map(|(m, next)| (m.eigenvalues, next))
+    /// The next eigenvalue's bound is the Sturm count's shift. Eigenvalues only are iterated
+    /// less far ([`request_tolerance`]).
+    fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
+        let tolerance = request_tolerance(request, self.tolerance);
+        let (modes, next) = self.solve_with_tolerance(system, request.count, tolerance)?;
+        Ok(SolvedModes::answering(request, modes, next))
     }
 }
 
 impl SparseSolver {
-    fn eigenvalue_tolerance(&self) -> f64 {
-        self.tolerance.max(0.1 * self.tolerance.sqrt())
-    }
-
-    fn solve(&self, system: &System, count: usize, tolerance: f64) -> Result<(Modes, f64), SolveError> {
+    fn solve_with_tolerance(
+        &self,
+        system: &System,
+        count: usize,
+        tolerance: f64,
+    ) -> Result<(Modes, f64), SolveError> {
         check_count(system, count)?;
         let n = system.dofs();
         let converted;

@@ -87,8 +87,22 @@ pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, MeasuredFileE
     Ok(bytes)
 }
 
-/// Parses the CSV text; errors start with `LINE: `.
-pub fn parse(text: &str) -> Result<Measurement, String> {
+/// An invalid measured-data CSV: the line and what is wrong there; shown as `LINE: MESSAGE`.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("{line}: {message}")]
+pub struct CsvError {
+    /// The 1-based line of the text.
+    pub line: usize,
+    /// What is wrong on it.
+    pub message: String,
+}
+
+fn at(line: usize, message: String) -> CsvError {
+    CsvError { line, message }
+}
+
+/// Parses the CSV text; errors name the line ([`CsvError`]).
+pub fn parse(text: &str) -> Result<Measurement, CsvError> {
     parse_with_notes(text).map(|(m, _)| m)
 }
 
@@ -115,8 +129,22 @@ pub fn shown_number(v: f64) -> String {
     }
 }
 
+/// Most lines a measured file may have: a modal test gives tens to hundreds of modes, so a file
+/// this long is a wrong file (a time series, a log), refused before it is parsed.
+pub const MAX_LINES: usize = 100_000;
+
 /// [`parse`] with the notes for the user (ignored columns), each starting with `LINE: `.
-pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), String> {
+pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), CsvError> {
+    let lines = text.lines().count();
+    if lines > MAX_LINES {
+        return Err(at(
+            MAX_LINES + 1,
+            format!(
+                "the file has {lines} lines, more than the {MAX_LINES} a measured file may have \
+                 (a modal test gives tens to hundreds of modes)"
+            ),
+        ));
+    }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
@@ -135,13 +163,13 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), String
         }
         Err(e) => {
             let line = e.position().map_or(1, |p| lines.at(p.byte()));
-            Some(Err(format!("{line}: not readable as CSV: {e}")))
+            Some(Err(at(line, format!("not readable as CSV: {e}"))))
         }
     });
     let (hline, header) = records
         .next()
         .transpose()?
-        .ok_or("1: empty file: expected the header `mode,frequency_hz[,std_hz]`")?;
+        .ok_or_else(|| at(1, "empty file: expected the header `mode,frequency_hz[,std_hz]`".into()))?;
     let mut col = [None; 3];
     let mut notes = Vec::new();
     for (i, c) in header.iter().enumerate() {
@@ -154,20 +182,24 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), String
                 continue;
             }
             other => {
-                return Err(format!(
-                    "{hline}: unknown column `{}`; the header must be `mode,frequency_hz[,std_hz]`",
-                    shown(other)
+                return Err(at(
+                    hline,
+                    format!(
+                        "unknown column `{}`; the header must be `mode,frequency_hz[,std_hz]`",
+                        shown(other)
+                    ),
                 ))
             }
         };
         if col[slot].replace(i).is_some() {
-            return Err(format!("{hline}: column `{c}` appears twice"));
+            return Err(at(hline, format!("column `{c}` appears twice")));
         }
     }
     for (slot, name) in [(0, "mode"), (1, "frequency_hz")] {
         if col[slot].is_none() {
-            return Err(format!(
-                "{hline}: missing column `{name}`; the header must be `mode,frequency_hz[,std_hz]`"
+            return Err(at(
+                hline,
+                format!("missing column `{name}`; the header must be `mode,frequency_hz[,std_hz]`"),
             ));
         }
     }
@@ -177,44 +209,47 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), String
     for record in records {
         let (line, row) = record?;
         if row.len() != header.len() {
-            return Err(format!("{line}: {} fields, but the header has {}", row.len(), header.len()));
+            return Err(at(line, format!("{} fields, but the header has {}", row.len(), header.len())));
         }
         let field = |slot: usize| col[slot].and_then(|i| row.get(i));
-        let number = |slot: usize, name: &str| -> Result<Option<f64>, String> {
+        let number = |slot: usize, name: &str| -> Result<Option<f64>, CsvError> {
             field(slot)
                 .map(|s| match s {
-                    "" => Err(format!("{line}: {name} is empty")),
-                    _ => {
-                        s.parse::<f64>().map_err(|_| format!("{line}: {name} `{}` is not a number", shown(s)))
-                    }
+                    "" => Err(at(line, format!("{name} is empty"))),
+                    _ => s
+                        .parse::<f64>()
+                        .map_err(|_| at(line, format!("{name} `{}` is not a number", shown(s)))),
                 })
                 .transpose()
         };
         let mode_text = field(0).unwrap_or_default();
         let mode: usize = mode_text.parse().ok().filter(|&m| m >= 1).ok_or_else(|| {
-            format!("{line}: mode `{}` must be a whole number ≥ 1 (modes count from 1)", shown(mode_text))
+            at(line, format!("mode `{}` must be a whole number ≥ 1 (modes count from 1)", shown(mode_text)))
         })?;
         let f = number(1, "frequency_hz")?.unwrap_or_default();
         if !(f.is_finite() && f > 0.0) {
-            return Err(format!("{line}: frequency_hz {} must be a positive finite number", shown_number(f)));
+            return Err(at(
+                line,
+                format!("frequency_hz {} must be a positive finite number", shown_number(f)),
+            ));
         }
         let std = number(2, "std_hz")?;
         if let Some(s) = std {
             if !(s.is_finite() && s > 0.0) {
-                return Err(format!("{line}: std_hz {} must be a positive finite number", shown_number(s)));
+                return Err(at(line, format!("std_hz {} must be a positive finite number", shown_number(s))));
             }
         }
         if let Some(first) = first_line.insert(mode, line) {
-            return Err(format!("{line}: mode {mode} is listed twice (first on line {first})"));
+            return Err(at(line, format!("mode {mode} is listed twice (first on line {first})")));
         }
         modes.push((line, MeasuredMode { mode: mode - 1, frequency_hz: f, std_hz: std, shape: None }));
     }
     if modes.is_empty() {
-        return Err(format!("{hline}: no data rows after the header"));
+        return Err(at(hline, "no data rows after the header".into()));
     }
     check_order(&modes)?;
-    let measurement =
-        Measurement::new(modes.into_iter().map(|(_, m)| m).collect()).map_err(|e| format!("{hline}: {e}"))?;
+    let measurement = Measurement::new(modes.into_iter().map(|(_, m)| m).collect())
+        .map_err(|e| at(hline, e.to_string()))?;
     Ok((measurement, notes))
 }
 
@@ -249,29 +284,35 @@ impl LineCounter<'_> {
 
 /// Natural frequencies increase with mode number (the model's modes are sorted): a row that
 /// breaks the order is a swapped row or a typing slip, and no stiffness can fit it.
-fn check_order(modes: &[(usize, MeasuredMode)]) -> Result<(), String> {
+fn check_order(modes: &[(usize, MeasuredMode)]) -> Result<(), CsvError> {
     let mut sorted: Vec<&(usize, MeasuredMode)> = modes.iter().collect();
     sorted.sort_by_key(|(_, m)| m.mode);
     for pair in sorted.windows(2) {
         let ((l0, a), (l1, b)) = (pair[0], pair[1]);
         let later = l0.max(l1);
         if b.frequency_hz == a.frequency_hz {
-            return Err(format!(
-                "{later}: mode {} has the same frequency as mode {} ({} Hz, lines {l0} and {l1}): \
+            return Err(at(
+                *later,
+                format!(
+                    "mode {} has the same frequency as mode {} ({} Hz, lines {l0} and {l1}): \
                  the model's modes are distinct, so the two cannot both be paired",
-                b.mode + 1,
-                a.mode + 1,
-                a.frequency_hz
+                    b.mode + 1,
+                    a.mode + 1,
+                    a.frequency_hz
+                ),
             ));
         }
         if b.frequency_hz < a.frequency_hz {
-            return Err(format!(
-                "{later}: mode {} ({} Hz, line {l1}) is below mode {} ({} Hz, line {l0}): natural \
+            return Err(at(
+                *later,
+                format!(
+                    "mode {} ({} Hz, line {l1}) is below mode {} ({} Hz, line {l0}): natural \
                  frequencies increase with mode number (a swapped row or a typing slip?)",
-                b.mode + 1,
-                b.frequency_hz,
-                a.mode + 1,
-                a.frequency_hz
+                    b.mode + 1,
+                    b.frequency_hz,
+                    a.mode + 1,
+                    a.frequency_hz
+                ),
             ));
         }
     }
@@ -292,45 +333,65 @@ mod tests {
     }
 
     #[test]
+    fn a_file_beyond_any_modal_test_is_refused_before_parsing() {
+        let mut text = String::from("mode,frequency_hz\n");
+        (1..=super::MAX_LINES).for_each(|k| text.push_str(&format!("{k},{}\n", 10 + k)));
+        let err = parse(&text).unwrap_err().to_string();
+        assert!(err.starts_with("100001: the file has 100001 lines, more than the 100000"), "{err}");
+        // One line fewer is parsed (and accepted: distinct increasing frequencies).
+        let shorter = &text[..text.rfind("100000,").unwrap()];
+        assert_eq!(parse(shorter).unwrap().len(), super::MAX_LINES - 1);
+    }
+
+    #[test]
     fn errors_name_the_line() {
-        assert_eq!(parse("").unwrap_err(), "1: empty file: expected the header `mode,frequency_hz[,std_hz]`");
         assert_eq!(
-            parse("mode,freq\n1,2\n").unwrap_err(),
+            parse("").unwrap_err().to_string(),
+            "1: empty file: expected the header `mode,frequency_hz[,std_hz]`"
+        );
+        assert_eq!(
+            parse("mode,freq\n1,2\n").unwrap_err().to_string(),
             "1: unknown column `freq`; the header must be `mode,frequency_hz[,std_hz]`"
         );
-        assert_eq!(parse("mode,frequency_hz\n1,abc\n").unwrap_err(), "2: frequency_hz `abc` is not a number");
         assert_eq!(
-            parse("mode,frequency_hz\n1,-3\n").unwrap_err(),
+            parse("mode,frequency_hz\n1,abc\n").unwrap_err().to_string(),
+            "2: frequency_hz `abc` is not a number"
+        );
+        assert_eq!(
+            parse("mode,frequency_hz\n1,-3\n").unwrap_err().to_string(),
             "2: frequency_hz -3 must be a positive finite number"
         );
         assert_eq!(
-            parse("mode,frequency_hz\n1,NaN\n").unwrap_err(),
+            parse("mode,frequency_hz\n1,NaN\n").unwrap_err().to_string(),
             "2: frequency_hz NaN must be a positive finite number"
         );
         assert_eq!(
-            parse("mode,frequency_hz\n1,3\n\n1,4\n").unwrap_err(),
+            parse("mode,frequency_hz\n1,3\n\n1,4\n").unwrap_err().to_string(),
             "4: mode 1 is listed twice (first on line 2)"
         );
         assert_eq!(
-            parse("mode,frequency_hz,std_hz\n1,3,0\n").unwrap_err(),
+            parse("mode,frequency_hz,std_hz\n1,3,0\n").unwrap_err().to_string(),
             "2: std_hz 0 must be a positive finite number"
         );
         assert_eq!(
-            parse("mode,frequency_hz\n0,3\n").unwrap_err(),
+            parse("mode,frequency_hz\n0,3\n").unwrap_err().to_string(),
             "2: mode `0` must be a whole number ≥ 1 (modes count from 1)"
         );
-        assert_eq!(parse("mode,frequency_hz\n1,3,4\n").unwrap_err(), "2: 3 fields, but the header has 2");
         assert_eq!(
-            parse("frequency_hz\n3\n").unwrap_err(),
+            parse("mode,frequency_hz\n1,3,4\n").unwrap_err().to_string(),
+            "2: 3 fields, but the header has 2"
+        );
+        assert_eq!(
+            parse("frequency_hz\n3\n").unwrap_err().to_string(),
             "1: missing column `mode`; the header must be `mode,frequency_hz[,std_hz]`"
         );
-        assert_eq!(parse("mode,frequency_hz\n").unwrap_err(), "1: no data rows after the header");
+        assert_eq!(parse("mode,frequency_hz\n").unwrap_err().to_string(), "1: no data rows after the header");
     }
 
     #[test]
     fn rfc4180_quoting_keeps_a_decimal_comma_in_one_field() {
         assert_eq!(
-            parse("mode,frequency_hz\n1,\"36,9\"\n").unwrap_err(),
+            parse("mode,frequency_hz\n1,\"36,9\"\n").unwrap_err().to_string(),
             "2: frequency_hz `36,9` is not a number"
         );
         let m = parse("\"mode\",\"frequency_hz\"\n\"1\",\"36.9\"\n").unwrap();
@@ -340,12 +401,13 @@ mod tests {
     #[test]
     fn frequencies_must_increase_with_mode_number() {
         assert_eq!(
-            parse("mode,frequency_hz\n1,84.5\n2,36.1\n").unwrap_err(),
+            parse("mode,frequency_hz\n1,84.5\n2,36.1\n").unwrap_err().to_string(),
             "3: mode 2 (36.1 Hz, line 3) is below mode 1 (84.5 Hz, line 2): natural frequencies \
              increase with mode number (a swapped row or a typing slip?)"
         );
         assert!(parse("mode,frequency_hz\n1,36.1\n2,36.1\n")
             .unwrap_err()
+            .to_string()
             .starts_with("3: mode 2 has the same frequency as mode 1 (36.1 Hz, lines 2 and 3)"));
         // Rows in any order are fine when the frequencies follow the mode numbers.
         assert_eq!(parse("mode,frequency_hz\n3,300\n1,36\n").unwrap().len(), 2);

@@ -1,9 +1,25 @@
 //! Synthetic measurements: a model's own frequencies, optionally with reproducible noise — for
 //! studies, tests and examples.
 
-use crate::eigen::EigenSolver;
-use crate::measurement::{MeasuredMode, Measurement};
-use crate::model::StructuralModel;
+use crate::eigen::{EigenSolver, SolveError};
+use crate::measurement::{MeasuredMode, Measurement, MeasurementError};
+use crate::model::{ModelError, StructuralModel};
+use thiserror::Error;
+
+/// Why a model's own frequencies could not be made into a measurement; the message is the
+/// failing step's own.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SynthesisError {
+    /// The model could not be assembled at the parameters given.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The eigen-solve failed.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// The frequencies do not make a valid measurement (e.g. a rigid-body zero).
+    #[error(transparent)]
+    Measurement(#[from] MeasurementError),
+}
 
 /// Reproducible standard-normal noise: SplitMix64 with the Box–Muller transform. The same seed
 /// gives the same sequence on every machine.
@@ -56,13 +72,12 @@ pub fn synthesise<M, S>(
     modes: usize,
     relative_std: f64,
     mut noise: Option<&mut NoiseRng>,
-) -> Result<Measurement, String>
+) -> Result<Measurement, SynthesisError>
 where
     M: StructuralModel + ?Sized,
     S: EigenSolver + ?Sized,
 {
-    let system = model.assemble(p).map_err(|e| e.to_string())?;
-    let f = solver.lowest(&system, modes).map_err(|e| e.to_string())?.frequencies_hz();
+    let f = solver.lowest(&model.assemble(p)?, modes)?.frequencies_hz();
     let measured = f
         .iter()
         .enumerate()
@@ -71,5 +86,5 @@ where
             MeasuredMode::new(k, f * (1.0 + relative_std * e)).with_std(relative_std * f)
         })
         .collect();
-    Measurement::new(measured).map_err(|e| e.to_string())
+    Ok(Measurement::new(measured)?)
 }

@@ -41,6 +41,7 @@ impl<'a, M: StructuralModel + ?Sized> Augmented<'a, M> {
             let sizes = [&c.stiffness, &c.mass]
                 .into_iter()
                 .chain(c.companions.iter().flat_map(|p| [&p.stiffness, &p.mass]))
+                .chain(c.graded.iter().flat_map(|g| [&g.stiffness, &g.mass]))
                 .chain(c.rerouted.iter().map(|(_, k)| k));
             if sizes.into_iter().any(|s| s.dim() != own) {
                 return Err(ModelError::Invalid(format!(
@@ -85,6 +86,11 @@ impl<'a, M: StructuralModel + ?Sized> Augmented<'a, M> {
             };
             k.push((&c.stiffness, fk));
             m.push((&c.mass, fm));
+            for g in c.graded.iter().filter(|_| c.parameter.is_some()) {
+                let (gk, gm) = c.law.factors(g.weight * p[first]);
+                k.push((&g.stiffness, gk));
+                m.push((&g.mass, gm));
+            }
             let companions = first + usize::from(c.parameter.is_some());
             for (q, comp) in c.companions.iter().enumerate() {
                 k.push((&comp.stiffness, p[companions + q]));
@@ -176,10 +182,14 @@ impl<M: StructuralModel + ?Sized> StructuralModel for Augmented<'_, M> {
             }
             if c.parameter.is_some() && i == first {
                 let (dk, dm) = c.law.derivatives(p[i]);
-                return Ok(SystemDerivative {
-                    stiffness: scaled(&c.stiffness, dk),
-                    mass: scaled(&c.mass, dm),
-                });
+                let mut out =
+                    SystemDerivative { stiffness: scaled(&c.stiffness, dk), mass: scaled(&c.mass, dm) };
+                for g in &c.graded {
+                    let (gk, gm) = c.law.derivatives(g.weight * p[i]);
+                    add_into(&mut out.stiffness, &g.stiffness, g.weight * gk);
+                    add_into(&mut out.mass, &g.mass, g.weight * gm);
+                }
+                return Ok(out);
             }
             let comp = &c.companions[i - first - usize::from(c.parameter.is_some())];
             return Ok(SystemDerivative { stiffness: comp.stiffness.clone(), mass: comp.mass.clone() });
@@ -205,6 +215,10 @@ fn renumbered(c: &Candidate, base_dofs: usize, offset: usize, n: usize) -> Candi
     for (comp, orig) in out.companions.iter_mut().zip(&c.companions) {
         comp.stiffness = move_to(&orig.stiffness);
         comp.mass = move_to(&orig.mass);
+    }
+    for (g, orig) in out.graded.iter_mut().zip(&c.graded) {
+        g.stiffness = move_to(&orig.stiffness);
+        g.mass = move_to(&orig.mass);
     }
     for (r, orig) in out.rerouted.iter_mut().zip(&c.rerouted) {
         r.1 = move_to(&orig.1);

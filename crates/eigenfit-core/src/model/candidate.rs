@@ -74,10 +74,28 @@ pub struct Candidate {
     /// Further fitted values beside [`parameter`](Self::parameter), each linear in K and M (a
     /// pedestal's stiffness beside its mass).
     pub companions: Vec<Companion>,
+    /// Further parts that enter by [`law`](Self::law) at `weight · value` each (a taper: every
+    /// element of the run changes its diameter by its share of the value); empty for most.
+    pub graded: Vec<GradedPart>,
+    /// For a graded effect over a run of elements, the element at which the value applies in
+    /// full (a taper's thin or thick end); `None` otherwise.
+    pub taper_to: Option<usize>,
     /// Model parameters whose contribution the effect re-routes through its added DOFs:
     /// `(parameter index, ΔK per unit value of that parameter)` (a bearing spring that now ends
     /// on the pedestal instead of the ground).
     pub rerouted: Vec<(usize, SparseSymmetric)>,
+}
+
+/// A part of a graded [`Candidate`]: ΔK and ΔM entering by the candidate's law at
+/// `weight · value`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GradedPart {
+    /// Share of the candidate's value this part takes.
+    pub weight: f64,
+    /// ΔK (as the candidate's).
+    pub stiffness: SparseSymmetric,
+    /// ΔM (as the candidate's).
+    pub mass: SparseSymmetric,
 }
 
 /// A further value of a [`Candidate`], entering K and M linearly.
@@ -115,6 +133,8 @@ impl Candidate {
             elements: None,
             extra_dofs: 0,
             companions: Vec::new(),
+            graded: Vec::new(),
+            taper_to: None,
             rerouted: Vec::new(),
         }
     }
@@ -142,16 +162,33 @@ impl Candidate {
 
     /// `kind@location` (or `kind@first-last`, `kind@x=…m`), or `kind` without a location.
     pub fn label(&self) -> String {
-        match (self.elements, self.position_m, self.location) {
-            (Some([a, b]), _, _) if a != b => format!("{}@{a}-{b}", self.kind),
-            (_, Some(x), _) => format!("{}@{x:.4}m", self.kind),
-            (_, _, Some(l)) => format!("{}@{l}", self.kind),
-            _ => self.kind.clone(),
-        }
+        label_of(&self.kind, self.location, self.position_m, self.elements, self.taper_to)
     }
 
     /// Unit of the value (empty for a switch).
     pub fn unit(&self) -> &str {
         self.parameter.as_ref().map_or("", |p| p.unit.as_str())
+    }
+}
+
+/// The label of an effect of `kind` placed so: `kind@first-last` for a run of elements,
+/// `kind@x.xxxxm` by position, `kind@location`, or `kind` alone; a taper whose value applies in
+/// full at element e ends in `~e`.
+pub fn label_of(
+    kind: &str,
+    location: Option<usize>,
+    position_m: Option<f64>,
+    elements: Option<[usize; 2]>,
+    taper_to: Option<usize>,
+) -> String {
+    let place = match (elements, position_m, location) {
+        (Some([a, b]), _, _) if a != b => format!("{kind}@{a}-{b}"),
+        (_, Some(x), _) => format!("{kind}@{x:.4}m"),
+        (_, _, Some(l)) => format!("{kind}@{l}"),
+        _ => kind.to_string(),
+    };
+    match taper_to {
+        Some(e) => format!("{place}~{e}"),
+        None => place,
     }
 }

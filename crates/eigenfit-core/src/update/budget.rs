@@ -1,6 +1,7 @@
 //! A cap on model evaluations, shared by every fit, refit and interval of one task, so that no
 //! input — a typing slip, data no stiffness can produce — can make eigenfit run for hours.
 
+use super::settings::{Guard, SettingsError};
 use crate::model::ParameterSet;
 use crate::problem::{Linearisation, Objective, ResidualError};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -22,6 +23,12 @@ impl Budget {
     /// A budget of `limit` evaluations.
     pub fn new(limit: usize) -> Self {
         Self { limit, used: AtomicUsize::new(0), refused: AtomicBool::new(false) }
+    }
+
+    /// A budget of `limit` evaluations, refused when zero (no fit could even start).
+    pub fn checked(limit: usize) -> Result<Self, SettingsError> {
+        Guard("budget").at_least_one("limit", limit)?;
+        Ok(Self::new(limit))
     }
 
     /// No limit (for callers that bound the work themselves).

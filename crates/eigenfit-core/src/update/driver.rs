@@ -1,6 +1,6 @@
 //! The iteration loop: termination reasons, observers, history.
 
-use super::{Budget, StepStatus, UpdateError, UpdateStrategy};
+use super::{Budget, Counted, StepStatus, UpdateError, UpdateStrategy};
 use crate::problem::{Linearisation, Objective};
 
 /// Why a run ended.
@@ -103,7 +103,8 @@ pub struct Estimate {
     pub parameters: Vec<f64>,
     /// Iterations taken.
     pub iterations: usize,
-    /// Model evaluations (eigen-solves with sensitivities), including rejected trials.
+    /// Model evaluations (eigen-solves) that reached the model, including rejected trials and
+    /// restart seeds, counted by the driver.
     pub evaluations: usize,
     /// Why the run ended.
     pub termination: Termination,
@@ -113,7 +114,18 @@ pub struct Estimate {
     pub last: Linearisation,
 }
 
-/// Owns the loop.
+/// Owns the loop: the iteration limit, the evaluation count (through a [`Counted`] adaptor, so
+/// strategies do not count their own), the [`Budget`], the history and the observers — like
+/// argmin's `Executor`.
+///
+/// ```
+/// # use eigenfit_core::update::{Driver, IterationRecordSink};
+/// let mut sink = IterationRecordSink::default();
+/// let driver = Driver { max_iterations: 50 };
+/// // driver.run(&problem, &mut strategy, &start) runs unobserved;
+/// // driver.observe(&mut [&mut sink]).run(&problem, &mut strategy, &start) shows each iteration.
+/// # let _ = (driver, &mut sink);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Driver {
     /// Iteration limit.
@@ -135,9 +147,8 @@ impl Driver {
         problem: &dyn Objective,
         strategy: &mut dyn UpdateStrategy,
         initial: &[f64],
-        observers: &mut [&mut dyn Observer],
     ) -> Result<Estimate, UpdateError> {
-        self.run_within(problem, strategy, initial, observers, &Budget::unlimited())
+        self.observe(&mut []).run(problem, strategy, initial)
     }
 
     /// [`Driver::run`] charging every evaluation, including the strategy's trials and restart
@@ -148,10 +159,45 @@ impl Driver {
         problem: &dyn Objective,
         strategy: &mut dyn UpdateStrategy,
         initial: &[f64],
-        observers: &mut [&mut dyn Observer],
         budget: &Budget,
     ) -> Result<Estimate, UpdateError> {
-        let budgeted = budget.wrap(problem);
+        self.observe(&mut []).run_within(problem, strategy, initial, budget)
+    }
+
+    /// This driver with `observers` called at the start and after every iteration.
+    pub fn observe<'a, 'b>(&self, observers: &'a mut [&'b mut dyn Observer]) -> ObservedDriver<'a, 'b> {
+        ObservedDriver { driver: *self, observers }
+    }
+}
+
+/// A [`Driver`] with observers ([`Driver::observe`]).
+pub struct ObservedDriver<'a, 'b> {
+    driver: Driver,
+    observers: &'a mut [&'b mut dyn Observer],
+}
+
+impl ObservedDriver<'_, '_> {
+    /// [`Driver::run`], observed.
+    pub fn run(
+        self,
+        problem: &dyn Objective,
+        strategy: &mut dyn UpdateStrategy,
+        initial: &[f64],
+    ) -> Result<Estimate, UpdateError> {
+        self.run_within(problem, strategy, initial, &Budget::unlimited())
+    }
+
+    /// [`Driver::run_within`], observed.
+    pub fn run_within(
+        self,
+        problem: &dyn Objective,
+        strategy: &mut dyn UpdateStrategy,
+        initial: &[f64],
+        budget: &Budget,
+    ) -> Result<Estimate, UpdateError> {
+        let observers = self.observers;
+        let counted = Counted::new(problem);
+        let budgeted = budget.wrap(&counted);
         let problem: &dyn Objective = &budgeted;
         if problem.parameters().is_empty() {
             return Err(UpdateError::Setup("the model has no parameter: nothing to estimate".into()));
@@ -161,13 +207,19 @@ impl Driver {
         strategy.start(problem, &current)?;
         let mut history = vec![IterationRecord::new(0, &current)];
         observers.iter_mut().for_each(|o| o.observe(&history[0]));
-        let mut evaluations = 1;
         let mut iterations = 0;
+        let mut accept = |next: Linearisation, current: &mut Linearisation, iterations: &mut usize| {
+            *iterations += 1;
+            *current = next;
+            let record = IterationRecord::new(*iterations, current);
+            observers.iter_mut().for_each(|o| o.observe(&record));
+            history.push(record);
+        };
         let termination = if strategy.converged(&current) {
             Termination::Converged
         } else {
             loop {
-                if iterations >= self.max_iterations {
+                if iterations >= self.driver.max_iterations {
                     break Termination::IterationLimit;
                 }
                 let step = strategy.step(problem, &current);
@@ -175,23 +227,13 @@ impl Driver {
                 // failed trial as "no better point") meaningless: the run is cut short.
                 if budget.exhausted() {
                     if let Some(step) = step.ok().filter(|s| s.next.cost() < current.cost()) {
-                        iterations += 1;
-                        evaluations += step.evaluations;
-                        current = step.next;
-                        let record = IterationRecord::new(iterations, &current);
-                        observers.iter_mut().for_each(|o| o.observe(&record));
-                        history.push(record);
+                        accept(step.next, &mut current, &mut iterations);
                     }
                     break Termination::BudgetExhausted { limit: budget.limit() };
                 }
                 match step {
                     Ok(step) => {
-                        iterations += 1;
-                        evaluations += step.evaluations;
-                        current = step.next;
-                        let record = IterationRecord::new(iterations, &current);
-                        observers.iter_mut().for_each(|o| o.observe(&record));
-                        history.push(record);
+                        accept(step.next, &mut current, &mut iterations);
                         if step.status == StepStatus::Converged {
                             break Termination::Converged;
                         }
@@ -206,7 +248,7 @@ impl Driver {
             strategy: strategy.name(),
             parameters: current.parameters.clone(),
             iterations,
-            evaluations,
+            evaluations: counted.count(),
             termination,
             history,
             last: current,

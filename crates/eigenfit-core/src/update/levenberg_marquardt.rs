@@ -1,5 +1,6 @@
 //! Damped least squares (Levenberg–Marquardt) in scaled parameters, with bounds and restarts.
 
+use super::settings::{Guard, SettingsError};
 use super::{Step, StepStatus, UpdateError, UpdateStrategy};
 use crate::model::ParameterSet;
 use crate::problem::{Linearisation, Objective};
@@ -18,30 +19,45 @@ use std::sync::Arc;
 /// best point it found. Restarts count as iterations.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LevenbergMarquardt {
-    /// A fit is exact when every |f_model − f_measured| / f_measured is below this.
-    pub residual_tolerance: f64,
-    /// Converged when a scaled step ‖δ‖∞ falls below this without heavy damping.
-    pub step_tolerance: f64,
-    /// Largest ‖δ‖∞ of one step in scaled units (ln 100: two decades for a log parameter).
-    pub max_step: f64,
-    /// Rejected trials allowed per iteration before the run counts as stuck.
-    pub max_trials: usize,
-    /// Restarts from the coarse grid allowed before the best point found is returned.
-    pub max_restarts: usize,
+    settings: LevenbergMarquardtSettings,
     /// Parameters held at their starting value (profile likelihood, partial updates).
-    pub fixed: Vec<bool>,
+    fixed: Vec<bool>,
     mu: f64,
     nu: f64,
     seeds: Option<Vec<Vec<f64>>>,
     shared_seeds: Option<Arc<Vec<Vec<f64>>>>,
     far_checked: bool,
     best: Option<Linearisation>,
+    /// Points this run started from (the initial point, then each restart seed), in scaled
+    /// units: a seed at one of them would only repeat that run.
+    started_from: Vec<Vec<f64>>,
     restarts: usize,
     stuck_for: usize,
     recent_cost: f64,
 }
 
-impl Default for LevenbergMarquardt {
+/// The settings of [`LevenbergMarquardt`], checked once by [`build`](Self::build).
+///
+/// ```
+/// use eigenfit_core::update::LevenbergMarquardtSettings;
+/// let refused = LevenbergMarquardtSettings { max_step: f64::NAN, ..Default::default() }.build();
+/// assert!(refused.unwrap_err().to_string().contains("max_step"));
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct LevenbergMarquardtSettings {
+    /// A fit is exact when every |f_model − f_measured| / f_measured is below this (≥ 0).
+    pub residual_tolerance: f64,
+    /// Converged when a scaled step ‖δ‖∞ falls below this without heavy damping (≥ 0).
+    pub step_tolerance: f64,
+    /// Largest ‖δ‖∞ of one step in scaled units (ln 100: two decades for a log parameter; > 0).
+    pub max_step: f64,
+    /// Rejected trials allowed per iteration before the run counts as stuck (≥ 1).
+    pub max_trials: usize,
+    /// Restarts from the coarse grid allowed before the best point found is returned.
+    pub max_restarts: usize,
+}
+
+impl Default for LevenbergMarquardtSettings {
     fn default() -> Self {
         Self {
             residual_tolerance: 1e-10,
@@ -49,17 +65,31 @@ impl Default for LevenbergMarquardt {
             max_step: 100f64.ln(),
             max_trials: 30,
             max_restarts: 8,
-            fixed: Vec::new(),
-            mu: 1e-3,
-            nu: 2.0,
-            seeds: None,
-            shared_seeds: None,
-            far_checked: false,
-            best: None,
-            restarts: 0,
-            stuck_for: 0,
-            recent_cost: f64::INFINITY,
         }
+    }
+}
+
+impl LevenbergMarquardtSettings {
+    /// Refuses a NaN, infinite or negative tolerance, a step cap that is not a positive number
+    /// and zero trials, naming the setting.
+    pub fn check(&self) -> Result<(), SettingsError> {
+        let guard = Guard("Levenberg–Marquardt");
+        guard.non_negative("residual_tolerance", self.residual_tolerance)?;
+        guard.non_negative("step_tolerance", self.step_tolerance)?;
+        guard.positive("max_step", self.max_step)?;
+        guard.at_least_one("max_trials", self.max_trials)
+    }
+
+    /// The strategy with these settings, once they pass [`check`](Self::check).
+    pub fn build(self) -> Result<LevenbergMarquardt, SettingsError> {
+        self.check()?;
+        Ok(LevenbergMarquardt::with_checked(self))
+    }
+}
+
+impl Default for LevenbergMarquardt {
+    fn default() -> Self {
+        Self::with_checked(LevenbergMarquardtSettings::default())
     }
 }
 
@@ -79,8 +109,34 @@ fn seeds_per_axis(free: usize) -> usize {
 const MAX_SEEDS: usize = 243;
 /// Relative frequency misfit above which a run starts from the best coarse-grid point.
 const FAR_START: f64 = 0.2;
+/// Scaled distance within which a restart seed counts as a point already started from (the
+/// nominal point is the middle of every odd grid axis, so the best seed is often the start).
+const SAME_START: f64 = 1e-6;
 
 impl LevenbergMarquardt {
+    /// The strategy with `settings` already checked.
+    fn with_checked(settings: LevenbergMarquardtSettings) -> Self {
+        Self {
+            settings,
+            fixed: Vec::new(),
+            mu: 1e-3,
+            nu: 2.0,
+            seeds: None,
+            shared_seeds: None,
+            far_checked: false,
+            best: None,
+            started_from: Vec::new(),
+            restarts: 0,
+            stuck_for: 0,
+            recent_cost: f64::INFINITY,
+        }
+    }
+
+    /// Its settings.
+    pub fn settings(&self) -> &LevenbergMarquardtSettings {
+        &self.settings
+    }
+
     /// Holds the parameters flagged `true` fixed.
     pub fn with_fixed(mut self, fixed: Vec<bool>) -> Self {
         self.fixed = fixed;
@@ -89,7 +145,7 @@ impl LevenbergMarquardt {
 
     /// Sets the number of restarts (0: a plain local Levenberg–Marquardt).
     pub fn with_max_restarts(mut self, max_restarts: usize) -> Self {
-        self.max_restarts = max_restarts;
+        self.settings.max_restarts = max_restarts;
         self
     }
 
@@ -106,26 +162,32 @@ impl LevenbergMarquardt {
         Arc::new(ranked_seeds(problem, &around, &[]))
     }
 
-    /// This run's seeds (ranked on first use, or copied from shared ones) and the evaluations spent.
-    fn seeds(&mut self, problem: &dyn Objective, around: &[f64]) -> (&mut Vec<Vec<f64>>, usize) {
-        let mut spent = 0;
+    /// This run's seeds (ranked on first use, or copied from shared ones).
+    fn seeds(&mut self, problem: &dyn Objective, around: &[f64]) -> &mut Vec<Vec<f64>> {
         if self.seeds.is_none() {
             let fixed = self.fixed.iter().any(|&f| f);
             self.seeds = Some(match (&self.shared_seeds, fixed) {
                 (Some(shared), false) => shared.as_ref().clone(),
-                _ => {
-                    let ranked = ranked_seeds(problem, around, &self.fixed);
-                    spent = ranked.len();
-                    ranked
-                }
+                _ => ranked_seeds(problem, around, &self.fixed),
             });
         }
-        (self.seeds.as_mut().expect("set above"), spent) // proof: assigned just above when None
+        self.seeds.as_mut().expect("set above") // proof: assigned just above when None
     }
 
     /// Restarts taken in the last run.
     pub fn restarts(&self) -> usize {
         self.restarts
+    }
+
+    /// Records `p` as a starting point; false when the run already started there.
+    fn first_start_from(&mut self, params: &ParameterSet, p: &[f64]) -> bool {
+        let s: Vec<f64> = params.iter().zip(p).map(|(q, &v)| q.to_scaled(v)).collect();
+        let seen =
+            self.started_from.iter().any(|t| t.iter().zip(&s).all(|(a, b)| (a - b).abs() <= SAME_START));
+        if !seen {
+            self.started_from.push(s);
+        }
+        !seen
     }
 
     fn is_free(&self, i: usize) -> bool {
@@ -152,23 +214,25 @@ impl LevenbergMarquardt {
     /// point found.
     fn restart(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
         self.remember(current);
-        let (_, mut evaluations) = self.seeds(problem, &current.parameters);
-        while self.restarts < self.max_restarts {
+        self.seeds(problem, &current.parameters);
+        while self.restarts < self.settings.max_restarts {
             let Some(p) = self.seeds.as_mut().and_then(|s| (!s.is_empty()).then(|| s.remove(0))) else {
                 break;
             };
-            evaluations += 1;
+            if !self.first_start_from(problem.parameters(), &p) {
+                continue;
+            }
             if let Ok(next) = problem.linearise(&p) {
                 self.restarts += 1;
                 self.mu = 1e-3;
                 self.nu = 2.0;
                 self.stuck_for = 0;
                 self.recent_cost = next.cost();
-                return Ok(Step { next, status: StepStatus::Continue, evaluations });
+                return Ok(Step { next, status: StepStatus::Continue });
             }
         }
         let best = self.best.clone().unwrap_or_else(|| current.clone());
-        Ok(Step { next: best, status: StepStatus::Converged, evaluations })
+        Ok(Step { next: best, status: StepStatus::Converged })
     }
 }
 
@@ -236,6 +300,8 @@ impl UpdateStrategy for LevenbergMarquardt {
         self.seeds = None;
         self.far_checked = false;
         self.best = None;
+        self.started_from.clear();
+        self.first_start_from(problem.parameters(), &initial.parameters);
         self.restarts = 0;
         self.stuck_for = 0;
         self.recent_cost = initial.cost();
@@ -245,23 +311,25 @@ impl UpdateStrategy for LevenbergMarquardt {
     fn converged(&self, lin: &Linearisation) -> bool {
         // Exact frequencies end the run only when they are the whole residual: with shape rows
         // (testdata::shapes) a mirror solution matches every frequency and still misfits.
-        lin.max_rel_diff() <= self.residual_tolerance && lin.residual.len() == lin.frequencies_hz.len()
+        lin.max_rel_diff() <= self.settings.residual_tolerance
+            && lin.residual.len() == lin.frequencies_hz.len()
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
         let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
         // Far from the data at the start (a frequency off by more than FAR_START): begin from
         // the best point of the coarse grid instead, when it fits better.
-        if !self.far_checked && self.max_restarts > 0 && current.max_rel_diff() > FAR_START {
+        if !self.far_checked && self.settings.max_restarts > 0 && current.max_rel_diff() > FAR_START {
             self.far_checked = true;
-            let (seeds, evaluations) = self.seeds(problem, &current.parameters);
+            let seeds = self.seeds(problem, &current.parameters);
             if let Some(Ok(next)) =
                 (!seeds.is_empty()).then(|| seeds.remove(0)).map(|p| problem.linearise(&p))
             {
                 if next.cost() < current.cost() {
+                    self.first_start_from(problem.parameters(), &next.parameters);
                     self.remember(current);
                     self.recent_cost = next.cost();
-                    return Ok(Step { next, status: StepStatus::Continue, evaluations: evaluations + 1 });
+                    return Ok(Step { next, status: StepStatus::Continue });
                 }
             }
         }
@@ -269,7 +337,7 @@ impl UpdateStrategy for LevenbergMarquardt {
             Ok(Some(step)) => {
                 let next = step.next;
                 if self.converged(&next) {
-                    return Ok(Step { next, status: StepStatus::Converged, evaluations: step.evaluations });
+                    return Ok(Step { next, status: StepStatus::Converged });
                 }
                 // Plateau watch: a long run of negligible progress on a point that does not fit.
                 if next.cost() < 0.999 * self.recent_cost {
@@ -279,19 +347,17 @@ impl UpdateStrategy for LevenbergMarquardt {
                     self.stuck_for += 1;
                 }
                 if self.stuck_for >= PLATEAU_ITERATIONS && !self.acceptable(&next, free) {
-                    let mut restarted = self.restart(problem, &next)?;
-                    restarted.evaluations += step.evaluations;
-                    return Ok(restarted);
+                    return self.restart(problem, &next);
                 }
-                Ok(Step { next, status: StepStatus::Continue, evaluations: step.evaluations })
+                Ok(Step { next, status: StepStatus::Continue })
             }
             // Stationary, or no step reduces the residual: done if the fit is good, else restart.
             Ok(None) | Err(UpdateError::Stalled(_))
-                if self.acceptable(current, free) || self.max_restarts == 0 =>
+                if self.acceptable(current, free) || self.settings.max_restarts == 0 =>
             {
                 self.remember(current);
                 let best = self.best.clone().unwrap_or_else(|| current.clone());
-                Ok(Step { next: best, status: StepStatus::Converged, evaluations: 0 })
+                Ok(Step { next: best, status: StepStatus::Converged })
             }
             Ok(None) | Err(UpdateError::Stalled(_)) => self.restart(problem, current),
             Err(e) => Err(e),
@@ -333,8 +399,7 @@ impl LevenbergMarquardt {
         let amax = a.diagonal().amax().max(f64::MIN_POSITIVE);
         let d = DVector::from_iterator(np, (0..np).map(|i| a[(i, i)].max(1e-12 * amax)));
         let cost0 = current.cost();
-        let mut evaluations = 0;
-        for _ in 0..self.max_trials {
+        for _ in 0..self.settings.max_trials {
             let mut lhs = a.clone();
             for i in 0..np {
                 if free[i] {
@@ -348,8 +413,8 @@ impl LevenbergMarquardt {
                 continue;
             };
             let cap = delta.amax();
-            if cap > self.max_step {
-                delta *= self.max_step / cap;
+            if cap > self.settings.max_step {
+                delta *= self.settings.max_step / cap;
             }
             let mut p_new = Vec::with_capacity(np);
             for (i, par) in params.iter().enumerate() {
@@ -357,7 +422,7 @@ impl LevenbergMarquardt {
                 delta[i] = s - s0[i];
                 p_new.push(par.from_scaled(s).clamp(par.lower, par.upper));
             }
-            if delta.amax() <= self.step_tolerance {
+            if delta.amax() <= self.settings.step_tolerance {
                 // Gauss–Newton has nothing left to do: a minimum — unless heavy damping alone
                 // made the step small, which is a stall, not a solution.
                 return if self.mu <= 1e6 {
@@ -371,7 +436,6 @@ impl LevenbergMarquardt {
                 };
             }
             let predicted = delta.dot(&g) - 0.5 * delta.dot(&(&a * &delta));
-            evaluations += 1;
             let trial = match problem.linearise(&p_new) {
                 Ok(t) if t.residual.iter().all(|v| v.is_finite()) => t,
                 _ => {
@@ -384,11 +448,11 @@ impl LevenbergMarquardt {
                 let rho = actual / predicted;
                 self.mu *= f64::max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0).powi(3));
                 self.nu = 2.0;
-                return Ok(Some(Step { next: trial, status: StepStatus::Continue, evaluations }));
+                return Ok(Some(Step { next: trial, status: StepStatus::Continue }));
             }
             self.reject();
         }
-        Err(UpdateError::Stalled(format!("no acceptable step in {} trials", self.max_trials)))
+        Err(UpdateError::Stalled(format!("no acceptable step in {} trials", self.settings.max_trials)))
     }
 
     fn reject(&mut self) {

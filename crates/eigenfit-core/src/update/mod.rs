@@ -5,18 +5,24 @@
 //! reason, like argmin's `Executor`.
 
 mod budget;
+mod counted;
 mod driver;
 pub(crate) mod levenberg_marquardt;
 mod newton;
 mod pstep;
+mod settings;
 #[cfg(test)]
 mod tests;
 
 pub use budget::{Budget, Budgeted, DEFAULT_EVALUATIONS};
-pub use driver::{Driver, Estimate, IterationRecord, IterationRecordSink, Observer, Termination};
-pub use levenberg_marquardt::LevenbergMarquardt;
+pub use counted::Counted;
+pub use driver::{
+    Driver, Estimate, IterationRecord, IterationRecordSink, ObservedDriver, Observer, Termination,
+};
+pub use levenberg_marquardt::{LevenbergMarquardt, LevenbergMarquardtSettings};
 pub use newton::Newton;
 pub use pstep::PStep;
+pub use settings::SettingsError;
 
 use crate::problem::{Linearisation, Objective, ResidualError};
 use thiserror::Error;
@@ -48,15 +54,13 @@ pub enum StepStatus {
     Converged,
 }
 
-/// One accepted step.
+/// One accepted step. The evaluations it spent are counted by the [`Driver`], not reported here.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Step {
     /// Linearisation at the new point.
     pub next: Linearisation,
     /// Convergence verdict at the new point.
     pub status: StepStatus,
-    /// Model evaluations spent (including rejected trials).
-    pub evaluations: usize,
 }
 
 /// One way of moving from the current linearisation to the next point.

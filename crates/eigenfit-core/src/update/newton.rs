@@ -1,5 +1,6 @@
 //! The paper's plain method (section III): Δk from eq. 28, added to k every iteration.
 
+use super::settings::{Guard, SettingsError};
 use super::{
     evaluate_or_diverge, newton_point, square_max_diff_hz, Step, StepStatus, UpdateError, UpdateStrategy,
 };
@@ -10,13 +11,26 @@ use crate::problem::{Linearisation, Objective};
 /// ends the run as diverged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Newton {
-    /// Convergence: every |f_model − f_measured| below this, Hz (the paper: 0.01 Hz).
-    pub tolerance_hz: f64,
+    tolerance_hz: f64,
 }
 
 impl Default for Newton {
     fn default() -> Self {
         Self { tolerance_hz: 0.01 }
+    }
+}
+
+impl Newton {
+    /// Converged when every |f_model − f_measured| is below `tolerance_hz` (the paper: 0.01 Hz);
+    /// refused unless a finite number greater than zero.
+    pub fn new(tolerance_hz: f64) -> Result<Self, SettingsError> {
+        Guard("Newton").positive("tolerance_hz", tolerance_hz)?;
+        Ok(Self { tolerance_hz })
+    }
+
+    /// The convergence tolerance, Hz.
+    pub fn tolerance_hz(&self) -> f64 {
+        self.tolerance_hz
     }
 }
 
@@ -37,6 +51,6 @@ impl UpdateStrategy for Newton {
         let p = newton_point(current, &current.measured_eigenvalues)?;
         let next = evaluate_or_diverge(problem, &p)?;
         let status = if self.converged(&next) { StepStatus::Converged } else { StepStatus::Continue };
-        Ok(Step { next, status, evaluations: 1 })
+        Ok(Step { next, status })
     }
 }

@@ -1,5 +1,6 @@
 //! The paper's Fig. 1: large eigenvalue differences are split into p parts, converged one by one.
 
+use super::settings::{Guard, SettingsError};
 use super::{
     evaluate_or_diverge, newton_point, square_max_diff_hz, Step, StepStatus, UpdateError, UpdateStrategy,
 };
@@ -15,11 +16,11 @@ use nalgebra::DVector;
 #[derive(Debug, Clone, PartialEq)]
 pub struct PStep {
     /// tol1: convergence of each stage and of the whole, Hz (the paper: 0.01 Hz).
-    pub tolerance_hz: f64,
+    tolerance_hz: f64,
     /// tol2: split when the largest starting difference exceeds this, Hz.
-    pub split_above_hz: f64,
+    split_above_hz: f64,
     /// p: number of parts.
-    pub parts: usize,
+    parts: usize,
     start_eigenvalues: DVector<f64>,
     stage: usize,
     stages: usize,
@@ -27,21 +28,35 @@ pub struct PStep {
 
 impl Default for PStep {
     fn default() -> Self {
-        Self::new(0.01, 5.0, 5)
+        Self::with_checked(0.01, 5.0, 5)
     }
 }
 
 impl PStep {
-    /// A p-step strategy with tol1, tol2 and p.
-    pub fn new(tolerance_hz: f64, split_above_hz: f64, parts: usize) -> Self {
+    /// A p-step strategy with tol1 (finite, > 0), tol2 (≥ 0; ∞ never splits) and p (≥ 1),
+    /// refused with the setting's name otherwise.
+    pub fn new(tolerance_hz: f64, split_above_hz: f64, parts: usize) -> Result<Self, SettingsError> {
+        let guard = Guard("p-step");
+        guard.positive("tolerance_hz", tolerance_hz)?;
+        guard.non_negative_or_infinite("split_above_hz", split_above_hz)?;
+        guard.at_least_one("parts", parts)?;
+        Ok(Self::with_checked(tolerance_hz, split_above_hz, parts))
+    }
+
+    fn with_checked(tolerance_hz: f64, split_above_hz: f64, parts: usize) -> Self {
         Self {
             tolerance_hz,
             split_above_hz,
-            parts: parts.max(1),
+            parts,
             start_eigenvalues: DVector::zeros(0),
             stage: 1,
             stages: 1,
         }
+    }
+
+    /// tol1, tol2 (Hz) and p.
+    pub fn settings(&self) -> (f64, f64, usize) {
+        (self.tolerance_hz, self.split_above_hz, self.parts)
     }
 
     fn target(&self, lin: &Linearisation) -> DVector<f64> {
@@ -87,6 +102,6 @@ impl UpdateStrategy for PStep {
         } else {
             StepStatus::Continue
         };
-        Ok(Step { next, status, evaluations: 1 })
+        Ok(Step { next, status })
     }
 }

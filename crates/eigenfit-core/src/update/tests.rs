@@ -25,7 +25,7 @@ fn problem(truth: &[f64]) -> Problem<Chain, DenseSolver> {
 fn every_strategy_recovers_the_chain_from_a_nearby_start() {
     let p = problem(&[3e4, 1e4]);
     for kind in StrategyKind::ALL {
-        let est = Driver::default().run(&p, kind.build().as_mut(), &[2.5e4, 1.3e4], &mut []).unwrap();
+        let est = Driver::default().run(&p, kind.build().as_mut(), &[2.5e4, 1.3e4]).unwrap();
         assert!(est.termination.is_converged(), "{}: {}", kind.name(), est.termination);
         // Paper strategies stop at 0.01 Hz; damped fits to round-off.
         let tol = if kind == StrategyKind::LevenbergMarquardt { 1e-8 } else { 1e-2 };
@@ -40,7 +40,7 @@ fn newton_leaving_the_physical_range_is_reported_as_diverged_with_history() {
     // Two nearly equal frequencies no positive pair of springs can produce: the chain's
     // eigenvalue ratio is bounded away from 1, so the linear steps drive a stiffness negative.
     let p = Problem::new(chain(), DenseSolver, Measurement::from_frequencies(&[10.0, 10.5]).unwrap());
-    let est = Driver::default().run(&p, &mut Newton::default(), &[1e4, 1e4], &mut []).unwrap();
+    let est = Driver::default().run(&p, &mut Newton::default(), &[1e4, 1e4]).unwrap();
     assert!(matches!(est.termination, Termination::Diverged(_)), "{}", est.termination);
     assert!(!est.history.is_empty());
     // The estimate is the last good iterate, not the rejected one.
@@ -50,7 +50,7 @@ fn newton_leaving_the_physical_range_is_reported_as_diverged_with_history() {
 #[test]
 fn damped_converges_from_far_away() {
     let p = problem(&[3e4, 1e4]);
-    let est = Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[5e8, 2e-2], &mut []).unwrap();
+    let est = Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[5e8, 2e-2]).unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
     assert!(est.last.max_rel_diff() < 1e-10);
 }
@@ -58,7 +58,7 @@ fn damped_converges_from_far_away() {
 #[test]
 fn iteration_limit_keeps_the_last_iterate() {
     let p = problem(&[3e4, 1e4]);
-    let est = Driver { max_iterations: 1 }.run(&p, &mut PStep::default(), &[3e5, 1e3], &mut []).unwrap();
+    let est = Driver { max_iterations: 1 }.run(&p, &mut PStep::default(), &[3e5, 1e3]).unwrap();
     assert_eq!(est.termination, Termination::IterationLimit);
     assert_eq!(est.iterations, 1);
     assert_eq!(est.parameters, est.history[1].parameters);
@@ -70,7 +70,7 @@ fn strategies_refuse_too_few_modes() {
     let one = Measurement::new(vec![MeasuredMode::new(0, 10.0)]).unwrap();
     let p = Problem::new(chain, DenseSolver, one);
     for kind in StrategyKind::ALL {
-        let err = Driver::default().run(&p, kind.build().as_mut(), &[1e4, 1e4], &mut []).unwrap_err();
+        let err = Driver::default().run(&p, kind.build().as_mut(), &[1e4, 1e4]).unwrap_err();
         assert!(matches!(err, UpdateError::Setup(_)), "{}: {err}", kind.name());
     }
 }
@@ -79,8 +79,10 @@ fn strategies_refuse_too_few_modes() {
 fn observers_see_every_iteration() {
     let p = problem(&[3e4, 1e4]);
     let mut sink = IterationRecordSink::default();
-    let est =
-        Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[1e3, 1e3], &mut [&mut sink]).unwrap();
+    let est = Driver::default()
+        .observe(&mut [&mut sink])
+        .run(&p, &mut LevenbergMarquardt::default(), &[1e3, 1e3])
+        .unwrap();
     assert_eq!(sink.records, est.history);
 }
 
@@ -119,7 +121,7 @@ fn a_free_free_structure_is_updated_from_its_elastic_mode() {
     let f = (1.5 * truth).sqrt() / (2.0 * std::f64::consts::PI);
     let p =
         Problem::new(FreeFree(params), DenseSolver, Measurement::new(vec![MeasuredMode::new(1, f)]).unwrap());
-    let est = Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[1e3], &mut []).unwrap();
+    let est = Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[1e3]).unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
     assert!((est.parameters[0] / truth - 1.0).abs() < 1e-8, "{:?}", est.parameters);
     // Asking for the rigid-body mode itself is refused, never answered with a number.
@@ -129,4 +131,88 @@ fn a_free_free_structure_is_updated_from_its_elastic_mode() {
         Measurement::new(vec![MeasuredMode::new(0, 1.0), MeasuredMode::new(1, f)]).unwrap(),
     );
     assert!(rigid.linearise(&[1e3]).is_err());
+}
+
+/// An objective counting the evaluations that reach it, independently of the driver.
+struct Tally<'a> {
+    inner: &'a dyn Objective,
+    calls: std::cell::Cell<usize>,
+}
+
+impl Objective for Tally<'_> {
+    fn parameters(&self) -> &ParameterSet {
+        self.inner.parameters()
+    }
+    fn linearise(&self, p: &[f64]) -> Result<crate::problem::Linearisation, crate::problem::ResidualError> {
+        self.calls.set(self.calls.get() + 1);
+        self.inner.linearise(p)
+    }
+    fn cost(&self, p: &[f64]) -> Option<f64> {
+        self.calls.set(self.calls.get() + 1);
+        self.inner.cost(p)
+    }
+}
+
+#[test]
+fn the_driver_counts_every_evaluation_the_model_saw() {
+    let p = problem(&[3e4, 1e4]);
+    // From far away Levenberg–Marquardt ranks its restart grid (cost calls) and takes trials.
+    for (kind, start) in [(StrategyKind::LevenbergMarquardt, [5e8, 2e-2]), (StrategyKind::PStep, [3e5, 1e3])]
+    {
+        let tally = Tally { inner: &p, calls: Default::default() };
+        let budget = Budget::new(10_000);
+        let est = Driver::default().run_within(&tally, kind.build().as_mut(), &start, &budget).unwrap();
+        assert!(est.evaluations > est.iterations, "{}: {} evaluations", kind.name(), est.evaluations);
+        assert_eq!(est.evaluations, tally.calls.get(), "{}", kind.name());
+        assert_eq!(est.evaluations, budget.used(), "{}", kind.name());
+    }
+}
+
+#[test]
+fn a_refused_evaluation_is_not_counted() {
+    let p = problem(&[3e4, 1e4]);
+    let tally = Tally { inner: &p, calls: Default::default() };
+    let budget = Budget::new(5);
+    let est = Driver::default()
+        .run_within(&tally, &mut LevenbergMarquardt::default(), &[5e8, 2e-2], &budget)
+        .unwrap();
+    assert_eq!(est.termination, Termination::BudgetExhausted { limit: 5 });
+    assert_eq!((est.evaluations, tally.calls.get()), (5, 5));
+}
+
+#[test]
+fn settings_are_refused_when_built_naming_the_setting() {
+    for bad in [f64::NAN, -1.0, 0.0, f64::INFINITY] {
+        let err = LevenbergMarquardtSettings { max_step: bad, ..Default::default() }.build().unwrap_err();
+        assert_eq!((err.owner, err.setting), ("Levenberg–Marquardt", "max_step"), "{bad}");
+        assert!(err.to_string().contains("`max_step`"), "{err}");
+    }
+    for (settings, name) in [
+        (
+            LevenbergMarquardtSettings { residual_tolerance: f64::NAN, ..Default::default() },
+            "residual_tolerance",
+        ),
+        (LevenbergMarquardtSettings { step_tolerance: -1e-9, ..Default::default() }, "step_tolerance"),
+        (LevenbergMarquardtSettings { max_trials: 0, ..Default::default() }, "max_trials"),
+    ] {
+        assert_eq!(settings.build().unwrap_err().setting, name);
+    }
+    let accepted =
+        LevenbergMarquardtSettings { residual_tolerance: 0.0, max_restarts: 0, ..Default::default() };
+    assert_eq!(accepted.clone().build().unwrap().settings(), &accepted);
+    assert_eq!(LevenbergMarquardt::default().settings(), &LevenbergMarquardtSettings::default());
+
+    assert_eq!(Newton::new(f64::NAN).unwrap_err().setting, "tolerance_hz");
+    assert_eq!(Newton::new(-0.01).unwrap_err().owner, "Newton");
+    assert_eq!(Newton::new(1e-4).unwrap().tolerance_hz(), 1e-4);
+
+    assert_eq!(PStep::new(0.0, 5.0, 5).unwrap_err().setting, "tolerance_hz");
+    assert_eq!(PStep::new(0.01, f64::NAN, 5).unwrap_err().setting, "split_above_hz");
+    assert_eq!(PStep::new(0.01, 5.0, 0).unwrap_err().setting, "parts");
+    assert_eq!(PStep::new(0.01, f64::INFINITY, 1).unwrap().settings(), (0.01, f64::INFINITY, 1));
+    assert_eq!(PStep::new(0.01, 5.0, 5).unwrap(), PStep::default());
+
+    let err = Budget::checked(0).unwrap_err();
+    assert_eq!((err.owner, err.setting), ("budget", "limit"));
+    assert_eq!(Budget::checked(3).unwrap().limit(), 3);
 }
