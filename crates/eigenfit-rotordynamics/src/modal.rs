@@ -142,33 +142,13 @@ pub fn solve(
 /// Models up to this many DOFs are solved densely; larger ones by shift-invert Arnoldi.
 pub const DENSE_DOFS: usize = 160;
 
-/// The `count` lowest oscillating modes (no left vectors): dense for small models, shift-invert
-/// Arnoldi on the banded matrices for large ones (falling back to dense when K is singular).
+/// The `count` lowest oscillating modes: dense for small models, shift-invert Arnoldi on the
+/// banded matrices for large ones (falling back to dense when K is singular). With `with_left`
+/// also the left vectors, for sensitivities: on the shift-invert route from the transposed
+/// problem — if (λ²Mᵀ + λDᵀ + Kᵀ)z = 0 then y = z̄ satisfies yᴴ(λ²M + λD + K) = 0 — matched to
+/// the problem's eigenpairs by eigenvalue (a dense solve of the compressor example's 1464
+/// states takes seconds; this, milliseconds).
 pub fn solve_lowest(
-    m: &Mat<f64>,
-    d: &Mat<f64>,
-    k: &Mat<f64>,
-    pairs: &[(usize, usize)],
-    count: usize,
-) -> Result<Vec<Mode>, RotorDynError> {
-    lowest(m, d, k, pairs, count, false)
-}
-
-/// [`solve_lowest`] with left vectors, for sensitivities. On the shift-invert route the left
-/// vectors come from the transposed problem: if (λ²Mᵀ + λDᵀ + Kᵀ)z = 0 then y = z̄ satisfies
-/// yᴴ(λ²M + λD + K) = 0; its eigenpairs are matched to the problem's by eigenvalue. (A dense
-/// solve of the compressor example's 1464 states takes seconds; this, milliseconds.)
-pub fn solve_lowest_with_left(
-    m: &Mat<f64>,
-    d: &Mat<f64>,
-    k: &Mat<f64>,
-    pairs: &[(usize, usize)],
-    count: usize,
-) -> Result<Vec<Mode>, RotorDynError> {
-    lowest(m, d, k, pairs, count, true)
-}
-
-fn lowest(
     m: &Mat<f64>,
     d: &Mat<f64>,
     k: &Mat<f64>,

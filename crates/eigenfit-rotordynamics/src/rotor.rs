@@ -216,13 +216,13 @@ impl Rotor {
     /// The `count` lowest modes of already assembled matrices with left vectors (for
     /// sensitivities), by the fastest exact route for the size.
     pub fn lowest_modes_of(&self, mats: &Matrices, count: usize) -> Result<Vec<Mode>, RotorDynError> {
-        modal::solve_lowest_with_left(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count)
+        modal::solve_lowest(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count, true)
     }
 
     /// The `count` lowest modes at speed Ω (rad/s), by the fastest exact route for the size.
     pub fn lowest_modes(&self, speed: f64, count: usize) -> Result<Vec<Mode>, RotorDynError> {
         let mats = self.matrices(speed);
-        modal::solve_lowest(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count)
+        modal::solve_lowest(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count, false)
     }
 
     /// The `count` lowest modes at several speeds, assembling the speed-independent part once.
@@ -233,7 +233,7 @@ impl Rotor {
             .iter()
             .map(|&s| {
                 let mats = self.matrices_from(&f, s);
-                modal::solve_lowest(&mats.m, &mats.d, &mats.k, &pairs, count)
+                modal::solve_lowest(&mats.m, &mats.d, &mats.k, &pairs, count, false)
             })
             .collect()
     }

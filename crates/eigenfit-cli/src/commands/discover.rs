@@ -52,7 +52,7 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
         }
         let report = eigenfit_workflow::rotordynamics::discover(path, &args.measured, args.assumed_std)?;
         crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
-        return Ok(0);
+        return Ok(crate::error::EXIT_OK);
     }
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
