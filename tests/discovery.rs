@@ -69,7 +69,9 @@ fn a_candidate_at_a_value_is_the_same_model_as_the_effect_in_a_file() {
     let base = presets::paper_rotor();
     // A candidate that adds degrees of freedom (a pedestal) has no `[[effect]]` form; it is held
     // to the independent generator instead (tests/independent_discovery.rs in the rotor crate).
-    for c in base.candidates().into_iter().filter(|c| c.extra_dofs == 0) {
+    // So is a taper (graded parts): its file form is a step per element, an approximation by
+    // design, not the same model.
+    for c in base.candidates().into_iter().filter(|c| c.extra_dofs == 0 && c.graded.is_empty()) {
         let value = c.parameter.as_ref().map_or(1.0, |p| 0.5 * c.plausible.1.min(p.upper));
         let aug = Augmented::new(&base, &c).unwrap();
         let mut p = base.nominal_stiffnesses();
