@@ -13,7 +13,7 @@
 
 mod common;
 
-use common::runner::{cases, check};
+use common::runner::{cases, check, Worst};
 use common::{all_modes, relative_gap, spec, RandomModel};
 use eigenfit_core::eigen::{DenseSolver, Modes};
 use eigenfit_core::matrix::{SparseSymmetric, System, SystemDerivative};
@@ -25,7 +25,7 @@ use eigenfit_core::sensitivity::{
 use eigenfit_core::sensitivity::{Sensitivities, SensitivityError};
 use nalgebra::DMatrix;
 use proptest::prelude::*;
-use proptest::test_runner::TestCaseError;
+use proptest::test_runner::{TestCaseError, TestCaseResult};
 
 const CASES: u32 = 256;
 
@@ -206,6 +206,20 @@ fn appended(spec: &common::Spec, j: prop::sample::Index, mass_log10: f64, delta:
     (Appended { inner, mass, stiffness }, j)
 }
 
+/// Runs `test` on `CASES` drawn [`Appended`] systems — a random 10-DOF inner model and an extra
+/// eigenvalue λⱼ(1 + δ), δ drawn from `delta` — given the model, j and δ.
+fn check_appended(
+    name: &str,
+    delta: impl Strategy<Value = f64>,
+    test: impl Fn(&Appended, usize, f64, &Worst) -> TestCaseResult,
+) {
+    let draws = (spec(10), any::<prop::sample::Index>(), -1.0..1.0f64, delta);
+    check(name, file!(), cases(CASES), draws, |(spec, j, mass_log10, delta), worst| {
+        let (model, j) = appended(&spec, j, mass_log10, delta);
+        test(&model, j, delta, worst)
+    });
+}
+
 /// The mode of the appended system that lives on the extra DOF, and the inner mode j's twin.
 fn pair(modes: &Modes, n: usize) -> (usize, usize) {
     let extra = (0..modes.count())
@@ -226,64 +240,57 @@ fn pair(modes: &Modes, n: usize) -> (usize, usize) {
 #[test]
 fn one_repeated_pair_is_refused_and_only_that_pair() {
     let delta = prop_oneof![Just(0.0), -5e-9..5e-9f64];
-    check(
-        "repeated pair",
-        file!(),
-        cases(CASES),
-        (spec(10), any::<prop::sample::Index>(), -1.0..1.0f64, delta),
-        |(spec, j, mass_log10, delta), worst| {
-            let (model, _) = appended(&spec, j, mass_log10, delta);
-            let p = model.inner.point.clone();
-            let n = model.inner.dofs();
-            let (sys, modes) = all_modes(&model, &p);
-            let floor = rigid_body_tolerance(&sys);
-            let (lo, hi) = pair(&modes, n);
-            worst.note("pair relative gap (must be ≤ 1e-8)", relative_gap(&modes.eigenvalues, lo));
-            prop_assert_eq!(hi, lo + 1, "the pair is adjacent in the sorted spectrum");
-            for k in 0..modes.count() {
-                let gap = relative_gap(&modes.eigenvalues, k);
-                for i in 0..p.len() {
-                    let d = model.derivative(&p, i).unwrap();
-                    let nelson = eigenvector_derivative_nelson(&sys, &modes, k, &d);
-                    let modal = eigenvector_derivative_modal(&modes, k, &d, floor);
-                    if k == lo || k == hi {
-                        expect_repeated(nelson, k, &modes)?;
-                        expect_repeated(modal, k, &modes)?;
-                    } else if gap > 1e-6 {
-                        // Well separated (a draw can put an inner pair within 1e-8; skip those).
-                        let (a, b) = (nelson.unwrap(), modal.unwrap());
-                        prop_assert!(a.iter().chain(b.iter()).all(|v| v.is_finite()));
-                    }
+    check_appended("repeated pair", delta, |model, _, _, worst| {
+        let p = model.inner.point.clone();
+        let n = model.inner.dofs();
+        let (sys, modes) = all_modes(&model, &p);
+        let floor = rigid_body_tolerance(&sys);
+        let (lo, hi) = pair(&modes, n);
+        worst.note("pair relative gap (must be ≤ 1e-8)", relative_gap(&modes.eigenvalues, lo));
+        prop_assert_eq!(hi, lo + 1, "the pair is adjacent in the sorted spectrum");
+        for k in 0..modes.count() {
+            let gap = relative_gap(&modes.eigenvalues, k);
+            for i in 0..p.len() {
+                let d = model.derivative(&p, i).unwrap();
+                let nelson = eigenvector_derivative_nelson(&sys, &modes, k, &d);
+                let modal = eigenvector_derivative_modal(&modes, k, &d, floor);
+                if k == lo || k == hi {
+                    expect_repeated(nelson, k, &modes)?;
+                    expect_repeated(modal, k, &modes)?;
+                } else if gap > 1e-6 {
+                    // Well separated (a draw can put an inner pair within 1e-8; skip those).
+                    let (a, b) = (nelson.unwrap(), modal.unwrap());
+                    prop_assert!(a.iter().chain(b.iter()).all(|v| v.is_finite()));
                 }
             }
-            // The pair inside the requested band (as its top mode, or deeper): refused.
-            for count in [lo + 1, hi + 1, modes.count()] {
-                match Sensitivities::compute(&model, &DenseSolver, &p, count) {
-                    Err(SensitivityError::RepeatedEigenvalue { mode, other, .. }) => {
-                        prop_assert!(
-                            [lo, hi].contains(&mode) || relative_gap(&modes.eigenvalues, mode) < 1e-8,
-                            "refused mode {mode} (pair {lo}/{hi})"
-                        );
-                        prop_assert!(mode < count && other != mode);
-                    }
-                    other => {
-                        return Err(TestCaseError::fail(format!(
-                            "compute({count}) with pair {lo}/{hi}: got {other:?}"
-                        )))
-                    }
+        }
+        // The pair inside the requested band (as its top mode, or deeper): refused.
+        for count in [lo + 1, hi + 1, modes.count()] {
+            match Sensitivities::compute(&model, &DenseSolver, &p, count) {
+                Err(SensitivityError::RepeatedEigenvalue { mode, other, .. }) => {
+                    prop_assert!(
+                        [lo, hi].contains(&mode) || relative_gap(&modes.eigenvalues, mode) < 1e-8,
+                        "refused mode {mode} (pair {lo}/{hi})"
+                    );
+                    prop_assert!(mode < count && other != mode);
+                }
+                other => {
+                    return Err(TestCaseError::fail(format!(
+                        "compute({count}) with pair {lo}/{hi}: got {other:?}"
+                    )))
                 }
             }
-            // The pair entirely above the requested band (lowest `lo` modes, the solve reaches lo
-            // but not hi): answered — provided the band itself is clean.
-            let band_clean = (0..lo).all(|k| relative_gap(&modes.eigenvalues, k) > 1e-6);
-            if lo > 0 && band_clean {
-                let s = Sensitivities::compute(&model, &DenseSolver, &p, lo)
-                    .map_err(|e| TestCaseError::fail(format!("compute({lo}): {e}")))?;
-                prop_assert!(s.eigenvalues.iter().all(|v| v.is_finite()));
-            }
-            Ok(())
-        },
-    );
+        }
+        // The pair entirely above the requested band (lowest `lo` modes, the solve reaches lo
+        // but not hi): answered — provided the band itself is clean.
+        let band_clean = (0..lo).all(|k| relative_gap(&modes.eigenvalues, k) > 1e-6);
+        if lo > 0 && band_clean {
+            let s = Sensitivities::compute(&model, &DenseSolver, &p, lo)
+                .map_err(|e| TestCaseError::fail(format!("compute({lo}): {e}")))?;
+            prop_assert!(s.eigenvalues.iter().all(|v| v.is_finite()));
+        }
+        Ok(())
+    });
 }
 
 /// Close but distinct (relative gap 1e-6..1e-4, well above the 1e-8 tolerance) and uncoupled:
@@ -292,54 +299,47 @@ fn one_repeated_pair_is_refused_and_only_that_pair() {
 #[test]
 fn close_but_distinct_pair_is_answered_exactly() {
     let delta = prop_oneof![1e-6..1e-4f64, -1e-4..-1e-6f64];
-    check(
-        "close pair",
-        file!(),
-        cases(CASES),
-        (spec(10), any::<prop::sample::Index>(), -1.0..1.0f64, delta),
-        |(spec, j, mass_log10, delta), worst| {
-            let (model, j) = appended(&spec, j, mass_log10, delta);
-            let p = model.inner.point.clone();
-            let n = model.inner.dofs();
-            let (_, inner_modes) = all_modes(&model.inner, &p);
-            prop_assume!(relative_gap(&inner_modes.eigenvalues, j) > 1e-3);
-            let (sys, modes) = all_modes(&model, &p);
-            // Inner mode j sits at index j or j+1 depending on the sign of δ.
-            let k = if delta > 0.0 { j } else { j + 1 };
-            prop_assert!(
-                modes.shapes[(n, k)].abs() <= 1e-12 * modes.shapes.column(k).amax(),
-                "mode {k} is not the inner mode"
-            );
-            let inner_sys = model.inner.assemble(&p).unwrap();
-            for i in 0..p.len() {
-                let d = model.derivative(&p, i).unwrap();
-                let d1 = model.inner.derivative(&p, i).unwrap();
-                let exact = eigenvector_derivative_nelson(&inner_sys, &inner_modes, j, &d1).unwrap();
-                let scale = exact.amax().max(inner_modes.shapes.column(j).amax() / p[i].abs());
-                for (name, got) in [
-                    ("Nelson", eigenvector_derivative_nelson(&sys, &modes, k, &d)),
-                    ("modal", eigenvector_derivative_modal(&modes, k, &d, rigid_body_tolerance(&sys))),
-                ] {
-                    let got = got.map_err(|e| TestCaseError::fail(format!("{name}: {e}")))?;
-                    prop_assert!(got[n].abs() <= 1e-9 * scale, "{name}: extra DOF moved");
-                    let err = (got.rows(0, n) - &exact).amax() / scale;
-                    worst.note("close pair: dφ vs inner model alone", err);
-                    prop_assert!(err < 1e-8, "{name} param {i}: {err:e}");
-                }
+    check_appended("close pair", delta, |model, j, delta, worst| {
+        let p = model.inner.point.clone();
+        let n = model.inner.dofs();
+        let (_, inner_modes) = all_modes(&model.inner, &p);
+        prop_assume!(relative_gap(&inner_modes.eigenvalues, j) > 1e-3);
+        let (sys, modes) = all_modes(&model, &p);
+        // Inner mode j sits at index j or j+1 depending on the sign of δ.
+        let k = if delta > 0.0 { j } else { j + 1 };
+        prop_assert!(
+            modes.shapes[(n, k)].abs() <= 1e-12 * modes.shapes.column(k).amax(),
+            "mode {k} is not the inner mode"
+        );
+        let inner_sys = model.inner.assemble(&p).unwrap();
+        for i in 0..p.len() {
+            let d = model.derivative(&p, i).unwrap();
+            let d1 = model.inner.derivative(&p, i).unwrap();
+            let exact = eigenvector_derivative_nelson(&inner_sys, &inner_modes, j, &d1).unwrap();
+            let scale = exact.amax().max(inner_modes.shapes.column(j).amax() / p[i].abs());
+            for (name, got) in [
+                ("Nelson", eigenvector_derivative_nelson(&sys, &modes, k, &d)),
+                ("modal", eigenvector_derivative_modal(&modes, k, &d, rigid_body_tolerance(&sys))),
+            ] {
+                let got = got.map_err(|e| TestCaseError::fail(format!("{name}: {e}")))?;
+                prop_assert!(got[n].abs() <= 1e-9 * scale, "{name}: extra DOF moved");
+                let err = (got.rows(0, n) - &exact).amax() / scale;
+                worst.note("close pair: dφ vs inner model alone", err);
+                prop_assert!(err < 1e-8, "{name} param {i}: {err:e}");
             }
-            let count = k + 1;
-            let s = Sensitivities::compute(&model, &DenseSolver, &p, count)
-                .map_err(|e| TestCaseError::fail(format!("compute: {e}")))?;
-            let s1 = Sensitivities::compute(&model.inner, &DenseSolver, &p, j + 1).unwrap();
-            for (i, &pi) in p.iter().enumerate() {
-                let (a, b) = (s.eigenvalues[(k, i)], s1.eigenvalues[(j, i)]);
-                let err = (a - b).abs() / b.abs().max(inner_modes.eigenvalues[j] / pi.abs());
-                worst.note("close pair: dλ vs inner model alone", err);
-                prop_assert!(err < 1e-10, "dλ param {i}: {a:e} vs {b:e}");
-            }
-            Ok(())
-        },
-    );
+        }
+        let count = k + 1;
+        let s = Sensitivities::compute(&model, &DenseSolver, &p, count)
+            .map_err(|e| TestCaseError::fail(format!("compute: {e}")))?;
+        let s1 = Sensitivities::compute(&model.inner, &DenseSolver, &p, j + 1).unwrap();
+        for (i, &pi) in p.iter().enumerate() {
+            let (a, b) = (s.eigenvalues[(k, i)], s1.eigenvalues[(j, i)]);
+            let err = (a - b).abs() / b.abs().max(inner_modes.eigenvalues[j] / pi.abs());
+            worst.note("close pair: dλ vs inner model alone", err);
+            prop_assert!(err < 1e-10, "dλ param {i}: {a:e} vs {b:e}");
+        }
+        Ok(())
+    });
 }
 
 /// The refusal names both modes and says why, for a person reading a CLI error.

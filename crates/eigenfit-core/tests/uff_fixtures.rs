@@ -9,6 +9,14 @@ fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/uff").join(name)
 }
 
+/// The universal file `STEM.unv`, parsed, and the values pyuff was given for it (`STEM.json`).
+fn fixture(stem: &str) -> (uff::UffFile, Value) {
+    let text = std::fs::read_to_string(data(&format!("{stem}.unv"))).unwrap();
+    let json =
+        serde_json::from_str(&std::fs::read_to_string(data(&format!("{stem}.json"))).unwrap()).unwrap();
+    (uff::parse(&text).unwrap(), json)
+}
+
 fn numbers(v: &Value) -> Vec<f64> {
     v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
 }
@@ -20,10 +28,7 @@ fn close(a: f64, b: f64) -> bool {
 
 #[test]
 fn pyuff_datasets_read_as_written() {
-    let text = std::fs::read_to_string(data("pyuff_datasets.unv")).unwrap();
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(data("pyuff_datasets.json")).unwrap()).unwrap();
-    let file = uff::parse(&text).unwrap();
+    let (file, json) = fixture("pyuff_datasets");
     // Dataset 15 (single precision) and 2411 (double precision) nodes.
     assert_eq!(file.nodes.len(), 5);
     for n in &file.nodes {
@@ -82,10 +87,7 @@ fn pyuff_datasets_read_as_written() {
 
 #[test]
 fn dataset_164_converts_millimetres_to_metres() {
-    let text = std::fs::read_to_string(data("symmetric_rotor.unv")).unwrap();
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(data("symmetric_rotor.json")).unwrap()).unwrap();
-    let file = uff::parse(&text).unwrap();
+    let (file, json) = fixture("symmetric_rotor");
     let z = numbers(&json["z_m"]);
     for (n, z) in file.nodes.iter().zip(&z) {
         assert!((n.coordinates[2] - z).abs() <= 1e-15, "{n:?} vs {z}");

@@ -351,47 +351,26 @@ mod tests {
 
     #[test]
     fn errors_name_the_line() {
-        assert_eq!(
-            parse("").unwrap_err().to_string(),
-            "1: empty file: expected the header `mode,frequency_hz[,std_hz]`"
-        );
-        assert_eq!(
-            parse("mode,freq\n1,2\n").unwrap_err().to_string(),
-            "1: unknown column `freq`; the header must be `mode,frequency_hz[,std_hz]`"
-        );
-        assert_eq!(
-            parse("mode,frequency_hz\n1,abc\n").unwrap_err().to_string(),
-            "2: frequency_hz `abc` is not a number"
-        );
-        assert_eq!(
-            parse("mode,frequency_hz\n1,-3\n").unwrap_err().to_string(),
-            "2: frequency_hz -3 must be a positive finite number"
-        );
-        assert_eq!(
-            parse("mode,frequency_hz\n1,NaN\n").unwrap_err().to_string(),
-            "2: frequency_hz NaN must be a positive finite number"
-        );
-        assert_eq!(
-            parse("mode,frequency_hz\n1,3\n\n1,4\n").unwrap_err().to_string(),
-            "4: mode 1 is listed twice (first on line 2)"
-        );
-        assert_eq!(
-            parse("mode,frequency_hz,std_hz\n1,3,0\n").unwrap_err().to_string(),
-            "2: std_hz 0 must be a positive finite number"
-        );
-        assert_eq!(
-            parse("mode,frequency_hz\n0,3\n").unwrap_err().to_string(),
-            "2: mode `0` must be a whole number ≥ 1 (modes count from 1)"
-        );
-        assert_eq!(
-            parse("mode,frequency_hz\n1,3,4\n").unwrap_err().to_string(),
-            "2: 3 fields, but the header has 2"
-        );
-        assert_eq!(
-            parse("frequency_hz\n3\n").unwrap_err().to_string(),
-            "1: missing column `mode`; the header must be `mode,frequency_hz[,std_hz]`"
-        );
-        assert_eq!(parse("mode,frequency_hz\n").unwrap_err().to_string(), "1: no data rows after the header");
+        // (file, the error it gets)
+        let cases = [
+            ("", "1: empty file: expected the header `mode,frequency_hz[,std_hz]`"),
+            ("mode,freq\n1,2\n", "1: unknown column `freq`; the header must be `mode,frequency_hz[,std_hz]`"),
+            ("mode,frequency_hz\n1,abc\n", "2: frequency_hz `abc` is not a number"),
+            ("mode,frequency_hz\n1,-3\n", "2: frequency_hz -3 must be a positive finite number"),
+            ("mode,frequency_hz\n1,NaN\n", "2: frequency_hz NaN must be a positive finite number"),
+            ("mode,frequency_hz\n1,3\n\n1,4\n", "4: mode 1 is listed twice (first on line 2)"),
+            ("mode,frequency_hz,std_hz\n1,3,0\n", "2: std_hz 0 must be a positive finite number"),
+            ("mode,frequency_hz\n0,3\n", "2: mode `0` must be a whole number ≥ 1 (modes count from 1)"),
+            ("mode,frequency_hz\n1,3,4\n", "2: 3 fields, but the header has 2"),
+            (
+                "frequency_hz\n3\n",
+                "1: missing column `mode`; the header must be `mode,frequency_hz[,std_hz]`",
+            ),
+            ("mode,frequency_hz\n", "1: no data rows after the header"),
+        ];
+        for (text, message) in cases {
+            assert_eq!(parse(text).unwrap_err().to_string(), message, "{text:?}");
+        }
     }
 
     #[test]

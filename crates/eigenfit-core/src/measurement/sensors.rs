@@ -143,19 +143,30 @@ pub fn map_by_coordinates(
     build(file, layout, &entries, true)
 }
 
-/// Ties sensors to model DOFs by an explicit map: CSV with header
-/// `node,model_node,direction[,sign]` — the file's node label, the model node (0-based),
-/// the direction (1…6 or x, y, z, rx, ry, rz) and an optional sign (±1, default +1).
-pub fn map_explicit(file: &UffFile, layout: &dyn NodeLayout, csv: &str) -> Result<SensorSet, SensorError> {
-    let bad = |line: usize, message: String| SensorError::Map { line, message };
+/// A CSV's trimmed lines with their 1-based numbers, blank lines and `#` comments skipped: the
+/// first (the header, with its line) and the rest; an empty file is an error naming `expected`.
+fn header_and_rows<'a>(
+    csv: &'a str,
+    expected: &str,
+) -> Result<(usize, &'a str, impl Iterator<Item = (usize, &'a str)>), SensorError> {
     let mut rows = csv
         .lines()
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = rows
-        .next()
-        .ok_or_else(|| bad(1, "empty: expected the header `node,model_node,direction[,sign]`".into()))?;
+    let (line, header) = rows.next().ok_or_else(|| SensorError::Map {
+        line: 1,
+        message: format!("empty: expected the header `{expected}`"),
+    })?;
+    Ok((line, header, rows))
+}
+
+/// Ties sensors to model DOFs by an explicit map: CSV with header
+/// `node,model_node,direction[,sign]` — the file's node label, the model node (0-based),
+/// the direction (1…6 or x, y, z, rx, ry, rz) and an optional sign (±1, default +1).
+pub fn map_explicit(file: &UffFile, layout: &dyn NodeLayout, csv: &str) -> Result<SensorSet, SensorError> {
+    let bad = |line: usize, message: String| SensorError::Map { line, message };
+    let (hline, header, rows) = header_and_rows(csv, "node,model_node,direction[,sign]")?;
     let cols: Vec<&str> = header.split(',').map(str::trim).collect();
     if cols != ["node", "model_node", "direction"] && cols != ["node", "model_node", "direction", "sign"] {
         return Err(bad(hline, format!("header `{header}`: expected `node,model_node,direction[,sign]`")));
@@ -356,13 +367,7 @@ pub fn shapes_from_csv(
     measured: &Measurement,
 ) -> Result<(Measurement, SensorSet), SensorError> {
     let bad = |line: usize, message: String| SensorError::Map { line, message };
-    let mut rows = csv
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) =
-        rows.next().ok_or_else(|| bad(1, "empty: expected the header `mode,node,direction,value`".into()))?;
+    let (hline, header, rows) = header_and_rows(csv, "mode,node,direction,value")?;
     let cols: Vec<&str> = header.split(',').map(str::trim).collect();
     if cols != ["mode", "node", "direction", "value"] {
         return Err(bad(hline, format!("header `{header}`: expected `mode,node,direction,value`")));
