@@ -1,6 +1,8 @@
 //! Validation errors from TOML name the line of the entry or key at fault; builder errors have
 //! no line.
 
+mod common;
+
 use eigenfit_rotor::{BearingSpec, Rotor, RotorError};
 
 /// A valid file, one entry of each kind; line numbers in the comments.
@@ -195,12 +197,7 @@ fn dotted_keys_and_inline_tables_are_placed_too() {
 
 #[test]
 fn a_file_error_names_the_file_and_the_line() {
-    let dir = std::env::temp_dir().join(format!("eigenfit-rotor-located-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("bad.toml");
-    std::fs::write(&path, VALID.replace("mass = 0.4", "mass = -0.4")).unwrap();
-    let err = Rotor::from_toml_file(&path).unwrap_err();
-    std::fs::remove_dir_all(&dir).unwrap();
+    let (path, err) = common::files::file_error("located", &VALID.replace("mass = 0.4", "mass = -0.4"));
     assert_eq!(
         err.to_string(),
         format!("{}: line 21: disk 0: mass = -0.4 is invalid: it must be finite and > 0", path.display())

@@ -1,5 +1,7 @@
 //! The TOML format: parse errors with line and column, round trip.
 
+mod common;
+
 use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorError, Section};
 
@@ -78,17 +80,14 @@ fn wrong_type_is_placed() {
 
 #[test]
 fn file_errors_name_the_file() {
-    let dir = std::env::temp_dir().join(format!("eigenfit-rotor-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("bad.toml");
-    std::fs::write(&path, VALID.replace("density = 7850.0", "density = \"heavy\"")).unwrap();
-    let err = Rotor::from_toml_file(&path).unwrap_err().to_string();
+    let (path, err) =
+        common::files::file_error("test", &VALID.replace("density = 7850.0", "density = \"heavy\""));
     assert_eq!(
-        err,
+        err.to_string(),
         format!("{}: line 5, column 11: invalid type: string \"heavy\", expected f64", path.display())
     );
-    std::fs::remove_dir_all(&dir).unwrap();
-    let missing = dir.join("missing.toml");
+    // The directory is gone by now.
+    let missing = path.with_file_name("missing.toml");
     let err = Rotor::from_toml_file(&missing).unwrap_err();
     assert!(matches!(err, RotorError::Io { .. }), "{err:?}");
     assert!(err.to_string().starts_with(&format!("{}: cannot read: ", missing.display())));
