@@ -4,8 +4,17 @@ use eigenfit::core::analysis::{uncertainty, Identifiability};
 use eigenfit::core::eigen::DenseSolver;
 use eigenfit::core::measurement::{MeasuredMode, Measurement};
 use eigenfit::core::problem::Problem;
-use eigenfit::core::update::{Driver, LevenbergMarquardt};
+use eigenfit::core::update::{Driver, Estimate, LevenbergMarquardt};
 use eigenfit::rotor::presets;
+
+/// The paper rotor fitted (damped least squares from 1e3 N/m) to measured frequencies with their
+/// standard deviations, (Hz, Hz) per mode from the first.
+fn fit_paper_rotor(data: &[(f64, f64)]) -> (Problem<eigenfit::rotor::Rotor, DenseSolver>, Estimate) {
+    let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
+    let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
+    let est = Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
+    (problem, est)
+}
 
 /// χ² with parameter `i` held at `value` and the others refitted.
 fn profile(
@@ -26,9 +35,7 @@ fn profile(
 fn stiff_support_gets_a_one_sided_profile_bound() {
     // The paper rotor at 1e8/1e8 N/m (frequencies from `eigenfit simulate`, rounded), ~0.1 % std.
     let data = [(59.029, 0.06), (203.444, 0.2), (670.711, 0.6)];
-    let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
-    let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est = Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
+    let (problem, est) = fit_paper_rotor(&data);
     assert!(est.termination.is_converged());
     let u = uncertainty(&problem, &est.last, true).unwrap();
     let Identifiability::LowerBoundOnly { lower } = u.identifiability[1] else {
@@ -49,9 +56,7 @@ fn stiff_support_gets_a_one_sided_profile_bound() {
 #[test]
 fn soft_supports_are_determined_with_tight_intervals() {
     let data = [(36.107, 0.036), (84.066, 0.084), (305.649, 0.31)];
-    let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
-    let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est = Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
+    let (problem, est) = fit_paper_rotor(&data);
     let u = uncertainty(&problem, &est.last, true).unwrap();
     assert!(u.identifiability.iter().all(Identifiability::is_determined), "{:?}", u.identifiability);
     for iv in &u.intervals {
@@ -73,9 +78,7 @@ impl eigenfit::core::update::Observer for Steps {
 #[test]
 fn the_interval_phase_reports_bounds_done_to_its_observers() {
     let data = [(59.029, 0.06), (203.444, 0.2), (670.711, 0.6)];
-    let modes = data.iter().enumerate().map(|(k, &(f, s))| MeasuredMode::new(k, f).with_std(s)).collect();
-    let problem = Problem::new(presets::paper_rotor(), DenseSolver, Measurement::new(modes).unwrap());
-    let est = Driver::default().run(&problem, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
+    let (problem, est) = fit_paper_rotor(&data);
     let mut steps = Steps::default();
     let budget = eigenfit::core::update::Budget::new(eigenfit::core::analysis::UNCERTAINTY_EVALUATIONS);
     let observed =

@@ -301,20 +301,7 @@ pub fn log_space(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 
 /// The full tensor grid of `axis` over `dims` parameters.
 pub fn tensor_grid(axis: &[f64], dims: usize) -> Vec<Vec<f64>> {
-    let mut out: Vec<Vec<f64>> = vec![Vec::new()];
-    for _ in 0..dims {
-        out = out
-            .into_iter()
-            .flat_map(|prefix| {
-                axis.iter().map(move |&v| {
-                    let mut p = prefix.clone();
-                    p.push(v);
-                    p
-                })
-            })
-            .collect();
-    }
-    out
+    crate::update::grid::tensor_product(&vec![axis.to_vec(); dims], usize::MAX)
 }
 
 fn relative_error(estimate: &[f64], target: &[f64]) -> f64 {

@@ -259,21 +259,7 @@ pub(crate) fn ranked_seeds(problem: &dyn Objective, around: &[f64], fixed: &[boo
             }
         })
         .collect();
-    let mut points: Vec<Vec<f64>> = vec![Vec::new()];
-    for axis in &axes {
-        points = points
-            .into_iter()
-            .flat_map(|pre| {
-                axis.iter().map(move |&v| {
-                    let mut q = pre.clone();
-                    q.push(v);
-                    q
-                })
-            })
-            .take(MAX_SEEDS)
-            .collect();
-    }
-    let mut ranked: Vec<(f64, Vec<f64>)> = points
+    let mut ranked: Vec<(f64, Vec<f64>)> = super::grid::tensor_product(&axes, MAX_SEEDS)
         .into_iter()
         .filter_map(|p| problem.cost(&p).map(|c| (c, p)))
         .filter(|(c, _)| c.is_finite())

@@ -7,6 +7,7 @@
 mod budget;
 mod counted;
 mod driver;
+pub(crate) mod grid;
 pub(crate) mod levenberg_marquardt;
 mod newton;
 mod pstep;
