@@ -44,38 +44,40 @@ fn syntax_error_has_line_and_column() {
     assert_eq!(err.to_string(), "line 14, column 8: invalid string\nexpected `\"`, `'`");
 }
 
+/// The keys a rotor file's top level accepts, as its errors list them.
+const TABLES: &str =
+    "expected one of `material`, `shaft`, `disk`, `bearing`, `point_mass`, `effect`, `parameter`";
+
+/// The error reading [`VALID`] with `from` replaced by `to`.
+fn error_after(from: &str, to: &str) -> String {
+    error(&VALID.replace(from, to))
+}
+
 #[test]
 fn unknown_key_is_named_with_position() {
-    let text = VALID.replace("diameter = 0.014", "diamter = 0.014");
     assert_eq!(
-        error(&text),
+        error_after("diameter = 0.014", "diamter = 0.014"),
         "line 10, column 1: unknown field `diamter`, expected one of `nodes`, `length`, `elements`, \
          `diameter`, `inner_diameter`, `material`, `section`"
     );
-    let text = VALID.replace("[[disk]]", "[[disc]]");
     assert_eq!(
-        error(&text),
-        "line 12, column 3: unknown field `disc`, expected one of `material`, `shaft`, `disk`, \
-         `bearing`, `point_mass`, `effect`, `parameter`"
+        error_after("[[disk]]", "[[disc]]"),
+        format!("line 12, column 3: unknown field `disc`, {TABLES}")
     );
 }
 
 #[test]
 fn missing_field_is_named_with_position() {
-    let text = VALID.replace("stiffness = 1e5", "");
-    assert_eq!(error(&text), "line 16, column 1: missing field `stiffness`");
-    let text = VALID.replace("[shaft]", "[axle]");
-    assert_eq!(
-        error(&text),
-        "line 7, column 2: unknown field `axle`, expected one of `material`, `shaft`, `disk`, \
-         `bearing`, `point_mass`, `effect`, `parameter`"
-    );
+    assert_eq!(error_after("stiffness = 1e5", ""), "line 16, column 1: missing field `stiffness`");
+    assert_eq!(error_after("[shaft]", "[axle]"), format!("line 7, column 2: unknown field `axle`, {TABLES}"));
 }
 
 #[test]
 fn wrong_type_is_placed() {
-    let text = VALID.replace("node = 2", "node = -2");
-    assert_eq!(error(&text), "line 13, column 8: invalid value: integer `-2`, expected usize");
+    assert_eq!(
+        error_after("node = 2", "node = -2"),
+        "line 13, column 8: invalid value: integer `-2`, expected usize"
+    );
 }
 
 #[test]

@@ -254,22 +254,12 @@ impl BandedSolver {
         }
         // Rigid-body modes: the dense solver's two shifts.
         let scale = k.diagonal_max() / m.diagonal_max();
-        shifted_twice(scale, |sigma| self.shifted(k, m, sigma, count, method, ws))
-    }
-
-    fn shifted(
-        &self,
-        k: &BandedSymmetric,
-        m: &BandedSymmetric,
-        sigma: f64,
-        count: usize,
-        method: Method,
-        ws: &mut Workspace,
-    ) -> Result<Modes, SolveError> {
-        if !ws.factor.factor_shifted(k, sigma, m) {
-            return Err(backend("K + σM is not positive definite: K has negative stiffness"));
-        }
-        self.iterate(m, sigma, count, method, ws)
+        shifted_twice(scale, |sigma| {
+            if !ws.factor.factor_shifted(k, sigma, m) {
+                return Err(backend("K + σM is not positive definite: K has negative stiffness"));
+            }
+            self.iterate(m, sigma, count, method, ws)
+        })
     }
 
     /// The lowest modes from the factor of K + σM held in the workspace: by Lanczos unless told
