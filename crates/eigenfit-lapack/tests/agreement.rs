@@ -185,6 +185,21 @@ fn identities(system: &System, modes: &Modes) -> (f64, f64) {
     (ortho, stiff)
 }
 
+/// `a` and `b` agree on all `count` modes to 1e-10 in λ and 1e-8 in φ, with the same signs (the
+/// sign rule makes two backends' shapes identical, not merely equal up to sign).
+fn assert_same_modes(a: &Modes, b: &Modes, count: usize, context: &str) {
+    let d = compare(a, b, count);
+    assert!(d.eigenvalue_rel < 1e-10, "{context}: {d:?}");
+    assert!(d.shape_rel < 1e-8, "{context}: {d:?}");
+    assert_eq!(d.sign_flips, 0, "{context}");
+}
+
+/// ΦᵀMΦ = I and ΦᵀKΦ = Λ to 1e-12 (see [`identities`]).
+fn assert_identities(system: &System, modes: &Modes, context: &str) {
+    let (ortho, stiff) = identities(system, modes);
+    assert!(ortho < 1e-12 && stiff < 1e-12, "{context}: {ortho:e} {stiff:e}");
+}
+
 fn check_conventions(modes: &Modes, count: usize, n: usize) {
     assert_eq!(modes.count(), count);
     assert_eq!(modes.shapes.shape(), (n, count));
@@ -273,13 +288,8 @@ fn beam_chains_agree_with_dense_on_every_mode() {
         check_conventions(&all, n, n);
         // Every eigenvalue of these chains is separated by ≥ 8e-6·λ_max (n = 400), so every
         // eigenvector is determined to ~ε/8e-6 and can be compared.
-        let d = compare(&all, &dense, n);
-        assert!(d.eigenvalue_rel < 1e-10, "n = {n}: {d:?}");
-        assert!(d.shape_rel < 1e-8, "n = {n}: {d:?}");
-        // The sign rule makes the two backends' shapes identical, not merely equal up to sign.
-        assert_eq!(d.sign_flips, 0, "n = {n}");
-        let (ortho, stiff) = identities(&system, &all);
-        assert!(ortho < 1e-12 && stiff < 1e-12, "n = {n}: {ortho:e} {stiff:e}");
+        assert_same_modes(&all, &dense, n, &format!("n = {n}"));
+        assert_identities(&system, &all, &format!("n = {n}"));
     }
 }
 
@@ -305,13 +315,14 @@ fn subset_path_agrees_with_full_path_and_dense_on_chains() {
             let subset = SUBSET.lowest(&system, count).unwrap();
             check_conventions(&subset, count, n);
             for (other, full) in [("all", &all_full), ("dense", &dense_full)] {
-                let d = compare(&subset, &truncate(full, count), count);
-                assert!(d.eigenvalue_rel < 1e-10, "n = {n}, count = {count}, {other}: {d:?}");
-                assert!(d.shape_rel < 1e-8, "n = {n}, count = {count}, {other}: {d:?}");
-                assert_eq!(d.sign_flips, 0, "n = {n}, count = {count}, {other}");
+                assert_same_modes(
+                    &subset,
+                    &truncate(full, count),
+                    count,
+                    &format!("n = {n}, count = {count}, {other}"),
+                );
             }
-            let (ortho, stiff) = identities(&system, &subset);
-            assert!(ortho < 1e-12 && stiff < 1e-12, "n = {n}: {ortho:e} {stiff:e}");
+            assert_identities(&system, &subset, &format!("n = {n}"));
         }
     }
 }
@@ -357,8 +368,7 @@ fn stiff_cantilever_agrees_to_the_conditioning_bound() {
         let d = compare(&subset, &ALL.lowest(&system, 10).unwrap(), 10);
         assert!(d.eigenvalue_rel < 1e-9 && d.shape_rel < 1e-9, "n = {n}: {d:?}");
         for modes in [&all, &subset] {
-            let (ortho, stiff) = identities(&system, modes);
-            assert!(ortho < 1e-12 && stiff < 1e-12, "n = {n}: {ortho:e} {stiff:e}");
+            assert_identities(&system, modes, &format!("n = {n}"));
         }
     }
 }
@@ -386,8 +396,7 @@ fn double_eigenvalues_give_orthonormal_bases_of_the_same_eigenspaces() {
     for solver in [ALL, SUBSET] {
         let modes = solver.lowest(&system, count).unwrap();
         check_conventions(&modes, count, n);
-        let (ortho, stiff) = identities(&system, &modes);
-        assert!(ortho < 1e-12 && stiff < 1e-12, "{solver:?}: {ortho:e} {stiff:e}");
+        assert_identities(&system, &modes, &format!("{solver:?}"));
         for j in 0..count {
             let rel = (modes.eigenvalues[j] - dense.eigenvalues[j]).abs() / dense.eigenvalues[j];
             assert!(rel < 1e-10, "{solver:?} λ{j}: {rel:e}");
