@@ -12,7 +12,7 @@ use truss::{GROUPS, TRUTH};
 
 #[test]
 fn the_truss_estimate_and_its_intervals_stay_within_the_budget_and_hold_the_truth() {
-    let measured = truss::measurement(0.0, 7);
+    let measured = truss::measurement(0.0, truss::SEED);
     let budget = Budget::new(5_000);
     let fit = truss::estimate(&measured, &budget);
     assert!(budget.used() <= 5_000 && !budget.exhausted(), "{} evaluations", budget.used());
@@ -26,7 +26,7 @@ fn the_truss_estimate_and_its_intervals_stay_within_the_budget_and_hold_the_trut
 
 #[test]
 fn a_small_budget_ends_the_truss_estimate_with_a_verdict_not_a_hang() {
-    let measured = truss::measurement(600.0, 7);
+    let measured = truss::measurement(truss::HIDDEN_KG, truss::SEED);
     let budget = Budget::new(40);
     let fit = truss::estimate(&measured, &budget);
     assert!(budget.used() <= 40, "{} evaluations", budget.used());
@@ -38,18 +38,42 @@ fn a_small_budget_ends_the_truss_estimate_with_a_verdict_not_a_hang() {
 
 #[test]
 fn the_truss_discovery_names_the_hidden_mass_within_its_budget() {
-    let measured = truss::measurement(600.0, 7);
+    let measured = truss::measurement(truss::HIDDEN_KG, truss::SEED);
     let report = truss::discover_within(&measured, 10_000).expect("discovery runs");
     assert!(report.evaluations <= 10_000, "{} evaluations", report.evaluations);
     assert!(report.disagreement_significant, "χ² {} on {} dof", report.chi2_before, report.dof_before);
     assert!(!report.budget_exhausted);
     let first = report.effects.first().expect("an effect named");
-    assert_eq!((first.place.kind.as_str(), first.place.location), ("added-node-mass", Some(2)), "{:?}", report.effects);
+    assert_eq!(
+        (first.place.kind.as_str(), first.place.location),
+        ("added-node-mass", Some(2)),
+        "{:?}",
+        report.effects
+    );
+    // θ = 200 kg / 400 kg; the noise moves it by a few per cent.
+    let theta = first.value.expect("a mass has a value");
+    assert!((theta - 0.5).abs() < 0.1, "θ = {theta}");
+}
+
+/// A mass so large that the calibration without it runs a group to its limit: no candidate then
+/// explains the data, and the search says so (a verdict, exit 3 in the CLI) within its budget.
+#[test]
+fn a_truss_too_far_from_its_model_ends_in_a_verdict_within_the_budget() {
+    let measured = truss::measurement(600.0, truss::SEED);
+    let report = truss::discover_within(&measured, 10_000).expect("discovery runs");
+    assert!(report.evaluations <= 10_000, "{} evaluations", report.evaluations);
+    assert!(report.disagreement_significant);
+    // Either the right answer or none: never a wrong place.
+    assert!(
+        report.effects.iter().all(|e| e.place.location == Some(2)),
+        "{:?}",
+        report.effects.iter().map(|e| &e.place.label).collect::<Vec<_>>()
+    );
 }
 
 #[test]
 fn the_truss_discovery_with_a_small_budget_stops_and_says_so() {
-    let measured = truss::measurement(600.0, 7);
+    let measured = truss::measurement(truss::HIDDEN_KG, truss::SEED);
     for budget in [20, 150, 400] {
         match truss::discover_within(&measured, budget) {
             // Cut short in the search: what it had, marked so, nothing named on a partial search.

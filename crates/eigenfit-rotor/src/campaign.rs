@@ -84,7 +84,8 @@ impl Campaign {
     /// Reads a campaign file; errors name the file (and the line for syntax errors).
     pub fn from_toml_file(path: &Path) -> Result<Self, CampaignError> {
         // Regular files only, size-capped, as every file a user names (a FIFO would block).
-        let bytes = read_checked_file(path, MAX_CAMPAIGN_FILE_BYTES, "a campaign file").map_err(CampaignError::Refused)?;
+        let bytes = read_checked_file(path, MAX_CAMPAIGN_FILE_BYTES, "a campaign file")
+            .map_err(CampaignError::Refused)?;
         let text = String::from_utf8(bytes)
             .map_err(|e| CampaignError::Unreadable { path: path.into(), message: e.to_string() })?;
         let mut c: Campaign = toml::from_str(&text).map_err(|e| CampaignError::Syntax {

@@ -4,6 +4,7 @@
 use super::style::{self, log_bounds, log_tick, px, pxi, strategy_colour, Swatch, INK};
 use super::{err, DrawResult, Figure};
 use eigenfit_core::update::Estimate;
+use plotters::coord::ranged1d::WithKeyPoints;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -16,13 +17,14 @@ fn panel<'a, DB: DrawingBackend>(
     x_end: f64,
     y: std::ops::Range<f64>,
     y_title: &str,
-) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, LogCoord<f64>>>, String> {
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, WithKeyPoints<LogCoord<f64>>>>, String> {
+    let (labelled, grid) = style::log_ticks(&y);
     let mut chart = ChartBuilder::on(area)
         .margin(px(15))
         .margin_left(px(20))
         .x_label_area_size(px(x_area))
         .y_label_area_size(px(90))
-        .build_cartesian_2d(0.0..x_end, y.log_scale())
+        .build_cartesian_2d(0.0..x_end, y.log_scale().with_key_points(labelled).with_light_points(grid))
         .map_err(err)?;
     let whole = |v: &f64| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() };
     style::grid(style::axes(&mut chart.configure_mesh(), "iteration", y_title), 0.4)
