@@ -171,17 +171,7 @@ fn the_convergence_plots_parameter_axis_is_labelled_below_1e5() {
 
 #[test]
 fn compare_plots_convergence_and_iteration_maps() {
-    let (scratch, out) = plotted(&[
-        "compare",
-        "--preset",
-        "paper-rotor",
-        "--targets",
-        "1e5:1e5",
-        "--grid",
-        "4",
-        "--strategies",
-        "newton,damped",
-    ]);
+    let (scratch, out) = plotted(&common::paper_compare("1e5:1e5", "4", &["--strategies", "newton,damped"]));
     let dir = scratch.path();
     // Not a terminal: no progress bar on stderr.
     assert!(out.stderr.is_empty(), "stderr: {}", String::from_utf8_lossy(&out.stderr));

@@ -4,7 +4,7 @@
 use super::style::{self, log_bounds, log_tick, px, pxi, strategy_colour, Swatch, INK};
 use super::{err, DrawResult, Figure};
 use eigenfit_core::update::Estimate;
-use plotters::coord::ranged1d::WithKeyPoints;
+use plotters::coord::combinators::WithKeyPoints;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -33,6 +33,17 @@ fn panel<'a, DB: DrawingBackend>(
         .draw()
         .map_err(err)?;
     Ok(chart)
+}
+
+/// A thin dashed horizontal reference line at `y` (a target value, a tolerance).
+fn guide<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, WithKeyPoints<LogCoord<f64>>>>,
+    y: f64,
+    x_end: f64,
+) -> DrawResult {
+    let line = DashedLineSeries::new([(0.0, y), (x_end, y)], px(4), px(5), INK.stroke_width(px(1)));
+    chart.draw_series(line).map_err(err)?;
+    Ok(())
 }
 
 /// Smallest |Δf| drawn on the log axis (exact convergence would be −∞).
@@ -112,14 +123,7 @@ impl Figure for Convergence {
         let mut entries = Vec::new();
         if let Some(t) = &self.target {
             for &v in t {
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        [(0.0, v), (x_end, v)],
-                        px(4),
-                        px(5),
-                        INK.stroke_width(px(1)),
-                    ))
-                    .map_err(err)?;
+                guide(&mut chart, v, x_end)?;
             }
             entries.push((Swatch::Guide, "target".to_string()));
         }
@@ -164,14 +168,7 @@ impl Figure for Convergence {
         let mut chart = panel(&bottom, 50, x_end, d_range, "max |f − f_measured| [Hz]")?;
         let mut entries = Vec::new();
         if let Some(tol) = self.tolerance_hz {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    [(0.0, tol), (x_end, tol)],
-                    px(4),
-                    px(5),
-                    INK.stroke_width(px(1)),
-                ))
-                .map_err(err)?;
+            guide(&mut chart, tol, x_end)?;
             entries.push((Swatch::Guide, format!("paper's tolerance, {tol} Hz")));
         }
         if let Some(sigma) = self.sigma_hz {
