@@ -166,6 +166,8 @@ fn the_convergence_plots_parameter_axis_is_labelled_below_1e5() {
             assert!(svg.contains(label), "from {initial}: no `{label}` on the parameter axis");
         }
         assert!(!svg.contains(crowded), "from {initial}: `{crowded}`: the decade is crowded with labels");
+        // The σ line's legend: three digits of the file's largest std_hz (2.0492 Hz), not 2·10⁰.
+        assert!(svg.contains("largest measurement σ, 2.05 Hz"), "from {initial}: σ legend");
     }
 }
 

@@ -180,7 +180,11 @@ impl Figure for Convergence {
                     INK.mix(0.6).stroke_width(px(2)),
                 ))
                 .map_err(err)?;
-            entries.push((Swatch::Guide, format!("largest measurement σ, {} Hz", log_tick(&sigma))));
+            // Three significant digits, plain where that reads well ("2.05 Hz", not "2·10⁰ Hz").
+            let decimals = (2 - sigma.log10().floor() as i32).max(0) as usize;
+            let value =
+                if (0.01..1e4).contains(&sigma) { style::trim(sigma, decimals) } else { log_tick(&sigma) };
+            entries.push((Swatch::Guide, format!("largest measurement σ, {value} Hz")));
         }
         for run in &self.runs {
             let c = strategy_colour(&run.strategy);
