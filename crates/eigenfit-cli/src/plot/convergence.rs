@@ -9,6 +9,9 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+/// A panel's coordinates: iterations across, a logarithmic axis with chosen ticks up.
+type Coords = Cartesian2d<RangedCoordf64, WithKeyPoints<LogCoord<f64>>>;
+
 /// A panel of the figure on `area`: iterations 0…`x_end` across (whole numbers labelled), `y`
 /// on a log axis titled `y_title`, with `x_area` pixels for the x labels.
 fn panel<'a, DB: DrawingBackend>(
@@ -17,7 +20,7 @@ fn panel<'a, DB: DrawingBackend>(
     x_end: f64,
     y: std::ops::Range<f64>,
     y_title: &str,
-) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, WithKeyPoints<LogCoord<f64>>>>, String> {
+) -> Result<ChartContext<'a, DB, Coords>, String> {
     let (labelled, grid) = style::log_ticks(&y);
     let mut chart = ChartBuilder::on(area)
         .margin(px(15))
@@ -36,11 +39,7 @@ fn panel<'a, DB: DrawingBackend>(
 }
 
 /// A thin dashed horizontal reference line at `y` (a target value, a tolerance).
-fn guide<DB: DrawingBackend>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, WithKeyPoints<LogCoord<f64>>>>,
-    y: f64,
-    x_end: f64,
-) -> DrawResult {
+fn guide<DB: DrawingBackend>(chart: &mut ChartContext<'_, DB, Coords>, y: f64, x_end: f64) -> DrawResult {
     let line = DashedLineSeries::new([(0.0, y), (x_end, y)], px(4), px(5), INK.stroke_width(px(1)));
     chart.draw_series(line).map_err(err)?;
     Ok(())
