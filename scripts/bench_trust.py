@@ -7,8 +7,10 @@ Runs, on the release binary (build it first with `cargo build --release -p eigen
 every case of `crates/eigenfit-cli/tests/trust_corpus/cases.toml` (the corpus the trust test
 asserts verdicts and messages on), then the cases a test cannot keep as files: large inputs
 generated into a temporary folder (a 10⁶-row CSV, 10⁵ materials, 10⁵ bearings, a 100 MB field),
-a FIFO and /dev/zero as input, a closed pipe, two runs streaming into one file at once,
-/dev/full as the stream. Prints per case the exit code (and the expected one), the best wall
+a FIFO and /dev/zero as input (model, measured CSV, universal and campaign files), a closed pipe, two runs streaming into one file at once,
+/dev/full as the stream; and the library consumer's 5-parameter truss
+(`crates/eigenfit-core/examples/five_group_truss.rs`, build it with `cargo build --release -p
+eigenfit-core --example five_group_truss`). Prints per case the exit code (and the expected one), the best wall
 time of N runs (default 3) and the first line of output; ends with exit code 1 if a case took
 2 s or more or ended with another exit code. A benchmark, not a test: the times depend on the
 machine and its load, so they are reported, never asserted in CI.
@@ -34,6 +36,7 @@ EIGENFIT, REPEAT = OPTIONS.eigenfit, OPTIONS.repeat
 LIMIT_S = 2.0
 HIDDEN = str(ROOT / "examples/measured_hidden_effect.csv")
 ROTOR = "three_disk_rotor.toml"
+TRUSS = ROOT / "target/release/examples/five_group_truss"
 
 
 def corpus_cases() -> list:
@@ -67,6 +70,8 @@ def big_inputs(tmp: pathlib.Path) -> dict:
     three.write_text(base + '\n[[bearing]]\nname = "mid"\nnode = 12\nstiffness = 1e7\n')
     fifo = tmp / "fifo.csv"
     os.mkfifo(fifo)
+    unv_fifo = tmp / "fifo.unv"
+    os.mkfifo(unv_fifo)
     return {k: str(v) for k, v in locals().items() if isinstance(v, pathlib.Path) and k != "tmp"}
 
 
@@ -84,16 +89,19 @@ def extra_cases(big: dict, tmp: pathlib.Path) -> list:
          ["compare", "--model", big["three"], "--targets", "1e6:1e6:1e6", "--grid", "1000"], 2),
         ("FIFO as --measured", ["estimate", *paper, "--measured", big["fifo"]], 2),
         ("FIFO as --model", ["simulate", "--model", big["fifo"]], 2),
+        ("FIFO as a campaign file", ["campaign", big["fifo"]], 2),
+        ("FIFO as a universal file", ["estimate", *paper, "--measured", big["unv_fifo"]], 2),
         ("discover, hidden effect", ["discover", *paper, "--measured", HIDDEN], 0),
         ("discover, hidden effect, --budget 1000", ["discover", *paper, "--measured", HIDDEN, "--budget", "1000"], 3),
     ]
 
 
-def run(argv: list, **kw) -> tuple:
-    """(exit code or "kill", seconds, first line of stdout, else of stderr)."""
+def run(argv: list, program: str = "", **kw) -> tuple:
+    """(exit code or "kill", seconds, first line of stdout, else of stderr) of `eigenfit ARGV`
+    (or of `program ARGV`)."""
     t0 = time.perf_counter()
     try:
-        out = subprocess.run([EIGENFIT, *argv], cwd=CORPUS, capture_output=True, timeout=60, **kw)
+        out = subprocess.run([program or EIGENFIT, *argv], cwd=CORPUS, capture_output=True, timeout=60, **kw)
         code = out.returncode
         text = (out.stdout or b"").decode(errors="replace").strip() or out.stderr.decode(errors="replace").strip()
     except subprocess.TimeoutExpired:
@@ -144,6 +152,15 @@ def main() -> int:
         for name, argv, expected in corpus_cases() + extra_cases(big, tmp):
             if OPTIONS.only in name:
                 report(name, expected, [run(argv) for _ in range(REPEAT)], bad)
+        # The library consumer's 5-parameter truss (issue 13: discover killed after 29 minutes):
+        # estimate with intervals and discover, for three trusses, in one example program.
+        name = "library: 5-parameter truss, estimate + intervals + discover ×3"
+        if OPTIONS.only in name:
+            if TRUSS.exists():
+                report(name, 0, [run([], program=str(TRUSS)) for _ in range(REPEAT)], bad)
+            else:
+                print(f"{name}: build it first: cargo build --release -p eigenfit-core --example five_group_truss")
+                bad.append(name)
         for name, case in [("closed pipe keeps exit 3", closed_pipe), ("two runs stream into one file", None)]:
             if OPTIONS.only in name:
                 results = [case() if case else two_streams(tmp) for _ in range(REPEAT)]

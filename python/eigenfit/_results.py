@@ -246,6 +246,12 @@ class DiscoverResult(Result):
         return bool(self._data["disagreement_significant"])
 
     @property
+    def explained(self) -> bool:
+        """Whether the data are explained, by the noise or by the named effect(s); False (exit
+        code 3) when a significant disagreement stays unexplained or the budget ran out."""
+        return bool(self._data.get("explained", self._exit_code == 0))
+
+    @property
     def calibrated_parameters(self) -> Dict[str, float]:
         """The nominal parameters calibrated before the search (name → value)."""
         return dict(self._data["calibrated_parameters"])

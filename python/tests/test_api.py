@@ -91,6 +91,7 @@ def test_discover_matches_cli(cli, examples):
     expected, _ = cli(["discover", "--preset", "paper-rotor", "--measured", str(measured)])
     assert d.to_dict() == expected
     assert d.disagreement_significant
+    assert d.explained and d.exit_code == 0
     assert d.missing_effect["kind"] == expected["missing_effect"]["kind"]
 
 

@@ -76,18 +76,11 @@ fn estimate_that_does_not_converge_exits_with_3_and_still_reports() {
 
 #[test]
 fn compare_prints_one_run_per_cell() {
-    let (code, v) = eigenfit(&[
-        "compare",
-        "--preset",
-        "paper-rotor",
-        "--targets",
+    let (code, v) = eigenfit(&common::paper_compare(
         "1e5:1e5,1e5:1e3",
-        "--grid",
         "3",
-        "--strategies",
-        "newton,p-step,damped",
-        "--json",
-    ]);
+        &["--strategies", "newton,p-step,damped", "--json"],
+    ));
     assert_eq!(code, 0);
     let runs = v["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 2 * 9 * 3);
@@ -232,18 +225,9 @@ fn stdout_of(args: &[&str]) -> Vec<u8> {
 #[test]
 fn the_same_input_gives_byte_for_byte_the_same_output() {
     let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/measured_hidden_effect.csv");
+    let compare = common::paper_compare("1e5:1e5,1e8:1e8", "4", &["--json", "--quiet"]);
     let runs: [&[&str]; 3] = [
-        &[
-            "compare",
-            "--preset",
-            "paper-rotor",
-            "--targets",
-            "1e5:1e5,1e8:1e8",
-            "--grid",
-            "4",
-            "--json",
-            "--quiet",
-        ],
+        &compare,
         &["estimate", "--preset", "paper-rotor", "--measured", data, "--initial", "1e3,1e3", "--json"],
         &["discover", "--preset", "paper-rotor", "--measured", data, "--json", "--quiet"],
     ];
@@ -258,19 +242,11 @@ fn the_same_input_gives_byte_for_byte_the_same_output() {
 fn compare_streams_every_finished_run() {
     let scratch = common::scratch();
     let path = common::write_in(&scratch, "runs.jsonl", "");
-    let (code, v) = eigenfit(&[
-        "compare",
-        "--preset",
-        "paper-rotor",
-        "--targets",
+    let (code, v) = eigenfit(&common::paper_compare(
         "1e5:1e5",
-        "--grid",
         "3",
-        "--json",
-        "--quiet",
-        "--stream",
-        path.to_str().unwrap(),
-    ]);
+        &["--json", "--quiet", "--stream", path.to_str().unwrap()],
+    ));
     assert_eq!(code, 0);
     let streamed: Vec<Value> =
         std::fs::read_to_string(&path).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();

@@ -58,22 +58,11 @@ fn simulate_prints_scipys_frequencies_with_the_sparse_solver() {
 #[test]
 fn set_overrides_parameters_by_name() {
     let model = plate("model.toml");
-    let (code, v, err) = eigenfit(&[
-        "simulate",
-        "--model",
-        &model,
-        "--modes",
-        "10",
-        "--json",
-        "--set",
-        "zone1=1.25",
-        "--set",
-        "zone2=0.8",
-        "--set",
-        "zone3=1.1",
-        "--set",
-        "zone4=0.9",
-    ]);
+    let mut args = vec!["simulate", "--model", &model, "--modes", "10", "--json"];
+    for set in ["zone1=1.25", "zone2=0.8", "zone3=1.1", "zone4=0.9"] {
+        args.extend(["--set", set]);
+    }
+    let (code, v, err) = eigenfit(&args);
     assert_eq!(code, 0, "{err}");
     assert_eq!(v["parameters"]["zone2"], 0.8);
     for (a, b) in floats(&v["frequencies_hz"]).iter().zip(&measured()) {

@@ -142,19 +142,38 @@ fn estimate_plots_its_convergence_history() {
     );
 }
 
+/// The parameter axis carries numbers over its whole range: from 1e6 down to the 5e4 N/m the
+/// fit ends at, plotters' own ticks labelled only 10⁵ and 10⁶ (nothing below 1e5), and from 1e4
+/// crowded nine labels into one decade.
+#[test]
+fn the_convergence_plots_parameter_axis_is_labelled_below_1e5() {
+    for (initial, expected, crowded) in
+        [("1e6,1e6", ["10⁵", "5·10⁴", "2·10⁴"], "3·10⁴"), ("1e4,1e4", ["10⁴", "5·10⁴", "2·10⁵"], "7·10⁴")]
+    {
+        let measured = example("measured_no_effect.csv");
+        let (scratch, _) = plotted(&[
+            "estimate",
+            "--preset",
+            "paper-rotor",
+            "--measured",
+            &measured,
+            "--initial",
+            initial,
+            "--quiet",
+        ]);
+        let svg = std::fs::read_to_string(scratch.path().join("convergence.svg")).unwrap();
+        for label in expected {
+            assert!(svg.contains(label), "from {initial}: no `{label}` on the parameter axis");
+        }
+        assert!(!svg.contains(crowded), "from {initial}: `{crowded}`: the decade is crowded with labels");
+        // The σ line's legend: three digits of the file's largest std_hz (2.0492 Hz), not 2·10⁰.
+        assert!(svg.contains("largest measurement σ, 2.05 Hz"), "from {initial}: σ legend");
+    }
+}
+
 #[test]
 fn compare_plots_convergence_and_iteration_maps() {
-    let (scratch, out) = plotted(&[
-        "compare",
-        "--preset",
-        "paper-rotor",
-        "--targets",
-        "1e5:1e5",
-        "--grid",
-        "4",
-        "--strategies",
-        "newton,damped",
-    ]);
+    let (scratch, out) = plotted(&common::paper_compare("1e5:1e5", "4", &["--strategies", "newton,damped"]));
     let dir = scratch.path();
     // Not a terminal: no progress bar on stderr.
     assert!(out.stderr.is_empty(), "stderr: {}", String::from_utf8_lossy(&out.stderr));

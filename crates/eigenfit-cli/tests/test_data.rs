@@ -205,17 +205,10 @@ fn a_declared_disk_mass_is_estimated_and_written_back() {
     let rig = scratch.path().join("rig.toml");
     std::fs::write(&rig, base.replacen("mass = 1.0", "mass = 1.3", 1)).unwrap();
     let file = scratch.path().join("rig.unv");
-    let (code, out, err) = run(&[
-        "simulate",
-        "--model",
-        rig.to_str().unwrap(),
-        "--stiffness",
-        "2e5,1.5e5",
-        "--modes",
-        "4",
-        "--uff",
-        file.to_str().unwrap(),
-    ]);
+    let rig_at = |modes: &'static str| {
+        ["simulate", "--model", rig.to_str().unwrap(), "--stiffness", "2e5,1.5e5", "--modes", modes]
+    };
+    let (code, out, err) = run(&[&rig_at("4")[..], &["--uff", file.to_str().unwrap()]].concat());
     assert_eq!(code, 0, "{out}{err}");
     let model = scratch.path().join("with-disk-mass.toml");
     std::fs::write(&model, format!("{base}\n[[parameter]]\nkind = \"disk-mass\"\nindex = 0\n")).unwrap();
@@ -234,16 +227,7 @@ fn a_declared_disk_mass_is_estimated_and_written_back() {
     assert!(text.contains("# m_disk_0 = 1.3") && text.contains("kind = \"disk-mass\""), "{text}");
     let (code, again) = json(&["simulate", "--model", updated.to_str().unwrap(), "--modes", "2", "--json"]);
     assert_eq!(code, 0);
-    let (_, rig_f) = json(&[
-        "simulate",
-        "--model",
-        rig.to_str().unwrap(),
-        "--stiffness",
-        "2e5,1.5e5",
-        "--modes",
-        "2",
-        "--json",
-    ]);
+    let (_, rig_f) = json(&[&rig_at("2")[..], &["--json"]].concat());
     for (a, b) in
         again["frequencies_hz"].as_array().unwrap().iter().zip(rig_f["frequencies_hz"].as_array().unwrap())
     {

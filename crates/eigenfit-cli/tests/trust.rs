@@ -109,9 +109,11 @@ fn discover_stays_within_the_budget_it_is_given_and_says_when_it_ran_out() {
         let used = v["evaluations"].as_u64().unwrap();
         assert!(used <= budget, "{used} evaluations for a budget of {budget}");
         assert_eq!(v["budget_limit"], budget);
-        // Exit 3 exactly when the search was cut short.
+        // Exit 0 exactly when the data are explained; a search cut short never is (exit 3).
         let cut = v["budget_exhausted"].as_bool().unwrap();
-        assert_eq!(out.status.code(), Some(if cut { 3 } else { 0 }), "budget {budget}: {v}");
+        let explained = v["explained"].as_bool().unwrap();
+        assert!(!(cut && explained), "budget {budget}: {v}");
+        assert_eq!(out.status.code(), Some(if explained { 0 } else { 3 }), "budget {budget}: {v}");
         // Enough budget: the effect is found without running out.
         if budget == 100_000 {
             assert!(!cut && v["missing_effect"]["kind"] == "disk-rotary-inertia", "{v}");
@@ -209,6 +211,39 @@ fn measured_file() -> impl Strategy<Value = String> {
             s
         },
     )
+}
+
+/// A FIFO is refused before it is opened (opening one for reading blocks until a writer
+/// appears): as a universal file, a campaign file, and a file a campaign names.
+#[test]
+fn fifos_named_as_universal_or_campaign_files_are_refused_not_waited_on() {
+    let scratch = tempfile::tempdir().expect("a temporary folder");
+    let dir = scratch.path();
+    let fifo = |name: &str| {
+        let path = dir.join(name);
+        let made = Command::new("mkfifo").arg(&path).status().expect("mkfifo runs");
+        assert!(made.success());
+        path.to_str().unwrap().to_string()
+    };
+    let (unv, campaign, measured) = (fifo("modes.unv"), fifo("campaign.toml"), fifo("measured.unv"));
+    let listed = dir.join("listed.toml");
+    let rotor = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/trust_corpus").join(ROTOR);
+    std::fs::write(
+        &listed,
+        format!("[[configuration]]\nmodel = {:?}\nmeasured = {measured:?}\n", rotor.to_str().unwrap()),
+    )
+    .unwrap();
+    let runs: [&[&str]; 3] = [
+        &["estimate", "--preset", "paper-rotor", "--measured", &unv],
+        &["campaign", &campaign],
+        &["campaign", listed.to_str().unwrap()],
+    ];
+    for args in runs {
+        let out = eigenfit(args);
+        let all = text(&out.stdout) + &text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {all}");
+        assert!(all.contains("not a regular file"), "{args:?}: {all}");
+    }
 }
 
 proptest! {

@@ -12,6 +12,7 @@
 //!
 //! Parameters of the same name in several configurations are one parameter.
 
+use eigenfit_core::measurement::measured_csv::read_checked_file;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -55,6 +56,9 @@ pub enum CampaignError {
         /// The system's reason.
         message: String,
     },
+    /// Not a regular file, too large, or unreadable: the message names the file and why.
+    #[error("{0}")]
+    Refused(String),
     /// The text is not a valid campaign (TOML syntax or a missing or mistyped key).
     #[error("{}{}: {message}", .path.display(), .line.map(|l| format!(":{l}")).unwrap_or_default())]
     Syntax {
@@ -73,10 +77,16 @@ pub enum CampaignError {
     },
 }
 
+/// Largest campaign file read (bytes): a campaign lists files, it does not hold data.
+pub const MAX_CAMPAIGN_FILE_BYTES: u64 = 1 << 20;
+
 impl Campaign {
     /// Reads a campaign file; errors name the file (and the line for syntax errors).
     pub fn from_toml_file(path: &Path) -> Result<Self, CampaignError> {
-        let text = std::fs::read_to_string(path)
+        // Regular files only, size-capped, as every file a user names (a FIFO would block).
+        let bytes = read_checked_file(path, MAX_CAMPAIGN_FILE_BYTES, "a campaign file")
+            .map_err(CampaignError::Refused)?;
+        let text = String::from_utf8(bytes)
             .map_err(|e| CampaignError::Unreadable { path: path.into(), message: e.to_string() })?;
         let mut c: Campaign = toml::from_str(&text).map_err(|e| CampaignError::Syntax {
             path: path.into(),

@@ -122,6 +122,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     let mut file_notes = Vec::new();
     for conf in &campaign.configurations {
         let name = conf.name.clone().unwrap_or_default();
+        crate::model::check_model_file(&conf.model).map_err(|e| input(format!("{name}: {e}")))?;
         let rotor = Rotor::from_toml_file(&conf.model).map_err(|e| input(format!("{name}: {e}")))?;
         let options = TestDataOptions {
             shapes: conf.shapes.clone(),

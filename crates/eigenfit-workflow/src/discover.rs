@@ -74,6 +74,10 @@ pub struct DiscoverReport {
     pub budget_limit: usize,
     /// True when the search stopped at its budget of eigen-solves.
     pub budget_exhausted: bool,
+    /// True when the data are explained: by the noise from the start, or by the named effects
+    /// (the search names effects only when, with them, the noise explains what is left). False
+    /// when a significant disagreement stays unexplained or the budget ran out: exit code 3.
+    pub explained: bool,
 }
 
 /// A parameter refitted with the named effect(s).
@@ -208,6 +212,7 @@ pub(crate) fn report_of(
         evaluations: r.evaluations,
         budget_limit: budget,
         budget_exhausted: r.budget_exhausted,
+        explained: !r.budget_exhausted && (!r.disagreement_significant || !effects.is_empty()),
     }
 }
 

@@ -5,6 +5,7 @@
 
 use crate::error::{input, WorkflowError};
 use eigenfit_core::matrix::{System, SystemDerivative};
+use eigenfit_core::measurement::measured_csv::check_regular_file;
 use eigenfit_core::model::{Candidate, ModelError, ParameterSet, StructuralModel};
 use eigenfit_matrices::MatricesModel;
 use eigenfit_rotor::{Rotor, UpdatableRotor};
@@ -120,23 +121,7 @@ pub const MAX_MODEL_FILE_BYTES: u64 = 64 << 20;
 /// Refuses a model file that is not a regular file (a FIFO would block every reader, a device
 /// like /dev/zero never end) or is larger than [`MAX_MODEL_FILE_BYTES`], before anything reads it.
 pub fn check_model_file(path: &Path) -> Result<(), WorkflowError> {
-    // A missing or unreadable file is left to the readers, whose messages name it.
-    let Ok(meta) = std::fs::metadata(path) else { return Ok(()) };
-    if !meta.is_file() && !meta.is_dir() {
-        return Err(input(format!(
-            "{}: not a regular file (a FIFO, socket or device would block or never end)",
-            path.display()
-        )));
-    }
-    if meta.len() > MAX_MODEL_FILE_BYTES {
-        return Err(input(format!(
-            "{}: {} MB, larger than the {} MB a model file may have",
-            path.display(),
-            meta.len() >> 20,
-            MAX_MODEL_FILE_BYTES >> 20
-        )));
-    }
-    Ok(())
+    check_regular_file(path, MAX_MODEL_FILE_BYTES, "a model file").map_err(input)
 }
 
 /// Whether the model file at `path` declares `kind = "matrices"` (unreadable files, and anything

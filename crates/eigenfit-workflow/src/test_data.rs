@@ -81,7 +81,9 @@ pub fn is_universal_file(path: &Path) -> bool {
 }
 
 fn read_text(path: &Path) -> Result<String, WorkflowError> {
-    let bytes = std::fs::read(path).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
+    // Regular files only, size-capped, as every file a user names (a FIFO would block).
+    let bytes = measured_csv::read_checked_file(path, measured_csv::MAX_FILE_BYTES, "a measured file")
+        .map_err(input)?;
     String::from_utf8(bytes).map_err(|e| {
         let line = e.as_bytes()[..e.utf8_error().valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
         input(format!(

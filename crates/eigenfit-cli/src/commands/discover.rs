@@ -41,7 +41,8 @@ pub struct DiscoverArgs {
     pub report: crate::output::ReportArgs,
 }
 
-/// Runs `discover`; returns the exit code (3 when the budget ran out before the search ended).
+/// Runs `discover`; returns the exit code: 0 when the data are explained (by the noise, or after
+/// the named effects), 3 when a significant disagreement stays unexplained or the budget ran out.
 pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
     // Two-plane rotors saved by ROSS, against a run-up CSV: the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
@@ -69,7 +70,7 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
     );
     crate::commands::simulate::print_notes(&notes);
     let Discovery { found, mut report } = found?;
-    let code = if report.budget_exhausted { EXIT_NOT_CONVERGED } else { EXIT_OK };
+    let code = if report.explained { EXIT_OK } else { EXIT_NOT_CONVERGED };
     crate::error::set_exit_on_closed_pipe(code);
     if let Some(path) = &args.write_model {
         let text = discover::augmented_model_toml(&found, &model)?;

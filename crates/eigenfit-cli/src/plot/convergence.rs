@@ -4,9 +4,13 @@
 use super::style::{self, log_bounds, log_tick, px, pxi, strategy_colour, Swatch, INK};
 use super::{err, DrawResult, Figure};
 use eigenfit_core::update::Estimate;
+use plotters::coord::combinators::WithKeyPoints;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+
+/// A panel's coordinates: iterations across, a logarithmic axis with chosen ticks up.
+type Coords = Cartesian2d<RangedCoordf64, WithKeyPoints<LogCoord<f64>>>;
 
 /// A panel of the figure on `area`: iterations 0…`x_end` across (whole numbers labelled), `y`
 /// on a log axis titled `y_title`, with `x_area` pixels for the x labels.
@@ -16,13 +20,14 @@ fn panel<'a, DB: DrawingBackend>(
     x_end: f64,
     y: std::ops::Range<f64>,
     y_title: &str,
-) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, LogCoord<f64>>>, String> {
+) -> Result<ChartContext<'a, DB, Coords>, String> {
+    let (labelled, grid) = style::log_ticks(&y);
     let mut chart = ChartBuilder::on(area)
         .margin(px(15))
         .margin_left(px(20))
         .x_label_area_size(px(x_area))
         .y_label_area_size(px(90))
-        .build_cartesian_2d(0.0..x_end, y.log_scale())
+        .build_cartesian_2d(0.0..x_end, y.log_scale().with_key_points(labelled).with_light_points(grid))
         .map_err(err)?;
     let whole = |v: &f64| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() };
     style::grid(style::axes(&mut chart.configure_mesh(), "iteration", y_title), 0.4)
@@ -31,6 +36,13 @@ fn panel<'a, DB: DrawingBackend>(
         .draw()
         .map_err(err)?;
     Ok(chart)
+}
+
+/// A thin dashed horizontal reference line at `y` (a target value, a tolerance).
+fn guide<DB: DrawingBackend>(chart: &mut ChartContext<'_, DB, Coords>, y: f64, x_end: f64) -> DrawResult {
+    let line = DashedLineSeries::new([(0.0, y), (x_end, y)], px(4), px(5), INK.stroke_width(px(1)));
+    chart.draw_series(line).map_err(err)?;
+    Ok(())
 }
 
 /// Smallest |Δf| drawn on the log axis (exact convergence would be −∞).
@@ -110,14 +122,7 @@ impl Figure for Convergence {
         let mut entries = Vec::new();
         if let Some(t) = &self.target {
             for &v in t {
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        [(0.0, v), (x_end, v)],
-                        px(4),
-                        px(5),
-                        INK.stroke_width(px(1)),
-                    ))
-                    .map_err(err)?;
+                guide(&mut chart, v, x_end)?;
             }
             entries.push((Swatch::Guide, "target".to_string()));
         }
@@ -162,14 +167,7 @@ impl Figure for Convergence {
         let mut chart = panel(&bottom, 50, x_end, d_range, "max |f − f_measured| [Hz]")?;
         let mut entries = Vec::new();
         if let Some(tol) = self.tolerance_hz {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    [(0.0, tol), (x_end, tol)],
-                    px(4),
-                    px(5),
-                    INK.stroke_width(px(1)),
-                ))
-                .map_err(err)?;
+            guide(&mut chart, tol, x_end)?;
             entries.push((Swatch::Guide, format!("paper's tolerance, {tol} Hz")));
         }
         if let Some(sigma) = self.sigma_hz {
@@ -181,7 +179,11 @@ impl Figure for Convergence {
                     INK.mix(0.6).stroke_width(px(2)),
                 ))
                 .map_err(err)?;
-            entries.push((Swatch::Guide, format!("largest measurement σ, {} Hz", log_tick(&sigma))));
+            // Three significant digits, plain where that reads well ("2.05 Hz", not "2·10⁰ Hz").
+            let decimals = (2 - sigma.log10().floor() as i32).max(0) as usize;
+            let value =
+                if (0.01..1e4).contains(&sigma) { style::trim(sigma, decimals) } else { log_tick(&sigma) };
+            entries.push((Swatch::Guide, format!("largest measurement σ, {value} Hz")));
         }
         for run in &self.runs {
             let c = strategy_colour(&run.strategy);

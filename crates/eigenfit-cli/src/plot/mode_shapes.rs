@@ -206,3 +206,23 @@ pub fn format_hz(f: f64) -> String {
         format!("{f:.4}")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The markers follow the model, not the order of the bearings: in the paper rotor K2 is at
+    /// x = 0 next to the 1.35 kg disk and K1 at x = 0.5 m next to the 0.4 kg disk
+    /// (docs/paper-rotor.md: Table 1's last row needs the heavy disk near the soft K2).
+    #[test]
+    fn the_paper_rotors_bearing_markers_sit_at_their_own_nodes() {
+        let rotor = eigenfit_rotor::presets::paper_rotor();
+        let solver = eigenfit_core::eigen::DenseSolver;
+        let plot = ModeShapes::of_rotor("paper-rotor", &rotor, &solver, &[1e5, 1e3], 2).unwrap();
+        let at = |name: &str| plot.bearings.iter().find(|b| b.label.starts_with(name)).map(|b| b.x);
+        assert_eq!((at("K1 "), at("K2 ")), (Some(0.5), Some(0.0)), "{:?}", plot.bearings);
+        let heavy = plot.masses.iter().find(|m| m.label == "disk 1.35 kg").unwrap();
+        assert!(heavy.x < 0.25, "the heavy disk is near K2: {heavy:?}");
+        assert!(plot.bearings.iter().any(|b| b.label == "K2 = 1e3 N/m"), "{:?}", plot.bearings);
+    }
+}

@@ -168,6 +168,24 @@ pub fn log_bounds(values: impl IntoIterator<Item = f64>, pad: f64) -> Range<f64>
     lo..hi
 }
 
+/// Labelled ticks of a logarithmic axis over `range`: every power of ten in it, and 2· and 5·
+/// when it spans fewer than four decades, so that every part of the axis carries a number
+/// (plotters' own choice left stretches of a decade unlabelled, or crowded one with nine labels).
+/// Second: the unlabelled grid, every 1…9· multiple.
+pub fn log_ticks(range: &Range<f64>) -> (Vec<f64>, Vec<f64>) {
+    let (lo, hi) = (range.start.min(range.end), range.start.max(range.end));
+    if !(lo > 0.0 && hi.is_finite()) {
+        return (Vec::new(), Vec::new());
+    }
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let inside = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
+    let multiples = |ms: &[f64]| -> Vec<f64> {
+        (first..=last).flat_map(|e| ms.iter().map(move |m| m * 10f64.powi(e))).filter(inside).collect()
+    };
+    let labelled = if last - first <= 4 { multiples(&[1.0, 2.0, 5.0]) } else { multiples(&[1.0]) };
+    (labelled, multiples(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]))
+}
+
 /// A symmetric logarithmic axis, y ↦ sign(y)·log₁₀(1 + |y|): linear near 0 (the ±2σ band stays
 /// visible), logarithmic far out (a 1000σ residual still fits).
 #[derive(Debug, Clone)]

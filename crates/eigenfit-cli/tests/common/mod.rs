@@ -28,6 +28,13 @@ pub fn paper_estimate<'a>(
     args
 }
 
+/// `compare` on the paper rotor: `--targets TARGETS --grid GRID`, then `more`.
+pub fn paper_compare<'a>(targets: &'a str, grid: &'a str, more: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["compare", "--preset", "paper-rotor", "--targets", targets, "--grid", grid];
+    args.extend_from_slice(more);
+    args
+}
+
 /// A fresh folder under the system's temporary folder, removed with everything in it when the
 /// value is dropped (also when the test fails).
 pub fn scratch() -> tempfile::TempDir {

@@ -57,35 +57,51 @@ pub fn read_with_notes(path: &Path) -> Result<(Measurement, Vec<String>), Measur
     Ok((measurement, notes))
 }
 
-/// The bytes of `path`, refusing anything but a regular file (a FIFO would block, a device never
-/// end) and files above `cap` bytes.
-pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, MeasuredFileError> {
-    let cannot =
-        |e: std::io::Error| MeasuredFileError::Unreadable(format!("{}: cannot read: {e}", path.display()));
-    // Checked before opening: opening a FIFO for reading blocks until a writer appears.
-    let meta = std::fs::metadata(path).map_err(cannot)?;
+/// Refuses, from its metadata alone and before anything opens it, a file that is not a regular
+/// file (opening a FIFO blocks until a writer appears, a device like /dev/zero never ends) or is
+/// larger than `cap` bytes; `what` names the kind of file in the message ("a model file").
+/// A missing file and a directory pass: reading them fails at once and the system says why.
+/// Shared by every reader of a user's file (model, measured CSV, universal file, campaign).
+pub fn check_regular_file(path: &Path, cap: u64, what: &str) -> Result<(), String> {
+    let Ok(meta) = std::fs::metadata(path) else { return Ok(()) };
     if meta.is_dir() {
-        // Reading fails at once and the system's message says why.
-        return std::fs::read(path).map_err(cannot);
+        return Ok(());
     }
     if !meta.is_file() {
-        return Err(MeasuredFileError::Unreadable(format!(
+        return Err(format!(
             "{}: not a regular file (a FIFO, socket or device would block or never end)",
             path.display()
-        )));
+        ));
     }
+    if meta.len() > cap {
+        return Err(format!(
+            "{}: {} MB, larger than the {} MB {what} may have",
+            path.display(),
+            meta.len() >> 20,
+            cap >> 20
+        ));
+    }
+    Ok(())
+}
+
+/// The bytes of `path` after [`check_regular_file`], reading at most `cap` bytes (`what` names
+/// the kind of file in the messages).
+pub fn read_checked_file(path: &Path, cap: u64, what: &str) -> Result<Vec<u8>, String> {
+    check_regular_file(path, cap, what)?;
+    let cannot = |e: std::io::Error| format!("{}: cannot read: {e}", path.display());
     let file = std::fs::File::open(path).map_err(cannot)?;
-    let mut bytes = Vec::with_capacity(meta.len().min(cap) as usize);
+    let mut bytes = Vec::new();
     // `take` bounds the read even if the file grows after the check.
     file.take(cap + 1).read_to_end(&mut bytes).map_err(cannot)?;
     if bytes.len() as u64 > cap {
-        return Err(MeasuredFileError::Unreadable(format!(
-            "{}: larger than the {} MB a measured file may have",
-            path.display(),
-            cap >> 20
-        )));
+        return Err(format!("{}: larger than the {} MB {what} may have", path.display(), cap >> 20));
     }
     Ok(bytes)
+}
+
+/// The bytes of a measured file at `path` ([`read_checked_file`] with `cap`).
+pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, MeasuredFileError> {
+    read_checked_file(path, cap, "a measured file").map_err(MeasuredFileError::Unreadable)
 }
 
 /// An invalid measured-data CSV: the line and what is wrong there; shown as `LINE: MESSAGE`.
