@@ -236,9 +236,6 @@ impl StructuralModel for LongChain {
     fn parameters(&self) -> &ParameterSet {
         &self.params
     }
-    fn dofs(&self) -> usize {
-        self.n
-    }
     fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
         self.params.check(p)?;
         let mut k = crate::matrix::BandedSymmetric::zeros(self.n, 1);
@@ -266,6 +263,9 @@ impl StructuralModel for LongChain {
             }
         }
         Ok(d)
+    }
+    fn dofs(&self) -> usize {
+        self.n
     }
 }
 
