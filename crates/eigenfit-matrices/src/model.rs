@@ -21,47 +21,25 @@ struct ModelFile {
     #[serde(default)]
     dofs: Option<PathBuf>,
     #[serde(default)]
-    parameter: Vec<ParameterTable>,
+    parameter: Vec<TermTable>,
     #[serde(default)]
-    candidate: Vec<CandidateTable>,
+    candidate: Vec<TermTable>,
 }
 
+/// A `[[parameter]]` or `[[candidate]]` table: both name a matrix term with its range; a
+/// parameter needs `nominal` and may have `scale`, a candidate may have `plausible` (checked
+/// when read, naming the table). A missing field reads as `None`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct ParameterTable {
+struct TermTable {
     name: String,
-    nominal: f64,
-    #[serde(default)]
-    lower: Option<f64>,
-    #[serde(default)]
-    upper: Option<f64>,
-    #[serde(default)]
-    scale: Option<Scale>,
-    #[serde(default)]
-    unit: Option<String>,
-    #[serde(default)]
-    stiffness: Option<PathBuf>,
-    #[serde(default)]
-    mass: Option<PathBuf>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CandidateTable {
-    name: String,
-    #[serde(default)]
     nominal: Option<f64>,
-    #[serde(default)]
     lower: Option<f64>,
-    #[serde(default)]
     upper: Option<f64>,
-    #[serde(default)]
+    scale: Option<Scale>,
     plausible: Option<[f64; 2]>,
-    #[serde(default)]
     unit: Option<String>,
-    #[serde(default)]
     stiffness: Option<PathBuf>,
-    #[serde(default)]
     mass: Option<PathBuf>,
 }
 
@@ -119,7 +97,12 @@ impl MatricesModel {
         let mut derivative_matrices = Vec::with_capacity(file.parameter.len());
         for (i, t) in file.parameter.iter().enumerate() {
             let table = format!("[[parameter]] {} (`{}`)", i + 1, t.name);
-            let parameter = parameter(&t.name, t.nominal, t.lower, t.upper, t.scale, t.unit.as_deref())
+            let refuse = |what: &str| MatricesError::invalid(path, format!("{table}: {what}"));
+            let nominal = t.nominal.ok_or_else(|| refuse("missing field `nominal`"))?;
+            if t.plausible.is_some() {
+                return Err(refuse("`plausible` belongs to a [[candidate]], not to a parameter"));
+            }
+            let parameter = parameter(&t.name, nominal, t.lower, t.upper, t.scale, t.unit.as_deref())
                 .map_err(|e| MatricesError::invalid(path, format!("{table}: {e}")))?;
             if t.stiffness.is_none() && t.mass.is_none() {
                 return Err(MatricesError::invalid(
@@ -136,6 +119,12 @@ impl MatricesModel {
         let mut candidates = Vec::with_capacity(file.candidate.len());
         for (i, t) in file.candidate.iter().enumerate() {
             let table = format!("[[candidate]] {} (`{}`)", i + 1, t.name);
+            if t.scale.is_some() {
+                return Err(MatricesError::invalid(
+                    path,
+                    format!("{table}: `scale` belongs to a [[parameter]]: a candidate is linear"),
+                ));
+            }
             let (stiffness, mass) = (read_opt(&t.stiffness)?, read_opt(&t.mass)?);
             if stiffness.is_none() && mass.is_none() {
                 return Err(MatricesError::invalid(

@@ -53,6 +53,9 @@ fn mistakes_name_the_file_and_the_place() {
         (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 50.0\nupper = 10\nstiffness = \"K1.mtx\"\n"), "nominal = 50 lies outside"),
         (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = -1.0\nscale = \"log\"\nstiffness = \"K1.mtx\"\n"), "scale = \"log\" needs a positive nominal"),
         (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\nstifness = \"K1.mtx\"\n"), "unknown field `stifness`"),
+        (format!("{HEAD}[[parameter]]\nname = \"k1\"\nstiffness = \"K1.mtx\"\n"), "[[parameter]] 1 (`k1`): missing field `nominal`"),
+        (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\nplausible = [0, 1]\nstiffness = \"K1.mtx\"\n"), "[[parameter]] 1 (`k1`): `plausible` belongs to a [[candidate]]"),
+        (format!("{HEAD}[[candidate]]\nname = \"c\"\nscale = \"log\"\nstiffness = \"K1.mtx\"\n"), "[[candidate]] 1 (`c`): `scale` belongs to a [[parameter]]"),
         ("kind = \"rotor\"\nstiffness = \"K0.mtx\"\nmass = \"M0.mtx\"\n".to_string(), "expected \"matrices\""),
         (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\nstiffness = \"K1.mtx\"\n[[parameter]]\nname = \"k1\"\nnominal = 1.0\nstiffness = \"K1.mtx\"\n"), "k1"),
     ];

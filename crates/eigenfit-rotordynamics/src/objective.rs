@@ -116,6 +116,7 @@ impl Objective for RunupObjective<'_> {
             }),
             jacobian: DMatrix::from_fn(m, np, |i, j| df[(i, j)] / sigma[i]),
             has_std,
+            round_off: Vec::new(),
         })
     }
 }

@@ -188,6 +188,7 @@ fn fit_quality(id: &Identification, points: &[RunupPoint], values: &[f64]) -> Fi
         residual: DVector::from_fn(m, |i, _| (points[i].frequency_hz - id.model_hz[i]) / sigma(i)),
         jacobian: DMatrix::from_fn(m, values.len(), |i, j| df_dp[(i, j)] / sigma(i)),
         has_std,
+        round_off: Vec::new(),
     };
     judge(&lin, values.len())
 }

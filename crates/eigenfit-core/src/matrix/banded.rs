@@ -104,6 +104,19 @@ impl BandedSymmetric {
         out
     }
 
+    /// Σᵢⱼ |Aᵢⱼ|·|xᵢ|·|xⱼ| (both triangles): how much the entries' own rounding can move xᵀAx.
+    pub fn abs_quadratic(&self, x: &[f64]) -> f64 {
+        let w = self.bandwidth + 1;
+        let mut sum = 0.0;
+        for j in 0..self.dim {
+            for d in 0..w.min(self.dim - j) {
+                let term = self.data[j * w + d].abs() * x[j + d].abs() * x[j].abs();
+                sum += if d == 0 { term } else { 2.0 * term };
+            }
+        }
+        sum
+    }
+
     /// Computes `out += alpha · A x`.
     pub fn mul_add(&self, alpha: f64, x: &[f64], out: &mut [f64]) {
         debug_assert!(x.len() == self.dim && out.len() == self.dim);

@@ -192,6 +192,20 @@ impl CscSymmetric {
         }
     }
 
+    /// Σᵢⱼ |Aᵢⱼ|·|xᵢ|·|xⱼ| (both triangles): how much the entries' own rounding can move xᵀAx.
+    pub fn abs_quadratic(&self, x: &[f64]) -> f64 {
+        let mut sum = 0.0;
+        for c in 0..self.dim {
+            let (rows, values) = self.column(c);
+            let xc = x[c].abs();
+            for (&r, &v) in rows.iter().zip(values) {
+                let term = v.abs() * x[r].abs() * xc;
+                sum += if r == c { term } else { 2.0 * term };
+            }
+        }
+        sum
+    }
+
     /// Largest |Aᵢⱼ|.
     pub fn amax(&self) -> f64 {
         self.values.iter().fold(0.0_f64, |a, v| a.max(v.abs()))

@@ -163,6 +163,22 @@ impl System {
         }
     }
 
+    /// (Σᵢⱼ |Kᵢⱼ||xᵢ||xⱼ|, Σᵢⱼ |Mᵢⱼ||xᵢ||xⱼ|) in the system's own storage: the change of xᵀKx and
+    /// xᵀMx that a relative error of one unit in every entry could cause.
+    pub fn abs_quadratic(&self, x: &[f64]) -> (f64, f64) {
+        let dense = |a: &DMatrix<f64>| {
+            a.row_iter()
+                .zip(x)
+                .map(|(row, xi)| xi.abs() * row.iter().zip(x).map(|(v, xj)| (v * xj).abs()).sum::<f64>())
+                .sum()
+        };
+        match &self.storage {
+            Storage::Dense { stiffness, mass } => (dense(stiffness), dense(mass)),
+            Storage::Banded { stiffness, mass, .. } => (stiffness.abs_quadratic(x), mass.abs_quadratic(x)),
+            Storage::Sparse { stiffness, mass, .. } => (stiffness.abs_quadratic(x), mass.abs_quadratic(x)),
+        }
+    }
+
     /// Consumes the system, returning (K, M) dense.
     pub fn into_parts(self) -> (DMatrix<f64>, DMatrix<f64>) {
         match self.storage {
@@ -275,7 +291,13 @@ mod tests {
         assert_eq!(banded.amax(), (2.0, 0.5));
         assert_eq!(banded.stiffness(), &k);
         assert_eq!(banded, dense);
-        assert_eq!(banded.clone().into_parts(), (k, m));
+        assert_eq!(banded.clone().into_parts(), (k.clone(), m.clone()));
+        // Σ|aᵢⱼ||xᵢ||xⱼ| by hand for x = (1, −2, 3): K gives 2·1 + 2·4 + 1·9 + 2·(1·2 + 1·6) = 35.
+        let sparse = System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap();
+        let x = [1.0, -2.0, 3.0];
+        for system in [&dense, &banded, &sparse] {
+            assert_eq!(system.abs_quadratic(&x), (35.0, 7.0));
+        }
         let mut bad = BandedSymmetric::zeros(3, 1);
         bad.add(2, 1, f64::INFINITY);
         assert!(matches!(

@@ -58,5 +58,6 @@ pub fn stack(p: &[f64], parts: &[Linearisation]) -> Linearisation {
         residual: vec(&|l| &l.residual),
         jacobian: mat(&|l| &l.jacobian),
         has_std: parts.iter().all(|l| l.has_std),
+        round_off: parts.iter().flat_map(|l| l.round_off.iter().copied()).collect(),
     }
 }

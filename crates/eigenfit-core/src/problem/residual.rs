@@ -80,6 +80,9 @@ pub struct Linearisation {
     pub jacobian: DMatrix<f64>,
     /// True when the residual is weighted by measured standard deviations (cost = ½χ²).
     pub has_std: bool,
+    /// Relative accuracy of each model frequency as the matrices define it (half the
+    /// eigenvalue's, [`crate::sensitivity::eigenvalue_round_off`]); empty when not known.
+    pub round_off: Vec<f64>,
 }
 
 impl Linearisation {
@@ -110,6 +113,11 @@ impl Linearisation {
     /// Largest |f_model − f_measured| in Hz (the paper's stopping test).
     pub fn max_abs_diff_hz(&self) -> f64 {
         self.frequencies_hz.iter().zip(&self.measured_hz).fold(0.0, |m, (a, b)| f64::max(m, (a - b).abs()))
+    }
+
+    /// Largest [`round_off`](Self::round_off) of the model frequencies (0 when not known).
+    pub fn max_round_off(&self) -> f64 {
+        self.round_off.iter().fold(0.0, |m, &v| f64::max(m, v))
     }
 
     /// Largest |f_model − f_measured| / f_measured.
@@ -191,6 +199,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             residual: DVector::zeros(m),
             jacobian: DMatrix::zeros(m, np),
             has_std: self.measured.has_std(),
+            round_off: vec![0.0; m],
         };
         for (row, (meas, &k)) in self.measured.modes().iter().zip(&paired).enumerate() {
             let lambda = sens.modes.eigenvalues[k];
@@ -200,6 +209,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             lin.measured_eigenvalues[row] = hz_to_eigenvalue(fm);
             lin.frequencies_hz[row] = f;
             lin.measured_hz[row] = fm;
+            lin.round_off[row] = 0.5 * sens.eigenvalue_round_off[k];
             lin.eigenvalue_jacobian.row_mut(row).copy_from(&sens.eigenvalues.row(k));
             let (r, scale, sigma) = self.residual_terms(meas, lambda);
             lin.residual[row] = r / sigma;

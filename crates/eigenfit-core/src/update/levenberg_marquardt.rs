@@ -45,7 +45,9 @@ pub struct LevenbergMarquardt {
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct LevenbergMarquardtSettings {
-    /// A fit is exact when every |f_model − f_measured| / f_measured is below this (≥ 0).
+    /// A fit is exact when every |f_model − f_measured| / f_measured is below this (≥ 0), or,
+    /// with more modes than free parameters, below twice the model frequencies' round-off when
+    /// that is larger ([`Linearisation::round_off`]).
     pub residual_tolerance: f64,
     /// Converged when a scaled step ‖δ‖∞ falls below this without heavy damping (≥ 0).
     pub step_tolerance: f64,
@@ -297,7 +299,8 @@ impl UpdateStrategy for LevenbergMarquardt {
     fn converged(&self, lin: &Linearisation) -> bool {
         // Exact frequencies end the run only when they are the whole residual: with shape rows
         // (testdata::shapes) a mirror solution matches every frequency and still misfits.
-        lin.max_rel_diff() <= self.settings.residual_tolerance
+        let free = (0..lin.parameters.len()).filter(|&i| self.is_free(i)).count();
+        lin.max_rel_diff() <= exact_fit_tolerance(self.settings.residual_tolerance, lin, free)
             && lin.residual.len() == lin.frequencies_hz.len()
     }
 
@@ -444,6 +447,20 @@ impl LevenbergMarquardt {
     fn reject(&mut self) {
         self.mu *= self.nu;
         self.nu *= 2.0;
+    }
+}
+
+/// The relative misfit below which a fit is exact: `residual_tolerance`, or, with more modes than
+/// `free` parameters, twice the round-off of the model frequencies when larger (a fine mesh).
+/// Measured values computed by another solver from the same matrices carry a round-off of the
+/// same size, and more modes than parameters cannot in general absorb it: a fit to that level is
+/// as exact as the matrices define it, and restarting from it only chases rounding. As many
+/// modes as parameters have an exact solution, which the iteration reaches quadratically.
+pub(crate) fn exact_fit_tolerance(residual_tolerance: f64, lin: &Linearisation, free: usize) -> f64 {
+    if lin.residual.len() > free {
+        residual_tolerance.max(2.0 * lin.max_round_off())
+    } else {
+        residual_tolerance
     }
 }
 
