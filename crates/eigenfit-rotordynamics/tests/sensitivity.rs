@@ -166,6 +166,15 @@ fn check_parameters(
     worst
 }
 
+/// Worst relative difference over every coefficient a run-up may estimate (kxx kxy kyx kyy cxx
+/// cxy cyx cyy of both bearings) on the test rotor with cross-coupled, damped bearings.
+fn every_coefficient_error(kxx: f64, ratio: f64, cross: f64, damp: f64, rpm: f64) -> f64 {
+    let k = [kxx, cross * kxx, -cross * kxx, ratio * kxx];
+    let r = rotor(k, [damp, 0.1 * damp, -0.1 * damp, 1.3 * damp], [0.8 * kxx, 0.0, 0.0, 1.2 * kxx]);
+    let params = bearing_parameters(&r, &COEFFICIENT_NAMES).unwrap();
+    check_parameters(&r, &params, rpm, 6, Difference::Ridders(2e-2))
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 12, .. ProptestConfig::default() })]
 
@@ -184,9 +193,6 @@ proptest! {
     fn cross_coupled_and_damping_sensitivities_match_finite_differences(
         kxx in 2e6f64..5e7, ratio in 0.5f64..2.0, cross in 0.05f64..0.3, damp in 1e2f64..3e3, rpm in 500.0f64..15000.0,
     ) {
-        let k = [kxx, cross * kxx, -cross * kxx, ratio * kxx];
-        let r = rotor(k, [damp, 0.1 * damp, -0.1 * damp, 1.3 * damp], [0.8 * kxx, 0.0, 0.0, 1.2 * kxx]);
-        let params = bearing_parameters(&r, &COEFFICIENT_NAMES).unwrap();
         // Damping moves damped frequencies only slightly (10⁻⁶–10⁻³ Hz per unit ln c): with a
         // step of 10⁻⁴ the eigen-solver's round-off (~10⁻¹¹ Hz per frequency) reached 5.7e-4 of
         // the column's scale (the first regression case); near a veering pair a fixed step of
@@ -194,7 +200,7 @@ proptest! {
         // crossing the sorted frequencies swapped within the step (see
         // `cross_coupled_sensitivities_near_veering_and_crossing_pairs`). Ridders' tableau
         // chooses the step; modes are followed by whirl and frequency.
-        let e = check_parameters(&r, &params, rpm, 6, Difference::Ridders(2e-2));
+        let e = every_coefficient_error(kxx, ratio, cross, damp, rpm);
         prop_assert!(e < 1e-5, "worst relative difference {e:.2e}");
     }
 }
@@ -214,10 +220,7 @@ fn cross_coupled_sensitivities_near_veering_and_crossing_pairs() {
         (2e6, 0.5, 0.05, 100.0, 500.0),
         (14107494.313402062, 0.905772137135027, 0.11993321475331609, 2585.640129955812, 3711.943471871223),
     ] {
-        let k = [kxx, cross * kxx, -cross * kxx, ratio * kxx];
-        let r = rotor(k, [damp, 0.1 * damp, -0.1 * damp, 1.3 * damp], [0.8 * kxx, 0.0, 0.0, 1.2 * kxx]);
-        let params = bearing_parameters(&r, &COEFFICIENT_NAMES).unwrap();
-        let e = check_parameters(&r, &params, rpm, 6, Difference::Ridders(2e-2));
+        let e = every_coefficient_error(kxx, ratio, cross, damp, rpm);
         assert!(e < 1e-5, "kxx {kxx} ratio {ratio} cross {cross}: worst relative difference {e:.2e}");
     }
 }
