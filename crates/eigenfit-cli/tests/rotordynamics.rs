@@ -165,3 +165,32 @@ fn estimate_with_cross_coupled_and_damping_parameters_and_verdicts() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("kzz"));
 }
+
+/// `discover` on a ROSS rotor keeps the rule of every `discover`: a budget too small for the
+/// calibration ends with exit code 3 (not a bad-input 2), naming the budget.
+#[test]
+fn ross_discover_with_a_budget_too_small_exits_3() {
+    let (model, measured) = (data("runup_nominal.toml"), data("discovery_disk.csv"));
+    let out = run(&["discover", "--model", &model, "--measured", &measured, "--budget", "3", "--json"]);
+    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("budget"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The control run-up (ROSS, nothing hidden, noise 0.02 Hz): nothing is named, and the exit code follows the report: 0 when the noise
+/// explains the misfit, 3 when a significant disagreement is left unexplained.
+#[test]
+fn ross_discover_on_clean_data_names_nothing() {
+    let (model, measured) = (data("runup_nominal.toml"), data("discovery_clean.csv"));
+    let out = run(&["discover", "--model", &model, "--measured", &measured, "--json"]);
+    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert!(v["missing_effects"].as_array().unwrap().is_empty(), "{}", v["missing_effects"]);
+    let significant = v["disagreement_significant"].as_bool().unwrap();
+    assert_eq!(out.status.code(), Some(if significant { 3 } else { 0 }));
+    assert!(v["evaluations"].as_u64().unwrap() <= 400, "evaluations {}", v["evaluations"]);
+    assert_eq!(v["points"].as_array().unwrap().len(), 36);
+    assert!(v["points"][0]["speed_rpm"].is_number() && v["points"][0]["before_hz"].is_number());
+}

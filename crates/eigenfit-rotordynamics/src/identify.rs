@@ -8,7 +8,7 @@
 //! eigen-solve is the symmetric (undamped) problem with sorted real eigenvalues, while here a
 //! "mode" is a damped complex eigenpair at one of many speeds.
 
-use crate::effects::Effect;
+use crate::effects::EffectKind;
 use crate::error::RotorDynError;
 use crate::interpolation::Coefficient;
 use crate::modal::{Mode, Whirl};
@@ -268,13 +268,14 @@ pub fn evaluate(
     evaluate_with(rotor, params, scales, &[], points)
 }
 
-/// [`evaluate`] with candidate effects added at the given values; the Jacobian's columns are
+/// [`evaluate`] with single-valued candidate effects (an [`EffectKind::Disk`] given by its
+/// [`parts`](EffectKind::parts)) added at the given values; the Jacobian's columns are
 /// d f/d ln s for the parameters, then d f/d value for the effects.
 pub fn evaluate_with(
     rotor: &Rotor,
     params: &[Parameter],
     scales: &[f64],
-    effects: &[(&Effect, f64)],
+    effects: &[(EffectKind, f64)],
     points: &[RunupPoint],
 ) -> Result<Evaluation, RotorDynError> {
     let r = scaled_rotor(rotor, params, scales);

@@ -233,7 +233,7 @@ pub fn augmented_model_toml(found: &RotorDiscovery, model: &AnyModel) -> Result<
 }
 
 /// The budget ran out before the calibration could finish: nothing to report but that.
-fn budget_error(budget: usize) -> WorkflowError {
+pub(crate) fn budget_error(budget: usize) -> WorkflowError {
     WorkflowError::BudgetExhausted(format!(
         "the budget of {budget} model evaluations ran out before the calibration finished (raise it with --budget)"
     ))

@@ -295,21 +295,16 @@ pub fn estimate(
     })
 }
 
-/// One run-up point before and after the discovered effects.
+/// One run-up point before and after the discovered effects: its speed and the keys of a
+/// planar `discover`'s mode (`mode` as measured at that speed, `measured_hz`, `std_hz` —
+/// assumed where the file gives none —, `before_hz`, `after_hz`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunupDiscoveryPoint {
     /// Speed (rpm).
     pub speed_rpm: f64,
-    /// Mode number as measured.
-    pub mode: usize,
-    /// Measured frequency (Hz).
-    pub measured_hz: f64,
-    /// Its standard deviation (Hz; assumed where the file gives none).
-    pub std_hz: f64,
-    /// Calibrated model without the effects (Hz).
-    pub before_hz: f64,
-    /// With the named effects (Hz).
-    pub after_hz: f64,
+    /// The mode before and after.
+    #[serde(flatten)]
+    pub mode: crate::discover::ModeReport,
 }
 
 /// `discover` on a two-plane rotor: the planar report's keys (`missing_effect`, `chi2_before`,
@@ -330,14 +325,16 @@ pub struct RunupDiscoverReport {
 /// the misfit against the noise and, when it is significant, name the effects (a mass, a
 /// diametral or polar inertia at a node, cross-coupling at a bearing, a stiffness loss in a
 /// shaft element) that explain it, by core's forward selection.
+/// `budget`: most model evaluations (each one eigen-solve round over the run-up's speeds).
 pub fn discover(
     path: &Path,
     measured: &Path,
     assumed_std: f64,
+    budget: usize,
 ) -> Result<RunupDiscoverReport, WorkflowError> {
     use eigenfit_core::discovery::{discover_effects, DiscoveryOptions};
     use eigenfit_rotordynamics::effects::candidates;
-    use eigenfit_rotordynamics::objective::{RunupObjective, RunupSearch};
+    use eigenfit_rotordynamics::objective::{RunupObjective, RunupSearch, DISCOVERY_FACTOR_RANGE};
     if !(assumed_std.is_finite() && assumed_std > 0.0) {
         return Err(input(format!("--assumed-std {assumed_std}: must be a positive number")));
     }
@@ -347,14 +344,21 @@ pub fn discover(
     if params.is_empty() {
         return Err(input(format!("{}: the rotor has no bearings to calibrate", path.display())));
     }
-    let base =
-        RunupObjective::new(&rotor, params.clone(), &points, Some(assumed_std)).map_err(to_workflow)?;
+    let (lower, upper) = DISCOVERY_FACTOR_RANGE;
+    let base = RunupObjective::new(&rotor, params.clone(), &points, Some(assumed_std))
+        .and_then(|o| o.within(lower, upper))
+        .map_err(to_workflow)?;
     let filled: Vec<RunupPoint> = base.points().to_vec();
     let effects = candidates(&rotor);
     let search = RunupSearch::new(base, &effects);
-    let options = DiscoveryOptions { assumed_relative_std: assumed_std, ..Default::default() };
+    let options =
+        DiscoveryOptions { assumed_relative_std: assumed_std, max_evaluations: budget, ..Default::default() };
     let r = discover_effects(&search, &search.candidates(), &vec![1.0; params.len()], &options)
-        .map_err(|e| input(format!("{}: {e}", measured.display())))?;
+        .map_err(|e| match e {
+            // The user's budget was too small for the calibration: no input error.
+            eigenfit_core::discovery::DiscoveryError::BudgetExhausted(_) => crate::discover::budget_error(budget),
+            e => input(format!("{}: {e}", measured.display())),
+        })?;
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
     let mut report = crate::discover::report_of(
         &path.display().to_string(),
@@ -381,11 +385,13 @@ pub fn discover(
         .zip(&r.modes)
         .map(|(p, m)| RunupDiscoveryPoint {
             speed_rpm: p.speed_rpm,
-            mode: p.mode,
-            measured_hz: p.frequency_hz,
-            std_hz: m.std_hz,
-            before_hz: m.before_hz,
-            after_hz: m.after_hz,
+            mode: crate::discover::ModeReport {
+                mode: p.mode,
+                measured_hz: p.frequency_hz,
+                std_hz: m.std_hz,
+                before_hz: m.before_hz,
+                after_hz: m.after_hz,
+            },
         })
         .collect();
     Ok(RunupDiscoverReport {

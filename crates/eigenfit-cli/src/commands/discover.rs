@@ -51,9 +51,17 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
                 "--write-model and --plot are not available for ROSS rotors (the report names the effects)",
             ));
         }
-        let report = eigenfit_workflow::rotordynamics::discover(path, &args.measured, args.assumed_std)?;
+        let report =
+            eigenfit_workflow::rotordynamics::discover(path, &args.measured, args.assumed_std, args.budget)?;
+        // The lead's rule for every discover: 0 when the data are explained (by the noise, or
+        // after the named effects), 3 when a significant disagreement remains unexplained or
+        // the budget ran out (the report is still printed).
+        let d = &report.discovery;
+        let unexplained = d.disagreement_significant && d.missing_effects.is_empty();
+        let code = if unexplained || d.budget_exhausted { EXIT_NOT_CONVERGED } else { EXIT_OK };
+        crate::error::set_exit_on_closed_pipe(code);
         crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
-        return Ok(crate::error::EXIT_OK);
+        return Ok(code);
     }
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
