@@ -910,3 +910,49 @@ fn refit<E: EffectSearch>(
         })
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{indistinguishable, separation2};
+    use crate::measurement::synthetic::NoiseRng;
+
+    #[test]
+    fn the_margin_is_the_floor_or_what_a_95_percent_test_cannot_reject() {
+        // Under the floor: always ambiguous, however far apart.
+        assert!(indistinguishable(1.9, 1e4, 2.0));
+        // Fits 1.96σ apart: the margin is 1.96² = 3.84.
+        let d2 = 1.959_963_984_540_054f64.powi(2);
+        assert!(indistinguishable(3.8, d2, 2.0));
+        assert!(!indistinguishable(3.9, d2, 2.0));
+        // Fits the data separate clearly: only the floor.
+        assert!(!indistinguishable(2.1, 100.0, 2.0));
+    }
+
+    /// When the alternative is the truth, the data reject it (it trails by more than the margin)
+    /// in about 2.5 % of noise draws — the one-sided 95 % test the margin stands for.
+    #[test]
+    fn a_true_alternative_is_rejected_in_one_draw_in_forty() {
+        let sigma = [1.0, 2.0, 0.5, 1.5];
+        let truth = [10.0, 20.0, 30.0, 40.0];
+        // The other fit: 1σ off in three modes, d² = 3 (margin 2·1.96·√3 − 3 = 3.79).
+        let other = [11.0, 18.0, 30.0, 41.5];
+        let d2 = separation2(&truth, &other, &sigma);
+        assert!((d2 - 3.0).abs() < 1e-12, "{d2}");
+        let mut rng = NoiseRng(7);
+        let draws = 40_000;
+        let mut rejected = 0;
+        for _ in 0..draws {
+            let y: Vec<f64> = truth.iter().zip(&sigma).map(|(t, s)| t + s * rng.normal()).collect();
+            let chi2 = |f: &[f64]| -> f64 {
+                y.iter().zip(f).zip(&sigma).map(|((y, f), s)| ((y - f) / s).powi(2)).sum()
+            };
+            // The truth trails the other fit by `delta` (when it trails at all).
+            let delta = chi2(&truth) - chi2(&other);
+            if delta > 0.0 && !indistinguishable(delta, d2, 0.0) {
+                rejected += 1;
+            }
+        }
+        let rate = rejected as f64 / draws as f64;
+        assert!((rate - 0.025).abs() < 0.004, "true alternative rejected in {rate} of draws");
+    }
+}
