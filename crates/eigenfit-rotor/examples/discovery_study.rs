@@ -4,8 +4,8 @@
 //!
 //! cargo run --release -p eigenfit-rotor --example discovery_study
 //! (`STUDY_CASES=pedestal,clean` for some cases only, `STUDY_VERBOSE=1` for every answer,
-//! `STUDY_SET=heldout` for the held-out draws of `generate.py --heldout` instead of the design
-//! draws)
+//! `STUDY_SET=heldout` for the draws of `generate.py --heldout`, `STUDY_SET=fresh` for those of
+//! `generate.py --fresh`, instead of the design draws)
 
 #[path = "../tests/common/study.rs"]
 mod study;
@@ -14,9 +14,13 @@ use std::time::Instant;
 use study::Outcome;
 
 fn main() {
-    let heldout = std::env::var("STUDY_SET").is_ok_and(|s| s == "heldout");
-    let fixtures = if heldout { study::load_heldout() } else { study::load() };
-    println!("draws: {}\n", if heldout { "held-out (heldout.toml)" } else { "design (independent.toml)" });
+    let set = std::env::var("STUDY_SET").unwrap_or_default();
+    let (fixtures, name) = match set.as_str() {
+        "heldout" => (study::load_heldout(), "held-out (heldout.toml, seed 99173)"),
+        "fresh" => (study::load_fresh(), "fresh held-out (fresh.toml, seed 60411)"),
+        _ => (study::load(), "design (independent.toml, seed 20261123)"),
+    };
+    println!("draws: {name}\n");
     println!("| case | noise | named | ambiguous (honest) | nothing | wrong | truth in 95 % interval |");
     println!("|---|---|---|---|---|---|---|");
     let mut slowest = 0.0f64;

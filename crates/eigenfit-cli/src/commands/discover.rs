@@ -133,7 +133,7 @@ fn print_report(
         println!("modes off by more than 2σ: {}", flagged.join(", "));
     }
     match (found.effects.is_empty(), r.disagreement_significant) {
-        (_, false) => println!("no significant disagreement: nothing added."),
+        (true, false) => println!("no significant disagreement: nothing added."),
         // Cut short, the search has not shown that nothing explains the data.
         (true, true) if r.budget_exhausted => {
             println!("no candidate effect confirmed before the budget ran out.");
@@ -155,7 +155,8 @@ fn print_report(
                 );
             }
         }
-        (false, true) => {
+        // Also without an overall significant misfit: the refined mesh is tested on its own.
+        (false, _) => {
             let title = if found.effects.len() == 1 { "missing effect" } else { "missing effects" };
             println!("{title}:");
             for e in &found.effects {

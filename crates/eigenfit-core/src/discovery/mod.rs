@@ -58,7 +58,8 @@ pub struct DiscoveryOptions {
     pub refits_per_kind: usize,
     /// Most effects added by forward selection (default 3).
     pub max_effects: usize,
-    /// Alternatives within this AICc of a named effect are reported as ambiguous (default 2).
+    /// Alternatives within this AICc of a named effect are always reported as ambiguous (default
+    /// 2); so is any alternative the data cannot reject ([`indistinguishable`]).
     pub ambiguity_aicc: f64,
     /// Most model evaluations (eigen-solves) the whole run may spend (default
     /// [`DEFAULT_EVALUATIONS`]): bounded time whatever the data. When they run out the search
@@ -275,7 +276,8 @@ pub struct NamedEffect {
     /// AICc gained when the effect was added, less the charge for choosing its place
     /// ([`Fit::score`]).
     pub delta_aicc: f64,
-    /// Alternatives within [`DiscoveryOptions::ambiguity_aicc`] when it was chosen.
+    /// Alternatives within [`DiscoveryOptions::ambiguity_aicc`] when it was chosen, or that the
+    /// data could not reject ([`indistinguishable`]).
     pub ambiguous_with: Vec<Alternative>,
     /// The effect's further fitted values ([`Candidate::companions`]) in the final joint fit.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -495,6 +497,7 @@ pub fn discover_effects<E: EffectSearch>(
             "{n} measured modes for {nb} parameters: detecting a missing effect needs more modes than parameters"
         )));
     }
+    let stds: Vec<f64> = rows.iter().map(|r| r.std_hz).collect();
     let budget = Budget::new(options.max_evaluations);
     // (a) calibrate
     let est = search
@@ -596,17 +599,26 @@ pub fn discover_effects<E: EffectSearch>(
             .into_iter()
             .chain(candidates.iter().enumerate().filter(|&(i, c)| c.needs_refit() && open(i)).map(|(i, _)| i))
             .collect();
-        let mut fits: Vec<(usize, Fit)> = to_refit
-            .into_iter()
-            .filter_map(|i| {
-                let mut set = chosen_refs.clone();
-                set.push(&candidates[i]);
-                let mut fit = refit(search, n, &set, &current.parameters, &budget)?;
-                fit.place_charge = current.place_charge + charges[i];
-                Some((i, fit))
-            })
-            .collect();
+        let refit_one = |i: usize| {
+            let mut set = chosen_refs.clone();
+            set.push(&candidates[i]);
+            let mut fit = refit(search, n, &set, &current.parameters, &budget)?;
+            fit.place_charge = current.place_charge + charges[i];
+            Some((i, fit))
+        };
+        let mut fits: Vec<(usize, Fit)> = to_refit.into_iter().filter_map(refit_one).collect();
         fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
+        // The linear screen misranks close variants of a large effect (a step and the tapers
+        // around it crowd each other out of the refits): every candidate of the leader's kind at
+        // an overlapping place is refitted too, so the choice and its ambiguities rest on fits.
+        if let Some(&(lead, _)) = fits.iter().find(|(_, f)| f.plausible) {
+            let near: Vec<usize> = (0..candidates.len())
+                .filter(|&i| open(i) && !fits.iter().any(|(j, _)| *j == i))
+                .filter(|&i| overlaps(&candidates[i], &candidates[lead]))
+                .collect();
+            fits.extend(near.into_iter().filter_map(refit_one));
+            fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
+        }
         if round == 0 {
             report.fits = fits.iter().map(|(_, f)| f.clone()).collect();
         }
@@ -621,7 +633,10 @@ pub fn discover_effects<E: EffectSearch>(
         let ambiguous_with = fits
             .iter()
             .filter(|(i, _)| !same_place(&candidates[*i], &candidates[best_i]))
-            .filter(|(_, f)| f.plausible && f.score() - best.score() < options.ambiguity_aicc)
+            .filter(|(_, f)| {
+                let apart = separation2(&f.frequencies_hz, &best.frequencies_hz, &stds);
+                f.plausible && indistinguishable(f.score() - best.score(), apart, options.ambiguity_aicc)
+            })
             .map(|(i, f)| Alternative::new(&candidates[*i], f, best.score()))
             .collect();
         named.push(NamedEffect::new(&candidates[best_i], current.score() - best.score(), ambiguous_with));
@@ -671,6 +686,24 @@ pub fn discover_effects<E: EffectSearch>(
     Ok(report)
 }
 
+/// Squared distance between two fits' predictions in units of the noise: Σ ((a − b)/σ)².
+pub fn separation2(a: &[f64], b: &[f64], std_hz: &[f64]) -> f64 {
+    a.iter().zip(b).zip(std_hz).map(|((a, b), s)| ((a - b) / s).powi(2)).sum()
+}
+
+/// Can the data not tell an alternative from the fit it trails by `delta` (its score minus the
+/// other's, ≥ 0), their predictions `separation2` apart ([`separation2`])? Always when `delta` is
+/// under `floor` (the AICc margin); else when a 95 % likelihood-ratio test cannot reject the
+/// alternative. Were the alternative true, the other fit's χ² would exceed its own by
+/// d² + 2d·Z (d = √separation2, Z standard normal: the noise projected on the difference of the
+/// predictions), so the data reject it only when `delta` > 2·1.96·d − d². The margin is largest,
+/// 1.96² = 3.84, for fits about 2σ apart (a taper and the step it resembles at 0.2 % noise) and
+/// falls under `floor` for fits the data separate clearly (d > 3.4).
+pub fn indistinguishable(delta: f64, separation2: f64, floor: f64) -> bool {
+    let d = separation2.max(0.0).sqrt();
+    delta < floor.max(2.0 * interval::Z_95 * d - separation2)
+}
+
 /// The charge for choosing each candidate's place: 2·ln m, m the number of places its kind is
 /// offered at. The best of m places fits noise better than one place given in advance (the
 /// look-elsewhere effect: the largest of m χ²₁ draws grows as 2·ln m), so a point mass picked
@@ -694,6 +727,18 @@ pub fn place_charges(candidates: &[Candidate]) -> Vec<f64> {
             2.0 * (m as f64).ln()
         })
         .collect()
+}
+
+/// Two candidates of one kind whose places overlap: element runs that share an element, or (for
+/// effects without a run) the same location.
+fn overlaps(a: &Candidate, b: &Candidate) -> bool {
+    if a.kind != b.kind {
+        return false;
+    }
+    match (a.elements, b.elements) {
+        (Some([a0, a1]), Some([b0, b1])) => a0 <= b1 && b0 <= a1,
+        _ => a.location.is_some() && a.location == b.location,
+    }
 }
 
 /// Two candidates that describe the same thing at the same place (never chosen twice).
@@ -864,4 +909,50 @@ fn refit<E: EffectSearch>(
             intervals,
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{indistinguishable, separation2};
+    use crate::measurement::synthetic::NoiseRng;
+
+    #[test]
+    fn the_margin_is_the_floor_or_what_a_95_percent_test_cannot_reject() {
+        // Under the floor: always ambiguous, however far apart.
+        assert!(indistinguishable(1.9, 1e4, 2.0));
+        // Fits 1.96σ apart: the margin is 1.96² = 3.84.
+        let d2 = 1.959_963_984_540_054f64.powi(2);
+        assert!(indistinguishable(3.8, d2, 2.0));
+        assert!(!indistinguishable(3.9, d2, 2.0));
+        // Fits the data separate clearly: only the floor.
+        assert!(!indistinguishable(2.1, 100.0, 2.0));
+    }
+
+    /// When the alternative is the truth, the data reject it (it trails by more than the margin)
+    /// in about 2.5 % of noise draws — the one-sided 95 % test the margin stands for.
+    #[test]
+    fn a_true_alternative_is_rejected_in_one_draw_in_forty() {
+        let sigma = [1.0, 2.0, 0.5, 1.5];
+        let truth = [10.0, 20.0, 30.0, 40.0];
+        // The other fit: 1σ off in three modes, d² = 3 (margin 2·1.96·√3 − 3 = 3.79).
+        let other = [11.0, 18.0, 30.0, 41.5];
+        let d2 = separation2(&truth, &other, &sigma);
+        assert!((d2 - 3.0).abs() < 1e-12, "{d2}");
+        let mut rng = NoiseRng(7);
+        let draws = 40_000;
+        let mut rejected = 0;
+        for _ in 0..draws {
+            let y: Vec<f64> = truth.iter().zip(&sigma).map(|(t, s)| t + s * rng.normal()).collect();
+            let chi2 = |f: &[f64]| -> f64 {
+                y.iter().zip(f).zip(&sigma).map(|((y, f), s)| ((y - f) / s).powi(2)).sum()
+            };
+            // The truth trails the other fit by `delta` (when it trails at all).
+            let delta = chi2(&truth) - chi2(&other);
+            if delta > 0.0 && !indistinguishable(delta, d2, 0.0) {
+                rejected += 1;
+            }
+        }
+        let rate = rejected as f64 / draws as f64;
+        assert!((rate - 0.025).abs() < 0.004, "true alternative rejected in {rate} of draws");
+    }
 }
