@@ -79,6 +79,12 @@ pub fn eigenvalue_derivatives(mats: &Matrices, modes: &[Mode], params: &[MatrixD
             end += 1;
         }
         let cluster = &modes[start..end];
+        // yᴴ(2λM + D)x does not depend on the parameter: once per mode, not once per pair.
+        let b: Vec<c64> = if cluster.len() == 2 {
+            Vec::new()
+        } else {
+            cluster.iter().map(|m| b_form(&m.left, mats, m.eigenvalue, &m.right)).collect()
+        };
         for (p, dq) in params.iter().enumerate() {
             let d = if cluster.len() == 2 {
                 pair_derivatives(mats, cluster, dq)
@@ -86,10 +92,8 @@ pub fn eigenvalue_derivatives(mats: &Matrices, modes: &[Mode], params: &[MatrixD
                 // Single modes (and, as an approximation, larger clusters): the formula as is.
                 cluster
                     .iter()
-                    .map(|m| {
-                        -q_prime(&m.left, dq, m.eigenvalue, &m.right)
-                            / b_form(&m.left, mats, m.eigenvalue, &m.right)
-                    })
+                    .zip(&b)
+                    .map(|(m, b)| -q_prime(&m.left, dq, m.eigenvalue, &m.right) / b)
                     .collect()
             };
             for (i, v) in d.into_iter().enumerate() {

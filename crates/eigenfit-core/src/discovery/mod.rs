@@ -438,6 +438,15 @@ pub trait EffectSearch {
 
     /// The measured rows, in the objective's residual order.
     fn rows(&self) -> Vec<MeasuredRow>;
+
+    /// Further starting values of the base parameters for every candidate's refit, besides the
+    /// calibrated ones (by default none). A calibration without the missing effect can drive the
+    /// base parameters to where they absorb part of it (a rotor's bearings onto their bounds
+    /// under a hidden hub); a refit started there can stay in that basin, while one started
+    /// from the model file's values finds the effect. The best fit over the starts is kept.
+    fn other_refit_starts(&self) -> Vec<Vec<f64>> {
+        Vec::new()
+    }
 }
 
 /// Discovery over structural models: each configuration's model with the effects added to its
@@ -859,13 +868,40 @@ fn refit<E: EffectSearch>(
     budget: &Budget,
 ) -> Option<Fit> {
     let candidate = *set.last()?;
-    let mut start = current.to_vec();
-    start.extend(candidate.parameters().map(|p| p.nominal));
+    let chosen_values: usize = set[..set.len() - 1].iter().map(|c| c.parameter_count()).sum();
+    let base_len = current.len().checked_sub(chosen_values)?;
+    // The calibrated start first; other starts replace the base parameters only.
+    let starts = std::iter::once(current.to_vec()).chain(
+        search.other_refit_starts().into_iter().filter(|b| b.len() == base_len).map(|b| {
+            let mut s = b;
+            s.extend_from_slice(&current[base_len..]);
+            s
+        }),
+    );
+    let fits: Vec<Fit> = starts
+        .filter_map(|mut start| {
+            start.extend(candidate.parameters().map(|p| p.nominal));
+            refit_from(search, n, set, &start, budget)
+        })
+        .collect();
+    fits.into_iter().min_by(|a, b| a.chi2.total_cmp(&b.chi2))
+}
+
+/// [`refit`] from one starting point (the base parameters, the chosen effects' values, the new
+/// candidate's nominal values).
+fn refit_from<E: EffectSearch>(
+    search: &E,
+    n: usize,
+    set: &[&Candidate],
+    start: &[f64],
+    budget: &Budget,
+) -> Option<Fit> {
+    let candidate = *set.last()?;
     search.with_effects(set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
         let est = Driver { max_iterations: 60 }
-            .run_within(problem, &mut LevenbergMarquardt::default(), &start, budget)
+            .run_within(problem, &mut LevenbergMarquardt::default(), start, budget)
             .ok()?;
         // A fit cut short by the budget is not a fit.
         if matches!(est.termination, Termination::BudgetExhausted { .. }) {
