@@ -439,12 +439,14 @@ pub trait EffectSearch {
     /// The measured rows, in the objective's residual order.
     fn rows(&self) -> Vec<MeasuredRow>;
 
-    /// Further starting values of the base parameters for every candidate's refit, besides the
-    /// calibrated ones (by default none). A calibration without the missing effect can drive the
-    /// base parameters to where they absorb part of it (a rotor's bearings onto their bounds
-    /// under a hidden hub); a refit started there can stay in that basin, while one started
-    /// from the model file's values finds the effect. The best fit over the starts is kept.
-    fn other_refit_starts(&self) -> Vec<Vec<f64>> {
+    /// Further starting values of the base parameters for a candidate's refit, besides the
+    /// `calibrated` ones it starts from anyway (by default none). A calibration without the
+    /// missing effect can drive the base parameters to where they absorb part of it (a rotor's
+    /// bearings onto their bounds under a hidden hub); a refit started there can stay in that
+    /// basin, while one started from the model file's values finds the effect. The best fit
+    /// over the starts is kept.
+    fn other_refit_starts(&self, calibrated: &[f64]) -> Vec<Vec<f64>> {
+        let _ = calibrated;
         Vec::new()
     }
 }
@@ -872,11 +874,13 @@ fn refit<E: EffectSearch>(
     let base_len = current.len().checked_sub(chosen_values)?;
     // The calibrated start first; other starts replace the base parameters only.
     let starts = std::iter::once(current.to_vec()).chain(
-        search.other_refit_starts().into_iter().filter(|b| b.len() == base_len).map(|b| {
-            let mut s = b;
-            s.extend_from_slice(&current[base_len..]);
-            s
-        }),
+        search.other_refit_starts(&current[..base_len]).into_iter().filter(|b| b.len() == base_len).map(
+            |b| {
+                let mut s = b;
+                s.extend_from_slice(&current[base_len..]);
+                s
+            },
+        ),
     );
     let fits: Vec<Fit> = starts
         .filter_map(|mut start| {
