@@ -439,15 +439,13 @@ pub trait EffectSearch {
     /// The measured rows, in the objective's residual order.
     fn rows(&self) -> Vec<MeasuredRow>;
 
-    /// Further starting values of the base parameters for a candidate's refit, besides the
-    /// `calibrated` ones it starts from anyway (by default none). A calibration without the
-    /// missing effect can drive the base parameters to where they absorb part of it (a rotor's
-    /// bearings onto their bounds under a hidden hub); a refit started there can stay in that
-    /// basin, while one started from the model file's values finds the effect. The best fit
-    /// over the starts is kept.
-    fn other_refit_starts(&self, calibrated: &[f64]) -> Vec<Vec<f64>> {
-        let _ = calibrated;
-        Vec::new()
+    /// The base parameters a candidate's refit starts from, given the `calibrated` ones (the
+    /// current fit's): by default those. A calibration without the missing effect can drive the
+    /// base parameters to where they absorb part of it (a rotor's bearings onto their bounds
+    /// under a hidden hub), and a refit started there can stay in that basin; a search that
+    /// can tell may start from elsewhere (the model file's values).
+    fn refit_base_start(&self, calibrated: &[f64]) -> Vec<f64> {
+        calibrated.to_vec()
     }
 }
 
@@ -872,23 +870,13 @@ fn refit<E: EffectSearch>(
     let candidate = *set.last()?;
     let chosen_values: usize = set[..set.len() - 1].iter().map(|c| c.parameter_count()).sum();
     let base_len = current.len().checked_sub(chosen_values)?;
-    // The calibrated start first; other starts replace the base parameters only.
-    let starts = std::iter::once(current.to_vec()).chain(
-        search.other_refit_starts(&current[..base_len]).into_iter().filter(|b| b.len() == base_len).map(
-            |b| {
-                let mut s = b;
-                s.extend_from_slice(&current[base_len..]);
-                s
-            },
-        ),
-    );
-    let fits: Vec<Fit> = starts
-        .filter_map(|mut start| {
-            start.extend(candidate.parameters().map(|p| p.nominal));
-            refit_from(search, n, set, &start, budget)
-        })
-        .collect();
-    fits.into_iter().min_by(|a, b| a.chi2.total_cmp(&b.chi2))
+    let mut start = search.refit_base_start(&current[..base_len]);
+    if start.len() != base_len {
+        return None;
+    }
+    start.extend_from_slice(&current[base_len..]);
+    start.extend(candidate.parameters().map(|p| p.nominal));
+    refit_from(search, n, set, &start, budget)
 }
 
 /// [`refit`] from one starting point (the base parameters, the chosen effects' values, the new
