@@ -195,44 +195,47 @@ fn ross_discover_on_clean_data_names_nothing() {
     assert!(v["points"][0]["speed_rpm"].is_number() && v["points"][0]["before_hz"].is_number());
 }
 
-/// The hidden hub (ROSS: a 4 kg disk, Id 0.01, Ip 0.02 kg·m², at node 4 of the file's rotor,
-/// noise 0.02 Hz): `discover` names a disk at node 4 whose mass interval holds 4 kg, explains the
-/// run-up (exit 0), and does it in bounded work (evaluations counted, not timed).
-#[test]
-fn ross_discover_names_the_hidden_hub() {
-    let (model, measured) = (data("runup_nominal.toml"), data("discovery_disk.csv"));
+/// `discover` on a ROSS run-up with one hidden effect: exit 0 (explained), exactly one effect
+/// named, of `kind` at `location`, whose interval holds `truth`; bounded work (evaluations
+/// counted, not timed). Returns the named effect.
+fn discover_names(measured: &str, kind: &str, location: u64, truth: f64) -> Value {
+    let (model, measured) = (data("runup_nominal.toml"), data(measured));
     let out = run(&["discover", "--model", &model, "--measured", &measured, "--json"]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(v["explained"], true);
     let effects = v["missing_effects"].as_array().unwrap();
     assert_eq!(effects.len(), 1, "{}", v["missing_effects"]);
-    let hub = &effects[0];
-    assert_eq!((hub["kind"].as_str(), hub["location"].as_u64()), (Some("disk"), Some(4)), "{hub}");
-    let [lo, hi] = [hub["interval"][0].as_f64().unwrap(), hub["interval"][1].as_f64().unwrap()];
-    assert!(lo <= 4.0 && 4.0 <= hi, "mass interval [{lo}, {hi}] misses the hidden 4 kg");
-    // Id and Ip, fitted with the mass, hold the hidden 0.01 and 0.02 kg·m² too.
-    for (name, truth) in [("Id_node_4", 0.01), ("Ip_node_4", 0.02)] {
-        let c = hub["companions"].as_array().unwrap().iter().find(|c| c["name"] == name).expect(name);
-        let [lo, hi] = [c["interval"][0].as_f64().unwrap(), c["interval"][1].as_f64().unwrap()];
-        assert!(lo <= truth && truth <= hi, "{name} interval [{lo}, {hi}] misses {truth}");
-    }
+    let effect = &effects[0];
+    assert_eq!(
+        (effect["kind"].as_str(), effect["location"].as_u64()),
+        (Some(kind), Some(location)),
+        "{effect}"
+    );
+    assert_inside(&effect["interval"], truth, kind);
     assert!(v["evaluations"].as_u64().unwrap() <= 4000, "evaluations {}", v["evaluations"]);
+    effect.clone()
 }
 
-/// The weakened shaft (ROSS: element 3 with E and G × 0.7, noise 0.02 Hz): `discover` names a
-/// stiffness loss in element 3 whose interval holds the hidden 0.3, exit 0, bounded work.
+fn assert_inside(interval: &Value, truth: f64, what: &str) {
+    let [lo, hi] = [interval[0].as_f64().unwrap(), interval[1].as_f64().unwrap()];
+    assert!(lo <= truth && truth <= hi, "{what}: interval [{lo}, {hi}] misses the hidden {truth}");
+}
+
+/// The hidden hub (ROSS: a 4 kg disk, Id 0.01, Ip 0.02 kg·m², at node 4 of the file's rotor,
+/// noise 0.02 Hz): a disk at node 4 whose mass, Id and Ip intervals hold the truth.
+#[test]
+fn ross_discover_names_the_hidden_hub() {
+    let hub = discover_names("discovery_disk.csv", "disk", 4, 4.0);
+    for (name, truth) in [("Id_node_4", 0.01), ("Ip_node_4", 0.02)] {
+        let c = hub["companions"].as_array().unwrap().iter().find(|c| c["name"] == name).expect(name);
+        assert_inside(&c["interval"], truth, name);
+    }
+}
+
+/// The weakened shaft (ROSS: element 3 with E and G × 0.7, noise 0.02 Hz): a stiffness loss in
+/// element 3 whose interval holds the hidden 0.3.
 #[test]
 fn ross_discover_names_the_weakened_shaft_element() {
-    let (model, measured) = (data("runup_nominal.toml"), data("discovery_shaft.csv"));
-    let out = run(&["discover", "--model", &model, "--measured", &measured, "--json"]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
-    let effects = v["missing_effects"].as_array().unwrap();
-    assert_eq!(effects.len(), 1, "{}", v["missing_effects"]);
-    let loss = &effects[0];
-    assert_eq!((loss["kind"].as_str(), loss["location"].as_u64()), (Some("shaft-stiffness-loss"), Some(3)));
-    let [lo, hi] = [loss["interval"][0].as_f64().unwrap(), loss["interval"][1].as_f64().unwrap()];
-    assert!(lo <= 0.3 && 0.3 <= hi, "loss interval [{lo}, {hi}] misses the hidden 0.3");
-    assert!(v["evaluations"].as_u64().unwrap() <= 4000, "evaluations {}", v["evaluations"]);
+    discover_names("discovery_shaft.csv", "shaft-stiffness-loss", 3, 0.3);
 }

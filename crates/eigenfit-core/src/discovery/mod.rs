@@ -859,7 +859,8 @@ fn screen<E: EffectSearch>(
 }
 
 /// Refits the current parameters with the candidate set `set` (the chosen ones, then the new
-/// one, last); intervals are the covariance ones (cheap: no profile per candidate).
+/// one, last); intervals are the covariance ones (cheap: no profile per candidate). The base
+/// parameters start where [`EffectSearch::refit_base_start`] says (by default the current ones).
 fn refit<E: EffectSearch>(
     search: &E,
     n: usize,
@@ -876,24 +877,11 @@ fn refit<E: EffectSearch>(
     }
     start.extend_from_slice(&current[base_len..]);
     start.extend(candidate.parameters().map(|p| p.nominal));
-    refit_from(search, n, set, &start, budget)
-}
-
-/// [`refit`] from one starting point (the base parameters, the chosen effects' values, the new
-/// candidate's nominal values).
-fn refit_from<E: EffectSearch>(
-    search: &E,
-    n: usize,
-    set: &[&Candidate],
-    start: &[f64],
-    budget: &Budget,
-) -> Option<Fit> {
-    let candidate = *set.last()?;
     search.with_effects(set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
         let est = Driver { max_iterations: 60 }
-            .run_within(problem, &mut LevenbergMarquardt::default(), start, budget)
+            .run_within(problem, &mut LevenbergMarquardt::default(), &start, budget)
             .ok()?;
         // A fit cut short by the budget is not a fit.
         if matches!(est.termination, Termination::BudgetExhausted { .. }) {
