@@ -177,7 +177,8 @@ const MODES: usize = 6;
 
 fn run(name: &str, test: impl Fn(&Rotor, &Cell<(usize, usize)>) -> Result<(), TestCaseError>) {
     let counts = Cell::new((0usize, 0usize)); // (compared, skipped)
-                                              // A fixed seed: the comparison counts below are then reproducible.
+
+    // A fixed seed: the comparison counts below are then reproducible.
     let mut runner = TestRunner::new_with_rng(
         Config { cases: CASES, failure_persistence: None, ..Config::default() },
         TestRng::deterministic_rng(RngAlgorithm::ChaCha),
