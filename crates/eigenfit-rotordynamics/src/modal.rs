@@ -158,7 +158,7 @@ pub fn solve_lowest(
 ) -> Result<Vec<Mode>, RotorDynError> {
     let n = m.nrows();
     if n > DENSE_DOFS {
-        if let Some(modes) = lowest_shift_invert(m, d, k, pairs, count, with_left) {
+        if let Some(modes) = lowest_shift_invert([m, d, k], pairs, count, with_left) {
             return Ok(modes);
         }
     }
@@ -169,10 +169,9 @@ pub fn solve_lowest(
 
 /// The shift-invert route; `None` (solve densely) when it fails or finds too few modes, or a
 /// left vector cannot be matched.
+/// `[m, d, k]`: the quadratic problem's matrices, as [`solve_lowest`] takes them.
 fn lowest_shift_invert(
-    m: &Mat<f64>,
-    d: &Mat<f64>,
-    k: &Mat<f64>,
+    [m, d, k]: [&Mat<f64>; 3],
     pairs: &[(usize, usize)],
     count: usize,
     with_left: bool,
