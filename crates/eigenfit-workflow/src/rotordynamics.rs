@@ -353,11 +353,15 @@ pub fn discover(
     let search = RunupSearch::new(base, &effects);
     let options =
         DiscoveryOptions { assumed_relative_std: assumed_std, max_evaluations: budget, ..Default::default() };
-    let r = discover_effects(&search, &search.candidates(), &vec![1.0; params.len()], &options)
-        .map_err(|e| match e {
-            // The user's budget was too small for the calibration: no input error.
-            eigenfit_core::discovery::DiscoveryError::BudgetExhausted(_) => crate::discover::budget_error(budget),
-            e => input(format!("{}: {e}", measured.display())),
+    let r =
+        discover_effects(&search, &search.candidates(), &vec![1.0; params.len()], &options).map_err(|e| {
+            match e {
+                // The user's budget was too small for the calibration: no input error.
+                eigenfit_core::discovery::DiscoveryError::BudgetExhausted(_) => {
+                    crate::discover::budget_error(budget)
+                }
+                e => input(format!("{}: {e}", measured.display())),
+            }
         })?;
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
     let mut report = crate::discover::report_of(
