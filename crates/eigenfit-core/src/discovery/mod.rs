@@ -43,7 +43,8 @@ pub enum DiscoveryError {
 pub struct DiscoveryOptions {
     /// Significance level of the χ² test (default 0.05).
     pub significance: f64,
-    /// Candidates refitted after screening (default 8; switches are always refitted).
+    /// Candidates refitted after screening (default 8; switches are always refitted), and the
+    /// most candidates predicting like the leading fit refitted beside it in each round.
     pub refits: usize,
     /// AICc improvement over the base model needed to name an effect (default 6: with ~130
     /// candidates to choose from, 4 named a noise fit in 2.4 % of 330 clean independent draws,
