@@ -118,13 +118,13 @@ fn main() {
 }
 
 fn cell(run: &CompareRun) -> String {
-    if !run.converged {
+    if !run.outcome.converged {
         return format!(
             "{} after {} it.",
-            run.termination.split(':').next().unwrap_or_default(),
-            run.iterations
+            run.outcome.termination.split(':').next().unwrap_or_default(),
+            run.outcome.iterations
         );
     }
     let alt = if run.alternatives.is_empty() { "" } else { ", ambiguous" };
-    format!("{:.4e} / {:.4e} ({} it.{alt})", run.estimate[0], run.estimate[1], run.iterations)
+    format!("{:.4e} / {:.4e} ({} it.{alt})", run.estimate[0], run.estimate[1], run.outcome.iterations)
 }

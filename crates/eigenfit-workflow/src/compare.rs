@@ -204,7 +204,7 @@ impl RunReport {
             strategy: r.strategy.name(),
             run: r.clone(),
             seconds: timing.then_some(r.seconds),
-            alternative_solutions: (r.strategy == StrategyKind::LevenbergMarquardt && r.converged)
+            alternative_solutions: (r.strategy == StrategyKind::LevenbergMarquardt && r.outcome.converged)
                 .then(|| r.alternatives.clone()),
             identifiable: r.identifiability.as_ref().map(|ids| ids.iter().map(Into::into).collect()),
         }
@@ -243,8 +243,8 @@ pub fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[Strate
     for t in targets {
         for &s in strategies {
             let group: Vec<&CompareRun> = runs.iter().filter(|r| &r.target == t && r.strategy == s).collect();
-            let conv: Vec<&&CompareRun> = group.iter().filter(|r| r.converged).collect();
-            let mut iters: Vec<usize> = conv.iter().map(|r| r.iterations).collect();
+            let conv: Vec<&&CompareRun> = group.iter().filter(|r| r.outcome.converged).collect();
+            let mut iters: Vec<usize> = conv.iter().map(|r| r.outcome.iterations).collect();
             iters.sort_unstable();
             out.push(Summary {
                 target: t.clone(),
@@ -287,8 +287,11 @@ pub fn basins(runs: &[CompareRun], strategies: &[StrategyKind]) -> Vec<Basin> {
             Basin {
                 strategy: s.name(),
                 runs: group.len(),
-                converged: group.iter().filter(|r| r.converged).count(),
-                at_target: group.iter().filter(|r| r.converged && r.relative_error <= AT_TARGET).count(),
+                converged: group.iter().filter(|r| r.outcome.converged).count(),
+                at_target: group
+                    .iter()
+                    .filter(|r| r.outcome.converged && r.relative_error <= AT_TARGET)
+                    .count(),
             }
         })
         .collect()

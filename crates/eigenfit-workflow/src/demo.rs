@@ -13,7 +13,7 @@ use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 use eigenfit_core::measurement::measured_csv;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::Problem;
-use eigenfit_core::update::{Driver, Estimate, StrategyKind};
+use eigenfit_core::update::{Driver, Estimate, Outcome, StrategyKind};
 use eigenfit_rotor::presets::{self, PAPER_TABLE_1};
 use serde::Serialize;
 
@@ -51,12 +51,9 @@ pub struct StrategyRun {
     pub strategy: &'static str,
     /// K1, K2 reached (N/m).
     pub parameters: Vec<f64>,
-    /// Iterations.
-    pub iterations: usize,
-    /// Whether it converged.
-    pub converged: bool,
-    /// Why it stopped.
-    pub termination: String,
+    /// Whether it converged, why it stopped, iterations and model evaluations.
+    #[serde(flatten)]
+    pub outcome: Outcome,
 }
 
 /// Table 3 case 1: target, start, the reference data and every strategy's result.
@@ -213,9 +210,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
                 .map(|e| StrategyRun {
                     strategy: e.strategy,
                     parameters: e.parameters.clone(),
-                    iterations: e.iterations,
-                    converged: e.termination.is_converged(),
-                    termination: e.termination.to_string(),
+                    outcome: Outcome::of(e, e.termination.is_converged()),
                 })
                 .collect(),
         },

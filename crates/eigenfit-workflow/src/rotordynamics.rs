@@ -231,8 +231,8 @@ pub fn estimate(
             .collect()
     });
     let quality = fit_quality(&id, &points, &value);
-    let acceptable = id.converged && quality.verdict != FitVerdict::Poor;
-    let verdict = if !id.converged {
+    let acceptable = id.outcome.converged && quality.verdict != FitVerdict::Poor;
+    let verdict = if !id.outcome.converged {
         "not-converged"
     } else if quality.verdict == FitVerdict::Poor {
         "poor-fit"
@@ -243,7 +243,7 @@ pub fn estimate(
     };
     let status = |i: usize| -> String {
         match &intervals {
-            _ if !id.converged => "(not computed: the run did not converge)".into(),
+            _ if !id.outcome.converged => "(not computed: the run did not converge)".into(),
             Some(iv) => format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]),
             None if !id.identifiable => {
                 "not identifiable: the frequencies fix only combinations of the parameters".into()
@@ -260,12 +260,7 @@ pub fn estimate(
     };
     Ok(RunupEstimateReport {
         model: path.display().to_string(),
-        outcome: Outcome {
-            converged: id.converged,
-            termination: id.reason.clone(),
-            iterations: id.iterations,
-            evaluations: id.evaluations,
-        },
+        outcome: id.outcome.clone(),
         acceptable,
         verdict,
         fit: FitQualityReport::of(&quality, |k| RunupPointId {
@@ -353,11 +348,15 @@ pub fn discover(
     let search = RunupSearch::new(base, &effects);
     let options =
         DiscoveryOptions { assumed_relative_std: assumed_std, max_evaluations: budget, ..Default::default() };
-    let r = discover_effects(&search, &search.candidates(), &vec![1.0; params.len()], &options)
-        .map_err(|e| match e {
-            // The user's budget was too small for the calibration: no input error.
-            eigenfit_core::discovery::DiscoveryError::BudgetExhausted(_) => crate::discover::budget_error(budget),
-            e => input(format!("{}: {e}", measured.display())),
+    let r =
+        discover_effects(&search, &search.candidates(), &vec![1.0; params.len()], &options).map_err(|e| {
+            match e {
+                // The user's budget was too small for the calibration: no input error.
+                eigenfit_core::discovery::DiscoveryError::BudgetExhausted(_) => {
+                    crate::discover::budget_error(budget)
+                }
+                e => input(format!("{}: {e}", measured.display())),
+            }
         })?;
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
     let mut report = crate::discover::report_of(

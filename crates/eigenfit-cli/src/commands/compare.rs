@@ -222,7 +222,7 @@ fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyK
                 let row: String = runs
                     .iter()
                     .filter(|r| &r.target == t && r.strategy == s && r.initial[0] == a)
-                    .map(|r| match (r.converged, r.relative_error <= WITHIN_1E6) {
+                    .map(|r| match (r.outcome.converged, r.relative_error <= WITHIN_1E6) {
                         (true, true) => '●',
                         (true, false) => '○',
                         _ => '·',

@@ -113,7 +113,7 @@ fn text(found: &Demo, dofs: usize, grid: usize) -> Vec<String> {
     for e in &t.estimates {
         say.push(format!(
             "{:<10}{:>16.4e}{:>16.4e}{:>8}  {}",
-            e.strategy, e.parameters[0], e.parameters[1], e.iterations, e.termination
+            e.strategy, e.parameters[0], e.parameters[1], e.outcome.iterations, e.outcome.termination
         ));
     }
     say.push(String::new());

@@ -7,7 +7,7 @@ use crate::measurement::synthetic::SynthesisError;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::problem::{Linearisation, Objective, Problem};
-use crate::update::{Budget, Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
+use crate::update::{Budget, Driver, LevenbergMarquardt, Outcome, StrategyKind, UpdateStrategy};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
@@ -44,14 +44,10 @@ pub struct CompareRun {
     pub target: Vec<f64>,
     /// Initial guess.
     pub initial: Vec<f64>,
-    /// Converged?
-    pub converged: bool,
-    /// Termination reason as text.
-    pub termination: String,
-    /// Iterations taken.
-    pub iterations: usize,
-    /// Model evaluations (eigen-solves), including rejected trials.
-    pub evaluations: usize,
+    /// Converged, termination reason as text, iterations, model evaluations (eigen-solves,
+    /// including rejected trials).
+    #[serde(flatten)]
+    pub outcome: Outcome,
     /// Final parameters.
     pub estimate: Vec<f64>,
     /// max |estimate / target − 1| over the parameters.
@@ -184,10 +180,7 @@ where
                 strategy,
                 target: target.to_vec(),
                 initial: initial.to_vec(),
-                converged,
-                termination: est.termination.to_string(),
-                iterations: est.iterations,
-                evaluations: est.evaluations,
+                outcome: Outcome::of(&est, converged),
                 relative_error: relative_error(&est.parameters, target),
                 estimate: est.parameters,
                 seconds,
@@ -199,10 +192,7 @@ where
             strategy,
             target: target.to_vec(),
             initial: initial.to_vec(),
-            converged: false,
-            termination: e.to_string(),
-            iterations: 0,
-            evaluations: 0,
+            outcome: Outcome { converged: false, termination: e.to_string(), iterations: 0, evaluations: 0 },
             estimate: initial.to_vec(),
             relative_error: relative_error(initial, target),
             seconds,
