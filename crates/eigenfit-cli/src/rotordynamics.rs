@@ -109,6 +109,6 @@ pub fn print_discovery(r: &RunupDiscoverReport) {
     }
     println!(
         "RMS residual {:.4} Hz → {:.4} Hz; {} eigen-solve rounds",
-        d.rms_residual_before_hz, d.rms_residual_after_hz, d.evaluations
+        d.rms.rms_residual_before_hz, d.rms.rms_residual_after_hz, d.evaluations
     );
 }

@@ -3,6 +3,7 @@
 //! discovery of a hidden effect in a built-in dataset.
 
 use crate::compare::{basins, Basin};
+use crate::discover::RmsResidual;
 use crate::error::{failure, WorkflowError};
 use crate::progress::Progress;
 use eigenfit_core::analysis::compare::{
@@ -89,10 +90,9 @@ pub struct HiddenEffect {
     pub chi2_before: f64,
     /// χ² with the effect added.
     pub chi2_after: f64,
-    /// RMS residual before (Hz).
-    pub rms_residual_before_hz: f64,
-    /// RMS residual after (Hz).
-    pub rms_residual_after_hz: f64,
+    /// RMS residual before and after (Hz).
+    #[serde(flatten)]
+    pub rms: RmsResidual,
 }
 
 /// The demo's report; `out`, `plots` and `seconds` are the front end's to fill.
@@ -195,8 +195,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
         fit: s.clone(),
         chi2_before: found.chi2_before,
         chi2_after: s.chi2,
-        rms_residual_before_hz: found.rms_before_hz,
-        rms_residual_after_hz: found.rms_after_hz,
+        rms: RmsResidual::of(&found),
     });
     let report = DemoReport {
         model: LABEL,
