@@ -5,7 +5,7 @@
 
 use eigenfit::core::analysis::{
     compare::reference_measurement, compare::run_case, compare::CompareRun, compare::CompareSettings,
-    compare::SharedData,
+    compare::ReferenceSettings, compare::SharedData,
 };
 use eigenfit::core::eigen::DenseSolver;
 use eigenfit::core::problem::Problem;
@@ -83,9 +83,7 @@ fn main() {
         println!("### {title}\n");
         for decimals in [Some(3), None] {
             let settings = CompareSettings {
-                modes: 2,
-                decimals,
-                std_hz: None,
+                reference: ReferenceSettings { modes: 2, decimals, std_hz: None },
                 max_iterations: 1000,
                 budget: eigenfit::core::update::DEFAULT_EVALUATIONS,
             };

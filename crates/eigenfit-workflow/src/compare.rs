@@ -8,7 +8,9 @@
 
 use crate::error::{input, WorkflowError};
 use crate::overrides::{parse_list, points};
-use eigenfit_core::analysis::compare::{log_space, run_grid, tensor_grid, CompareRun, CompareSettings};
+use eigenfit_core::analysis::compare::{
+    log_space, run_grid, tensor_grid, CompareRun, CompareSettings, ReferenceSettings,
+};
 use eigenfit_core::analysis::Identifiability;
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
@@ -140,9 +142,11 @@ pub fn plan(request: &CompareRequest, np: usize) -> Result<ComparePlan, Workflow
         return Err(input("--budget 0: at least one model evaluation is needed"));
     }
     let settings = CompareSettings {
-        modes: request.modes.unwrap_or(np).max(np),
-        decimals: request.decimals,
-        std_hz: request.std_hz,
+        reference: ReferenceSettings {
+            modes: request.modes.unwrap_or(np).max(np),
+            decimals: request.decimals,
+            std_hz: request.std_hz,
+        },
         max_iterations: request.max_iterations,
         budget: request.budget,
     };
@@ -304,12 +308,10 @@ pub struct CompareReport {
     pub model: String,
     /// The eigen-solver's name.
     pub solver: String,
-    /// Reference modes.
-    pub modes: usize,
-    /// Decimals the reference frequencies were rounded to.
-    pub decimals: Option<i32>,
-    /// Reference standard deviation (Hz).
-    pub std_hz: Option<f64>,
+    /// Reference modes, the decimals their frequencies were rounded to, their standard
+    /// deviation (Hz).
+    #[serde(flatten)]
+    pub reference: ReferenceSettings,
     /// Every run.
     pub runs: Vec<RunReport>,
     /// Per target and strategy.
@@ -338,9 +340,7 @@ pub fn run(
     Ok(CompareReport {
         model: label.to_string(),
         solver: solver.name().to_string(),
-        modes: plan.settings.modes,
-        decimals: plan.settings.decimals,
-        std_hz: plan.settings.std_hz,
+        reference: plan.settings.reference.clone(),
         runs: runs.iter().map(|r| RunReport::new(r, plan.timing)).collect(),
         summary: summarise(&runs, &plan.targets, &plan.strategies),
         plots: None,

@@ -7,7 +7,7 @@ use crate::discover::RmsResidual;
 use crate::error::{failure, WorkflowError};
 use crate::progress::Progress;
 use eigenfit_core::analysis::compare::{
-    log_space, reference_measurement, run_grid, tensor_grid, CompareRun, CompareSettings,
+    log_space, reference_measurement, run_grid, tensor_grid, CompareRun, CompareSettings, ReferenceSettings,
 };
 use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit};
 use eigenfit_core::eigen::{DenseSolver, EigenSolver};
@@ -158,9 +158,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
     }
     // 2. Table 3 case 1 with all three strategies.
     let settings = CompareSettings {
-        modes: 2,
-        decimals: Some(3),
-        std_hz: None,
+        reference: ReferenceSettings { modes: 2, decimals: Some(3), std_hz: None },
         max_iterations: 1000,
         budget: eigenfit_core::update::DEFAULT_EVALUATIONS,
     };

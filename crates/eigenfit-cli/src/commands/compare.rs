@@ -123,7 +123,7 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
             plan.targets.len(),
             plan.initials.len(),
             plan.strategies.len(),
-            report.modes
+            report.reference.modes
         );
         println!(
             "{:<16}{:<9}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",

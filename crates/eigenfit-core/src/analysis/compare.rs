@@ -16,9 +16,10 @@ use thiserror::Error;
 /// Local fits tried when looking for other solutions of a damped run.
 const ALTERNATIVE_STARTS: usize = 6;
 
-/// How the reference data are made and how each run is limited.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CompareSettings {
+/// How the reference data are made: `modes`, `decimals`, `std_hz`, as a comparison's report
+/// states them (flattened into it).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ReferenceSettings {
     /// Number of lowest modes measured (the paper: as many as parameters).
     pub modes: usize,
     /// Round reference frequencies to this many decimals (the paper's Table 1: 3), or exact.
@@ -26,6 +27,13 @@ pub struct CompareSettings {
     /// Standard deviation attached to each reference frequency (Hz), enabling intervals and
     /// identifiability flags for the damped strategy.
     pub std_hz: Option<f64>,
+}
+
+/// How the reference data are made and how each run is limited.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareSettings {
+    /// Modes, rounding and standard deviation of the reference data.
+    pub reference: ReferenceSettings,
     /// Iteration limit per run.
     pub max_iterations: usize,
     /// Most model evaluations (eigen-solves) one run may spend on its fit and, for a damped run,
@@ -91,8 +99,8 @@ where
     M: StructuralModel + ?Sized,
     S: EigenSolver + ?Sized,
 {
-    let modes = solver.lowest(&model.assemble(target)?, settings.modes)?;
-    let round = |f: f64| match settings.decimals {
+    let modes = solver.lowest(&model.assemble(target)?, settings.reference.modes)?;
+    let round = |f: f64| match settings.reference.decimals {
         Some(d) => (f * 10f64.powi(d)).round() / 10f64.powi(d),
         None => f,
     };
@@ -100,7 +108,12 @@ where
         .frequencies_hz()
         .into_iter()
         .enumerate()
-        .map(|(k, f)| MeasuredMode { mode: k, frequency_hz: round(f), std_hz: settings.std_hz, shape: None })
+        .map(|(k, f)| MeasuredMode {
+            mode: k,
+            frequency_hz: round(f),
+            std_hz: settings.reference.std_hz,
+            shape: None,
+        })
         .collect();
     Ok(Measurement::new(measured)?)
 }
@@ -311,9 +324,7 @@ mod tests {
         let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
         let strategies = StrategyKind::ALL;
         let settings = CompareSettings {
-            modes: 3,
-            decimals: Some(3),
-            std_hz: Some(0.01),
+            reference: ReferenceSettings { modes: 3, decimals: Some(3), std_hz: Some(0.01) },
             max_iterations: 100,
             budget: crate::update::DEFAULT_EVALUATIONS,
         };
