@@ -29,7 +29,7 @@ pub fn print_estimate(r: &RunupEstimateReport) {
     println!(
         "{}: {} bearing coefficients from {} run-up frequencies: {} after {} iterations; verdict: {}",
         r.model,
-        r.parameters.0.len(),
+        r.values.parameters.0.len(),
         r.points.len(),
         if r.outcome.converged { "converged" } else { "NOT converged" },
         r.outcome.iterations,
@@ -37,7 +37,7 @@ pub fn print_estimate(r: &RunupEstimateReport) {
     );
     println!("{:<28}{:>16}{:>16}{:>32}", "parameter", "initial", "estimate", "95% interval / status");
     for (((name, initial), (_, value)), (_, status)) in
-        r.initial.iter().zip(r.parameters.iter()).zip(r.parameter_status.iter())
+        r.values.initial.iter().zip(r.values.parameters.iter()).zip(r.values.parameter_status.iter())
     {
         println!("{name:<28}{initial:>16.4e}{value:>16.6e}{status:>32}");
     }

@@ -3,7 +3,7 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::{FitQualityReport, Outcome};
+use crate::outcome::{FitQualityReport, Outcome, ParameterValues};
 use crate::overrides::{fixed, parameter_vector};
 use crate::progress::{Progress, StepsObserver};
 use crate::rotordynamics::{self, RunupEstimateReport};
@@ -173,12 +173,9 @@ pub struct EstimateReport {
     /// Evaluations spent in each phase reached: reachability, fit, intervals,
     /// mirror_solutions, other_solutions (on a large model each is an eigen-solve of seconds).
     pub evaluations_by_phase: Named<usize>,
-    /// Initial values.
-    pub initial: Named<f64>,
-    /// Estimated values.
-    pub parameters: Named<f64>,
-    /// What the data say about each parameter, in words.
-    pub parameter_status: Named<String>,
+    /// Initial and estimated values, and what the data say about each parameter, in words.
+    #[serde(flatten)]
+    pub values: ParameterValues,
     /// Parameters on a limit.
     pub at_limit: Vec<String>,
     /// Intervals and what the data determine (a converged run with std or scatter).
@@ -485,9 +482,7 @@ pub fn run(
         fit: FitQualityReport::of(&quality, |k| mode_numbers[k]),
         budget: BudgetReport { limit: budget.limit(), used: budget.used(), exhausted: budget_spent },
         evaluations_by_phase: phase_counts(&phases),
-        initial: Named::new(&names, initial.iter().copied()),
-        parameters: Named::new(&names, estimate.parameters.iter().copied()),
-        parameter_status: Named::new(&names, (0..np).map(status)),
+        values: ParameterValues::new(&names, &initial, &estimate.parameters, status),
         at_limit: pinned,
         alternative_solutions: alternatives
             .iter()

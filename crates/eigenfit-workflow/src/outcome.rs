@@ -1,5 +1,6 @@
 //! How an iteration ended, as every estimating report states it.
 
+use crate::named::Named;
 use serde::Serialize;
 
 /// `converged`, `termination`, `iterations`, `evaluations`, flattened into every estimating
@@ -53,6 +54,35 @@ impl<D> FitQualityReport<D> {
             p_value: quality.p_value,
             relative_rms_residual: quality.relative_rms,
             disagreeing_modes: quality.disagreeing.iter().map(|&k| name(k)).collect(),
+        }
+    }
+}
+
+/// `initial`, `parameters`, `parameter_status`: each parameter's start, its estimate and what the
+/// data say about it in words (its interval, or why there is none), as estimate and the run-up
+/// estimate state them, flattened into the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParameterValues {
+    /// Initial values.
+    pub initial: Named<f64>,
+    /// Estimated values.
+    pub parameters: Named<f64>,
+    /// What the data say about each parameter, in words.
+    pub parameter_status: Named<String>,
+}
+
+impl ParameterValues {
+    /// The parameters `names` from `initial` to `estimated`, the i-th described by `status(i)`.
+    pub fn new(
+        names: &[String],
+        initial: &[f64],
+        estimated: &[f64],
+        status: impl Fn(usize) -> String,
+    ) -> Self {
+        Self {
+            initial: Named::new(names, initial.iter().copied()),
+            parameters: Named::new(names, estimated.iter().copied()),
+            parameter_status: Named::new(names, (0..names.len()).map(status)),
         }
     }
 }

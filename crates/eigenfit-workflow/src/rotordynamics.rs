@@ -3,7 +3,7 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::{FitQualityReport, Outcome};
+use crate::outcome::{FitQualityReport, Outcome, ParameterValues};
 use eigenfit_core::analysis::verdict::{judge, FitQuality, FitVerdict};
 use eigenfit_core::problem::Linearisation;
 use eigenfit_rotordynamics::identify::{
@@ -136,12 +136,10 @@ pub struct RunupEstimateReport {
     pub fit: FitQualityReport<RunupPointId>,
     /// The speed the coefficients are reported at (the lowest measured, rpm).
     pub reference_speed_rpm: f64,
-    /// Nominal coefficients (N/m or N·s/m).
-    pub initial: Named<f64>,
-    /// Estimated coefficients (N/m or N·s/m).
-    pub parameters: Named<f64>,
-    /// Each parameter's interval as text, or why there is none.
-    pub parameter_status: Named<String>,
+    /// Nominal and estimated coefficients (N/m or N·s/m), each one's interval as text or why
+    /// there is none.
+    #[serde(flatten)]
+    pub values: ParameterValues,
     /// Estimated scale factors on the nominal curves.
     pub scales: Named<f64>,
     /// Σ r².
@@ -268,9 +266,7 @@ pub fn estimate(
             mode: points[k].mode,
         }),
         reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
-        initial: Named::new(&names, nominal.iter().copied()),
-        parameters: Named::new(&names, value.iter().copied()),
-        parameter_status: Named::new(&names, (0..params.len()).map(status)),
+        values: ParameterValues::new(&names, &nominal, &value, status),
         scales: Named::new(&names, id.scales.iter().copied()),
         cost: id.cost,
         identifiable: id.identifiable,
