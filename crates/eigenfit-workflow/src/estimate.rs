@@ -3,7 +3,7 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::{FitQualityReport, Outcome, ParameterValues};
+use crate::outcome::{FitQualityReport, Outcome, PairedFrequencies, ParameterValues};
 use crate::overrides::{fixed, parameter_vector};
 use crate::progress::{Progress, StepsObserver};
 use crate::rotordynamics::{self, RunupEstimateReport};
@@ -183,10 +183,9 @@ pub struct EstimateReport {
     pub uncertainty: Option<IntervalsReport>,
     /// Other equally good solutions.
     pub alternative_solutions: Vec<AlternativeSolution>,
-    /// Model frequencies at the estimate (Hz).
-    pub frequencies_hz: Vec<f64>,
-    /// Measured frequencies (Hz).
-    pub measured_hz: Vec<f64>,
+    /// Model frequencies at the estimate and measured frequencies (Hz).
+    #[serde(flatten)]
+    pub frequencies: PairedFrequencies,
     /// The iterations.
     pub history: Vec<HistoryRecord>,
     /// Plot files written.
@@ -498,8 +497,7 @@ pub fn run(
                 }
             })
             .collect(),
-        frequencies_hz: estimate.last.frequencies_hz.clone(),
-        measured_hz: estimate.last.measured_hz.clone(),
+        frequencies: PairedFrequencies::of(&estimate.last),
         history: estimate
             .history
             .iter()

@@ -86,3 +86,20 @@ impl ParameterValues {
         }
     }
 }
+
+/// `frequencies_hz`, `measured_hz`: the model's frequencies of the paired modes at the estimate
+/// beside the measured ones, as estimate and each configuration of a campaign state them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PairedFrequencies {
+    /// Model frequencies at the estimate (Hz).
+    pub frequencies_hz: Vec<f64>,
+    /// Measured frequencies (Hz).
+    pub measured_hz: Vec<f64>,
+}
+
+impl PairedFrequencies {
+    /// The frequencies of a linearisation (the estimate's last).
+    pub fn of(lin: &eigenfit_core::problem::Linearisation) -> Self {
+        Self { frequencies_hz: lin.frequencies_hz.clone(), measured_hz: lin.measured_hz.clone() }
+    }
+}

@@ -152,7 +152,7 @@ fn print_report(est: &Estimation) {
         );
     }
     println!("{:>6}{:>16}{:>16}{:>14}", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]");
-    for (k, (m, f)) in r.measured_hz.iter().zip(&r.frequencies_hz).enumerate() {
+    for (k, (m, f)) in r.frequencies.measured_hz.iter().zip(&r.frequencies.frequencies_hz).enumerate() {
         println!("{:>6}{m:>16.6}{f:>16.6}{:>14.2e}", est.mode_numbers[k], f - m);
     }
     match (est.quality.verdict, r.fit.chi2) {
