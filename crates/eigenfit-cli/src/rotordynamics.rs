@@ -33,7 +33,7 @@ pub fn print_estimate(r: &RunupEstimateReport) {
         r.points.len(),
         if r.outcome.converged { "converged" } else { "NOT converged" },
         r.outcome.iterations,
-        r.verdict
+        r.verdict.verdict
     );
     println!("{:<28}{:>16}{:>16}{:>32}", "parameter", "initial", "estimate", "95% interval / status");
     for (((name, initial), (_, value)), (_, status)) in

@@ -1,6 +1,7 @@
 //! How an iteration ended, as every estimating report states it.
 
 use crate::named::Named;
+use eigenfit_core::analysis::verdict::FitVerdict;
 use serde::Serialize;
 
 /// `converged`, `termination`, `iterations`, `evaluations`, flattened into every estimating
@@ -101,5 +102,43 @@ impl PairedFrequencies {
     /// The frequencies of a linearisation (the estimate's last).
     pub fn of(lin: &eigenfit_core::problem::Linearisation) -> Self {
         Self { frequencies_hz: lin.frequencies_hz.clone(), measured_hz: lin.measured_hz.clone() }
+    }
+}
+
+/// `acceptable`, `verdict`: whether an estimate can be used and, in words, the first thing that
+/// stands against it, as estimate and the run-up estimate state it, flattened into the report.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Verdict {
+    /// Converged, fit not poor, no parameter on a limit, budget not spent, every mode paired: the
+    /// exit verdict.
+    pub acceptable: bool,
+    /// The run's stop reason when it did not converge, `budget-exhausted`, `poor-fit`,
+    /// `not-identifiable` (a parameter on a limit), or `converged` (saying so when the fit quality
+    /// could not be judged).
+    pub verdict: &'static str,
+}
+
+impl Verdict {
+    /// The verdict of a run that stopped for `not_converged` (`None`: it converged), with
+    /// `budget_spent`, fit quality `fit`, some parameter `on_limit`, and some measured mode
+    /// `unpaired` (no verdict word of its own: the pairing report says which).
+    pub fn of(
+        not_converged: Option<&'static str>,
+        budget_spent: bool,
+        fit: FitVerdict,
+        on_limit: bool,
+        unpaired: bool,
+    ) -> Self {
+        let verdict = match not_converged {
+            Some(reason) => reason,
+            None if budget_spent => "budget-exhausted",
+            None if fit == FitVerdict::Poor => "poor-fit",
+            None if on_limit => "not-identifiable",
+            None if fit == FitVerdict::NotJudged => "converged (fit quality not judged: no std)",
+            None => "converged",
+        };
+        let acceptable =
+            not_converged.is_none() && fit != FitVerdict::Poor && !on_limit && !budget_spent && !unpaired;
+        Self { acceptable, verdict }
     }
 }

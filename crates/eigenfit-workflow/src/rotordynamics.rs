@@ -3,8 +3,8 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::{FitQualityReport, Outcome, ParameterValues};
-use eigenfit_core::analysis::verdict::{judge, FitQuality, FitVerdict};
+use crate::outcome::{FitQualityReport, Outcome, ParameterValues, Verdict};
+use eigenfit_core::analysis::verdict::{judge, FitQuality};
 use eigenfit_core::problem::Linearisation;
 use eigenfit_rotordynamics::identify::{
     bearing_parameters, identify, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
@@ -127,10 +127,10 @@ pub struct RunupEstimateReport {
     /// Converged, why it stopped, iterations, eigen-solve rounds.
     #[serde(flatten)]
     pub outcome: Outcome,
-    /// Converged and the fit not poor: the exit verdict.
-    pub acceptable: bool,
-    /// `converged`, `poor-fit`, `not-converged` or converged with the quality not judged.
-    pub verdict: &'static str,
+    /// Converged and the fit not poor (the exit verdict); `converged`, `poor-fit`,
+    /// `not-converged` or converged with the quality not judged.
+    #[serde(flatten)]
+    pub verdict: Verdict,
     /// χ², dof, p-value, relative RMS and the run-up points that miss by more than 3σ.
     #[serde(flatten)]
     pub fit: FitQualityReport<RunupPointId>,
@@ -229,16 +229,9 @@ pub fn estimate(
             .collect()
     });
     let quality = fit_quality(&id, &points, &value);
-    let acceptable = id.outcome.converged && quality.verdict != FitVerdict::Poor;
-    let verdict = if !id.outcome.converged {
-        "not-converged"
-    } else if quality.verdict == FitVerdict::Poor {
-        "poor-fit"
-    } else if quality.verdict == FitVerdict::NotJudged {
-        "converged (fit quality not judged: no std)"
-    } else {
-        "converged"
-    };
+    // A run-up fit has no budget, limits or pairing of its own to fail on.
+    let verdict =
+        Verdict::of((!id.outcome.converged).then_some("not-converged"), false, quality.verdict, false, false);
     let status = |i: usize| -> String {
         match &intervals {
             _ if !id.outcome.converged => "(not computed: the run did not converge)".into(),
@@ -259,7 +252,6 @@ pub fn estimate(
     Ok(RunupEstimateReport {
         model: path.display().to_string(),
         outcome: id.outcome.clone(),
-        acceptable,
         verdict,
         fit: FitQualityReport::of(&quality, |k| RunupPointId {
             speed_rpm: points[k].speed_rpm,
