@@ -96,16 +96,9 @@ fn a_candidate_at_a_value_is_the_same_model_as_the_effect_in_a_file() {
 #[test]
 fn names_both_mirror_bearings_of_a_symmetric_rotor() {
     use eigenfit::rotor::discovery::discover_rotor;
-    use eigenfit::rotor::{BearingSpec, Disk, Material};
-    let rotor = Rotor::builder()
-        .material(Material::steel())
-        .uniform(0.6, 10)
-        .diameter(0.02)
-        .disk(Disk::new(5, 2.0))
-        .bearing(BearingSpec::new(0, 1e5))
-        .bearing(BearingSpec::new(10, 1e5))
-        .build()
-        .unwrap();
+    use eigenfit::rotor::Disk;
+    let rotor =
+        presets::steel_shaft_on_end_bearings(0.6, 10, 0.02, 1e5).disk(Disk::new(5, 2.0)).build().unwrap();
     let truth = rotor.with_effect(EffectSpec::new("support-mass", Some(0), 0.4)).unwrap();
     let measured = measure(&truth, &[1e5, 1e5], 8, 5e-4, 11);
     let found = discover_rotor(

@@ -17,44 +17,31 @@ pub(crate) fn sygvd(n: usize, a: &[f64], b: &[f64]) -> Result<(Vec<f64>, Vec<f64
     let mut a = a.to_vec();
     let mut b = b.to_vec();
     let mut w = vec![0.0; n];
-    let mut info = 0;
-
-    // Workspace query (LWORK = LIWORK = -1): optimal sizes come back in work[0] and iwork[0].
-    let mut work = [0.0];
-    let mut iwork = [0];
-    // SAFETY: every array is at least as long as LAPACK reads or writes for these arguments:
-    // a and b are n×n with leading dimension n, w has n entries, and a query writes only
-    // work[0] and iwork[0].
-    unsafe {
-        lapack::dsygvd(
-            &ITYPE, b'V', UPLO, ni, &mut a, ni, &mut b, ni, &mut w, &mut work, -1, &mut iwork, -1, &mut info,
-        );
-    }
-    check_info("dsygvd", info, n, None)?;
+    // One call site for the workspace query and the solve, so their arguments cannot drift apart;
+    // `query` asks for the optimal sizes (LWORK = LIWORK = -1), which come back in work[0], iwork[0].
+    let mut dsygvd = |work: &mut [f64], iwork: &mut [i32], query: bool| -> Result<i32, SolveError> {
+        let (lwork, liwork) = if query {
+            (-1, -1)
+        } else {
+            (lapack_int(work.len(), "lwork")?, lapack_int(iwork.len(), "liwork")?)
+        };
+        let mut info = 0;
+        // SAFETY: every array is at least as long as LAPACK reads or writes for these arguments:
+        // a and b are n×n with leading dimension n, w has n entries, work and iwork have the
+        // lengths passed as LWORK and LIWORK, and a query writes only work[0] and iwork[0].
+        unsafe {
+            lapack::dsygvd(
+                &ITYPE, b'V', UPLO, ni, &mut a, ni, &mut b, ni, &mut w, work, lwork, iwork, liwork, &mut info,
+            );
+        }
+        Ok(info)
+    };
+    let (mut work, mut iwork) = ([0.0], [0]);
+    check_info("dsygvd", dsygvd(&mut work, &mut iwork, true)?, n, None)?;
     // Documented minima for JOBZ = 'V'; never trust a query to return less.
     let lwork = workspace(work[0], 1 + 6 * n + 2 * n * n, "lwork")?;
     let liwork = workspace(f64::from(iwork[0]), 3 + 5 * n, "liwork")?;
-    let mut work = vec![0.0; lwork];
-    let mut iwork = vec![0; liwork];
-    // SAFETY: as above, and work/iwork have the lengths passed as LWORK/LIWORK.
-    unsafe {
-        lapack::dsygvd(
-            &ITYPE,
-            b'V',
-            UPLO,
-            ni,
-            &mut a,
-            ni,
-            &mut b,
-            ni,
-            &mut w,
-            &mut work,
-            lapack_int(lwork, "lwork")?,
-            &mut iwork,
-            lapack_int(liwork, "liwork")?,
-            &mut info,
-        );
-    }
+    let info = dsygvd(&mut vec![0.0; lwork], &mut vec![0; liwork], false)?;
     check_info("dsygvd", info, n, None)?;
     Ok((w, a))
 }
@@ -78,51 +65,30 @@ pub(crate) fn sygvx(
     let mut iwork = vec![0; 5 * n];
     let mut ifail = vec![0; n];
     let mut found = 0;
-    let mut info = 0;
     // SAFETY: dlamch only reads its character argument.
     let abstol = 2.0 * unsafe { lapack::dlamch(b'S') };
 
+    // One call site for the workspace query and the solve (see `sygvd`); a query (LWORK = -1)
+    // returns the optimal size in work[0].
+    let mut dsygvx = |work: &mut [f64], query: bool| -> Result<i32, SolveError> {
+        let lwork = if query { -1 } else { lapack_int(work.len(), "lwork")? };
+        let mut info = 0;
+        // SAFETY: a, b are n×n (leading dimension n); w has n entries; z is n×count with leading
+        // dimension n, and RANGE = 'I' with IU − IL + 1 = count yields exactly count columns;
+        // iwork has 5n and ifail n entries; work has the length passed as LWORK, and a query
+        // writes only work[0].
+        unsafe {
+            lapack::dsygvx(
+                &ITYPE, b'V', b'I', UPLO, ni, &mut a, ni, &mut b, ni, 0.0, 0.0, il, iu, abstol, &mut found,
+                &mut w, &mut z, ni, work, lwork, &mut iwork, &mut ifail, &mut info,
+            );
+        }
+        Ok(info)
+    };
     let mut work = [0.0];
-    // SAFETY: a, b are n×n (leading dimension n); w has n entries; z is n×count with leading
-    // dimension n, and RANGE = 'I' with IU − IL + 1 = count yields exactly count columns;
-    // iwork has 5n and ifail n entries; a query (LWORK = -1) writes only work[0].
-    unsafe {
-        lapack::dsygvx(
-            &ITYPE, b'V', b'I', UPLO, ni, &mut a, ni, &mut b, ni, 0.0, 0.0, il, iu, abstol, &mut found,
-            &mut w, &mut z, ni, &mut work, -1, &mut iwork, &mut ifail, &mut info,
-        );
-    }
-    check_info("dsygvx", info, n, None)?;
+    check_info("dsygvx", dsygvx(&mut work, true)?, n, None)?;
     let lwork = workspace(work[0], (8 * n).max(1), "lwork")?;
-    let mut work = vec![0.0; lwork];
-    // SAFETY: as above, and work has the length passed as LWORK.
-    unsafe {
-        lapack::dsygvx(
-            &ITYPE,
-            b'V',
-            b'I',
-            UPLO,
-            ni,
-            &mut a,
-            ni,
-            &mut b,
-            ni,
-            0.0,
-            0.0,
-            il,
-            iu,
-            abstol,
-            &mut found,
-            &mut w,
-            &mut z,
-            ni,
-            &mut work,
-            lapack_int(lwork, "lwork")?,
-            &mut iwork,
-            &mut ifail,
-            &mut info,
-        );
-    }
+    let info = dsygvx(&mut vec![0.0; lwork], false)?;
     check_info("dsygvx", info, n, Some(&ifail))?;
     if usize::try_from(found) != Ok(count) {
         return Err(backend(format!("dsygvx returned {found} eigenpairs, {count} were requested")));

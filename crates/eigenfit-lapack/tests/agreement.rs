@@ -7,6 +7,7 @@ use eigenfit_core::matrix::System;
 use eigenfit_lapack::{LapackSolver, Method};
 use nalgebra::{Cholesky, DMatrix, DVector, QR};
 use proptest::prelude::*;
+use std::sync::OnceLock;
 
 const ALL: LapackSolver = LapackSolver::new(Method::All);
 const SUBSET: LapackSolver = LapackSolver::new(Method::Subset);
@@ -279,17 +280,40 @@ proptest! {
 // (b) Banded beam-like chains
 // ---------------------------------------------------------------------------------------------
 
+/// A beam chain with all its modes by `All` and by the dense solver.
+struct SolvedChain {
+    n: usize,
+    system: System,
+    all: Modes,
+    dense: Modes,
+}
+
+/// The chains of 22, 100 and 400 DOFs, solved once for every test that compares against their
+/// full spectra (the n = 400 solves dominate those tests' time).
+fn solved_chains() -> &'static [SolvedChain] {
+    static CHAINS: OnceLock<Vec<SolvedChain>> = OnceLock::new();
+    CHAINS.get_or_init(|| {
+        [22, 100, 400]
+            .into_iter()
+            .map(|n| {
+                let system = beam_chain(n);
+                let all = ALL.lowest(&system, n).unwrap();
+                let dense = DenseSolver.lowest(&system, n).unwrap();
+                SolvedChain { n, system, all, dense }
+            })
+            .collect()
+    })
+}
+
 #[test]
 fn beam_chains_agree_with_dense_on_every_mode() {
-    for n in [22, 100, 400] {
-        let system = beam_chain(n);
-        let dense = DenseSolver.lowest(&system, n).unwrap();
-        let all = ALL.lowest(&system, n).unwrap();
-        check_conventions(&all, n, n);
+    for SolvedChain { n, system, all, dense } in solved_chains() {
+        let n = *n;
+        check_conventions(all, n, n);
         // Every eigenvalue of these chains is separated by ≥ 8e-6·λ_max (n = 400), so every
         // eigenvector is determined to ~ε/8e-6 and can be compared.
-        assert_same_modes(&all, &dense, n, &format!("n = {n}"));
-        assert_identities(&system, &all, &format!("n = {n}"));
+        assert_same_modes(all, dense, n, &format!("n = {n}"));
+        assert_identities(system, all, &format!("n = {n}"));
     }
 }
 
@@ -303,18 +327,16 @@ fn truncate(modes: &Modes, count: usize) -> Modes {
 
 #[test]
 fn subset_path_agrees_with_full_path_and_dense_on_chains() {
-    for n in [22, 100, 400] {
-        let system = beam_chain(n);
-        // Solving all modes once keeps this test fast. With at most half the modes `All` solves
-        // the inverted problem, with more the textbook one: the two agree to round-off.
-        let all_full = ALL.lowest(&system, n).unwrap();
-        let dense_full = DenseSolver.lowest(&system, n).unwrap();
-        let d = compare(&ALL.lowest(&system, 5).unwrap(), &truncate(&all_full, 5), 5);
+    // Solving all modes once keeps this test fast. With at most half the modes `All` solves
+    // the inverted problem, with more the textbook one: the two agree to round-off.
+    for SolvedChain { n, system, all: all_full, dense: dense_full } in solved_chains() {
+        let n = *n;
+        let d = compare(&ALL.lowest(system, 5).unwrap(), &truncate(all_full, 5), 5);
         assert!(d.eigenvalue_rel < 1e-10 && d.shape_rel < 1e-8, "n = {n}, inverted vs textbook: {d:?}");
         for count in [1, 5, n / 4, n / 2, n] {
-            let subset = SUBSET.lowest(&system, count).unwrap();
+            let subset = SUBSET.lowest(system, count).unwrap();
             check_conventions(&subset, count, n);
-            for (other, full) in [("all", &all_full), ("dense", &dense_full)] {
+            for (other, full) in [("all", all_full), ("dense", dense_full)] {
                 assert_same_modes(
                     &subset,
                     &truncate(full, count),
@@ -322,7 +344,7 @@ fn subset_path_agrees_with_full_path_and_dense_on_chains() {
                     &format!("n = {n}, count = {count}, {other}"),
                 );
             }
-            assert_identities(&system, &subset, &format!("n = {n}"));
+            assert_identities(system, &subset, &format!("n = {n}"));
         }
     }
 }

@@ -130,19 +130,14 @@ pub fn add_images(rotor: &Rotor, effects: &mut [NamedEffect]) {
 #[cfg(test)]
 mod tests {
     use super::Mirror;
-    use crate::{presets, BearingSpec, Disk, EffectSpec, Material, Rotor};
+    use crate::{presets, Disk, EffectSpec, Rotor};
     use eigenfit_core::discovery::{NamedEffect, Place};
     use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 
     fn symmetric() -> Rotor {
-        Rotor::builder()
-            .material(Material::steel())
-            .uniform(0.6, 10)
-            .diameter(0.02)
+        presets::steel_shaft_on_end_bearings(0.6, 10, 0.02, 1e5)
             .disk(Disk::new(2, 1.0))
             .disk(Disk::new(8, 1.0))
-            .bearing(BearingSpec::new(0, 1e5))
-            .bearing(BearingSpec::new(10, 1e5))
             .build()
             .unwrap()
     }

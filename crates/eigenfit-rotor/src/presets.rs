@@ -1,7 +1,7 @@
 //! Built-in rotors: the paper's rotor, the ROSS cross-check rotor and a uniform rotor of any mesh
-//! size for scale studies.
+//! size for scale studies, and the steel shaft on end bearings most small rotors start from.
 
-use crate::{BearingSpec, Disk, Material, Rotor, RotorError};
+use crate::{BearingSpec, Disk, Material, Rotor, RotorBuilder, RotorError};
 
 /// Names accepted by [`by_name`].
 pub const NAMES: [&str; 3] = ["paper-rotor", "ross-example", "uniform-rotor"];
@@ -45,16 +45,36 @@ pub fn uniform_rotor(elements: usize) -> Result<Rotor, RotorError> {
 /// 0.4 kg at node 2 and 1.35 kg at node 8, 1e5 N/m bearings at nodes 0 and 10.
 /// ROSS gives 36.954 Hz, 81.302 Hz and 302.94 Hz.
 pub fn ross_example() -> Rotor {
-    Rotor::builder()
-        .material(Material::steel())
-        .uniform(0.5, 10)
-        .diameter(0.014)
+    steel_shaft_on_end_bearings(0.5, 10, 0.014, 1e5)
         .disk(Disk::new(2, 0.4))
         .disk(Disk::new(8, 1.35))
-        .bearing(BearingSpec::new(0, 1e5))
-        .bearing(BearingSpec::new(10, 1e5))
         .build()
         .expect("the ROSS example is valid") // proof: fixed data, checked by the test below
+}
+
+/// A uniform steel shaft of `length` m in `elements` equal elements, Ø`diameter` m, on two
+/// bearings of `stiffness` N/m at its ends (nodes 0 and `elements`, parameters `k_bearing_0` and
+/// `k_bearing_1`): the start of most small rotors. Add disks, point masses or sections, then
+/// [`build`](RotorBuilder::build); the values are checked there.
+///
+/// ```
+/// use eigenfit_rotor::{presets, Disk};
+/// let rotor = presets::steel_shaft_on_end_bearings(0.6, 10, 0.02, 1e5).disk(Disk::new(5, 2.0)).build()?;
+/// assert_eq!((rotor.nodes().len(), rotor.bearings().len()), (11, 2));
+/// # Ok::<(), eigenfit_rotor::RotorError>(())
+/// ```
+pub fn steel_shaft_on_end_bearings(
+    length: f64,
+    elements: usize,
+    diameter: f64,
+    stiffness: f64,
+) -> RotorBuilder {
+    Rotor::builder()
+        .material(Material::steel())
+        .uniform(length, elements)
+        .diameter(diameter)
+        .bearing(BearingSpec::new(0, stiffness))
+        .bearing(BearingSpec::new(elements, stiffness))
 }
 
 /// The paper's Table 1: support stiffnesses [K1, K2] (N/m) and the first two natural

@@ -85,6 +85,13 @@ fn solve_all(rotor: &Rotor, p: &[f64]) -> Modes {
     DenseSolver.lowest(&sys, sys.dofs()).unwrap()
 }
 
+/// All modes with bearing `i` at stiffness `k` and the others at `p`: one finite-difference point.
+fn solve_with_stiffness(rotor: &Rotor, p: &[f64], i: usize, k: f64) -> Modes {
+    let mut q = p.to_vec();
+    q[i] = k;
+    solve_all(rotor, &q)
+}
+
 /// Smallest relative gap |λₖ − λₗ| / max(|λₖ|, |λₗ|) to a neighbour.
 fn relative_gap(lam: &DVector<f64>, k: usize) -> f64 {
     let rel = |l: usize| (lam[k] - lam[l]).abs() / lam[k].abs().max(lam[l].abs());
@@ -168,14 +175,15 @@ fn fd_where_separated(
 /// How many modes of each random rotor are compared (the ones an update fits).
 const MODES: usize = 6;
 
-fn run(name: &str, test: impl Fn(&RandomRotor, &Cell<(usize, usize)>) -> Result<(), TestCaseError>) {
+fn run(name: &str, test: impl Fn(&Rotor, &Cell<(usize, usize)>) -> Result<(), TestCaseError>) {
     let counts = Cell::new((0usize, 0usize)); // (compared, skipped)
-                                              // A fixed seed: the comparison counts below are then reproducible.
+
+    // A fixed seed: the comparison counts below are then reproducible.
     let mut runner = TestRunner::new_with_rng(
         Config { cases: CASES, failure_persistence: None, ..Config::default() },
         TestRng::deterministic_rng(RngAlgorithm::ChaCha),
     );
-    runner.run(&random_rotor(), |r| test(&r, &counts)).unwrap();
+    runner.run(&random_rotor(), |r| test(&r.build(), &counts)).unwrap();
     let (compared, skipped) = counts.get();
     eprintln!("{name}: compared {compared}, skipped {skipped} (FD not converged or modes too close)");
     // With the fixed seed, of 972 (mode, bearing) pairs dλ/dk compares 657 and dφ/dk 678 with the
@@ -199,8 +207,7 @@ fn mass_orthonormal_and_diagonalising() {
     // half of an FE spectrum is discretisation-dominated), the ones an update uses: a backend may
     // trade the accuracy of the top of the spectrum (λ/λ₁ up to 1e12 here) for the bottom's, as
     // the inverted (K-Cholesky) reduction does.
-    run("orthonormality", |r, counts| {
-        let rotor = r.build();
+    run("orthonormality", |rotor, counts| {
         let sys = rotor.nominal_system().unwrap();
         let m = MODES.min(sys.dofs() / 2);
         let modes = DenseSolver.lowest(&sys, m).unwrap();
@@ -231,16 +238,13 @@ fn mass_orthonormal_and_diagonalising() {
 #[test]
 fn eigenvalue_derivative_is_squared_bearing_displacement_and_matches_fd() {
     let worst = Cell::new(0.0f64);
-    run("dλ/dk", |r, counts| {
-        let rotor = r.build();
+    run("dλ/dk", |rotor, counts| {
         let p = rotor.nominal_stiffnesses();
-        let modes = solve_all(&rotor, &p);
+        let modes = solve_all(rotor, &p);
         for (i, b) in rotor.bearings().iter().enumerate() {
             let d = rotor.derivative(&p, i).unwrap();
             let lam_at = |k: f64| {
-                let mut q = p.clone();
-                q[i] = k;
-                let lam = solve_all(&rotor, &q).eigenvalues;
+                let lam = solve_with_stiffness(rotor, &p, i, k).eigenvalues;
                 DMatrix::from_row_slice(1, lam.len(), lam.as_slice())
             };
             let fd = fd_where_separated(lam_at, p[i], MODES.min(modes.count()), &modes.eigenvalues, counts);
@@ -267,13 +271,12 @@ fn eigenvalue_derivative_is_squared_bearing_displacement_and_matches_fd() {
 
 #[test]
 fn analytic_system_derivative_equals_core_finite_difference() {
-    run("∂K/∂k", |r, counts| {
-        let rotor = r.build();
+    run("∂K/∂k", |rotor, counts| {
         let p = rotor.nominal_stiffnesses();
         let sys = rotor.assemble(&p).unwrap();
         for (i, b) in rotor.bearings().iter().enumerate() {
             let exact = rotor.derivative(&p, i).unwrap();
-            let fd = finite_difference_derivative(&rotor, &p, i).unwrap();
+            let fd = finite_difference_derivative(rotor, &p, i).unwrap();
             let j = Rotor::displacement_dof(b.node);
             prop_assert_eq!(exact.stiffness.entries(), &[(j, j, 1.0)][..]);
             prop_assert!(exact.mass.is_empty() && fd.mass.is_empty());
@@ -295,19 +298,16 @@ fn analytic_system_derivative_equals_core_finite_difference() {
 #[test]
 fn nelson_mode_shape_derivative_matches_fd() {
     let worst = Cell::new(0.0f64);
-    run("dφ/dk", |r, counts| {
-        let rotor = r.build();
+    run("dφ/dk", |rotor, counts| {
         let p = rotor.nominal_stiffnesses();
         let sys = rotor.assemble(&p).unwrap();
-        let modes = solve_all(&rotor, &p);
+        let modes = solve_all(rotor, &p);
         let m_phi = sys.mass() * &modes.shapes;
         let count = MODES.min(modes.count());
         for i in 0..p.len() {
             let d = rotor.derivative(&p, i).unwrap();
             let shapes_at = |kb: f64| {
-                let mut q = p.clone();
-                q[i] = kb;
-                let mut shapes = solve_all(&rotor, &q).shapes.columns(0, count).into_owned();
+                let mut shapes = solve_with_stiffness(rotor, &p, i, kb).shapes.columns(0, count).into_owned();
                 // Align each shape's sign with the unperturbed one.
                 for (c, mut col) in shapes.column_iter_mut().enumerate() {
                     if col.dot(&m_phi.column(c)) < 0.0 {

@@ -1,16 +1,12 @@
 //! One test per error class, asserting the exact message the user sees.
 
-use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorBuilder, RotorError, Section};
+use eigenfit_rotor::{
+    presets, BearingSpec, Disk, Material, PointMass, Rotor, RotorBuilder, RotorError, Section,
+};
 
 /// A valid rotor to break one thing at a time: 4 elements of 0.1 m.
 fn base() -> RotorBuilder {
-    Rotor::builder()
-        .material(Material::steel())
-        .uniform(0.4, 4)
-        .diameter(0.014)
-        .disk(Disk::new(2, 0.4))
-        .bearing(BearingSpec::new(0, 1e5))
-        .bearing(BearingSpec::new(4, 1e5))
+    presets::steel_shaft_on_end_bearings(0.4, 4, 0.014, 1e5).disk(Disk::new(2, 0.4))
 }
 
 fn message(b: RotorBuilder) -> String {
