@@ -1,4 +1,6 @@
-//! How an iteration ended, as every estimating report states it.
+//! The blocks the estimating reports state alike (how the iteration ended, the budget, the fit
+//! quality, the verdict, the parameters, the frequencies), each built by one function; all but
+//! the budget are flattened into the report, so their keys stand at its top level.
 
 use crate::named::Named;
 use eigenfit_core::analysis::verdict::FitVerdict;
