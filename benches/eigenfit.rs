@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use eigenfit::core::analysis::{
     compare::log_space, compare::run_grid, compare::run_grid_serial, compare::tensor_grid,
-    compare::CompareSettings,
+    compare::CompareSettings, compare::ReferenceSettings,
 };
 use eigenfit::core::analysis::{monte_carlo, monte_carlo::StudySettings};
 use eigenfit::core::discovery::{discover, DiscoveryOptions};
@@ -146,9 +146,7 @@ fn compare_grid(c: &mut Criterion) {
     let initials = tensor_grid(&log_space(1e1, 1e9, 5), 2);
     let strategies = StrategyKind::ALL;
     let settings = CompareSettings {
-        modes: 2,
-        decimals: None,
-        std_hz: None,
+        reference: ReferenceSettings { modes: 2, decimals: None, std_hz: None },
         max_iterations: 1000,
         budget: eigenfit::core::update::DEFAULT_EVALUATIONS,
     };

@@ -5,7 +5,7 @@
 
 use eigenfit::core::analysis::{
     compare::reference_measurement, compare::run_case, compare::CompareRun, compare::CompareSettings,
-    compare::SharedData,
+    compare::ReferenceSettings, compare::SharedData,
 };
 use eigenfit::core::eigen::DenseSolver;
 use eigenfit::core::problem::Problem;
@@ -83,9 +83,7 @@ fn main() {
         println!("### {title}\n");
         for decimals in [Some(3), None] {
             let settings = CompareSettings {
-                modes: 2,
-                decimals,
-                std_hz: None,
+                reference: ReferenceSettings { modes: 2, decimals, std_hz: None },
                 max_iterations: 1000,
                 budget: eigenfit::core::update::DEFAULT_EVALUATIONS,
             };
@@ -118,13 +116,13 @@ fn main() {
 }
 
 fn cell(run: &CompareRun) -> String {
-    if !run.converged {
+    if !run.outcome.converged {
         return format!(
             "{} after {} it.",
-            run.termination.split(':').next().unwrap_or_default(),
-            run.iterations
+            run.outcome.termination.split(':').next().unwrap_or_default(),
+            run.outcome.iterations
         );
     }
     let alt = if run.alternatives.is_empty() { "" } else { ", ambiguous" };
-    format!("{:.4e} / {:.4e} ({} it.{alt})", run.estimate[0], run.estimate[1], run.iterations)
+    format!("{:.4e} / {:.4e} ({} it.{alt})", run.estimate[0], run.estimate[1], run.outcome.iterations)
 }

@@ -29,15 +29,15 @@ pub fn print_estimate(r: &RunupEstimateReport) {
     println!(
         "{}: {} bearing coefficients from {} run-up frequencies: {} after {} iterations; verdict: {}",
         r.model,
-        r.parameters.0.len(),
+        r.values.parameters.0.len(),
         r.points.len(),
         if r.outcome.converged { "converged" } else { "NOT converged" },
         r.outcome.iterations,
-        r.verdict
+        r.verdict.verdict
     );
     println!("{:<28}{:>16}{:>16}{:>32}", "parameter", "initial", "estimate", "95% interval / status");
     for (((name, initial), (_, value)), (_, status)) in
-        r.initial.iter().zip(r.parameters.iter()).zip(r.parameter_status.iter())
+        r.values.initial.iter().zip(r.values.parameters.iter()).zip(r.values.parameter_status.iter())
     {
         println!("{name:<28}{initial:>16.4e}{value:>16.6e}{status:>32}");
     }
@@ -109,6 +109,6 @@ pub fn print_discovery(r: &RunupDiscoverReport) {
     }
     println!(
         "RMS residual {:.4} Hz → {:.4} Hz; {} eigen-solve rounds",
-        d.rms_residual_before_hz, d.rms_residual_after_hz, d.evaluations
+        d.rms.rms_residual_before_hz, d.rms.rms_residual_after_hz, d.evaluations
     );
 }

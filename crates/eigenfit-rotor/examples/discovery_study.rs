@@ -1,15 +1,17 @@
 //! The independent-data discovery study of docs/discovery.md: every draw of
 //! `tests/fixtures/discovery/independent.toml` (numpy-generated, see `generate.py` there),
-//! scored per case and noise level, with the slowest run's wall time.
+//! scored per case and noise level, with the eigen-solves spent and the slowest run's wall time.
 //!
 //! cargo run --release -p eigenfit-rotor --example discovery_study
 //! (`STUDY_CASES=pedestal,clean` for some cases only, `STUDY_VERBOSE=1` for every answer,
 //! `STUDY_SET=heldout` for the draws of `generate.py --heldout`, `STUDY_SET=fresh` for those of
-//! `generate.py --fresh`, instead of the design draws)
+//! `generate.py --fresh`, `STUDY_SET=fresh2` for those of `generate.py --fresh2`, instead of the
+//! design draws)
 
 #[path = "../tests/common/study.rs"]
 mod study;
 
+use std::sync::atomic::Ordering;
 use std::time::Instant;
 use study::Outcome;
 
@@ -18,11 +20,14 @@ fn main() {
     let (fixtures, name) = match set.as_str() {
         "heldout" => (study::load_heldout(), "held-out (heldout.toml, seed 99173)"),
         "fresh" => (study::load_fresh(), "fresh held-out (fresh.toml, seed 60411)"),
+        "fresh2" => (study::load_fresh2(), "second fresh held-out (fresh2.toml, seed 53913)"),
         _ => (study::load(), "design (independent.toml, seed 20261123)"),
     };
     println!("draws: {name}\n");
-    println!("| case | noise | named | ambiguous (honest) | nothing | wrong | truth in 95 % interval |");
-    println!("|---|---|---|---|---|---|---|");
+    println!(
+        "| case | noise | named | ambiguous (honest) | nothing | wrong | truth in 95 % interval | eigen-solves (mean, most) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
     let mut slowest = 0.0f64;
     // STUDY_CASES=pedestal,clean runs only those cases.
     let only = std::env::var("STUDY_CASES").ok();
@@ -34,10 +39,16 @@ fn main() {
         for noise in noises {
             let mut counts = [0usize; 4];
             let (mut covered, mut total) = (0, 0);
+            let (mut solves, mut most, mut exhausted) = (0, 0, 0);
             for draw in fixtures.draw.iter().filter(|d| d.case == case.name && d.noise == noise) {
                 let t = Instant::now();
-                let named = study::run(draw);
+                let solver = study::CountingSolver::default();
+                let found = study::run_counted(&draw.frequency_hz, &draw.std_hz, &solver);
                 slowest = slowest.max(t.elapsed().as_secs_f64());
+                let spent = solver.solves.load(Ordering::Relaxed);
+                (solves, most) = (solves + spent, most.max(spent));
+                exhausted += usize::from(found.report.budget_exhausted);
+                let named = found.effects;
                 let (outcome, inside) = study::score(&case.expect, &named);
                 counts[outcome as usize] += 1;
                 if matches!(outcome, Outcome::Named) {
@@ -57,14 +68,17 @@ fn main() {
             }
             let n: usize = counts.iter().sum();
             println!(
-                "| {} | {:.2} % | {}/{n} | {}/{n} | {}/{n} | {}/{n} | {} |",
+                "| {} | {:.2} % | {}/{n} | {}/{n} | {}/{n} | {}/{n} | {} | {}, {}{} |",
                 case.name,
                 noise * 100.0,
                 counts[0],
                 counts[1],
                 counts[2],
                 counts[3],
-                if total > 0 { format!("{covered}/{total}") } else { "–".into() }
+                if total > 0 { format!("{covered}/{total}") } else { "–".into() },
+                solves / n,
+                most,
+                if exhausted > 0 { format!(" ({exhausted} out of budget)") } else { String::new() }
             );
         }
     }

@@ -121,9 +121,12 @@ impl<S: EigenSolver> Request<'_, S> {
             ..options.clone()
         };
         // First the refined mesh alone (one calibration): if it explains the data, that is the
-        // answer — said instead of a physical effect, or beside one that fits about as well.
-        let fine_base =
-            discover(&fine_rotor, solver, measured, &[], initial, &left(coarse_result.report.evaluations));
+        // answer — said instead of a physical effect, or beside one that fits about as well. It
+        // starts from the user's mesh's calibration (the same stiffnesses to within the mesh
+        // error), so on data the user's mesh explains it needs a few solves, not a search.
+        let calibrated = coarse_result.report.base_parameters.clone();
+        let local = DiscoveryOptions { local_calibration: true, ..left(coarse_result.report.evaluations) };
+        let fine_base = discover(&fine_rotor, solver, measured, &[], &calibrated, &local);
         if let Err(DiscoveryError::BudgetExhausted(_)) = fine_base {
             coarse_result.report.budget_exhausted = true;
         }

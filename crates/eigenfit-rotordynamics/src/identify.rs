@@ -15,6 +15,7 @@ use crate::modal::{Mode, Whirl};
 use crate::rotor::Rotor;
 use crate::rpm_to_rad;
 use crate::sensitivity::{eigenvalue_derivatives, MatrixDerivative};
+use eigenfit_core::update::Outcome;
 use faer::Mat;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
@@ -424,17 +425,12 @@ pub struct Identification {
     pub jacobian: DMatrix<f64>,
     /// Σ r² (weighted by std_hz, or relative residuals without).
     pub cost: f64,
-    /// Iterations taken.
-    pub iterations: usize,
-    /// Eigen-solve rounds (one per measured speed each).
-    pub evaluations: usize,
-    /// Whether the iteration met its tolerance.
-    pub converged: bool,
+    /// Whether the iteration met its tolerance, why it stopped, iterations taken and eigen-solve
+    /// rounds (one per measured speed each).
+    pub outcome: Outcome,
     /// Whether every parameter is determined by the data (Jacobian of full rank at the
     /// estimate, singular values above 10⁻¹² of the largest).
     pub identifiable: bool,
-    /// Why the iteration stopped.
-    pub reason: String,
 }
 
 /// Levenberg–Marquardt in ln s from `initial` scales, in stages when the selection holds more
@@ -466,8 +462,8 @@ pub fn identify(
         start[i] = first.scales[k];
     }
     let mut out = levenberg_marquardt(&whole, &start)?;
-    out.iterations += first.iterations;
-    out.evaluations += first.evaluations;
+    out.outcome.iterations += first.outcome.iterations;
+    out.outcome.evaluations += first.outcome.evaluations;
     Ok(out)
 }
 
@@ -613,10 +609,7 @@ fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, Rot
         model_whirl: eval.whirl.clone(),
         jacobian: eval.jacobian.clone(),
         cost,
-        iterations,
-        evaluations,
-        converged,
+        outcome: Outcome { converged, termination: reason, iterations, evaluations },
         identifiable,
-        reason,
     })
 }

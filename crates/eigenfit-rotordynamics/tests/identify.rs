@@ -37,7 +37,7 @@ fn recovers_every_bearings_kxx_and_kyy_from_a_runup() {
     let truth = [1.3, 0.75, 0.9, 1.2];
     let points = runup(&truth, Some(0.01));
     let id = identify(&r, &params, &points, &[1.0; 4], 100).unwrap();
-    assert!(id.converged, "{}", id.reason);
+    assert!(id.outcome.converged, "{}", id.outcome.termination);
     for (k, (s, t)) in id.scales.iter().zip(truth).enumerate() {
         assert!((s - t).abs() < 1e-6 * t, "{}: {s} vs {t}", names[k]);
     }
@@ -60,7 +60,12 @@ fn interval_width_follows_the_measurement_noise() {
     let wide = identify(&r, &params, &runup(&truth, Some(0.1)), &truth, 5).unwrap();
     let info = format!(
         "{} {} {} / {} {} {}",
-        narrow.iterations, narrow.reason, narrow.cost, wide.iterations, wide.reason, wide.cost
+        narrow.outcome.iterations,
+        narrow.outcome.termination,
+        narrow.cost,
+        wide.outcome.iterations,
+        wide.outcome.termination,
+        wide.cost
     );
     let (a, b) = (narrow.ln_std.unwrap(), wide.ln_std.unwrap());
     for k in 0..4 {
@@ -112,7 +117,7 @@ fn recovers_cross_coupled_and_damping_coefficients_from_a_ross_runup() {
     let params = bearing_parameters(&r, &["kxx", "kyy", "kxy", "kyx", "cxx", "cyy"]).unwrap();
     assert_eq!(params.len(), 12);
     let id = identify(&r, &params, &points, &vec![1.0; params.len()], 200).unwrap();
-    assert!(id.converged, "{}", id.reason);
+    assert!(id.outcome.converged, "{}", id.outcome.termination);
     assert!(id.identifiable);
     let mut worst = 0.0f64;
     for (p, s) in params.iter().zip(&id.scales) {
@@ -123,7 +128,7 @@ fn recovers_cross_coupled_and_damping_coefficients_from_a_ross_runup() {
         "ROSS run-up: {} frequencies, {} parameters, {} iterations, χ² {:.3e}, worst factor error {worst:.2e}",
         points.len(),
         params.len(),
-        id.iterations,
+        id.outcome.iterations,
         id.cost
     );
     assert!(worst < 1e-5, "worst relative factor error {worst:.3e}: {:?}", id.scales);
@@ -160,9 +165,9 @@ fn compressor_bearings_come_back_from_a_start_forty_percent_off() {
     let start: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("realistic_runups.json")).unwrap()).unwrap();
     let id = identify(&r, &params, &points, &[1.0; 4], 100).unwrap();
-    assert!(id.converged, "{}", id.reason);
+    assert!(id.outcome.converged, "{}", id.outcome.termination);
     // Bounded work, counted: measured 40 eigen-solve rounds.
-    assert!(id.evaluations <= 80, "{} evaluations", id.evaluations);
+    assert!(id.outcome.evaluations <= 80, "{} evaluations", id.outcome.evaluations);
     let sd = id.ln_std.clone().expect("std given");
     for (k, p) in params.iter().enumerate() {
         let (coef, tag) = p.name.split_once('_').unwrap();

@@ -4,7 +4,7 @@
 use crate::error::{failure, input, WorkflowError};
 use crate::model::Updatable;
 use crate::named::Named;
-use crate::outcome::{BudgetReport, Outcome};
+use crate::outcome::{BudgetReport, Outcome, PairedFrequencies};
 use crate::overrides::fixed;
 use crate::progress::Progress;
 use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDataOptions};
@@ -39,10 +39,9 @@ pub struct CampaignRequest {
 pub struct ConfigurationReport {
     /// Its name.
     pub name: String,
-    /// Model frequencies (Hz).
-    pub frequencies_hz: Vec<f64>,
-    /// Measured frequencies (Hz).
-    pub measured_hz: Vec<f64>,
+    /// Model and measured frequencies (Hz).
+    #[serde(flatten)]
+    pub frequencies: PairedFrequencies,
     /// Measured mode number → model mode number, both from 1.
     pub pairing: Named<usize>,
     /// MAC matrix (shapes).
@@ -189,8 +188,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         configurations.push(ConfigurationReport {
             name: names[k].clone(),
             pairing: pairing(fit.measured(), &lin.paired_modes),
-            frequencies_hz: lin.frequencies_hz,
-            measured_hz: lin.measured_hz,
+            frequencies: PairedFrequencies::of(&lin),
             mac: mac.as_ref().map(|r| r.matrix.clone()),
             unpaired: mac.as_ref().map(|r| r.unpaired.clone()),
             notes: data[k].notes.clone(),

@@ -8,7 +8,9 @@
 
 use crate::error::{input, WorkflowError};
 use crate::overrides::{parse_list, points};
-use eigenfit_core::analysis::compare::{log_space, run_grid, tensor_grid, CompareRun, CompareSettings};
+use eigenfit_core::analysis::compare::{
+    log_space, run_grid, tensor_grid, CompareRun, CompareSettings, ReferenceSettings,
+};
 use eigenfit_core::analysis::Identifiability;
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
@@ -140,9 +142,11 @@ pub fn plan(request: &CompareRequest, np: usize) -> Result<ComparePlan, Workflow
         return Err(input("--budget 0: at least one model evaluation is needed"));
     }
     let settings = CompareSettings {
-        modes: request.modes.unwrap_or(np).max(np),
-        decimals: request.decimals,
-        std_hz: request.std_hz,
+        reference: ReferenceSettings {
+            modes: request.modes.unwrap_or(np).max(np),
+            decimals: request.decimals,
+            std_hz: request.std_hz,
+        },
         max_iterations: request.max_iterations,
         budget: request.budget,
     };
@@ -204,7 +208,7 @@ impl RunReport {
             strategy: r.strategy.name(),
             run: r.clone(),
             seconds: timing.then_some(r.seconds),
-            alternative_solutions: (r.strategy == StrategyKind::LevenbergMarquardt && r.converged)
+            alternative_solutions: (r.strategy == StrategyKind::LevenbergMarquardt && r.outcome.converged)
                 .then(|| r.alternatives.clone()),
             identifiable: r.identifiability.as_ref().map(|ids| ids.iter().map(Into::into).collect()),
         }
@@ -243,8 +247,8 @@ pub fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[Strate
     for t in targets {
         for &s in strategies {
             let group: Vec<&CompareRun> = runs.iter().filter(|r| &r.target == t && r.strategy == s).collect();
-            let conv: Vec<&&CompareRun> = group.iter().filter(|r| r.converged).collect();
-            let mut iters: Vec<usize> = conv.iter().map(|r| r.iterations).collect();
+            let conv: Vec<&&CompareRun> = group.iter().filter(|r| r.outcome.converged).collect();
+            let mut iters: Vec<usize> = conv.iter().map(|r| r.outcome.iterations).collect();
             iters.sort_unstable();
             out.push(Summary {
                 target: t.clone(),
@@ -287,8 +291,11 @@ pub fn basins(runs: &[CompareRun], strategies: &[StrategyKind]) -> Vec<Basin> {
             Basin {
                 strategy: s.name(),
                 runs: group.len(),
-                converged: group.iter().filter(|r| r.converged).count(),
-                at_target: group.iter().filter(|r| r.converged && r.relative_error <= AT_TARGET).count(),
+                converged: group.iter().filter(|r| r.outcome.converged).count(),
+                at_target: group
+                    .iter()
+                    .filter(|r| r.outcome.converged && r.relative_error <= AT_TARGET)
+                    .count(),
             }
         })
         .collect()
@@ -301,12 +308,10 @@ pub struct CompareReport {
     pub model: String,
     /// The eigen-solver's name.
     pub solver: String,
-    /// Reference modes.
-    pub modes: usize,
-    /// Decimals the reference frequencies were rounded to.
-    pub decimals: Option<i32>,
-    /// Reference standard deviation (Hz).
-    pub std_hz: Option<f64>,
+    /// Reference modes, the decimals their frequencies were rounded to, their standard
+    /// deviation (Hz).
+    #[serde(flatten)]
+    pub reference: ReferenceSettings,
     /// Every run.
     pub runs: Vec<RunReport>,
     /// Per target and strategy.
@@ -335,9 +340,7 @@ pub fn run(
     Ok(CompareReport {
         model: label.to_string(),
         solver: solver.name().to_string(),
-        modes: plan.settings.modes,
-        decimals: plan.settings.decimals,
-        std_hz: plan.settings.std_hz,
+        reference: plan.settings.reference.clone(),
         runs: runs.iter().map(|r| RunReport::new(r, plan.timing)).collect(),
         summary: summarise(&runs, &plan.targets, &plan.strategies),
         plots: None,

@@ -3,17 +3,18 @@
 //! discovery of a hidden effect in a built-in dataset.
 
 use crate::compare::{basins, Basin};
+use crate::discover::RmsResidual;
 use crate::error::{failure, WorkflowError};
 use crate::progress::Progress;
 use eigenfit_core::analysis::compare::{
-    log_space, reference_measurement, run_grid, tensor_grid, CompareRun, CompareSettings,
+    log_space, reference_measurement, run_grid, tensor_grid, CompareRun, CompareSettings, ReferenceSettings,
 };
 use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit};
 use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 use eigenfit_core::measurement::measured_csv;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::Problem;
-use eigenfit_core::update::{Driver, Estimate, StrategyKind};
+use eigenfit_core::update::{Driver, Estimate, Outcome, StrategyKind};
 use eigenfit_rotor::presets::{self, PAPER_TABLE_1};
 use serde::Serialize;
 
@@ -51,12 +52,9 @@ pub struct StrategyRun {
     pub strategy: &'static str,
     /// K1, K2 reached (N/m).
     pub parameters: Vec<f64>,
-    /// Iterations.
-    pub iterations: usize,
-    /// Whether it converged.
-    pub converged: bool,
-    /// Why it stopped.
-    pub termination: String,
+    /// Whether it converged, why it stopped, iterations and model evaluations.
+    #[serde(flatten)]
+    pub outcome: Outcome,
 }
 
 /// Table 3 case 1: target, start, the reference data and every strategy's result.
@@ -92,10 +90,9 @@ pub struct HiddenEffect {
     pub chi2_before: f64,
     /// χ² with the effect added.
     pub chi2_after: f64,
-    /// RMS residual before (Hz).
-    pub rms_residual_before_hz: f64,
-    /// RMS residual after (Hz).
-    pub rms_residual_after_hz: f64,
+    /// RMS residual before and after (Hz).
+    #[serde(flatten)]
+    pub rms: RmsResidual,
 }
 
 /// The demo's report; `out`, `plots` and `seconds` are the front end's to fill.
@@ -161,9 +158,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
     }
     // 2. Table 3 case 1 with all three strategies.
     let settings = CompareSettings {
-        modes: 2,
-        decimals: Some(3),
-        std_hz: None,
+        reference: ReferenceSettings { modes: 2, decimals: Some(3), std_hz: None },
         max_iterations: 1000,
         budget: eigenfit_core::update::DEFAULT_EVALUATIONS,
     };
@@ -198,8 +193,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
         fit: s.clone(),
         chi2_before: found.chi2_before,
         chi2_after: s.chi2,
-        rms_residual_before_hz: found.rms_before_hz,
-        rms_residual_after_hz: found.rms_after_hz,
+        rms: RmsResidual::of(&found),
     });
     let report = DemoReport {
         model: LABEL,
@@ -213,9 +207,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
                 .map(|e| StrategyRun {
                     strategy: e.strategy,
                     parameters: e.parameters.clone(),
-                    iterations: e.iterations,
-                    converged: e.termination.is_converged(),
-                    termination: e.termination.to_string(),
+                    outcome: Outcome::of(e, e.termination.is_converged()),
                 })
                 .collect(),
         },

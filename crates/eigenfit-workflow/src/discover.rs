@@ -51,10 +51,9 @@ pub struct DiscoverReport {
     pub missing_effects: Vec<NamedEffect>,
     /// Mesh refinement factor settled on (1: the user's mesh).
     pub mesh_refinement: usize,
-    /// RMS residual before (Hz).
-    pub rms_residual_before_hz: f64,
-    /// RMS residual after (Hz).
-    pub rms_residual_after_hz: f64,
+    /// RMS residual before and after (Hz).
+    #[serde(flatten)]
+    pub rms: RmsResidual,
     /// The nominal parameters calibrated.
     pub calibrated_parameters: Named<f64>,
     /// The model's own parameters refitted together with the selected effect(s): the values a
@@ -78,6 +77,23 @@ pub struct DiscoverReport {
     /// (the search names effects only when, with them, the noise explains what is left). False
     /// when a significant disagreement stays unexplained or the budget ran out: exit code 3.
     pub explained: bool,
+}
+
+/// `rms_residual_before_hz`, `rms_residual_after_hz`: how far model and measurement lie apart
+/// before and after the named effects, as `discover` and the demo's discovery state it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RmsResidual {
+    /// RMS residual before (Hz).
+    pub rms_residual_before_hz: f64,
+    /// RMS residual after (Hz).
+    pub rms_residual_after_hz: f64,
+}
+
+impl RmsResidual {
+    /// The RMS residuals of a discovery run.
+    pub fn of(r: &DiscoveryReport) -> Self {
+        Self { rms_residual_before_hz: r.rms_before_hz, rms_residual_after_hz: r.rms_after_hz }
+    }
 }
 
 /// A parameter refitted with the named effect(s).
@@ -188,8 +204,7 @@ pub(crate) fn report_of(
         missing_effect: effects.first().cloned(),
         missing_effects: effects.to_vec(),
         mesh_refinement,
-        rms_residual_before_hz: r.rms_before_hz,
-        rms_residual_after_hz: r.rms_after_hz,
+        rms: RmsResidual::of(r),
         chi2_before: r.chi2_before,
         dof_before: r.dof_before,
         p_value: r.p_value,

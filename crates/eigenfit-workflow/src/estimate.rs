@@ -3,7 +3,7 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::{FitQualityReport, Outcome};
+use crate::outcome::{FitQualityReport, Outcome, PairedFrequencies, ParameterValues, Verdict};
 use crate::overrides::{fixed, parameter_vector};
 use crate::progress::{Progress, StepsObserver};
 use crate::rotordynamics::{self, RunupEstimateReport};
@@ -161,10 +161,10 @@ pub struct EstimateReport {
     /// Converged, why it stopped, iterations, model evaluations of the fit.
     #[serde(flatten)]
     pub outcome: Outcome,
-    /// Converged, fit not poor, no parameter on a limit, budget not spent, every mode paired.
-    pub acceptable: bool,
-    /// The verdict in words.
-    pub verdict: String,
+    /// Converged, fit not poor, no parameter on a limit, budget not spent, every mode paired; the
+    /// verdict in words.
+    #[serde(flatten)]
+    pub verdict: Verdict,
     /// χ², dof, p-value, relative RMS and the measured mode numbers that disagree by > 3σ.
     #[serde(flatten)]
     pub fit: FitQualityReport<usize>,
@@ -173,12 +173,9 @@ pub struct EstimateReport {
     /// Evaluations spent in each phase reached: reachability, fit, intervals,
     /// mirror_solutions, other_solutions (on a large model each is an eigen-solve of seconds).
     pub evaluations_by_phase: Named<usize>,
-    /// Initial values.
-    pub initial: Named<f64>,
-    /// Estimated values.
-    pub parameters: Named<f64>,
-    /// What the data say about each parameter, in words.
-    pub parameter_status: Named<String>,
+    /// Initial and estimated values, and what the data say about each parameter, in words.
+    #[serde(flatten)]
+    pub values: ParameterValues,
     /// Parameters on a limit.
     pub at_limit: Vec<String>,
     /// Intervals and what the data determine (a converged run with std or scatter).
@@ -186,10 +183,9 @@ pub struct EstimateReport {
     pub uncertainty: Option<IntervalsReport>,
     /// Other equally good solutions.
     pub alternative_solutions: Vec<AlternativeSolution>,
-    /// Model frequencies at the estimate (Hz).
-    pub frequencies_hz: Vec<f64>,
-    /// Measured frequencies (Hz).
-    pub measured_hz: Vec<f64>,
+    /// Model frequencies at the estimate and measured frequencies (Hz).
+    #[serde(flatten)]
+    pub frequencies: PairedFrequencies,
     /// The iterations.
     pub history: Vec<HistoryRecord>,
     /// Plot files written.
@@ -438,21 +434,14 @@ pub fn run(
     let pinned: Vec<String> = (0..np).filter(|&i| limits[i] != 0).map(|i| names[i].clone()).collect();
     // A measured mode below the MAC threshold makes the result not acceptable.
     let unpaired = mac.as_ref().is_some_and(|r| !r.unpaired.is_empty());
-    let acceptable =
-        converged && quality.verdict != FitVerdict::Poor && pinned.is_empty() && !budget_spent && !unpaired;
-    let verdict = if !converged {
-        estimate.termination.label()
-    } else if budget_spent {
-        "budget-exhausted"
-    } else if quality.verdict == FitVerdict::Poor {
-        "poor-fit"
-    } else if !pinned.is_empty() {
-        "not-identifiable"
-    } else if quality.verdict == FitVerdict::NotJudged {
-        "converged (fit quality not judged: no std)"
-    } else {
-        "converged"
-    };
+    let verdict = Verdict::of(
+        (!converged).then(|| estimate.termination.label()),
+        budget_spent,
+        quality.verdict,
+        !pinned.is_empty(),
+        unpaired,
+    );
+    let acceptable = verdict.acceptable;
     // What the data say about each parameter, in words.
     let status = |i: usize| -> String {
         let bound = unc.as_ref().map(|u| &u.identifiability[i]);
@@ -480,14 +469,11 @@ pub fn run(
         model: label,
         strategy: estimate.strategy,
         outcome: Outcome::of(&estimate, converged),
-        acceptable,
-        verdict: verdict.to_string(),
+        verdict,
         fit: FitQualityReport::of(&quality, |k| mode_numbers[k]),
         budget: BudgetReport { limit: budget.limit(), used: budget.used(), exhausted: budget_spent },
         evaluations_by_phase: phase_counts(&phases),
-        initial: Named::new(&names, initial.iter().copied()),
-        parameters: Named::new(&names, estimate.parameters.iter().copied()),
-        parameter_status: Named::new(&names, (0..np).map(status)),
+        values: ParameterValues::new(&names, &initial, &estimate.parameters, status),
         at_limit: pinned,
         alternative_solutions: alternatives
             .iter()
@@ -503,8 +489,7 @@ pub fn run(
                 }
             })
             .collect(),
-        frequencies_hz: estimate.last.frequencies_hz.clone(),
-        measured_hz: estimate.last.measured_hz.clone(),
+        frequencies: PairedFrequencies::of(&estimate.last),
         history: estimate
             .history
             .iter()

@@ -3,8 +3,8 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::{FitQualityReport, Outcome};
-use eigenfit_core::analysis::verdict::{judge, FitQuality, FitVerdict};
+use crate::outcome::{FitQualityReport, Outcome, ParameterValues, Verdict};
+use eigenfit_core::analysis::verdict::{judge, FitQuality};
 use eigenfit_core::problem::Linearisation;
 use eigenfit_rotordynamics::identify::{
     bearing_parameters, identify, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
@@ -127,21 +127,19 @@ pub struct RunupEstimateReport {
     /// Converged, why it stopped, iterations, eigen-solve rounds.
     #[serde(flatten)]
     pub outcome: Outcome,
-    /// Converged and the fit not poor: the exit verdict.
-    pub acceptable: bool,
-    /// `converged`, `poor-fit`, `not-converged` or converged with the quality not judged.
-    pub verdict: &'static str,
+    /// Converged and the fit not poor (the exit verdict); `converged`, `poor-fit`,
+    /// `not-converged` or converged with the quality not judged.
+    #[serde(flatten)]
+    pub verdict: Verdict,
     /// χ², dof, p-value, relative RMS and the run-up points that miss by more than 3σ.
     #[serde(flatten)]
     pub fit: FitQualityReport<RunupPointId>,
     /// The speed the coefficients are reported at (the lowest measured, rpm).
     pub reference_speed_rpm: f64,
-    /// Nominal coefficients (N/m or N·s/m).
-    pub initial: Named<f64>,
-    /// Estimated coefficients (N/m or N·s/m).
-    pub parameters: Named<f64>,
-    /// Each parameter's interval as text, or why there is none.
-    pub parameter_status: Named<String>,
+    /// Nominal and estimated coefficients (N/m or N·s/m), each one's interval as text or why
+    /// there is none.
+    #[serde(flatten)]
+    pub values: ParameterValues,
     /// Estimated scale factors on the nominal curves.
     pub scales: Named<f64>,
     /// Σ r².
@@ -231,19 +229,12 @@ pub fn estimate(
             .collect()
     });
     let quality = fit_quality(&id, &points, &value);
-    let acceptable = id.converged && quality.verdict != FitVerdict::Poor;
-    let verdict = if !id.converged {
-        "not-converged"
-    } else if quality.verdict == FitVerdict::Poor {
-        "poor-fit"
-    } else if quality.verdict == FitVerdict::NotJudged {
-        "converged (fit quality not judged: no std)"
-    } else {
-        "converged"
-    };
+    // A run-up fit has no budget, limits or pairing of its own to fail on.
+    let verdict =
+        Verdict::of((!id.outcome.converged).then_some("not-converged"), false, quality.verdict, false, false);
     let status = |i: usize| -> String {
         match &intervals {
-            _ if !id.converged => "(not computed: the run did not converge)".into(),
+            _ if !id.outcome.converged => "(not computed: the run did not converge)".into(),
             Some(iv) => format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]),
             None if !id.identifiable => {
                 "not identifiable: the frequencies fix only combinations of the parameters".into()
@@ -260,22 +251,14 @@ pub fn estimate(
     };
     Ok(RunupEstimateReport {
         model: path.display().to_string(),
-        outcome: Outcome {
-            converged: id.converged,
-            termination: id.reason.clone(),
-            iterations: id.iterations,
-            evaluations: id.evaluations,
-        },
-        acceptable,
+        outcome: id.outcome.clone(),
         verdict,
         fit: FitQualityReport::of(&quality, |k| RunupPointId {
             speed_rpm: points[k].speed_rpm,
             mode: points[k].mode,
         }),
         reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
-        initial: Named::new(&names, nominal.iter().copied()),
-        parameters: Named::new(&names, value.iter().copied()),
-        parameter_status: Named::new(&names, (0..params.len()).map(status)),
+        values: ParameterValues::new(&names, &nominal, &value, status),
         scales: Named::new(&names, id.scales.iter().copied()),
         cost: id.cost,
         identifiable: id.identifiable,

@@ -69,7 +69,8 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         }
         for c in &report.configurations {
             println!("{}:", c.name);
-            for (k, (m, f)) in c.measured_hz.iter().zip(&c.frequencies_hz).enumerate() {
+            for (k, (m, f)) in c.frequencies.measured_hz.iter().zip(&c.frequencies.frequencies_hz).enumerate()
+            {
                 let mac_text = c
                     .mac_pairing
                     .as_ref()

@@ -123,7 +123,7 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
             plan.targets.len(),
             plan.initials.len(),
             plan.strategies.len(),
-            report.modes
+            report.reference.modes
         );
         println!(
             "{:<16}{:<9}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",
@@ -222,7 +222,7 @@ fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyK
                 let row: String = runs
                     .iter()
                     .filter(|r| &r.target == t && r.strategy == s && r.initial[0] == a)
-                    .map(|r| match (r.converged, r.relative_error <= WITHIN_1E6) {
+                    .map(|r| match (r.outcome.converged, r.relative_error <= WITHIN_1E6) {
                         (true, true) => '●',
                         (true, false) => '○',
                         _ => '·',

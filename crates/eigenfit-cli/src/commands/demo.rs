@@ -113,7 +113,7 @@ fn text(found: &Demo, dofs: usize, grid: usize) -> Vec<String> {
     for e in &t.estimates {
         say.push(format!(
             "{:<10}{:>16.4e}{:>16.4e}{:>8}  {}",
-            e.strategy, e.parameters[0], e.parameters[1], e.iterations, e.termination
+            e.strategy, e.parameters[0], e.parameters[1], e.outcome.iterations, e.outcome.termination
         ));
     }
     say.push(String::new());
@@ -151,7 +151,7 @@ fn text(found: &Demo, dofs: usize, grid: usize) -> Vec<String> {
             ));
             say.push(format!(
                 "   χ² {:.0} → {:.2}, RMS residual {:.3} → {:.4} Hz",
-                s.chi2_before, s.chi2_after, s.rms_residual_before_hz, s.rms_residual_after_hz
+                s.chi2_before, s.chi2_after, s.rms.rms_residual_before_hz, s.rms.rms_residual_after_hz
             ));
         }
         None => say.push("   no single effect explains the disagreement".into()),

@@ -84,7 +84,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     print_notes(&notes);
     let mut est = match outcome? {
         EstimateOutcome::Runup(report) => {
-            let code = if report.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
+            let code = if report.verdict.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
             crate::output::report(args.report.json, &*report, crate::rotordynamics::print_estimate);
             return Ok(code);
         }
@@ -101,7 +101,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             let r = &est.report;
             let figure = Convergence {
                 title: format!("{}: convergence of the {} strategy", r.model, r.strategy),
-                parameter_names: r.parameters.iter().map(|(n, _)| n.clone()).collect(),
+                parameter_names: r.values.parameters.iter().map(|(n, _)| n.clone()).collect(),
                 unit: est.unit.clone(),
                 runs: vec![Run::from_estimate(&est.estimate)],
                 target: None,
@@ -136,7 +136,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
 /// The text report: parameters, modes, fit quality, other solutions.
 fn print_report(est: &Estimation) {
     let r = &est.report;
-    let names: Vec<&str> = r.parameters.iter().map(|(n, _)| n.as_str()).collect();
+    let names: Vec<&str> = r.values.parameters.iter().map(|(n, _)| n.as_str()).collect();
     println!(
         "{}: {} strategy, {} after {} iterations ({} model evaluations)",
         r.model, r.strategy, r.outcome.termination, r.outcome.iterations, r.budget.used
@@ -144,11 +144,15 @@ fn print_report(est: &Estimation) {
     println!("{:<20}{:>16}{:>16}   95% interval [N/m]", "parameter", "initial [N/m]", "estimate [N/m]");
     for (i, n) in names.iter().enumerate() {
         // A value on a limit is where the search stopped, not an estimate.
-        let value = if est.on_limit[i] { "—".to_string() } else { format!("{:.6e}", r.parameters.0[i].1) };
-        println!("{n:<20}{:>16.4e}{value:>16}   {}", r.initial.0[i].1, r.parameter_status.0[i].1);
+        let value =
+            if est.on_limit[i] { "—".to_string() } else { format!("{:.6e}", r.values.parameters.0[i].1) };
+        println!(
+            "{n:<20}{:>16.4e}{value:>16}   {}",
+            r.values.initial.0[i].1, r.values.parameter_status.0[i].1
+        );
     }
     println!("{:>6}{:>16}{:>16}{:>14}", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]");
-    for (k, (m, f)) in r.measured_hz.iter().zip(&r.frequencies_hz).enumerate() {
+    for (k, (m, f)) in r.frequencies.measured_hz.iter().zip(&r.frequencies.frequencies_hz).enumerate() {
         println!("{:>6}{m:>16.6}{f:>16.6}{:>14.2e}", est.mode_numbers[k], f - m);
     }
     match (est.quality.verdict, r.fit.chi2) {

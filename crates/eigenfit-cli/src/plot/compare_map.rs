@@ -94,12 +94,12 @@ impl CompareMaps {
                     .filter(|r| &r.target == t && r.strategy == s)
                     .map(|r| Cell {
                         initial: [r.initial[0], r.initial[1]],
-                        outcome: match (r.converged, r.relative_error <= AT_TARGET) {
+                        outcome: match (r.outcome.converged, r.relative_error <= AT_TARGET) {
                             (true, true) => Outcome::AtTarget,
                             (true, false) => Outcome::Elsewhere,
                             _ => Outcome::Failed,
                         },
-                        iterations: r.iterations,
+                        iterations: r.outcome.iterations,
                     })
                     .collect();
                 panels.push(Panel { strategy: s.name().to_string(), target: [t[0], t[1]], cells });

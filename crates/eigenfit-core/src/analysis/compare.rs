@@ -7,7 +7,7 @@ use crate::measurement::synthetic::SynthesisError;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::problem::{Linearisation, Objective, Problem};
-use crate::update::{Budget, Driver, LevenbergMarquardt, StrategyKind, UpdateStrategy};
+use crate::update::{Budget, Driver, LevenbergMarquardt, Outcome, StrategyKind, UpdateStrategy};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
@@ -16,9 +16,10 @@ use thiserror::Error;
 /// Local fits tried when looking for other solutions of a damped run.
 const ALTERNATIVE_STARTS: usize = 6;
 
-/// How the reference data are made and how each run is limited.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CompareSettings {
+/// How the reference data are made: `modes`, `decimals`, `std_hz`, as a comparison's report
+/// states them (flattened into it).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ReferenceSettings {
     /// Number of lowest modes measured (the paper: as many as parameters).
     pub modes: usize,
     /// Round reference frequencies to this many decimals (the paper's Table 1: 3), or exact.
@@ -26,6 +27,13 @@ pub struct CompareSettings {
     /// Standard deviation attached to each reference frequency (Hz), enabling intervals and
     /// identifiability flags for the damped strategy.
     pub std_hz: Option<f64>,
+}
+
+/// How the reference data are made and how each run is limited.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareSettings {
+    /// Modes, rounding and standard deviation of the reference data.
+    pub reference: ReferenceSettings,
     /// Iteration limit per run.
     pub max_iterations: usize,
     /// Most model evaluations (eigen-solves) one run may spend on its fit and, for a damped run,
@@ -44,14 +52,10 @@ pub struct CompareRun {
     pub target: Vec<f64>,
     /// Initial guess.
     pub initial: Vec<f64>,
-    /// Converged?
-    pub converged: bool,
-    /// Termination reason as text.
-    pub termination: String,
-    /// Iterations taken.
-    pub iterations: usize,
-    /// Model evaluations (eigen-solves), including rejected trials.
-    pub evaluations: usize,
+    /// Converged, termination reason as text, iterations, model evaluations (eigen-solves,
+    /// including rejected trials).
+    #[serde(flatten)]
+    pub outcome: Outcome,
     /// Final parameters.
     pub estimate: Vec<f64>,
     /// max |estimate / target − 1| over the parameters.
@@ -95,8 +99,8 @@ where
     M: StructuralModel + ?Sized,
     S: EigenSolver + ?Sized,
 {
-    let modes = solver.lowest(&model.assemble(target)?, settings.modes)?;
-    let round = |f: f64| match settings.decimals {
+    let modes = solver.lowest(&model.assemble(target)?, settings.reference.modes)?;
+    let round = |f: f64| match settings.reference.decimals {
         Some(d) => (f * 10f64.powi(d)).round() / 10f64.powi(d),
         None => f,
     };
@@ -104,7 +108,12 @@ where
         .frequencies_hz()
         .into_iter()
         .enumerate()
-        .map(|(k, f)| MeasuredMode { mode: k, frequency_hz: round(f), std_hz: settings.std_hz, shape: None })
+        .map(|(k, f)| MeasuredMode {
+            mode: k,
+            frequency_hz: round(f),
+            std_hz: settings.reference.std_hz,
+            shape: None,
+        })
         .collect();
     Ok(Measurement::new(measured)?)
 }
@@ -184,10 +193,7 @@ where
                 strategy,
                 target: target.to_vec(),
                 initial: initial.to_vec(),
-                converged,
-                termination: est.termination.to_string(),
-                iterations: est.iterations,
-                evaluations: est.evaluations,
+                outcome: Outcome::of(&est, converged),
                 relative_error: relative_error(&est.parameters, target),
                 estimate: est.parameters,
                 seconds,
@@ -199,10 +205,7 @@ where
             strategy,
             target: target.to_vec(),
             initial: initial.to_vec(),
-            converged: false,
-            termination: e.to_string(),
-            iterations: 0,
-            evaluations: 0,
+            outcome: Outcome { converged: false, termination: e.to_string(), iterations: 0, evaluations: 0 },
             estimate: initial.to_vec(),
             relative_error: relative_error(initial, target),
             seconds,
@@ -321,9 +324,7 @@ mod tests {
         let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
         let strategies = StrategyKind::ALL;
         let settings = CompareSettings {
-            modes: 3,
-            decimals: Some(3),
-            std_hz: Some(0.01),
+            reference: ReferenceSettings { modes: 3, decimals: Some(3), std_hz: Some(0.01) },
             max_iterations: 100,
             budget: crate::update::DEFAULT_EVALUATIONS,
         };

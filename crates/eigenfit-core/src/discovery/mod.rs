@@ -43,7 +43,8 @@ pub enum DiscoveryError {
 pub struct DiscoveryOptions {
     /// Significance level of the χ² test (default 0.05).
     pub significance: f64,
-    /// Candidates refitted after screening (default 8; switches are always refitted).
+    /// Candidates refitted after screening (default 8; switches are always refitted), and the
+    /// most candidates predicting like the leading fit refitted beside it in each round.
     pub refits: usize,
     /// AICc improvement over the base model needed to name an effect (default 6: with ~130
     /// candidates to choose from, 4 named a noise fit in 2.4 % of 330 clean independent draws,
@@ -65,6 +66,10 @@ pub struct DiscoveryOptions {
     /// [`DEFAULT_EVALUATIONS`]): bounded time whatever the data. When they run out the search
     /// stops with what it has ([`DiscoveryReport::budget_exhausted`]).
     pub max_evaluations: usize,
+    /// Calibrate by a local fit from `initial` only, without restarts from a coarse grid
+    /// (default false): for a start known to be close, such as one mesh's calibration carried
+    /// to a refined mesh, where restarts would only spend solves on a misfit no start removes.
+    pub local_calibration: bool,
 }
 
 /// Evaluations a discovery run may spend by default: about 1 s of one core on 8 modes of the
@@ -85,6 +90,7 @@ impl Default for DiscoveryOptions {
             max_effects: 3,
             ambiguity_aicc: 2.0,
             max_evaluations: DEFAULT_EVALUATIONS,
+            local_calibration: false,
         }
     }
 }
@@ -511,7 +517,11 @@ pub fn discover_effects<E: EffectSearch>(
     // (a) calibrate
     let est = search
         .with_base(|base| {
-            Some(Driver::default().run_within(base, &mut LevenbergMarquardt::default(), initial, &budget))
+            let mut strategy = LevenbergMarquardt::default();
+            if options.local_calibration {
+                strategy = strategy.with_max_restarts(0);
+            }
+            Some(Driver::default().run_within(base, &mut strategy, initial, &budget))
         })
         .ok_or_else(|| DiscoveryError::Data("the base problem could not be built".into()))?
         .map_err(|e| match budget.exhausted() {
@@ -568,22 +578,22 @@ pub fn discover_effects<E: EffectSearch>(
         }
         let chosen_refs: Vec<&Candidate> = chosen.iter().map(|&i| &candidates[i]).collect();
         let open = |i: usize| !chosen.iter().any(|&c| same_place(&candidates[c], &candidates[i]));
-        let mut scored: Vec<(usize, f64)> = search
+        let (screened, projector) = search
             .with_effects(&chosen_refs, |problem| {
                 let lin = budget.wrap(problem).linearise(&current.parameters).ok()?;
                 let projector = Projector::new(problem, &lin);
-                Some(
-                    candidates
-                        .iter()
-                        .enumerate()
-                        .filter(|&(i, c)| !c.needs_refit() && open(i))
-                        .filter_map(|(i, c)| {
-                            screen(search, &chosen_refs, c, (&lin, &projector), &budget).map(|s| (i, s))
-                        })
-                        .collect(),
-                )
+                let screened: Vec<(usize, Screened)> = candidates
+                    .iter()
+                    .enumerate()
+                    .filter(|&(i, c)| !c.needs_refit() && open(i))
+                    .filter_map(|(i, c)| {
+                        screen(search, &chosen_refs, c, (&lin, &projector), &budget).map(|s| (i, s))
+                    })
+                    .collect();
+                Some((screened, projector))
             })
-            .unwrap_or_default();
+            .unwrap_or_else(|| (Vec::new(), Projector::none()));
+        let mut scored: Vec<(usize, f64)> = screened.iter().map(|(i, s)| (*i, s.reduction)).collect();
         scored.sort_by(|a, b| b.1.total_cmp(&a.1));
         if round == 0 {
             report.screening = scored.iter().map(|&(i, s)| (candidates[i].label(), s)).collect();
@@ -618,13 +628,19 @@ pub fn discover_effects<E: EffectSearch>(
         let mut fits: Vec<(usize, Fit)> = to_refit.into_iter().filter_map(refit_one).collect();
         fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
         // The linear screen misranks close variants of a large effect (a step and the tapers
-        // around it crowd each other out of the refits): every candidate of the leader's kind at
-        // an overlapping place is refitted too, so the choice and its ambiguities rest on fits.
-        if let Some(&(lead, _)) = fits.iter().find(|(_, f)| f.plausible) {
-            let near: Vec<usize> = (0..candidates.len())
-                .filter(|&i| open(i) && !fits.iter().any(|(j, _)| *j == i))
-                .filter(|&i| overlaps(&candidates[i], &candidates[lead]))
+        // around it crowd each other out of the refits, whether their places overlap or not):
+        // the candidates whose predictions are most alike the leader's are refitted too, so the
+        // choice and its ambiguities rest on fits. At most `refits` of them: bounded work.
+        if let Some((_, lead)) = fits.iter().find(|(_, f)| f.plausible) {
+            let change = projector.apply(&noise_units(&lead.frequencies_hz, &current.frequencies_hz, &stds));
+            let mut alike: Vec<(usize, f64)> = screened
+                .iter()
+                .filter(|(i, _)| !fits.iter().any(|(j, _)| j == i))
+                .map(|(i, s)| (*i, likeness(&s.direction, &change)))
                 .collect();
+            alike.sort_by(|a, b| b.1.total_cmp(&a.1));
+            let near: Vec<usize> =
+                alike.iter().take_while(|(_, l)| *l >= ALIKE).take(options.refits).map(|&(i, _)| i).collect();
             fits.extend(near.into_iter().filter_map(refit_one));
             fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
         }
@@ -639,12 +655,19 @@ pub fn discover_effects<E: EffectSearch>(
         if round == 0 {
             report.runner_up = plausible.next().map(|(_, f)| f.clone());
         }
-        let ambiguous_with = fits
+        // The chosen fit is the best of every plausible one compared: each is tested against it
+        // at 95 % / (their number), so the named effect and its alternatives together hold the
+        // truth in ≥ 95 % of draws however many were compared (Bonferroni).
+        let others: Vec<&(usize, Fit)> = fits
             .iter()
-            .filter(|(i, _)| !same_place(&candidates[*i], &candidates[best_i]))
+            .filter(|(i, f)| f.plausible && !same_place(&candidates[*i], &candidates[best_i]))
+            .collect();
+        let z = normal_quantile_upper(0.025 / others.len().max(1) as f64);
+        let ambiguous_with = others
+            .into_iter()
             .filter(|(_, f)| {
                 let apart = separation2(&f.frequencies_hz, &best.frequencies_hz, &stds);
-                f.plausible && indistinguishable(f.score() - best.score(), apart, options.ambiguity_aicc)
+                within_margin(f.score() - best.score(), apart, options.ambiguity_aicc, z)
             })
             .map(|(i, f)| Alternative::new(&candidates[*i], f, best.score()))
             .collect();
@@ -709,9 +732,33 @@ pub fn separation2(a: &[f64], b: &[f64], std_hz: &[f64]) -> f64 {
 /// 1.96² = 3.84, for fits about 2σ apart (a taper and the step it resembles at 0.2 % noise) and
 /// falls under `floor` for fits the data separate clearly (d > 3.4).
 pub fn indistinguishable(delta: f64, separation2: f64, floor: f64) -> bool {
-    let d = separation2.max(0.0).sqrt();
-    delta < floor.max(2.0 * interval::Z_95 * d - separation2)
+    within_margin(delta, separation2, floor, interval::Z_95)
 }
+
+/// [`indistinguishable`] by a one-sided test at the normal quantile `z` (1.96: 2.5 %; larger when
+/// one test of several): the margin 2·z·d − d², at least `floor`.
+fn within_margin(delta: f64, separation2: f64, floor: f64, z: f64) -> bool {
+    let d = separation2.max(0.0).sqrt();
+    delta < floor.max(2.0 * z * d - separation2)
+}
+
+/// z with P(Z > z) = `tail` for a standard normal Z (bisection on P(Z² ≥ z²) = 2·tail; `tail`
+/// in (0, 0.5)).
+fn normal_quantile_upper(tail: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 40.0f64);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if chi2_upper_tail(mid * mid, 1) > 2.0 * tail {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Likeness ([`likeness`]) from which a candidate is refitted beside the leading fit.
+const ALIKE: f64 = 0.9;
 
 /// The charge for choosing each candidate's place: 2·ln m, m the number of places its kind is
 /// offered at. The best of m places fits noise better than one place given in advance (the
@@ -738,15 +785,19 @@ pub fn place_charges(candidates: &[Candidate]) -> Vec<f64> {
         .collect()
 }
 
-/// Two candidates of one kind whose places overlap: element runs that share an element, or (for
-/// effects without a run) the same location.
-fn overlaps(a: &Candidate, b: &Candidate) -> bool {
-    if a.kind != b.kind {
-        return false;
-    }
-    match (a.elements, b.elements) {
-        (Some([a0, a1]), Some([b0, b1])) => a0 <= b1 && b0 <= a1,
-        _ => a.location.is_some() && a.location == b.location,
+/// (a − b)/σ per measured value: a change of predictions in units of the noise.
+fn noise_units(a: &[f64], b: &[f64], std_hz: &[f64]) -> DVector<f64> {
+    DVector::from_iterator(a.len(), a.iter().zip(b).zip(std_hz).map(|((a, b), s)| (a - b) / s))
+}
+
+/// How alike two changes of the predictions are, whatever their size or sign: |cos| of the
+/// angle between them (0 when either is nothing).
+fn likeness(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
+    let norms = a.norm() * b.norm();
+    if norms > 0.0 {
+        (a.dot(b) / norms).abs()
+    } else {
+        0.0
     }
 }
 
@@ -803,6 +854,11 @@ impl Projector {
         }
     }
 
+    /// Projects nothing off (no base Jacobian to project).
+    fn none() -> Self {
+        Self { basis: nalgebra::DMatrix::zeros(0, 0) }
+    }
+
     fn apply(&self, v: &DVector<f64>) -> DVector<f64> {
         if self.basis.ncols() == 0 {
             return v.clone();
@@ -831,15 +887,24 @@ where
     f(&stacked)
 }
 
-/// Predicted χ² reduction of fitting the candidate's value alone, after the current parameters
-/// have absorbed what they can; 0 when the fit would need a value outside the bounds' sign.
+/// What the linear screen says of one candidate.
+struct Screened {
+    /// Predicted χ² reduction of fitting its value alone, after the current parameters have
+    /// absorbed what they can; 0 when the fit would need a value outside the bounds' sign.
+    reduction: f64,
+    /// How its value moves the predictions (in noise units), off what the current parameters
+    /// can do.
+    direction: DVector<f64>,
+}
+
+/// Screens one candidate ([`Screened`]).
 fn screen<E: EffectSearch>(
     search: &E,
     chosen: &[&Candidate],
     candidate: &Candidate,
     (current, projector): (&Linearisation, &Projector),
     budget: &Budget,
-) -> Option<f64> {
+) -> Option<Screened> {
     let par = candidate.parameter.as_ref()?;
     let mut p = current.parameters.clone();
     p.push(par.nominal);
@@ -850,12 +915,13 @@ fn screen<E: EffectSearch>(
     let r = projector.apply(&lin.residual);
     let jj = j.norm_squared();
     if jj == 0.0 {
-        return Some(0.0);
+        return Some(Screened { reduction: 0.0, direction: j });
     }
     let step = j.dot(&r) / jj;
     let admissible = (par.nominal + step).clamp(par.lower, par.upper) - par.nominal;
     // χ² reduction of the (bound-limited) linear step: 2·a·(j·r) − a²·‖j‖².
-    Some((2.0 * admissible * j.dot(&r) - admissible * admissible * jj).max(0.0))
+    let reduction = (2.0 * admissible * j.dot(&r) - admissible * admissible * jj).max(0.0);
+    Some(Screened { reduction, direction: j })
 }
 
 /// Refits the current parameters with the candidate set `set` (the chosen ones, then the new
@@ -929,8 +995,17 @@ fn refit<E: EffectSearch>(
 
 #[cfg(test)]
 mod tests {
-    use super::{indistinguishable, separation2};
+    use super::interval::Z_95;
+    use super::{indistinguishable, normal_quantile_upper, separation2};
     use crate::measurement::synthetic::NoiseRng;
+
+    #[test]
+    fn the_normal_quantile_matches_its_tables() {
+        assert!((normal_quantile_upper(0.025) - Z_95).abs() < 1e-6);
+        // 0.025/10 (ten alternatives compared): 2.807; 0.005: 2.576.
+        assert!((normal_quantile_upper(0.0025) - 2.807_033_768).abs() < 1e-6);
+        assert!((normal_quantile_upper(0.005) - 2.575_829_304).abs() < 1e-6);
+    }
 
     #[test]
     fn the_margin_is_the_floor_or_what_a_95_percent_test_cannot_reject() {

@@ -114,6 +114,33 @@ pub struct Estimate {
     pub last: Linearisation,
 }
 
+/// `converged`, `termination`, `iterations`, `evaluations`: how an iteration ended, as every
+/// estimating report (estimate, run-up estimate, campaign, each run of a comparison) states it,
+/// flattened into it.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct Outcome {
+    /// Whether the iteration converged (and, where it applies, every mode was paired).
+    pub converged: bool,
+    /// Why it stopped.
+    pub termination: String,
+    /// Iterations taken.
+    pub iterations: usize,
+    /// Model evaluations (eigen-solves) spent.
+    pub evaluations: usize,
+}
+
+impl Outcome {
+    /// The outcome of a driver run; `converged` as given (the caller may require more).
+    pub fn of(estimate: &Estimate, converged: bool) -> Self {
+        Self {
+            converged,
+            termination: estimate.termination.to_string(),
+            iterations: estimate.iterations,
+            evaluations: estimate.evaluations,
+        }
+    }
+}
+
 /// Owns the loop: the iteration limit, the evaluation count (through a [`Counted`] adaptor, so
 /// strategies do not count their own), the [`Budget`], the history and the observers — like
 /// argmin's `Executor`.

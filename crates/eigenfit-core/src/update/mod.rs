@@ -18,7 +18,7 @@ mod tests;
 pub use budget::{Budget, Budgeted, DEFAULT_EVALUATIONS};
 pub use counted::Counted;
 pub use driver::{
-    Driver, Estimate, IterationRecord, IterationRecordSink, ObservedDriver, Observer, Termination,
+    Driver, Estimate, IterationRecord, IterationRecordSink, ObservedDriver, Observer, Outcome, Termination,
 };
 pub use levenberg_marquardt::{LevenbergMarquardt, LevenbergMarquardtSettings};
 pub use newton::Newton;
