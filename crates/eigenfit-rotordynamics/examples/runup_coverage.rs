@@ -40,7 +40,7 @@ fn main() {
         let worst = id.scales.iter().map(|s| (s - 1.0).abs()).fold(0.0, f64::max);
         println!(
             "noise-free, start {what}: converged {}, largest |factor − 1| {worst:.2e}, χ² {:.2e} (std 0.02 Hz)",
-            id.converged, id.cost
+            id.outcome.converged, id.cost
         );
     }
 
@@ -59,8 +59,8 @@ fn main() {
             })
             .collect();
         let id = identify(&rotor, &params, &noisy, &START, 100).expect("fit");
-        evaluations += id.evaluations;
-        converged += usize::from(id.converged);
+        evaluations += id.outcome.evaluations;
+        converged += usize::from(id.outcome.converged);
         let sd = id.ln_std.as_ref().expect("std_hz given: intervals");
         let mut all = true;
         for (k, (s, sd)) in id.scales.iter().zip(sd).enumerate() {
