@@ -61,26 +61,21 @@ impl Material {
 ///
 /// Give either `nodes` (positions in m, strictly increasing) or `length` (m) with `elements`
 /// (equal elements starting at 0).
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShaftSpec {
     /// Node positions along the shaft axis (m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nodes: Option<Vec<f64>>,
     /// Total length for a uniform mesh (m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<f64>,
     /// Number of equal elements for a uniform mesh.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elements: Option<usize>,
     /// Default outer diameter (m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub diameter: Option<f64>,
     /// Default inner diameter (m) of a hollow shaft; 0 (solid) when absent.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inner_diameter: Option<f64>,
     /// Default material name; may be left out when exactly one material is defined.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// `[[shaft.section]]` per-element overrides.
     #[serde(default, rename = "section", skip_serializing_if = "Vec::is_empty")]
@@ -88,19 +83,17 @@ pub struct ShaftSpec {
 }
 
 /// A `[[shaft.section]]`: overrides for the elements `first..=last`.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Section {
     /// `[first, last]` element indices, inclusive, 0-based.
     pub elements: [usize; 2],
     /// Outer diameter (m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub diameter: Option<f64>,
     /// Inner diameter (m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inner_diameter: Option<f64>,
     /// Material name.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
 }
 
@@ -178,11 +171,11 @@ impl PointMass {
 }
 
 /// A bearing (`[[bearing]]`) as written: a spring to ground at a node.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BearingSpec {
     /// Name; `bearing_<i>` (i = its index among the bearings) when absent.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// Node index (0-based).
     pub node: usize,
@@ -213,26 +206,25 @@ impl BearingSpec {
 }
 
 /// An `[[effect]]` entry: one effect switched on at a value.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EffectSpec {
     /// One of [`KINDS`](crate::effects::KINDS).
     pub kind: String,
     /// Location index (disk, bearing, node or element), where the kind has one.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub location: Option<usize>,
     /// The effect's value (ignored by `shear-deformation`).
     #[serde(default)]
     pub value: f64,
     /// Position along the shaft (m) of a `point-mass` placed by coordinate.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position_m: Option<f64>,
     /// First and last element of a `section-change` over a run of elements.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elements: Option<[usize; 2]>,
 }
 
 /// A `[[parameter]]` table: one more updatable quantity of the model.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ParameterSpec {
@@ -240,15 +232,11 @@ pub struct ParameterSpec {
     pub kind: String,
     /// Which bearing, disk, point mass or `[[shaft.section]]` (0-based, in file order); for the
     /// section kinds, absent means the whole shaft.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub index: Option<usize>,
     /// Parameter name; a default is derived from the kind and index when absent.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// Lower bound (default: nominal / 100 for scales, nominal·1e-6 otherwise).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lower: Option<f64>,
     /// Upper bound (default: nominal·100 for scales, nominal·1e6 otherwise).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub upper: Option<f64>,
 }

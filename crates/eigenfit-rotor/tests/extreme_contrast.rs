@@ -7,37 +7,7 @@
 use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
 use eigenfit_rotor::Rotor;
 
-const MODEL: &str = r#"
-[[material]]
-name = "m0"
-youngs_modulus = 70580000000000000.0
-density = 654600000000.0
-
-[shaft]
-length = 57080.0
-elements = 30
-diameter = 980.0000000000001
-material = "m0"
-
-[[bearing]]
-node = 28
-stiffness = 638700000000000.0
-rotational_stiffness = 80.69000000000001
-
-[[bearing]]
-node = 12
-stiffness = 51.41
-rotational_stiffness = 0.07671
-
-[[point_mass]]
-node = 20
-mass = 0.000000007937
-
-[[point_mass]]
-node = 0
-mass = 0.0000051409999999999996
-
-"#;
+const MODEL: &str = include_str!("fixtures/models/extreme_contrast.toml");
 
 #[test]
 fn banded_solver_never_returns_modes_out_of_order() {

@@ -6,46 +6,7 @@ mod common;
 use eigenfit_rotor::{BearingSpec, Rotor, RotorError};
 
 /// A valid file, one entry of each kind; line numbers in the comments.
-const VALID: &str = r#"[[material]]
-name = "steel"
-youngs_modulus = 2.1e11
-density = 7850.0
-
-[shaft]
-nodes = [
-    0.0,
-    0.1,
-    0.2,
-    0.3,
-]
-diameter = 0.014
-
-[[shaft.section]]
-elements = [1, 2]
-diameter = 0.02
-
-[[disk]]
-node = 1
-mass = 0.4
-
-[[bearing]]
-name = "drive_end"
-node = 0
-stiffness = 1e5
-
-[[bearing]]
-node = 3
-stiffness = 1e5
-
-[[point_mass]]
-node = 2
-mass = 0.1
-
-[[effect]]
-kind = "support-mass"
-location = 1
-value = 0.5
-"#;
+const VALID: &str = include_str!("fixtures/models/located.toml");
 
 /// The error of `VALID` with `from` replaced by `to`: (line, message without the line).
 fn error(from: &str, to: &str) -> (Option<usize>, String) {

@@ -5,25 +5,7 @@ mod common;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{BearingSpec, Disk, Material, PointMass, Rotor, RotorError, Section};
 
-const VALID: &str = r#"
-[[material]]
-name = "steel"
-youngs_modulus = 2.1e11
-density = 7850.0
-
-[shaft]
-length = 0.5
-elements = 10
-diameter = 0.014
-
-[[disk]]
-node = 2
-mass = 0.4
-
-[[bearing]]
-node = 0
-stiffness = 1e5
-"#;
+const VALID: &str = include_str!("fixtures/models/small_rotor.toml");
 
 fn error(text: &str) -> String {
     Rotor::from_toml_str(text).unwrap_err().to_string()

@@ -8,70 +8,7 @@ use eigenfit_core::problem::Problem;
 use eigenfit_core::update::{Driver, LevenbergMarquardt};
 use eigenfit_rotor::{Rotor, UpdatableRotor};
 
-const MODEL: &str = r#"
-[[material]]
-name = "steel"
-youngs_modulus = 2.1e11
-density = 7850.0
-
-[shaft]
-length = 0.6
-elements = 6
-diameter = 0.02
-
-[[shaft.section]]
-elements = [2, 3]
-diameter = 0.03
-
-[[shaft.section]]
-elements = [4, 5]
-inner_diameter = 0.008
-
-[[disk]]
-node = 3
-mass = 2.0
-diametral_inertia = 0.004
-
-[[point_mass]]
-node = 1
-mass = 0.3
-
-[[bearing]]
-name = "de"
-node = 0
-stiffness = 2e5
-rotational_stiffness = 50.0
-
-[[bearing]]
-name = "nde"
-node = 6
-stiffness = 3e5
-
-[[parameter]]
-kind = "bearing-rotational-stiffness"
-index = 0
-
-[[parameter]]
-kind = "disk-mass"
-index = 0
-
-[[parameter]]
-kind = "disk-inertia"
-index = 0
-
-[[parameter]]
-kind = "point-mass"
-index = 0
-
-[[parameter]]
-kind = "section-modulus-scale"
-index = 0
-
-[[parameter]]
-kind = "section-diameter-scale"
-index = 1
-name = "d_outer"
-"#;
+const MODEL: &str = include_str!("fixtures/models/updatable.toml");
 
 fn model() -> UpdatableRotor {
     UpdatableRotor::new(Rotor::from_toml_str(MODEL).unwrap()).unwrap()

@@ -183,6 +183,7 @@ impl From<&Identifiability> for RunIdentifiability {
 }
 
 /// One run of a comparison: the run's own fields and, on request, its time and statistics.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunReport {
     /// Strategy name.
@@ -191,13 +192,10 @@ pub struct RunReport {
     #[serde(flatten)]
     pub run: CompareRun,
     /// Wall-clock time, when asked for.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub seconds: Option<f64>,
     /// Other equally good solutions (converged damped runs).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub alternative_solutions: Option<Vec<Vec<f64>>>,
     /// Identifiability of each parameter (with a reference std).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub identifiable: Option<Vec<RunIdentifiability>>,
 }
 

@@ -165,6 +165,7 @@ pub fn check_modes(modes: usize, dofs: usize) -> Result<(), WorkflowError> {
 }
 
 /// `simulate` at one point: frequencies and their sensitivities.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PointReport {
     /// The model's label (file or preset).
@@ -172,20 +173,16 @@ pub struct PointReport {
     /// The eigen-solver's name.
     pub solver: String,
     /// DOFs (reported for a matrices model).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub dofs: Option<usize>,
     /// The parameter values.
     pub parameters: Named<f64>,
     /// Natural frequencies (Hz), lowest first.
     pub frequencies_hz: Vec<f64>,
     /// df_k/dp_i in Hz per parameter unit, one array over modes per parameter.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub sensitivities_hz: Option<Named<Vec<f64>>>,
     /// Why there are no sensitivities (repeated or rigid-body modes).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub sensitivities_unavailable: Option<String>,
     /// Plot files written (the CLI's `--plot`).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub plots: Option<Vec<String>>,
     /// Notes for the log (round-off that may reach the trailing digits).
     #[serde(skip)]
