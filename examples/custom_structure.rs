@@ -295,10 +295,10 @@ fn main() {
         let report = discover_storey_mass(&measurements(hidden, Some(&mut Noise(SEED))));
         print!(
             "\n== discovery on the data {title}: χ² = {:.1} on {} dof, p = {:.1e}: ",
-            report.chi2_before, report.dof_before, report.p_value
+            report.before.chi2, report.before.dof, report.before.p_value
         );
         match &report.selected {
-            None if !report.disagreement_significant => {
+            None if !report.before.significant => {
                 println!("no significant disagreement, nothing added")
             }
             None => println!("significant, but no candidate explains it"),
@@ -310,7 +310,7 @@ fn main() {
                     fit.value.unwrap_or(f64::NAN),
                     HIDDEN_MASS.1 / MASSES[HIDDEN_MASS.0],
                     fit.chi2,
-                    report.aicc_before - fit.aicc
+                    report.before.aicc - fit.aicc
                 );
                 if let Some(r) = &report.runner_up {
                     println!("   runner-up: {} (ΔAICc {:.1} behind)", r.label, r.aicc - fit.aicc);

@@ -154,7 +154,7 @@ proptest! {
 #[test]
 fn discovery_names_the_hidden_storey_mass() {
     let report = discover_storey_mass(&measurements(true, Some(&mut Noise(SEED))));
-    assert!(report.disagreement_significant);
+    assert!(report.before.significant);
     let fit = report.selected.expect("an effect is named");
     // Storey 3 (floor index 2), +30% of its mass.
     assert_eq!((fit.kind.as_str(), fit.location), ("added-storey-mass", Some(3)));

@@ -26,7 +26,7 @@ fn run(hidden: Option<EffectSpec>, seed: u64) -> DiscoveryReport {
 
 fn assert_names(report: &DiscoveryReport, kind: &str, location: Option<usize>, value: f64) {
     let sel = report.selected.as_ref().unwrap_or_else(|| panic!("nothing named; fits: {:#?}", report.fits));
-    assert!(report.disagreement_significant);
+    assert!(report.before.significant);
     assert_eq!((sel.kind.as_str(), sel.location), (kind, location), "fits: {:#?}", report.fits);
     let iv = sel.interval.unwrap();
     assert!(iv[0] <= value && value <= iv[1], "true value {value} outside the interval {iv:?}");
@@ -59,7 +59,7 @@ fn names_a_cracked_element() {
 #[test]
 fn adds_nothing_when_the_model_already_fits() {
     let r = run(None, 4);
-    assert!(!r.disagreement_significant, "p = {}", r.p_value);
+    assert!(!r.before.significant, "p = {}", r.before.p_value);
     assert!(r.selected.is_none());
     assert_eq!(r.rms_after_hz, r.rms_before_hz);
 }

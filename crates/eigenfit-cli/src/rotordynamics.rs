@@ -80,18 +80,8 @@ pub fn print_discovery(r: &RunupDiscoverReport) {
     for (n, v) in d.calibrated_parameters.iter() {
         println!("  {n} = {v:.6e} N/m");
     }
-    println!(
-        "misfit: χ² = {:.2} on {} degrees of freedom, p = {:.3e} → {}",
-        d.chi2_before,
-        d.dof_before,
-        d.p_value,
-        if d.disagreement_significant {
-            "significant: the model misses something"
-        } else {
-            "explained by the noise"
-        }
-    );
-    if !d.disagreement_significant {
+    crate::commands::discover::print_misfit(&d.before);
+    if !d.before.significant {
         println!("no significant disagreement: nothing added.");
     } else if d.missing_effects.is_empty() {
         println!("no candidate effect, alone or with others, explains the disagreement down to the noise.");

@@ -246,7 +246,7 @@ fn main() {
             .collect();
         println!(
             "  discover: χ² {:.2} on {} dof, p = {:.3e}, named {named:?}, {} evaluations, budget exhausted: {}",
-            report.chi2_before, report.dof_before, report.p_value, report.evaluations, report.budget_exhausted
+            report.before.chi2, report.before.dof, report.before.p_value, report.evaluations, report.budget_exhausted
         );
     }
 }

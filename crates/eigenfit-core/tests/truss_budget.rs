@@ -41,7 +41,7 @@ fn the_truss_discovery_names_the_hidden_mass_within_its_budget() {
     let measured = truss::measurement(truss::HIDDEN_KG, truss::SEED);
     let report = truss::discover_within(&measured, 10_000).expect("discovery runs");
     assert!(report.evaluations <= 10_000, "{} evaluations", report.evaluations);
-    assert!(report.disagreement_significant, "χ² {} on {} dof", report.chi2_before, report.dof_before);
+    assert!(report.before.significant, "χ² {} on {} dof", report.before.chi2, report.before.dof);
     assert!(!report.budget_exhausted);
     let first = report.effects.first().expect("an effect named");
     assert_eq!(
@@ -62,7 +62,7 @@ fn a_truss_too_far_from_its_model_ends_in_a_verdict_within_the_budget() {
     let measured = truss::measurement(600.0, truss::SEED);
     let report = truss::discover_within(&measured, 10_000).expect("discovery runs");
     assert!(report.evaluations <= 10_000, "{} evaluations", report.evaluations);
-    assert!(report.disagreement_significant);
+    assert!(report.before.significant);
     // Either the right answer or none: never a wrong place.
     assert!(
         report.effects.iter().all(|e| e.place.location == Some(2)),

@@ -113,7 +113,7 @@ impl<S: EigenSolver> Request<'_, S> {
         let coarse = discover(rotor, solver, measured, &effects::candidates(rotor), initial, options)?;
         let mut coarse_result =
             RotorDiscovery { effects: coarse.effects.clone(), report: coarse, mesh_factor: 1 };
-        let significant = coarse_result.report.disagreement_significant;
+        let significant = coarse_result.report.before.significant;
         let Ok(fine_rotor) = mesh::refined(rotor, REFINEMENT) else { return Ok(coarse_result) };
         // The refined-mesh runs share what the first run left of the evaluation budget.
         let left = |spent: usize| DiscoveryOptions {
@@ -133,14 +133,14 @@ impl<S: EigenSolver> Request<'_, S> {
         if let Ok(mut fine_base) = fine_base {
             coarse_result.report.evaluations += fine_base.evaluations;
             fine_base.evaluations = coarse_result.report.evaluations;
-            let gain = final_aicc(&coarse_result.report) - fine_base.aicc_before;
+            let gain = final_aicc(&coarse_result.report) - fine_base.before.aicc;
             let apart = separation2(&coarse_result.report, &fine_base);
             let explains = if significant {
                 // The refined mesh is held to the test a named effect must pass (what is left is
                 // a misfit noise can explain, P(χ²) ≥ min_after_p_value), not to the detection
                 // level: at 5 %, one draw in twenty of data the refined mesh fits exactly would be
                 // refused. It is preferred unless the user's-mesh explanation is clearly better.
-                chi2_upper_tail(fine_base.chi2_before, fine_base.dof_before) >= options.min_after_p_value
+                chi2_upper_tail(fine_base.before.chi2, fine_base.before.dof) >= options.min_after_p_value
                     && indistinguishable(-gain, apart, options.ambiguity_aicc)
             } else {
                 // A misfit the χ² test over all modes lets pass can still be the discretisation
@@ -190,7 +190,7 @@ impl<S: EigenSolver> Request<'_, S> {
         let (chi2, k) = fine
             .selected
             .as_ref()
-            .map_or((fine.chi2_before, initial.len()), |s| (s.chi2, s.parameters.len()));
+            .map_or((fine.before.chi2, initial.len()), |s| (s.chi2, s.parameters.len()));
         let n = fine.modes.len();
         let consistent = n > k && chi2_upper_tail(chi2, n - k) >= options.min_after_p_value;
         if gain < options.min_aicc_gain || !consistent {
@@ -204,10 +204,7 @@ impl<S: EigenSolver> Request<'_, S> {
         let diffs: Vec<f64> = fine.modes.iter().map(|m| m.after_hz - m.measured_hz).collect();
         fine.rms_after_hz = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
         fine.rms_before_hz = c.rms_before_hz;
-        fine.chi2_before = c.chi2_before;
-        fine.p_value = c.p_value;
-        fine.aicc_before = c.aicc_before;
-        fine.disagreement_significant = c.disagreement_significant;
+        fine.before = c.before;
         let mut named = fine.effects.clone();
         named.push(mesh_effect(gain, Vec::new()));
         named.sort_by(|a, b| b.delta_aicc.total_cmp(&a.delta_aicc));
@@ -243,10 +240,7 @@ fn mesh_explains(
         m.before_hz = before.before_hz;
     }
     fine.rms_before_hz = c.rms_before_hz;
-    fine.chi2_before = c.chi2_before;
-    fine.p_value = c.p_value;
-    fine.aicc_before = c.aicc_before;
-    fine.disagreement_significant = c.disagreement_significant;
+    fine.before = c.before;
     fine.fits = c.fits;
     fine.screening = c.screening;
     let effect = mesh_effect(gain, ambiguous_with);
@@ -277,5 +271,5 @@ fn separation2(coarse: &DiscoveryReport, fine: &DiscoveryReport) -> f64 {
 /// AICc of what a run ends with: its named effects (with the charge for choosing their places,
 /// [`eigenfit_core::discovery::Fit::score`]), or the calibrated base.
 fn final_aicc(r: &DiscoveryReport) -> f64 {
-    r.selected.as_ref().map_or(r.aicc_before, |s| s.score().min(r.aicc_before))
+    r.selected.as_ref().map_or(r.before.aicc, |s| s.score().min(r.before.aicc))
 }

@@ -70,7 +70,7 @@ fn names_the_refined_mesh_when_the_overall_test_lets_its_error_pass() {
     let draw =
         fixtures.draw.iter().find(|d| d.case == "fine-mesh" && d.noise == 0.002 && d.draw == 1).unwrap();
     let found = study::run_counted(&draw.frequency_hz, &draw.std_hz, &Default::default());
-    assert!(!found.report.disagreement_significant, "p = {}", found.report.p_value);
+    assert!(!found.report.before.significant, "p = {}", found.report.before.p_value);
     let kinds: Vec<&str> = found.effects.iter().map(|e| e.kind.as_str()).collect();
     assert_eq!(kinds, ["mesh-refinement"]);
     assert_eq!(found.mesh_factor, eigenfit_rotor::discovery::REFINEMENT);

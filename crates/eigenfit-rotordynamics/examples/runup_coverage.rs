@@ -85,7 +85,7 @@ fn main() {
             let r = discover_effects(&search, &search.candidates(), &[1.0; 4], &DiscoveryOptions::default())
                 .expect("discovery");
             named += usize::from(!r.effects.is_empty());
-            discovery_significant += usize::from(r.disagreement_significant);
+            discovery_significant += usize::from(r.before.significant);
             discovery_evaluations += r.evaluations;
         }
     }

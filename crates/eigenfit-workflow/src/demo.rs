@@ -191,7 +191,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
     let found = found.map_err(failure)?;
     let discovery = found.selected.as_ref().map(|s| HiddenEffect {
         fit: s.clone(),
-        chi2_before: found.chi2_before,
+        chi2_before: found.before.chi2,
         chi2_after: s.chi2,
         rms: RmsResidual::of(&found),
     });

@@ -7,7 +7,7 @@ use crate::named::Named;
 use crate::progress::Progress;
 use eigenfit_core::analysis::verdict::check_reachable;
 use eigenfit_core::discovery::{
-    discover, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect,
+    discover, BaseMisfit, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect,
 };
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
@@ -37,14 +37,10 @@ pub struct ModeReport {
 pub struct DiscoverReport {
     /// The model's label.
     pub model: String,
-    /// χ² before.
-    pub chi2_before: f64,
-    /// Degrees of freedom before.
-    pub dof_before: usize,
-    /// P(χ² this large from noise alone).
-    pub p_value: f64,
-    /// Whether the misfit is beyond the noise.
-    pub disagreement_significant: bool,
+    /// χ² before, its degrees of freedom, P(χ² this large from noise alone), whether the misfit
+    /// is beyond the noise.
+    #[serde(flatten)]
+    pub before: BaseMisfit,
     /// The strongest named effect.
     pub missing_effect: Option<NamedEffect>,
     /// Every named effect, strongest first.
@@ -200,14 +196,11 @@ pub(crate) fn report_of(
 ) -> DiscoverReport {
     DiscoverReport {
         model: label.to_string(),
-        disagreement_significant: r.disagreement_significant,
+        before: r.before,
         missing_effect: effects.first().cloned(),
         missing_effects: effects.to_vec(),
         mesh_refinement,
         rms: RmsResidual::of(r),
-        chi2_before: r.chi2_before,
-        dof_before: r.dof_before,
-        p_value: r.p_value,
         calibrated_parameters: Named::new(names, r.base_parameters.iter().copied()),
         refitted_parameters: refitted(r, names),
         runner_up: r.runner_up.clone(),
@@ -227,7 +220,7 @@ pub(crate) fn report_of(
         evaluations: r.evaluations,
         budget_limit: budget,
         budget_exhausted: r.budget_exhausted,
-        explained: !r.budget_exhausted && (!r.disagreement_significant || !effects.is_empty()),
+        explained: !r.budget_exhausted && (!r.before.significant || !effects.is_empty()),
     }
 }
 

@@ -140,7 +140,7 @@ fn text(found: &Demo, dofs: usize, grid: usize) -> Vec<String> {
     );
     say.push(format!(
         "   stiffnesses alone: K1 = {:.3e}, K2 = {:.3e} N/m (truth 2e5, 5e4), χ² = {:.0} on {} d.o.f.",
-        d.base_parameters[0], d.base_parameters[1], d.chi2_before, d.dof_before
+        d.base_parameters[0], d.base_parameters[1], d.before.chi2, d.before.dof
     ));
     match &r.discovery {
         Some(s) => {

@@ -7,7 +7,7 @@ use crate::plot::discovery::DiscoveryPlot;
 use crate::progress::Bars;
 use crate::source::ModelArgs;
 use clap::Args;
-use eigenfit_core::discovery::DiscoveryReport;
+use eigenfit_core::discovery::{BaseMisfit, DiscoveryReport};
 use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::discovery::RotorDiscovery;
 use eigenfit_workflow::discover::{self, Discovery, Refitted};
@@ -57,7 +57,7 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
         // after the named effects), 3 when a significant disagreement remains unexplained or
         // the budget ran out (the report is still printed).
         let d = &report.discovery;
-        let unexplained = d.disagreement_significant && d.missing_effects.is_empty();
+        let unexplained = d.before.significant && d.missing_effects.is_empty();
         let code = if unexplained || d.budget_exhausted { EXIT_NOT_CONVERGED } else { EXIT_OK };
         crate::error::set_exit_on_closed_pipe(code);
         crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
@@ -112,17 +112,7 @@ fn print_report(
     for ((n, v), u) in names.iter().zip(&r.base_parameters).zip(units) {
         println!("  {n} = {v:.6e} {u}");
     }
-    println!(
-        "misfit: χ² = {:.2} on {} degrees of freedom, p = {:.3e} → {}",
-        r.chi2_before,
-        r.dof_before,
-        r.p_value,
-        if r.disagreement_significant {
-            "significant: the model misses something"
-        } else {
-            "explained by the noise"
-        }
-    );
+    print_misfit(&r.before);
     let flagged: Vec<String> = r
         .modes
         .iter()
@@ -132,7 +122,7 @@ fn print_report(
     if !flagged.is_empty() {
         println!("modes off by more than 2σ: {}", flagged.join(", "));
     }
-    match (found.effects.is_empty(), r.disagreement_significant) {
+    match (found.effects.is_empty(), r.before.significant) {
         (true, false) => println!("no significant disagreement: nothing added."),
         // Cut short, the search has not shown that nothing explains the data.
         (true, true) if r.budget_exhausted => {
@@ -140,7 +130,7 @@ fn print_report(
             if let Some(best) = r.fits.iter().find(|f| f.plausible) {
                 println!(
                     "  best partial explanation so far: {} (χ² {:.2} → {:.2})",
-                    best.label, r.chi2_before, best.chi2
+                    best.label, r.before.chi2, best.chi2
                 );
             }
         }
@@ -151,7 +141,7 @@ fn print_report(
             if let Some(best) = r.fits.iter().find(|f| f.plausible) {
                 println!(
                     "  best partial explanation: {} (χ² {:.2} → {:.2})",
-                    best.label, r.chi2_before, best.chi2
+                    best.label, r.before.chi2, best.chi2
                 );
             }
         }
@@ -181,10 +171,10 @@ fn print_report(
                 }
             }
             let (chi2, aicc) =
-                r.selected.as_ref().map_or((r.chi2_before, r.aicc_before), |s| (s.chi2, s.aicc));
+                r.selected.as_ref().map_or((r.before.chi2, r.before.aicc), |s| (s.chi2, s.aicc));
             println!(
                 "  evidence: χ² {:.2} → {:.2}, AICc {:.2} → {:.2}, RMS residual {:.4} → {:.4} Hz",
-                r.chi2_before, chi2, r.aicc_before, aicc, r.rms_before_hz, r.rms_after_hz
+                r.before.chi2, chi2, r.before.aicc, aicc, r.rms_before_hz, r.rms_after_hz
             );
             if let Some(rows) = refitted {
                 println!("  the model's parameters refitted with the effect:");
@@ -222,4 +212,14 @@ fn print_report(
             m.normalised_after()
         );
     }
+}
+
+/// The base model's misfit test, one line (planar, matrices and ROSS rotors alike).
+pub(crate) fn print_misfit(before: &BaseMisfit) {
+    let verdict =
+        if before.significant { "significant: the model misses something" } else { "explained by the noise" };
+    println!(
+        "misfit: χ² = {:.2} on {} degrees of freedom, p = {:.3e} → {verdict}",
+        before.chi2, before.dof, before.p_value
+    );
 }

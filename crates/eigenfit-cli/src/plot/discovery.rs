@@ -36,7 +36,7 @@ impl DiscoveryPlot {
             },
             None => "after: nothing added (same as before)".to_string(),
         };
-        let chi2_after = r.selected.as_ref().map_or(r.chi2_before, |s| s.chi2);
+        let chi2_after = r.selected.as_ref().map_or(r.before.chi2, |s| s.chi2);
         Self {
             title: label.to_string(),
             modes: r
@@ -47,7 +47,7 @@ impl DiscoveryPlot {
             after_label,
             subtitle: format!(
                 "χ² {} → {} on {} modes; RMS residual {:.4} → {:.4} Hz",
-                style::trim(r.chi2_before, 2),
+                style::trim(r.before.chi2, 2),
                 style::trim(chi2_after, 2),
                 r.modes.len(),
                 r.rms_before_hz,

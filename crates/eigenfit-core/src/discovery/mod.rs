@@ -322,21 +322,34 @@ impl NamedEffect {
     }
 }
 
+/// How far the calibrated base model (no effect added) misses the data: the test that decides
+/// whether to search at all. Serialises with the keys `discover` reports (`chi2_before`,
+/// `dof_before`, `p_value`, `disagreement_significant`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct BaseMisfit {
+    /// χ² of the calibrated base model.
+    #[serde(rename = "chi2_before")]
+    pub chi2: f64,
+    /// Degrees of freedom of the base fit (modes − parameters).
+    #[serde(rename = "dof_before")]
+    pub dof: usize,
+    /// P(χ² ≥ observed) under noise alone.
+    pub p_value: f64,
+    /// True when the misfit is significant at the chosen level.
+    #[serde(rename = "disagreement_significant")]
+    pub significant: bool,
+    /// AICc of the base model (the score every effect must beat).
+    #[serde(skip)]
+    pub aicc: f64,
+}
+
 /// Everything the workflow found, for reports.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DiscoveryReport {
     /// Calibrated nominal parameters.
     pub base_parameters: Vec<f64>,
-    /// χ² of the calibrated base model.
-    pub chi2_before: f64,
-    /// Degrees of freedom of the base fit (modes − parameters).
-    pub dof_before: usize,
-    /// P(χ² ≥ observed) under noise alone.
-    pub p_value: f64,
-    /// True when the misfit is significant at the chosen level.
-    pub disagreement_significant: bool,
-    /// AICc of the base model.
-    pub aicc_before: f64,
+    /// How far the calibrated base model misses the data, and whether that is beyond the noise.
+    pub before: BaseMisfit,
     /// Screening scores (predicted χ² reduction), best first.
     pub screening: Vec<(String, f64)>,
     /// Refitted candidates, best AICc first.
@@ -533,18 +546,18 @@ pub fn discover_effects<E: EffectSearch>(
         return Err(DiscoveryError::BudgetExhausted(options.max_evaluations));
     }
     let base_lin = est.last;
-    let chi2_before = 2.0 * base_lin.cost();
-    let dof_before = n - nb;
-    let p_value = chi2_upper_tail(chi2_before, dof_before);
-    let aicc_before = aicc(chi2_before, n, nb);
-    let disagreement_significant = p_value < options.significance;
+    let chi2 = 2.0 * base_lin.cost();
+    let p_value = chi2_upper_tail(chi2, n - nb);
+    let before = BaseMisfit {
+        chi2,
+        dof: n - nb,
+        p_value,
+        significant: p_value < options.significance,
+        aicc: aicc(chi2, n, nb),
+    };
     let mut report = DiscoveryReport {
         base_parameters: base_lin.parameters.clone(),
-        chi2_before,
-        dof_before,
-        p_value,
-        disagreement_significant,
-        aicc_before,
+        before,
         screening: Vec::new(),
         fits: Vec::new(),
         selected: None,
@@ -556,7 +569,7 @@ pub fn discover_effects<E: EffectSearch>(
         evaluations: 0,
         budget_exhausted: false,
     };
-    if !disagreement_significant {
+    if !before.significant {
         report.evaluations = budget.used();
         report.budget_exhausted = budget.exhausted();
         return Ok(report);
@@ -566,7 +579,7 @@ pub fn discover_effects<E: EffectSearch>(
     // adds the best plausible one if it earns its parameter (AICc); it stops when the noise
     // explains what is left.
     let mut chosen: Vec<usize> = Vec::new();
-    let mut current = Fit::base(&base_lin, aicc_before);
+    let mut current = Fit::base(&base_lin, before.aicc);
     let charges = place_charges(candidates);
     let mut named: Vec<NamedEffect> = Vec::new();
     for round in 0..options.max_effects {
