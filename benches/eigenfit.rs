@@ -3,11 +3,11 @@
 //! LAPACK backend); figures and ratios are in docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use eigenfit::core::analysis::monte_carlo;
 use eigenfit::core::analysis::{
     compare::log_space, compare::run_grid, compare::run_grid_serial, compare::tensor_grid,
     compare::CompareSettings, compare::ReferenceSettings,
 };
-use eigenfit::core::analysis::{monte_carlo, monte_carlo::StudySettings};
 use eigenfit::core::discovery::{discover, DiscoveryOptions};
 use eigenfit::core::eigen::{BandedSolver, DenseSolver, EigenSolver};
 use eigenfit::core::matrix::{BandedSymmetric, System};
@@ -168,14 +168,7 @@ fn monte_carlo_study(c: &mut Criterion) {
     let mut g = c.benchmark_group("monte_carlo");
     g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(3));
     let rotor = paper_rotor();
-    let settings = StudySettings {
-        trials: 200,
-        seed: 1,
-        modes: 3,
-        relative_std: 1e-3,
-        initial: vec![1e4, 1e6],
-        max_iterations: 200,
-    };
+    let settings = eigenfit::rotor::presets::paper_rotor_coverage_study(200, 1);
     let solver = BandedSolver::default();
     g.bench_function("200_trials_parallel", |b| {
         b.iter(|| monte_carlo::run(&rotor, &solver, &[1e5, 1e5], &settings))

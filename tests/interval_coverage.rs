@@ -4,7 +4,7 @@
 //! 93–97% is ±4 of them (with 240 trials, one seed gave 99.2% for K2 — a 3σ draw from a rate
 //! that 4,000-trial runs put at 94.4–95.8%). The study runs in parallel (`monte_carlo::run`).
 
-use eigenfit::core::analysis::{monte_carlo::run, monte_carlo::StudySettings};
+use eigenfit::core::analysis::monte_carlo::run;
 use eigenfit::core::eigen::BandedSolver;
 use eigenfit::rotor::presets;
 
@@ -12,14 +12,7 @@ use eigenfit::rotor::presets;
 fn intervals_cover_the_truth_at_the_nominal_rate() {
     let rotor = presets::paper_rotor();
     let truth = [1e5, 1e5];
-    let settings = StudySettings {
-        trials: 2000,
-        seed: 20261121,
-        modes: 3,
-        relative_std: 1e-3,
-        initial: vec![1e4, 1e6],
-        max_iterations: 200,
-    };
+    let settings = presets::paper_rotor_coverage_study(2000, 20261121);
     let study = run(&rotor, &BandedSolver::default(), &truth, &settings);
     assert_eq!(study.converged(), settings.trials, "every trial converges");
     for (i, rate) in study.coverage().iter().enumerate() {
