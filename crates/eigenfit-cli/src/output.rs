@@ -159,3 +159,13 @@ impl Stream {
         }
     }
 }
+
+/// The base model's misfit test, one line (planar, matrices and ROSS rotors alike).
+pub(crate) fn print_misfit(before: &eigenfit_core::discovery::BaseMisfit) {
+    let verdict =
+        if before.significant { "significant: the model misses something" } else { "explained by the noise" };
+    println!(
+        "misfit: χ² = {:.2} on {} degrees of freedom, p = {:.3e} → {verdict}",
+        before.chi2, before.dof, before.p_value
+    );
+}

@@ -80,7 +80,7 @@ pub fn print_discovery(r: &RunupDiscoverReport) {
     for (n, v) in d.calibrated_parameters.iter() {
         println!("  {n} = {v:.6e} N/m");
     }
-    crate::commands::discover::print_misfit(&d.before);
+    crate::output::print_misfit(&d.before);
     if !d.before.significant {
         println!("no significant disagreement: nothing added.");
     } else if d.missing_effects.is_empty() {

@@ -7,7 +7,7 @@ use crate::plot::discovery::DiscoveryPlot;
 use crate::progress::Bars;
 use crate::source::ModelArgs;
 use clap::Args;
-use eigenfit_core::discovery::{BaseMisfit, DiscoveryReport};
+use eigenfit_core::discovery::DiscoveryReport;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::discovery::RotorDiscovery;
 use eigenfit_workflow::discover::{self, Discovery, Refitted};
@@ -112,7 +112,7 @@ fn print_report(
     for ((n, v), u) in names.iter().zip(&r.base_parameters).zip(units) {
         println!("  {n} = {v:.6e} {u}");
     }
-    print_misfit(&r.before);
+    crate::output::print_misfit(&r.before);
     let flagged: Vec<String> = r
         .modes
         .iter()
@@ -212,14 +212,4 @@ fn print_report(
             m.normalised_after()
         );
     }
-}
-
-/// The base model's misfit test, one line (planar, matrices and ROSS rotors alike).
-pub(crate) fn print_misfit(before: &BaseMisfit) {
-    let verdict =
-        if before.significant { "significant: the model misses something" } else { "explained by the noise" };
-    println!(
-        "misfit: χ² = {:.2} on {} degrees of freedom, p = {:.3e} → {verdict}",
-        before.chi2, before.dof, before.p_value
-    );
 }
