@@ -173,3 +173,31 @@ fn an_indefinite_mass_is_refused_after_a_good_one() {
     ));
     assert!(solver.lowest(&System::banded(k, good).unwrap(), 3).is_ok());
 }
+
+/// Found by the random test above in CI (stop 24): Lanczos stops at its step limit (eigenvalues
+/// 1.54094 and 1.54131 0.02 % apart), the subspace iteration converges at 5 % per iteration and
+/// used to be taken at residual 7.7e-7 as if at its round-off floor — shape 1 then 4.9e-7 off
+/// the dense solver's (relative residual 1e-8 against 1.6e-16).
+#[test]
+fn slow_subspace_convergence_is_not_taken_for_its_floor() {
+    let seed = [
+        0.28043179976554355,
+        0.27143170340267414,
+        0.19375017188732616,
+        0.7134013463749053,
+        0.9563110581459529,
+        0.7522451762610609,
+        0.057494425941877245,
+        0.5030674665099661,
+    ];
+    let k = spd_band(61, 4, &seed, 2.649855756693869, 1.0);
+    let m = spd_band(61, 1, &seed[1..], 2.0, 1.0);
+    let system = System::banded(k, m).unwrap();
+    let dense = DenseSolver.lowest(&system, 4).unwrap();
+    let (banded, _) = BandedSolver::default().lowest_with_next(&system, 3).unwrap();
+    let head = Modes {
+        eigenvalues: dense.eigenvalues.rows(0, 3).into_owned(),
+        shapes: dense.shapes.columns(0, 3).into_owned(),
+    };
+    assert_agree(&banded, &head, dense.eigenvalues.as_slice(), "the CI case");
+}
