@@ -53,12 +53,9 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
         }
         let report =
             eigenfit_workflow::rotordynamics::discover(path, &args.measured, args.assumed_std, args.budget)?;
-        // The lead's rule for every discover: 0 when the data are explained (by the noise, or
-        // after the named effects), 3 when a significant disagreement remains unexplained or
-        // the budget ran out (the report is still printed).
-        let d = &report.discovery;
-        let unexplained = d.before.significant && d.missing_effects.is_empty();
-        let code = if unexplained || d.budget_exhausted { EXIT_NOT_CONVERGED } else { EXIT_OK };
+        // The rule of every discover, decided once in the workflow's report (`explained`): 0 when
+        // the data are explained, 3 when not or the budget ran out (the report is still printed).
+        let code = if report.discovery.explained { EXIT_OK } else { EXIT_NOT_CONVERGED };
         crate::error::set_exit_on_closed_pipe(code);
         crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
         return Ok(code);
