@@ -1,4 +1,5 @@
-//! The χ² distribution: the probability that noise alone explains a misfit.
+//! The χ² distribution (the probability that noise alone explains a misfit) and the normal
+//! quantiles the intervals and ambiguity tests use.
 
 /// P(χ²_ν > x): the upper tail of the χ² distribution with `dof` degrees of freedom.
 pub fn chi2_upper_tail(x: f64, dof: usize) -> f64 {
@@ -9,6 +10,24 @@ pub fn chi2_upper_tail(x: f64, dof: usize) -> f64 {
         return 0.0; // an infinite (or undefined) misfit is never explained by noise
     }
     1.0 - regularized_lower_gamma(dof as f64 / 2.0, x / 2.0)
+}
+
+/// 1.96: the two-sided 95 % quantile of the normal distribution.
+pub(crate) const Z_95: f64 = 1.959_963_984_540_054;
+
+/// z with P(Z > z) = `tail` for a standard normal Z (bisection on P(Z² ≥ z²) = 2·tail; `tail`
+/// in (0, 0.5)).
+pub(crate) fn normal_quantile_upper(tail: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 40.0f64);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if chi2_upper_tail(mid * mid, 1) > 2.0 * tail {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// P(a, x) = γ(a, x)/Γ(a) by its series (x < a + 1) or Lentz's continued fraction (otherwise).
@@ -78,6 +97,14 @@ fn ln_gamma(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_normal_quantile_matches_its_tables() {
+        assert!((normal_quantile_upper(0.025) - Z_95).abs() < 1e-6);
+        // 0.025/10 (ten alternatives compared): 2.807; 0.005: 2.576.
+        assert!((normal_quantile_upper(0.0025) - 2.807_033_768).abs() < 1e-6);
+        assert!((normal_quantile_upper(0.005) - 2.575_829_304).abs() < 1e-6);
+    }
 
     #[test]
     fn matches_tabulated_quantiles() {

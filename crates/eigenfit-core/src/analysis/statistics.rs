@@ -1,14 +1,13 @@
 //! What the data say about the estimate: covariance, 95% intervals, singular values, and which
 //! parameters the data cannot determine (with the one-sided bound they do support).
 
+use crate::analysis::chi2::Z_95;
 use crate::problem::{Linearisation, Objective};
 use crate::update::{Budget, Driver, LevenbergMarquardt, LevenbergMarquardtSettings, Observer};
 use nalgebra::DMatrix;
 
 /// χ² quantile of one degree of freedom at 95%: the profile-likelihood threshold.
 const CHI2_95_1DOF: f64 = 3.841_458_820_694_124;
-/// Two-sided 95% normal quantile.
-const Z_95: f64 = 1.959_963_984_540_054;
 /// Linearised σ in scaled units above which a parameter is checked by its profile:
 /// a 95% interval wider than a factor of 10 each way for a log parameter.
 const PROFILE_TRIGGER: f64 = std::f64::consts::LN_10 / Z_95;

@@ -7,8 +7,7 @@
 
 use crate::problem::{Linearisation, Objective};
 
-/// 1.96: the two-sided 95 % quantile of the normal distribution.
-pub(crate) const Z_95: f64 = 1.959_963_984_540_054;
+use crate::analysis::chi2::Z_95;
 
 /// The 95 % covariance interval of every parameter (in each parameter's scale, mapped back), or
 /// `None` for a parameter the data do not determine (singular information matrix).

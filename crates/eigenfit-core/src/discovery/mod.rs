@@ -12,6 +12,7 @@
 
 mod interval;
 
+use crate::analysis::chi2::{normal_quantile_upper, Z_95};
 use crate::analysis::chi2_upper_tail;
 use crate::eigen::EigenSolver;
 use crate::measurement::{MeasuredMode, Measurement};
@@ -745,7 +746,7 @@ pub fn separation2(a: &[f64], b: &[f64], std_hz: &[f64]) -> f64 {
 /// 1.96² = 3.84, for fits about 2σ apart (a taper and the step it resembles at 0.2 % noise) and
 /// falls under `floor` for fits the data separate clearly (d > 3.4).
 pub fn indistinguishable(delta: f64, separation2: f64, floor: f64) -> bool {
-    within_margin(delta, separation2, floor, interval::Z_95)
+    within_margin(delta, separation2, floor, Z_95)
 }
 
 /// [`indistinguishable`] by a one-sided test at the normal quantile `z` (1.96: 2.5 %; larger when
@@ -753,21 +754,6 @@ pub fn indistinguishable(delta: f64, separation2: f64, floor: f64) -> bool {
 fn within_margin(delta: f64, separation2: f64, floor: f64, z: f64) -> bool {
     let d = separation2.max(0.0).sqrt();
     delta < floor.max(2.0 * z * d - separation2)
-}
-
-/// z with P(Z > z) = `tail` for a standard normal Z (bisection on P(Z² ≥ z²) = 2·tail; `tail`
-/// in (0, 0.5)).
-fn normal_quantile_upper(tail: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0f64, 40.0f64);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if chi2_upper_tail(mid * mid, 1) > 2.0 * tail {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// Likeness ([`likeness`]) from which a candidate is refitted beside the leading fit.
@@ -1008,17 +994,8 @@ fn refit<E: EffectSearch>(
 
 #[cfg(test)]
 mod tests {
-    use super::interval::Z_95;
-    use super::{indistinguishable, normal_quantile_upper, separation2};
+    use super::{indistinguishable, separation2};
     use crate::measurement::synthetic::NoiseRng;
-
-    #[test]
-    fn the_normal_quantile_matches_its_tables() {
-        assert!((normal_quantile_upper(0.025) - Z_95).abs() < 1e-6);
-        // 0.025/10 (ten alternatives compared): 2.807; 0.005: 2.576.
-        assert!((normal_quantile_upper(0.0025) - 2.807_033_768).abs() < 1e-6);
-        assert!((normal_quantile_upper(0.005) - 2.575_829_304).abs() < 1e-6);
-    }
 
     #[test]
     fn the_margin_is_the_floor_or_what_a_95_percent_test_cannot_reject() {
