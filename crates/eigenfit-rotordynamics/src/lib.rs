@@ -17,6 +17,7 @@ pub mod modal;
 pub mod objective;
 pub mod ross_file;
 pub mod rotor;
+pub mod search;
 pub mod sensitivity;
 pub mod shift_invert;
 

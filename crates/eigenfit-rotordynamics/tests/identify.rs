@@ -180,3 +180,60 @@ fn compressor_bearings_come_back_from_a_start_forty_percent_off() {
         );
     }
 }
+
+/// A run-up of `runup_nominal.toml`'s rotor (two fluid-film bearings whose coefficients change
+/// with speed, ROSS-saved) computed by this crate at the file's bearings, with whirl.
+fn nominal_runup(r: &eigenfit_rotordynamics::Rotor) -> Vec<RunupPoint> {
+    let params = stiffness_parameters(r);
+    let mut points = Vec::new();
+    for rpm in [1000.0, 3000.0, 5000.0, 7000.0, 9000.0] {
+        for mode in 1..=6 {
+            points.push(RunupPoint { speed_rpm: rpm, mode, frequency_hz: 1.0, std_hz: Some(0.01), whirl: None });
+        }
+    }
+    let e = evaluate(r, &params, &[1.0; 4], &points).unwrap();
+    for (i, p) in points.iter_mut().enumerate() {
+        p.frequency_hz = e.frequencies_hz[i];
+        p.whirl = Some(e.whirl[i]);
+    }
+    points
+}
+
+/// From kxx ×1.4, kyy ×0.7 on both bearings the local fit stops in another basin (χ² ~10⁶);
+/// the fit from the best screened starts reaches the truth, in counted, bounded work.
+#[test]
+fn a_fit_stuck_in_another_basin_is_rescued_by_screened_starts() {
+    use eigenfit_rotordynamics::search::identify_from_best_start;
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let r = ross_file::read(&dir.join("runup_nominal.toml")).unwrap();
+    let params = stiffness_parameters(&r);
+    let points = nominal_runup(&r);
+    let start = [1.4, 0.7, 1.4, 0.7];
+    let single = identify(&r, &params, &points, &start, 200).unwrap();
+    assert!(single.cost > 1e3, "the trap this test is about is gone: cost {}", single.cost);
+    let searched = identify_from_best_start(&r, &params, &points, &start, 200, 6).unwrap();
+    assert!(searched.cost < 1e-10, "cost {}", searched.cost);
+    for s in &searched.scales {
+        assert!((s - 1.0).abs() < 1e-6, "{:?}", searched.scales);
+    }
+    assert!((1..=6).contains(&searched.refits), "{} refits", searched.refits);
+    // Counted: the first fit, 48 screened starts and the refits (measured 146).
+    assert!(searched.outcome.evaluations <= 300, "{} evaluations", searched.outcome.evaluations);
+    // A fit that passes is not searched further.
+    let at_truth = identify_from_best_start(&r, &params, &points, &[1.0; 4], 200, 6).unwrap();
+    assert_eq!(at_truth.refits, 0);
+}
+
+/// "Every bearing" leaves the compressor's 12 seals out (a run-up does not determine them);
+/// a seal's coefficient is still there by its full name.
+#[test]
+fn every_bearing_means_the_bearings_and_seals_are_named_one_by_one() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let r = ross_file::read(&dir.join("compressor.toml")).unwrap();
+    assert!(r.bearings.iter().filter(|b| b.class == "SealElement").count() >= 10);
+    let names = |sel: &[&str]| -> Vec<String> {
+        bearing_parameters(&r, sel).unwrap().into_iter().map(|p| p.name).collect()
+    };
+    assert_eq!(names(&["kxx", "kyy"]), ["kxx_Bearing 0", "kyy_Bearing 0", "kxx_Bearing 13", "kyy_Bearing 13"]);
+    assert_eq!(names(&["kxx", "kxx_Seal 1"]), ["kxx_Bearing 0", "kxx_Bearing 13", "kxx_Seal 1"]);
+}

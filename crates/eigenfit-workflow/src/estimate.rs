@@ -258,6 +258,7 @@ pub fn run(
             &request.measured,
             request.bearing_parameters.as_deref(),
             request.max_iterations,
+            request.alternative_starts,
         )
         .map(|r| EstimateOutcome::Runup(Box::new(r)));
     }

@@ -7,8 +7,9 @@ use crate::outcome::{FitQualityReport, Outcome, ParameterValues, Verdict};
 use eigenfit_core::analysis::verdict::{judge, FitQuality};
 use eigenfit_core::problem::Linearisation;
 use eigenfit_rotordynamics::identify::{
-    bearing_parameters, identify, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
+    bearing_parameters, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
 };
+use eigenfit_rotordynamics::search::identify_from_best_start;
 use eigenfit_rotordynamics::{campbell, ross_file, rpm_to_rad, Campbell, Rotor, RotorDynError};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -146,6 +147,9 @@ pub struct RunupEstimateReport {
     pub cost: f64,
     /// Whether every parameter is determined by the data.
     pub identifiable: bool,
+    /// Fits from screened other starts run because the fit from the file's bearings did not
+    /// pass the χ² test (0: it did, or the search was turned off).
+    pub refits: usize,
     /// The run-up points at the estimate.
     pub points: Vec<RunupPointReport>,
     /// Intervals, with std only.
@@ -192,12 +196,15 @@ fn fit_quality(id: &Identification, points: &[RunupPoint], values: &[f64]) -> Fi
 }
 
 /// `estimate --model ROSS-FILE --measured RUNUP.csv [--parameters kxx,kyy,…]`: bearing
-/// coefficients from a run-up (`selection` `None`: kxx and kyy of every bearing).
+/// coefficients from a run-up (`selection` `None`: kxx and kyy of every bearing, seals left
+/// out). When the fit from the file's bearings fails the χ² test, up to `refits` fits from
+/// screened other starts follow ([`identify_from_best_start`]).
 pub fn estimate(
     path: &Path,
     measured: &Path,
     selection: Option<&str>,
     max_iterations: usize,
+    refits: usize,
 ) -> Result<RunupEstimateReport, WorkflowError> {
     let rotor = load(path)?;
     let points = read_runup(measured).map_err(to_workflow)?;
@@ -210,7 +217,8 @@ pub fn estimate(
         return Err(input(format!("{}: the rotor has no bearings to estimate", path.display())));
     }
     let initial = vec![1.0; params.len()];
-    let id = identify(&rotor, &params, &points, &initial, max_iterations).map_err(to_workflow)?;
+    let id = identify_from_best_start(&rotor, &params, &points, &initial, max_iterations, refits)
+        .map_err(to_workflow)?;
     // Report each coefficient at the lowest measured speed (constant bearings: their value).
     let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
     let nominal: Vec<f64> = params.iter().map(|p| p.nominal(&rotor, w0)).collect();
@@ -262,6 +270,7 @@ pub fn estimate(
         scales: Named::new(&names, id.scales.iter().copied()),
         cost: id.cost,
         identifiable: id.identifiable,
+        refits: id.refits,
         points: points
             .iter()
             .enumerate()

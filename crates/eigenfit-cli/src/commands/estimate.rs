@@ -43,7 +43,8 @@ pub struct EstimateArgs {
     /// Points of the coarse grid refitted locally when searching for other equally good
     /// solutions (0: no such search; the exchange of like parameters is still checked). Each is
     /// a local fit of several model evaluations: on a large model most of a run's time
-    /// (`evaluations_by_phase` in --json).
+    /// (`evaluations_by_phase` in --json). ROSS rotors: the most refits from screened starts
+    /// when the fit from the file's bearings fails the χ² test (`refits` in --json).
     #[arg(long, value_name = "N", default_value_t = eigenfit_workflow::estimate::ALTERNATIVE_STARTS)]
     pub alternative_starts: usize,
     /// Write the convergence history (convergence.svg/.png) into this folder.
