@@ -26,9 +26,22 @@ pub struct Campbell {
     /// Modes followed by MAC: per curve, per speed, the index into that speed's list (`None`
     /// where the curve left the N lowest).
     pub curves: Vec<Vec<Option<usize>>>,
-    /// Critical speeds: where a followed mode crosses the 1× line.
+    /// Critical speeds: where a followed mode crosses the 1× line with damping ratio below
+    /// [`NO_PEAK_DAMPING_RATIO`].
     pub critical_speeds: Vec<CriticalSpeed>,
+    /// Crossings of the 1× line by modes damped at or beyond [`NO_PEAK_DAMPING_RATIO`]: no
+    /// resonance there, so not critical speeds (listed so that nothing computed is hidden).
+    pub overdamped_crossings: Vec<CriticalSpeed>,
 }
+
+/// From this damping ratio (1/√2) on, a mode's response has no resonance peak: the amplitude
+/// of a single-degree-of-freedom system falls monotonically with frequency. ROSS's compressor
+/// (`ross/tests/data/rotor.toml`) has seal-dominated modes with ζ ≈ 0.9–1.0 whose curves cross
+/// 1× at 2.6, 22 and 6573 rpm; listed as critical speeds they would tell an engineer to avoid
+/// running speeds where nothing resonates. API 684's separation-margin rule (amplification
+/// factor below 2.5, ζ above 0.2) is stricter and left to the reader: each critical speed
+/// carries its damping ratio.
+pub const NO_PEAK_DAMPING_RATIO: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
 /// A crossing of a followed mode with the synchronous line.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -41,6 +54,8 @@ pub struct CriticalSpeed {
     pub whirl: Whirl,
     /// Log decrement there (interpolated).
     pub log_dec: f64,
+    /// Damping ratio there (interpolated).
+    pub damping_ratio: f64,
 }
 
 /// Modal assurance criterion of two complex shapes.
@@ -73,7 +88,7 @@ pub fn campbell(rotor: &Rotor, speeds_rpm: &[f64], n_modes: usize) -> Result<Cam
     }
     let kept: Vec<&[Mode]> = all.iter().map(|m| &m[..m.len().min(n_modes + SPARE_MODES)]).collect();
     let curves = follow(&kept, n_modes);
-    let mut critical = Vec::new();
+    let mut crossings = Vec::new();
     for (c, curve) in curves.iter().enumerate() {
         for k in 1..speeds.len() {
             let (Some(i0), Some(i1)) = (curve[k - 1], curve[k]) else { continue };
@@ -85,11 +100,14 @@ pub fn campbell(rotor: &Rotor, speeds_rpm: &[f64], n_modes: usize) -> Result<Cam
                 let rpm = speeds_rpm[k - 1] + t * (speeds_rpm[k] - speeds_rpm[k - 1]);
                 let near = if t < 0.5 { m0 } else { m1 };
                 let log_dec = m0.log_dec() + t * (m1.log_dec() - m0.log_dec());
-                critical.push(CriticalSpeed { rpm, curve: c, whirl: near.whirl, log_dec });
+                let damping_ratio = m0.damping_ratio() + t * (m1.damping_ratio() - m0.damping_ratio());
+                crossings.push(CriticalSpeed { rpm, curve: c, whirl: near.whirl, log_dec, damping_ratio });
             }
         }
     }
-    critical.sort_by(|a, b| a.rpm.total_cmp(&b.rpm));
+    crossings.sort_by(|a, b| a.rpm.total_cmp(&b.rpm));
+    let (critical, overdamped): (Vec<_>, Vec<_>) =
+        crossings.into_iter().partition(|k| k.damping_ratio < NO_PEAK_DAMPING_RATIO);
     // Curves reported by index into the N shown (ascending) lists.
     let curves =
         curves.into_iter().map(|c| c.into_iter().map(|i| i.filter(|&i| i < n_modes)).collect()).collect();
@@ -100,6 +118,7 @@ pub fn campbell(rotor: &Rotor, speeds_rpm: &[f64], n_modes: usize) -> Result<Cam
         log_dec: all.iter().map(|m| m[..n_modes].iter().map(Mode::log_dec).collect()).collect(),
         curves,
         critical_speeds: critical,
+        overdamped_crossings: overdamped,
     })
 }
 

@@ -44,3 +44,46 @@ fn critical_speeds_lie_on_the_synchronous_line() {
         assert!(nearest < 1e-2, "critical speed {} rpm: nearest mode {:.2e} off", k.rpm, nearest);
     }
 }
+
+/// ROSS's rotor_example with a heavily damped absorber at node 3 (1 kg on 1 kN/m and
+/// 60 N·s/m: ζ = 60/(2·√1000) = 0.95). Its mode (1.59 Hz) crosses 1× near 95 rpm, where nothing
+/// resonates: listed as an overdamped crossing, not as a critical speed; the shaft's own
+/// crossings (ζ 0.004) stay critical speeds.
+#[test]
+fn a_mode_damped_beyond_resonance_is_not_a_critical_speed() {
+    use eigenfit_rotordynamics::campbell::NO_PEAK_DAMPING_RATIO;
+    let mut text = std::fs::read_to_string(data("rotor_example.toml")).unwrap();
+    text.push_str(
+        r#"
+["BearingElement_Damper"]
+cxx = [ 60.0,]
+cxy = [ 0,]
+cyx = [ 0,]
+cyy = [ 60.0,]
+kxx = [ 1000.0,]
+kxy = [ 0,]
+kyx = [ 0,]
+kyy = [ 1000.0,]
+n = 3
+n_link = 7
+tag = "Damper"
+
+["PointMass_Absorber"]
+n = 7
+mx = 1.0
+my = 1.0
+tag = "Absorber"
+"#,
+    );
+    let rotor = ross_file::parse(&text).unwrap();
+    let speeds: Vec<f64> = (0..=30).map(|i| 100.0 * i as f64).collect();
+    let c = campbell(&rotor, &speeds, 4).unwrap();
+    assert_eq!(c.overdamped_crossings.len(), 2, "{:?}", c.overdamped_crossings);
+    for k in &c.overdamped_crossings {
+        assert!((k.damping_ratio - 0.949).abs() < 5e-3 && (k.rpm - 95.0).abs() < 2.0, "{k:?}");
+    }
+    assert_eq!(c.critical_speeds.len(), 2, "{:?}", c.critical_speeds);
+    for k in &c.critical_speeds {
+        assert!(k.damping_ratio < NO_PEAK_DAMPING_RATIO && (850.0..950.0).contains(&k.rpm), "{k:?}");
+    }
+}

@@ -58,10 +58,26 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
             println!();
         }
         if report.campbell.critical_speeds.is_empty() {
-            println!("no critical speed in range (no followed mode crosses the 1× line)");
+            if report.campbell.overdamped_crossings.is_empty() {
+                println!("no critical speed in range (no followed mode crosses the 1× line)");
+            } else {
+                println!("no critical speed in range (only modes damped beyond resonance cross the 1× line)");
+            }
         }
         for k in &report.campbell.critical_speeds {
-            println!("critical speed {:.1} rpm ({} whirl, log dec {:.4})", k.rpm, k.whirl.name(), k.log_dec);
+            println!(
+                "critical speed {:.1} rpm ({} whirl, log dec {:.4}, damping ratio {:.3})",
+                k.rpm,
+                k.whirl.name(),
+                k.log_dec,
+                k.damping_ratio
+            );
+        }
+        for k in &report.campbell.overdamped_crossings {
+            println!(
+                "not a critical speed: {:.1} rpm, where a mode with damping ratio {:.3} (≥ 1/√2: no resonance peak) crosses 1×",
+                k.rpm, k.damping_ratio
+            );
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     });
