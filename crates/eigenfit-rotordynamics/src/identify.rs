@@ -310,24 +310,17 @@ pub fn evaluate_with(
             effect.add_to(&r, &mut mats, w, *value);
         }
         let here: Vec<usize> = (0..points.len()).filter(|&i| points[i].speed_rpm == rpm).collect();
-        let by_whirl = here.iter().all(|&i| points[i].whirl.is_some());
         let highest = here.iter().map(|&i| points[i].mode).max().unwrap_or(0);
-        // By order: one more than the highest measured mode (its whirl partner, should they
-        // coincide). By whirl: spares among which to find the measured ones.
-        let needed = if by_whirl { 2 * highest + 6 } else { highest + 1 };
-        let modes = r.lowest_modes_of(&mats, needed)?;
-        let pairs: Vec<usize> = if by_whirl {
-            let measured: Vec<&RunupPoint> = here.iter().map(|&i| &points[i]).collect();
-            pair_by_whirl(&measured, &modes).ok_or_else(|| {
-                RotorDynError::Data(format!(
-                    "{} modes measured at {rpm} rpm but the model has only {} oscillating modes there",
-                    here.len(),
-                    modes.len()
-                ))
-            })?
-        } else {
-            here.iter().map(|&i| points[i].mode - 1).collect()
-        };
+        // Spares among which to find the measured modes (a run-up may not show every mode).
+        let modes = r.lowest_modes_of(&mats, 2 * highest + 6)?;
+        let measured: Vec<&RunupPoint> = here.iter().map(|&i| &points[i]).collect();
+        let pairs = pair_modes(&measured, &modes).ok_or_else(|| {
+            RotorDynError::Data(format!(
+                "{} modes measured at {rpm} rpm but the model has only {} oscillating modes there",
+                here.len(),
+                modes.len()
+            ))
+        })?;
         let derivs: Vec<MatrixDerivative> = params
             .iter()
             .map(|p| {
@@ -369,16 +362,30 @@ pub fn evaluate_with(
 /// same): the whirl tells them apart where the frequencies cannot.
 const WHIRL_MISMATCH: f64 = 0.009_084; // ln²(1.1)
 
-/// Pairs the measured modes of one speed (each with a whirl) with computed modes: the
-/// assignment minimising Σ ln²(f_measured/f_model) + [`WHIRL_MISMATCH`] per whirl that differs,
-/// each model mode used once (so modes the run-up did not show — heavily damped ones — are
-/// skipped). Exact, by dynamic programming over the subsets of measured modes.
+/// What leaving out an undamped model mode below the highest measured frequency costs, in the
+/// same units: as much as a 25 % frequency difference. A run-up shows every lightly damped mode
+/// in its range, so the pairing may not skip one to reach a closer partner; it may skip a mode
+/// damped so heavily that it shows no peak. The cost falls with the damping ratio ζ as
+/// (1 − ζ/[`SKIP_FREE_DAMPING_RATIO`])², free from there on.
+const SKIP_UNDAMPED: f64 = 0.049_793; // ln²(1.25)
+
+/// From this damping ratio on a model mode may be left out of the pairing at no cost: ROSS's
+/// compressor's seal modes (ζ 0.4–0.95) lie between the lightly damped ones a run-up shows.
+const SKIP_FREE_DAMPING_RATIO: f64 = 0.5;
+
+/// Pairs the measured modes of one speed with computed modes: the assignment minimising
+/// Σ ln²(f_measured/f_model), plus [`WHIRL_MISMATCH`] per whirl that differs where the whirl
+/// was measured, plus [`SKIP_UNDAMPED`] (less with damping) per model mode left out below the
+/// highest measured frequency. Each model mode is used once. With every mode measured and the
+/// model near, this is pairing by order; modes the run-up did not show (heavily damped ones) are
+/// skipped. Exact, by dynamic programming over the subsets of measured modes.
 /// `None` when there are more measured than computed modes.
-fn pair_by_whirl(measured: &[&RunupPoint], modes: &[Mode]) -> Option<Vec<usize>> {
+fn pair_modes(measured: &[&RunupPoint], modes: &[Mode]) -> Option<Vec<usize>> {
     let (a, b) = (measured.len(), modes.len());
     if a > b || a > 20 {
         return None;
     }
+    let top = measured.iter().map(|p| p.frequency_hz).fold(0.0, f64::max);
     let full = (1usize << a) - 1;
     // best[mask]: least cost with the measured modes in `mask` paired among the model modes
     // seen so far; choice[j][mask]: the measured mode model mode j took (or none).
@@ -387,25 +394,31 @@ fn pair_by_whirl(measured: &[&RunupPoint], modes: &[Mode]) -> Option<Vec<usize>>
     let mut choice = vec![vec![usize::MAX; full + 1]; b];
     for (j, mode) in modes.iter().enumerate() {
         let f = mode.frequency_hz();
+        let skip = if f <= top {
+            SKIP_UNDAMPED * (1.0 - mode.damping_ratio() / SKIP_FREE_DAMPING_RATIO).max(0.0).powi(2)
+        } else {
+            0.0
+        };
         let before = best.clone();
+        // Leaving model mode j out.
+        for (slot, &from) in best.iter_mut().zip(&before) {
+            *slot = from + skip;
+        }
         for (mask, &from) in before.iter().enumerate() {
             if !from.is_finite() {
                 continue;
             }
             for (i, p) in measured.iter().enumerate().filter(|(i, _)| mask & (1 << i) == 0) {
-                let mismatch = if p.whirl == Some(mode.whirl) { 0.0 } else { WHIRL_MISMATCH };
+                let mismatch = match p.whirl {
+                    Some(w) if w != mode.whirl => WHIRL_MISMATCH,
+                    _ => 0.0,
+                };
                 let c = from + (p.frequency_hz / f).ln().powi(2) + mismatch;
                 let next = mask | (1 << i);
                 if c < best[next] {
                     best[next] = c;
                     choice[j][next] = i;
                 }
-            }
-        }
-        // A cost improved at model mode j came from it; the rest stay as they were.
-        for mask in 0..=full {
-            if best[mask] == before[mask] {
-                choice[j][mask] = usize::MAX;
             }
         }
     }
@@ -632,4 +645,62 @@ fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, Rot
         identifiable,
         refits: 0,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::c64;
+
+    /// A model mode at `hz` with damping ratio `zeta` (no shape: the pairing reads neither).
+    fn mode(hz: f64, zeta: f64, whirl: Whirl) -> Mode {
+        let wn = 2.0 * PI * hz / (1.0 - zeta * zeta).sqrt();
+        Mode { eigenvalue: c64::new(-zeta * wn, 2.0 * PI * hz), right: vec![], left: vec![], whirl }
+    }
+
+    fn point(mode: usize, hz: f64, whirl: Option<Whirl>) -> RunupPoint {
+        RunupPoint { speed_rpm: 3000.0, mode, frequency_hz: hz, std_hz: None, whirl }
+    }
+
+    fn pairs(measured: &[RunupPoint], modes: &[Mode]) -> Vec<usize> {
+        pair_modes(&measured.iter().collect::<Vec<_>>(), modes).unwrap()
+    }
+
+    #[test]
+    fn every_mode_measured_pairs_by_order_unless_a_skipped_mode_is_heavily_damped() {
+        let f = Whirl::Forward;
+        let measured = [point(1, 100.0, None), point(2, 120.0, None)];
+        // Pairing 1→2, 2→3 would match closer (0 % and 4 % off instead of 5 % and 17 %), but
+        // leaving out the undamped model mode 1 costs as much as a 25 % frequency difference.
+        let modes = [mode(95.0, 0.01, f), mode(100.0, 0.01, f), mode(125.0, 0.01, f)];
+        assert_eq!(pairs(&measured, &modes), [0, 1]);
+        // Heavily damped (ζ 0.6), model mode 1 may be left out: it shows no peak.
+        let damped = [mode(95.0, 0.6, f), mode(100.0, 0.01, f), mode(125.0, 0.01, f)];
+        assert_eq!(pairs(&measured, &damped), [1, 2]);
+    }
+
+    #[test]
+    fn a_heavily_damped_model_mode_the_runup_did_not_show_is_skipped() {
+        let (f, b) = (Whirl::Forward, Whirl::Backward);
+        let measured = [point(1, 201.5, None), point(2, 270.9, None), point(3, 301.8, None)];
+        // As ROSS's compressor at 9000 rpm: seal modes with ζ 0.44 and 0.40 between the shown ones.
+        let modes = [
+            mode(201.5, 0.35, f),
+            mode(204.4, 0.44, b),
+            mode(270.9, 0.29, b),
+            mode(295.8, 0.40, f),
+            mode(301.8, 0.32, f),
+        ];
+        assert_eq!(pairs(&measured, &modes), [0, 2, 4]);
+        // By order it would have been 0, 1, 2: measured 270.9 against the 204.4 seal mode.
+    }
+
+    #[test]
+    fn measured_whirl_separates_a_forward_backward_pair() {
+        let (f, b) = (Whirl::Forward, Whirl::Backward);
+        let measured = [point(1, 100.0, Some(f)), point(2, 103.0, Some(b))];
+        let modes = [mode(100.5, 0.01, b), mode(102.5, 0.01, f)];
+        assert_eq!(pairs(&measured, &modes), [1, 0]);
+        assert!(pair_modes(&measured.iter().collect::<Vec<_>>(), &modes[..1]).is_none());
+    }
 }

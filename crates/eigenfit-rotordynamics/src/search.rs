@@ -20,10 +20,16 @@ const SCREEN_RANGE_LN: f64 = 1.098_612_288_668_109_8;
 /// Screened starts per refit: the refits begin at the best `SCREENED_PER_REFIT × refits`.
 const SCREENED_PER_REFIT: usize = 8;
 
-/// Whether a fit's χ² (with std on every point) passes the test core's verdict applies.
+/// Largest RMS relative residual that counts as an exact fit when no std is given (the
+/// eigen-solver's agreement with itself; a fit that close cannot be bettered by another start).
+const EXACT_RELATIVE_RMS: f64 = 1e-9;
+
+/// Whether a fit's χ² (with std on every point) passes the test core's verdict applies; without
+/// std, whether it is exact.
 fn passes(id: &Identification, points: &[RunupPoint]) -> bool {
     if !points.iter().all(|p| p.std_hz.is_some()) {
-        return false;
+        // Without std the cost is Σ (relative residual)².
+        return id.cost <= EXACT_RELATIVE_RMS.powi(2) * points.len() as f64;
     }
     let dof = points.len().saturating_sub(id.parameters.len());
     if dof == 0 {
@@ -64,8 +70,8 @@ fn screened_starts(params: &[Parameter], initial: &[f64], count: usize) -> Vec<V
         .collect()
 }
 
-/// [`identify`] from `initial`, and when that fit does not pass the χ² test (or no std is
-/// given, so it cannot be judged), `refits` more fits from the best of
+/// [`identify`] from `initial`, and when that fit does not pass the χ² test (or, without std,
+/// is not exact), `refits` more fits from the best of
 /// `8 × refits` screened starts (factors ⅓…3 on the direct stiffnesses, kept apart), stopping
 /// at the first that passes. Returns the fit of least cost with `Identification::refits` set and every
 /// evaluation counted in its outcome. `refits` 0: the fit from `initial` alone.
