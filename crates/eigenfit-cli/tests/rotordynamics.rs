@@ -61,15 +61,12 @@ fn campbell_lists_every_speed_and_the_critical_speeds() {
     assert!(v["critical_speeds_rpm"].is_array());
 }
 
-#[test]
-fn estimate_recovers_bearing_stiffnesses_from_a_runup() {
-    // Measured run-up made by the model itself with kxx of both bearings raised 20 %.
-    let model = data("rotor_example.toml");
-    let text = std::fs::read_to_string(&model).unwrap();
+/// A run-up CSV (std 0.01 Hz) written into `dir`, made by the model itself: rotor_example with
+/// kxx of both bearings raised 20 %.
+fn stiffer_runup(dir: &std::path::Path) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(data("rotor_example.toml")).unwrap();
     let stiffer = text.replace("kxx = [ 1000000.0,]", "kxx = [ 1200000.0,]");
     assert_ne!(text, stiffer, "fixture layout changed");
-    let scratch = common::scratch();
-    let dir = scratch.path();
     let truth = dir.join("truth.toml");
     std::fs::write(&truth, stiffer).unwrap();
     let mut csv = String::from("speed_rpm,mode,frequency_hz,std_hz\n");
@@ -90,6 +87,14 @@ fn estimate_recovers_bearing_stiffnesses_from_a_runup() {
     }
     let measured = dir.join("runup.csv");
     std::fs::write(&measured, csv).unwrap();
+    measured
+}
+
+#[test]
+fn estimate_recovers_bearing_stiffnesses_from_a_runup() {
+    let model = data("rotor_example.toml");
+    let scratch = common::scratch();
+    let measured = stiffer_runup(scratch.path());
     let out = run(&["estimate", "--model", &model, "--measured", measured.to_str().unwrap(), "--json"]);
     let v = json(&out);
     for (name, truth) in
@@ -168,6 +173,27 @@ fn estimate_with_cross_coupled_and_damping_parameters_and_verdicts() {
 
 /// `discover` on a ROSS rotor keeps the rule of every `discover`: a budget too small for the
 /// calibration ends with exit code 3 (not a bad-input 2), naming the budget.
+/// `--budget` bounds a run-up estimate too: the run-up of rotor_example with kxx 20 % up takes
+/// more than 5 evaluations from the file; with 5 the run stops, says why, exits 3 and still
+/// prints its best.
+#[test]
+fn ross_estimate_within_a_budget_too_small_exits_3_with_its_best_fit() {
+    let model = data("rotor_example.toml");
+    let scratch = common::scratch();
+    let measured = stiffer_runup(scratch.path());
+    let measured = measured.to_str().unwrap();
+    let full = json(&run(&["estimate", "--model", &model, "--measured", measured, "--json"]));
+    assert_eq!(full["verdict"], "converged");
+    assert!(full["evaluations"].as_u64().unwrap() > 5, "{}", full["evaluations"]);
+    let out = run(&["estimate", "--model", &model, "--measured", measured, "--budget", "5", "--json"]);
+    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON printed");
+    assert_eq!(v["verdict"], "budget-exhausted");
+    assert!(v["evaluations"].as_u64().unwrap() <= 5, "{}", v["evaluations"]);
+    assert!(v["termination"].as_str().unwrap().contains("budget 5"), "{}", v["termination"]);
+    assert_eq!(v["parameters"].as_object().unwrap().len(), 4);
+}
+
 #[test]
 fn ross_discover_with_a_budget_too_small_exits_3() {
     let (model, measured) = (data("runup_nominal.toml"), data("discovery_disk.csv"));

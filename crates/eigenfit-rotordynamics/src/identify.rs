@@ -478,7 +478,20 @@ pub fn identify(
     initial: &[f64],
     max_iterations: usize,
 ) -> Result<Identification, RotorDynError> {
-    let whole = Fit { rotor, params, points, max_iterations };
+    identify_within(rotor, params, points, initial, max_iterations, usize::MAX)
+}
+
+/// [`identify`] spending at most `max_evaluations` evaluations (eigen-solve rounds over the
+/// run-up's speeds); when they run out the fit stops, not converged, and says so.
+pub fn identify_within(
+    rotor: &Rotor,
+    params: &[Parameter],
+    points: &[RunupPoint],
+    initial: &[f64],
+    max_iterations: usize,
+    max_evaluations: usize,
+) -> Result<Identification, RotorDynError> {
+    let whole = Fit { rotor, params, points, max_iterations, max_evaluations };
     let direct: Vec<usize> = (0..params.len()).filter(|&i| matches!(params[i].coefficient, 0 | 3)).collect();
     if direct.is_empty() || direct.len() == params.len() {
         return levenberg_marquardt(&whole, initial);
@@ -493,19 +506,47 @@ pub fn identify(
     for (k, &i) in direct.iter().enumerate() {
         start[i] = first.scales[k];
     }
-    let mut out = levenberg_marquardt(&whole, &start)?;
+    if !first.outcome.converged && first.outcome.evaluations >= max_evaluations {
+        return Ok(first_stage_only(first, params, &direct, &start));
+    }
+    let rest = max_evaluations.saturating_sub(first.outcome.evaluations);
+    let mut out = levenberg_marquardt(&Fit { max_evaluations: rest, ..whole }, &start)?;
     out.outcome.iterations += first.outcome.iterations;
     out.outcome.evaluations += first.outcome.evaluations;
     Ok(out)
 }
 
-/// One least-squares problem: a rotor, the parameters on it, the run-up, the iteration limit.
+/// The first stage's fit reported for the whole selection when the budget ran out in it: the
+/// held parameters at their start, without a Jacobian column (zero) or intervals.
+fn first_stage_only(
+    first: Identification,
+    params: &[Parameter],
+    direct: &[usize],
+    start: &[f64],
+) -> Identification {
+    let mut jacobian = DMatrix::zeros(first.jacobian.nrows(), params.len());
+    for (k, &i) in direct.iter().enumerate() {
+        jacobian.set_column(i, &first.jacobian.column(k));
+    }
+    Identification {
+        parameters: params.to_vec(),
+        scales: start.to_vec(),
+        ln_std: None,
+        jacobian,
+        identifiable: false,
+        ..first
+    }
+}
+
+/// One least-squares problem: a rotor, the parameters on it, the run-up, the iteration and
+/// evaluation limits.
 #[derive(Clone, Copy)]
 struct Fit<'a> {
     rotor: &'a Rotor,
     params: &'a [Parameter],
     points: &'a [RunupPoint],
     max_iterations: usize,
+    max_evaluations: usize,
 }
 
 /// Largest change of any ln s in one step (a trust region): whirl frequencies are sorted at each
@@ -514,7 +555,7 @@ const MAX_LN_STEP: f64 = 0.2;
 
 /// Levenberg–Marquardt in ln s from `initial` scales.
 fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, RotorDynError> {
-    let Fit { rotor, params, points, max_iterations } = *fit;
+    let Fit { rotor, params, points, max_iterations, max_evaluations } = *fit;
     let m = points.len();
     let np = params.len();
     if m < np {
@@ -575,6 +616,9 @@ fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, Rot
                 mu *= 4.0;
                 continue;
             }
+            if evaluations >= max_evaluations {
+                break;
+            }
             let trial = &theta + &step;
             let scales: Vec<f64> = trial.iter().map(|t| t.exp()).collect();
             let e = evaluate(rotor, params, &scales, points)?;
@@ -603,6 +647,10 @@ fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, Rot
             }
         }
         if converged {
+            break;
+        }
+        if !accepted && evaluations >= max_evaluations {
+            reason = format!("evaluation budget {max_evaluations} reached");
             break;
         }
         if !accepted {

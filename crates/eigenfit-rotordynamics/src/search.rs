@@ -8,7 +8,7 @@
 //! from the best screened start it reaches the truth (χ² ≈ dof).
 
 use crate::error::RotorDynError;
-use crate::identify::{evaluate, identify, Identification, Parameter, RunupPoint};
+use crate::identify::{evaluate, identify_within, Identification, Parameter, RunupPoint};
 use eigenfit_core::analysis::chi2_upper_tail;
 use eigenfit_core::analysis::verdict::{POOR_FIT_CHI2_NO_DOF, POOR_FIT_P_VALUE};
 
@@ -74,7 +74,9 @@ fn screened_starts(params: &[Parameter], initial: &[f64], count: usize) -> Vec<V
 /// is not exact), `refits` more fits from the best of
 /// `8 × refits` screened starts (factors ⅓…3 on the direct stiffnesses, kept apart), stopping
 /// at the first that passes. Returns the fit of least cost with `Identification::refits` set and every
-/// evaluation counted in its outcome. `refits` 0: the fit from `initial` alone.
+/// evaluation counted in its outcome. `refits` 0: the fit from `initial` alone. At most
+/// `max_evaluations` evaluations in all: when they run out before a fit passes, the best fit
+/// so far is returned marked not converged, its termination saying why.
 pub fn identify_from_best_start(
     rotor: &crate::rotor::Rotor,
     params: &[Parameter],
@@ -82,15 +84,19 @@ pub fn identify_from_best_start(
     initial: &[f64],
     max_iterations: usize,
     refits: usize,
+    max_evaluations: usize,
 ) -> Result<Identification, RotorDynError> {
-    let mut best = identify(rotor, params, points, initial, max_iterations)?;
-    if refits == 0 || passes(&best, points) {
+    let mut best = identify_within(rotor, params, points, initial, max_iterations, max_evaluations)?;
+    if refits == 0 || passes(&best, points) || best.outcome.evaluations >= max_evaluations {
         return Ok(best);
     }
     let (mut evaluations, mut iterations) = (best.outcome.evaluations, best.outcome.iterations);
     let sigma: Vec<f64> = points.iter().map(|p| p.std_hz.unwrap_or(p.frequency_hz)).collect();
     let mut screened: Vec<(f64, Vec<f64>)> = Vec::new();
     for start in screened_starts(params, initial, SCREENED_PER_REFIT * refits) {
+        if evaluations >= max_evaluations {
+            break;
+        }
         evaluations += 1;
         // A start where a measured mode has no model partner is no start: skip it.
         if let Ok(e) = evaluate(rotor, params, &start, points) {
@@ -112,8 +118,12 @@ pub fn identify_from_best_start(
     }
     let mut done = 0;
     for start in chosen {
+        if evaluations >= max_evaluations {
+            break;
+        }
         done += 1;
-        let Ok(id) = identify(rotor, params, points, &start, max_iterations) else { continue };
+        let rest = max_evaluations - evaluations;
+        let Ok(id) = identify_within(rotor, params, points, &start, max_iterations, rest) else { continue };
         evaluations += id.outcome.evaluations;
         iterations += id.outcome.iterations;
         let good = passes(&id, points);
@@ -127,6 +137,14 @@ pub fn identify_from_best_start(
     best.outcome.evaluations = evaluations;
     best.outcome.iterations = iterations;
     best.refits = done;
+    if evaluations >= max_evaluations && !passes(&best, points) {
+        // The search was cut short: the fit reported is the best found, not a converged one.
+        best.outcome.converged = false;
+        best.outcome.termination = format!(
+            "evaluation budget {max_evaluations} reached in the search from other starts ({}; best fit kept)",
+            best.outcome.termination
+        );
+    }
     Ok(best)
 }
 

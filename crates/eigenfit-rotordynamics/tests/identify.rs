@@ -188,7 +188,13 @@ fn nominal_runup(r: &eigenfit_rotordynamics::Rotor) -> Vec<RunupPoint> {
     let mut points = Vec::new();
     for rpm in [1000.0, 3000.0, 5000.0, 7000.0, 9000.0] {
         for mode in 1..=6 {
-            points.push(RunupPoint { speed_rpm: rpm, mode, frequency_hz: 1.0, std_hz: Some(0.01), whirl: None });
+            points.push(RunupPoint {
+                speed_rpm: rpm,
+                mode,
+                frequency_hz: 1.0,
+                std_hz: Some(0.01),
+                whirl: None,
+            });
         }
     }
     let e = evaluate(r, &params, &[1.0; 4], &points).unwrap();
@@ -211,7 +217,7 @@ fn a_fit_stuck_in_another_basin_is_rescued_by_screened_starts() {
     let start = [1.4, 0.7, 1.4, 0.7];
     let single = identify(&r, &params, &points, &start, 200).unwrap();
     assert!(single.cost > 1e3, "the trap this test is about is gone: cost {}", single.cost);
-    let searched = identify_from_best_start(&r, &params, &points, &start, 200, 6).unwrap();
+    let searched = identify_from_best_start(&r, &params, &points, &start, 200, 6, usize::MAX).unwrap();
     assert!(searched.cost < 1e-10, "cost {}", searched.cost);
     for s in &searched.scales {
         assert!((s - 1.0).abs() < 1e-6, "{:?}", searched.scales);
@@ -219,8 +225,13 @@ fn a_fit_stuck_in_another_basin_is_rescued_by_screened_starts() {
     assert!((1..=6).contains(&searched.refits), "{} refits", searched.refits);
     // Counted: the first fit, 48 screened starts and the refits (measured 146).
     assert!(searched.outcome.evaluations <= 300, "{} evaluations", searched.outcome.evaluations);
+    // Bounded: with 40 evaluations the search stops there, keeps its best and says so.
+    let cut = identify_from_best_start(&r, &params, &points, &start, 200, 6, 40).unwrap();
+    assert!(cut.outcome.evaluations <= 40 && !cut.outcome.converged, "{:?}", cut.outcome);
+    assert!(cut.outcome.termination.contains("budget 40"), "{}", cut.outcome.termination);
+    assert!(cut.cost <= single.cost);
     // A fit that passes is not searched further.
-    let at_truth = identify_from_best_start(&r, &params, &points, &[1.0; 4], 200, 6).unwrap();
+    let at_truth = identify_from_best_start(&r, &params, &points, &[1.0; 4], 200, 6, usize::MAX).unwrap();
     assert_eq!(at_truth.refits, 0);
 }
 
@@ -234,6 +245,9 @@ fn every_bearing_means_the_bearings_and_seals_are_named_one_by_one() {
     let names = |sel: &[&str]| -> Vec<String> {
         bearing_parameters(&r, sel).unwrap().into_iter().map(|p| p.name).collect()
     };
-    assert_eq!(names(&["kxx", "kyy"]), ["kxx_Bearing 0", "kyy_Bearing 0", "kxx_Bearing 13", "kyy_Bearing 13"]);
+    assert_eq!(
+        names(&["kxx", "kyy"]),
+        ["kxx_Bearing 0", "kyy_Bearing 0", "kxx_Bearing 13", "kyy_Bearing 13"]
+    );
     assert_eq!(names(&["kxx", "kxx_Seal 1"]), ["kxx_Bearing 0", "kxx_Bearing 13", "kxx_Seal 1"]);
 }

@@ -259,6 +259,7 @@ pub fn run(
             request.bearing_parameters.as_deref(),
             request.max_iterations,
             request.alternative_starts,
+            request.budget,
         )
         .map(|r| EstimateOutcome::Runup(Box::new(r)));
     }

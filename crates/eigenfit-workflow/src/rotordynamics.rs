@@ -198,13 +198,15 @@ fn fit_quality(id: &Identification, points: &[RunupPoint], values: &[f64]) -> Fi
 /// `estimate --model ROSS-FILE --measured RUNUP.csv [--parameters kxx,kyy,…]`: bearing
 /// coefficients from a run-up (`selection` `None`: kxx and kyy of every bearing, seals left
 /// out). When the fit from the file's bearings fails the χ² test, up to `refits` fits from
-/// screened other starts follow ([`identify_from_best_start`]).
+/// screened other starts follow ([`identify_from_best_start`]), all within `budget` evaluations
+/// (one eigen-solve round over the run-up's speeds each).
 pub fn estimate(
     path: &Path,
     measured: &Path,
     selection: Option<&str>,
     max_iterations: usize,
     refits: usize,
+    budget: usize,
 ) -> Result<RunupEstimateReport, WorkflowError> {
     let rotor = load(path)?;
     let points = read_runup(measured).map_err(to_workflow)?;
@@ -217,7 +219,7 @@ pub fn estimate(
         return Err(input(format!("{}: the rotor has no bearings to estimate", path.display())));
     }
     let initial = vec![1.0; params.len()];
-    let id = identify_from_best_start(&rotor, &params, &points, &initial, max_iterations, refits)
+    let id = identify_from_best_start(&rotor, &params, &points, &initial, max_iterations, refits, budget)
         .map_err(to_workflow)?;
     // Report each coefficient at the lowest measured speed (constant bearings: their value).
     let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
@@ -237,9 +239,10 @@ pub fn estimate(
             .collect()
     });
     let quality = fit_quality(&id, &points, &value);
-    // A run-up fit has no budget, limits or pairing of its own to fail on.
-    let verdict =
-        Verdict::of((!id.outcome.converged).then_some("not-converged"), false, quality.verdict, false, false);
+    // A run-up fit has no limits or pairing of its own to fail on; its budget can run out.
+    let budget_spent = !id.outcome.converged && id.outcome.evaluations >= budget;
+    let not_converged = (!id.outcome.converged && !budget_spent).then_some("not-converged");
+    let verdict = Verdict::of(not_converged, budget_spent, quality.verdict, false, false);
     let status = |i: usize| -> String {
         match &intervals {
             _ if !id.outcome.converged => "(not computed: the run did not converge)".into(),
