@@ -35,6 +35,15 @@ pub fn print_estimate(r: &RunupEstimateReport) {
         r.outcome.iterations,
         r.verdict.verdict
     );
+    if r.refits > 0 {
+        println!(
+            "the fit from the file's bearings did not pass (χ² test; without std: not exact): {} more from screened starts, the best kept ({} evaluations in all)",
+            r.refits, r.outcome.evaluations
+        );
+    }
+    if !r.outcome.converged {
+        println!("stopped: {}", r.outcome.termination);
+    }
     println!("{:<28}{:>16}{:>16}{:>32}", "parameter", "initial", "estimate", "95% interval / status");
     for (((name, initial), (_, value)), (_, status)) in
         r.values.initial.iter().zip(r.values.parameters.iter()).zip(r.values.parameter_status.iter())
