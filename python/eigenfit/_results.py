@@ -314,7 +314,10 @@ class CampbellResult(Result):
     )
     log_dec = _float_array("log_dec", "Logarithmic decrements, shape (speeds, modes).")
     critical_speeds_rpm = _float_array(
-        "critical_speeds_rpm", "Speeds (rpm) where a followed mode crosses the 1× line, ascending."
+        "critical_speeds_rpm",
+        "Speeds (rpm) where a followed mode with damping ratio below 1/√2 crosses the 1× line, ascending "
+        "(crossings by more heavily damped modes, which have no resonance peak: "
+        "``result['overdamped_crossings']``).",
     )
 
     @property
