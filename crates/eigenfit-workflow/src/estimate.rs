@@ -253,15 +253,19 @@ pub fn run(
 ) -> Result<EstimateOutcome, WorkflowError> {
     // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
     if let Some(path) = rotordynamics::ross_model(request.source.model.as_deref()) {
-        return rotordynamics::estimate(
+        // A run-up fit on a large rotor takes minutes (each evaluation solves every speed):
+        // a spinner with the elapsed time shows it is working.
+        progress.begin("fitting the run-up", None);
+        let report = rotordynamics::estimate(
             path,
             &request.measured,
             request.bearing_parameters.as_deref(),
             request.max_iterations,
             request.alternative_starts,
             request.budget,
-        )
-        .map(|r| EstimateOutcome::Runup(Box::new(r)));
+        );
+        progress.end();
+        return report.map(|r| EstimateOutcome::Runup(Box::new(r)));
     }
     if request.bearing_parameters.is_some() {
         return Err(input(
