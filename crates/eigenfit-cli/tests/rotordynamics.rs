@@ -265,3 +265,34 @@ fn ross_discover_names_the_hidden_hub() {
 fn ross_discover_names_the_weakened_shaft_element() {
     discover_names("discovery_shaft.csv", "shaft-stiffness-loss", 3, 0.3);
 }
+
+/// What the numbers rest on is said: a speed outside a bearing's table (extrapolated, as ROSS
+/// does) and an unstable mode; nothing is said of a rotor that needs no such word.
+#[test]
+fn simulate_notes_extrapolated_tables_and_unstable_modes_and_nothing_else() {
+    let notes = |model: &str, rpm: &str| -> Vec<String> {
+        let v = json(&run(&["simulate", "--model", model, "--speed", rpm, "--modes", "4", "--json"]));
+        v.get("notes").map_or(Vec::new(), |n| {
+            n.as_array().unwrap().iter().map(|s| s.as_str().unwrap().to_string()).collect()
+        })
+    };
+    let compressor = data("compressor.toml");
+    let at_rest = notes(&compressor, "0");
+    assert!(
+        at_rest
+            .iter()
+            .any(|n| n.contains("0 rpm lies outside the 4000–11000 rpm tables of Bearing 0, Bearing 13")),
+        "{at_rest:?}"
+    );
+    assert!(notes(&compressor, "5000").is_empty());
+    // rotor_example is undamped: its damping ratios are round-off (|ζ| < 1e-13), not instability.
+    assert!(notes(&data("rotor_example.toml"), "0").is_empty());
+    let text = std::fs::read_to_string(data("rotor_example.toml")).unwrap();
+    let negative =
+        text.replace("cxx = [ 0,]", "cxx = [ -2000.0,]").replace("cyy = [ 0,]", "cyy = [ -2000.0,]");
+    let scratch = common::scratch();
+    let path = scratch.path().join("negative_damping.toml");
+    std::fs::write(&path, negative).unwrap();
+    let unstable = notes(path.to_str().unwrap(), "0");
+    assert!(unstable.iter().any(|n| n.contains("unstable at 0 rpm")), "{unstable:?}");
+}

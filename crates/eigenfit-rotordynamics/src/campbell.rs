@@ -29,8 +29,9 @@ pub struct Campbell {
     /// Critical speeds: where a followed mode crosses the 1× line with damping ratio below
     /// [`NO_PEAK_DAMPING_RATIO`].
     pub critical_speeds: Vec<CriticalSpeed>,
-    /// Crossings of the 1× line by modes damped at or beyond [`NO_PEAK_DAMPING_RATIO`]: no
-    /// resonance there, so not critical speeds (listed so that nothing computed is hidden).
+    /// Crossings of the 1× line by modes damped at or beyond [`NO_PEAK_DAMPING_RATIO`] (or
+    /// growing as fast: ζ ≤ −1/√2): no resonance there, so not critical speeds (listed so that
+    /// nothing computed is hidden).
     pub overdamped_crossings: Vec<CriticalSpeed>,
 }
 
@@ -107,7 +108,7 @@ pub fn campbell(rotor: &Rotor, speeds_rpm: &[f64], n_modes: usize) -> Result<Cam
     }
     crossings.sort_by(|a, b| a.rpm.total_cmp(&b.rpm));
     let (critical, overdamped): (Vec<_>, Vec<_>) =
-        crossings.into_iter().partition(|k| k.damping_ratio < NO_PEAK_DAMPING_RATIO);
+        crossings.into_iter().partition(|k| k.damping_ratio.abs() < NO_PEAK_DAMPING_RATIO);
     // Curves reported by index into the N shown (ascending) lists.
     let curves =
         curves.into_iter().map(|c| c.into_iter().map(|i| i.filter(|&i| i < n_modes)).collect()).collect();

@@ -45,6 +45,57 @@ pub struct Matrices {
 }
 
 impl Rotor {
+    /// Notes for speeds (rpm) outside the speed range of the bearings' tabulated coefficients,
+    /// one per range shared by several bearings: there the coefficients are the end pieces of
+    /// the fitted curve, extrapolated (as ROSS does), and may be far from any real bearing —
+    /// ROSS's own compressor (tables over 3000–11 000 rpm) gets negative stiffness and modes
+    /// with negative damping at standstill.
+    pub fn extrapolation_notes(&self, speeds_rpm: &[f64]) -> Vec<String> {
+        let mut ranges: Vec<((f64, f64), Vec<&str>)> = Vec::new();
+        for b in &self.bearings {
+            let range = b.k.iter().chain(&b.c).chain(&b.m).find_map(|c| match c {
+                crate::interpolation::Coefficient::Table(t) => {
+                    let s = t.speeds();
+                    Some((crate::rad_to_rpm(s[0]), crate::rad_to_rpm(s[s.len() - 1])))
+                }
+                crate::interpolation::Coefficient::Constant(_) => None,
+            });
+            let Some(range) = range else { continue };
+            match ranges.iter_mut().find(|(r, _)| *r == range) {
+                Some((_, tags)) => tags.push(&b.tag),
+                None => ranges.push((range, vec![&b.tag])),
+            }
+        }
+        let mut notes = Vec::new();
+        for ((lo, hi), tags) in ranges {
+            let mut outside: Vec<f64> = speeds_rpm
+                .iter()
+                .copied()
+                .filter(|&s| s < lo * (1.0 - 1e-9) || s > hi * (1.0 + 1e-9))
+                .collect();
+            outside.sort_by(f64::total_cmp);
+            outside.dedup();
+            if outside.is_empty() {
+                continue;
+            }
+            let (a, b) =
+                outside.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &s| (a.min(s), b.max(s)));
+            let shown: Vec<&str> = tags.iter().take(4).copied().collect();
+            let more = if tags.len() > 4 { format!(" and {} more", tags.len() - 4) } else { String::new() };
+            let which = if outside.len() == 1 {
+                format!("{a:.0} rpm lies")
+            } else {
+                format!("{} speeds from {a:.0} to {b:.0} rpm lie", outside.len())
+            };
+            notes.push(format!(
+                "{which} outside the {lo:.0}–{hi:.0} rpm tables of {}{more}: their coefficients \
+                 there are extrapolated (as ROSS does)",
+                shown.join(", ")
+            ));
+        }
+        notes
+    }
+
     /// Builds a rotor, checking that every element sits on an existing node.
     pub fn new(
         mut shafts: Vec<ShaftElement>,

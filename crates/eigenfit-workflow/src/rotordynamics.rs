@@ -64,7 +64,15 @@ pub struct SpeedReport {
     /// The rotor's DOFs.
     #[serde(skip)]
     pub dofs: usize,
+    /// What the numbers rest on that a reader should know: bearing tables extrapolated,
+    /// unstable modes.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
+
+/// Damping ratio below which a mode is called unstable: an undamped rotor's come out of the
+/// eigen-solver within ±1e-13 of 0 (rotor_example: |ζ| ≤ 6.2e-14 at 0 and 5000 rpm).
+const UNSTABLE_BELOW: f64 = -1e-9;
 
 /// `simulate --model ROSS-FILE [--speed RPM] --modes N`: damped modes at one speed.
 pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize) -> Result<SpeedReport, WorkflowError> {
@@ -82,6 +90,17 @@ pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize) -> Result<Spe
         )));
     }
     let shown = &all[..modes];
+    let mut notes = rotor.extrapolation_notes(&[rpm]);
+    let unstable: Vec<String> = (0..modes)
+        .filter(|&i| shown[i].damping_ratio() < UNSTABLE_BELOW)
+        .map(|i| (i + 1).to_string())
+        .collect();
+    if !unstable.is_empty() {
+        notes.push(format!(
+            "mode(s) {} unstable at {rpm} rpm: negative damping ratio (the vibration grows)",
+            unstable.join(", ")
+        ));
+    }
     Ok(SpeedReport {
         model: path.display().to_string(),
         speed_rpm: rpm,
@@ -91,6 +110,7 @@ pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize) -> Result<Spe
         damping_ratio: shown.iter().map(|m| m.damping_ratio()).collect(),
         log_dec: shown.iter().map(|m| m.log_dec()).collect(),
         dofs: rotor.dofs(),
+        notes,
     })
 }
 
@@ -152,6 +172,9 @@ pub struct RunupEstimateReport {
     pub refits: usize,
     /// The run-up points at the estimate.
     pub points: Vec<RunupPointReport>,
+    /// Bearing tables extrapolated at measured speeds.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
     /// Intervals, with std only.
     #[serde(flatten)]
     pub with_std: Option<RunupIntervals>,
@@ -274,6 +297,7 @@ pub fn estimate(
         cost: id.cost,
         identifiable: id.identifiable,
         refits: id.refits,
+        notes: rotor.extrapolation_notes(&points.iter().map(|p| p.speed_rpm).collect::<Vec<_>>()),
         points: points
             .iter()
             .enumerate()
@@ -435,6 +459,9 @@ pub struct CampbellReport {
     /// Plot files written.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plots: Option<Vec<String>>,
+    /// Bearing tables extrapolated, speeds with unstable modes.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// `campbell`: damped frequencies, whirl and log decrement of a ROSS rotor against speed.
@@ -445,11 +472,24 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
         return Err(input("--modes 0: at least one mode"));
     }
     let c = campbell(&rotor, &speeds, modes).map_err(|e| input(format!("{}: {e}", path.display())))?;
+    let mut notes = rotor.extrapolation_notes(&speeds);
+    let unstable: Vec<String> = (0..speeds.len())
+        .filter(|&k| c.log_dec[k].iter().any(|&d| d < 2.0 * std::f64::consts::PI * UNSTABLE_BELOW))
+        .map(|k| format!("{:.0}", speeds[k]))
+        .collect();
+    if !unstable.is_empty() {
+        notes.push(format!(
+            "a mode with negative damping ratio (unstable: the vibration grows) at {} of the speeds: {} rpm",
+            unstable.len(),
+            unstable.join(", ")
+        ));
+    }
     Ok(CampbellReport {
         model: path.display().to_string(),
         critical_speeds_rpm: c.critical_speeds.iter().map(|k| k.rpm).collect(),
         campbell: c,
         plots: None,
+        notes,
     })
 }
 

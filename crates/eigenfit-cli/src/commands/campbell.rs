@@ -32,6 +32,7 @@ pub struct CampbellArgs {
 /// Runs `campbell`.
 pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
     let mut report = campbell_diagram(&args.model, &args.speeds, args.modes)?;
+    crate::commands::simulate::print_notes(&report.notes);
     let plots = match &args.plot {
         Some(dir) => {
             let figure = CampbellPlot { title: report.model.clone(), campbell: &report.campbell };
@@ -75,7 +76,7 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
         }
         for k in &report.campbell.overdamped_crossings {
             println!(
-                "not a critical speed: {:.1} rpm, where a mode with damping ratio {:.3} (≥ 1/√2: no resonance peak) crosses 1×",
+                "not a critical speed: {:.1} rpm, where a mode with damping ratio {:.3} (|ζ| ≥ 1/√2: no resonance peak) crosses 1×",
                 k.rpm, k.damping_ratio
             );
         }

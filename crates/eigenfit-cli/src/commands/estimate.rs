@@ -85,6 +85,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     print_notes(&notes);
     let mut est = match outcome? {
         EstimateOutcome::Runup(report) => {
+            print_notes(&report.notes);
             let code = if report.verdict.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
             crate::output::report(args.report.json, &*report, crate::rotordynamics::print_estimate);
             return Ok(code);

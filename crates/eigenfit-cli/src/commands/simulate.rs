@@ -67,6 +67,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
         let report = eigenfit_workflow::rotordynamics::simulate(path, args.speed, args.modes)?;
+        print_notes(&report.notes);
         crate::output::report(args.report.json, &report, |report| {
             crate::rotordynamics::print_speed(report);
         });
