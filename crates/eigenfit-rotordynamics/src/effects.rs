@@ -74,7 +74,7 @@ pub struct Effect {
     /// What and where.
     pub kind: EffectKind,
     /// Kind, location, value parameter and plausible range for core's discovery. Its ΔK and ΔM
-    /// are left empty: the two-plane model applies the effect itself ([`Effect::unit`]), since
+    /// are left empty: the two-plane model applies the effect itself ([`EffectKind::unit`]), since
     /// cross-coupling and polar inertia are not symmetric K, M contributions.
     pub candidate: Candidate,
 }
