@@ -96,96 +96,46 @@ pub fn identify_from_best_start(
     refits: usize,
     max_evaluations: usize,
 ) -> Result<Identification, RotorDynError> {
-    let mut best = identify_within(rotor, params, points, initial, max_iterations, max_evaluations)?;
+    let best = identify_within(rotor, params, points, initial, max_iterations, max_evaluations)?;
     if refits == 0 || passes(&best, points) || best.outcome.evaluations >= max_evaluations {
         return Ok(best);
     }
-    let (mut evaluations, mut iterations) = (best.outcome.evaluations, best.outcome.iterations);
-    let sigma: Vec<f64> = points.iter().map(|p| p.std_hz.unwrap_or(p.frequency_hz)).collect();
-    let mut screened: Vec<(f64, Vec<f64>)> = Vec::new();
-    for start in screened_starts(params, initial, SCREENED_PER_REFIT * refits, SCREEN_RANGE_LN) {
-        if evaluations >= max_evaluations {
-            break;
-        }
-        evaluations += 1;
-        // A start where a measured mode has no model partner is no start: skip it.
-        if let Ok(e) = evaluate(rotor, params, &start, points) {
-            let cost: f64 = (0..points.len())
-                .map(|i| ((e.frequencies_hz[i] - points[i].frequency_hz) / sigma[i]).powi(2))
-                .sum();
-            screened.push((cost, start));
-        }
-    }
-    screened.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut search = Search {
+        rotor,
+        params,
+        points,
+        sigma: points.iter().map(|p| p.std_hz.unwrap_or(p.frequency_hz)).collect(),
+        max_iterations,
+        max_evaluations,
+        evaluations: best.outcome.evaluations,
+        iterations: best.outcome.iterations,
+        refits: 0,
+        best,
+    };
+    let screened =
+        search.screen(screened_starts(params, initial, SCREENED_PER_REFIT * refits, SCREEN_RANGE_LN));
     // The best screened starts, each at least half the screened range (in ln s) from those
     // chosen before: the cheapest points cluster in one basin, often the wrong one.
     let mut chosen: Vec<Vec<f64>> = Vec::new();
-    for (_, start) in screened {
+    for start in screened {
         let apart = |c: &Vec<f64>| c.iter().zip(&start).map(|(a, b)| (a / b).ln().abs()).fold(0.0, f64::max);
         if chosen.len() < refits && chosen.iter().all(|c| apart(c) >= 0.5 * SCREEN_RANGE_LN) {
             chosen.push(start);
         }
     }
-    let mut done = 0;
-    for start in chosen {
-        if evaluations >= max_evaluations {
-            break;
-        }
-        done += 1;
-        let rest = max_evaluations - evaluations;
-        let Ok(id) = identify_within(rotor, params, points, &start, max_iterations, rest) else { continue };
-        evaluations += id.outcome.evaluations;
-        iterations += id.outcome.iterations;
-        let good = passes(&id, points);
-        if id.cost < best.cost {
-            best = id;
-        }
-        if good {
-            break;
-        }
-    }
+    search.refit(chosen);
     // Near the answer, heavily damped modes that trade partners as the bearings change can
     // hold the best fit in a neighbouring basin: the last refits start close around it.
-    if !passes(&best, points) {
-        let around = best.scales.clone();
-        let mut near: Vec<(f64, Vec<f64>)> = Vec::new();
-        for start in screened_starts(params, &around, SCREENED_PER_REFIT * 2, NEAR_RANGE_LN) {
-            if evaluations >= max_evaluations {
-                break;
-            }
-            evaluations += 1;
-            if let Ok(e) = evaluate(rotor, params, &start, points) {
-                let cost: f64 = (0..points.len())
-                    .map(|i| ((e.frequencies_hz[i] - points[i].frequency_hz) / sigma[i]).powi(2))
-                    .sum();
-                near.push((cost, start));
-            }
-        }
-        near.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (_, start) in near.into_iter().take(NEAR_REFITS) {
-            if evaluations >= max_evaluations {
-                break;
-            }
-            done += 1;
-            let rest = max_evaluations - evaluations;
-            let Ok(id) = identify_within(rotor, params, points, &start, max_iterations, rest) else {
-                continue;
-            };
-            evaluations += id.outcome.evaluations;
-            iterations += id.outcome.iterations;
-            let good = passes(&id, points);
-            if id.cost < best.cost {
-                best = id;
-            }
-            if good {
-                break;
-            }
-        }
+    if !passes(&search.best, points) {
+        let around = search.best.scales.clone();
+        let near = search.screen(screened_starts(params, &around, SCREENED_PER_REFIT * 2, NEAR_RANGE_LN));
+        search.refit(near.into_iter().take(NEAR_REFITS).collect());
     }
-    best.outcome.evaluations = evaluations;
-    best.outcome.iterations = iterations;
-    best.refits = done;
-    if evaluations >= max_evaluations && !passes(&best, points) {
+    let mut best = search.best;
+    best.outcome.evaluations = search.evaluations;
+    best.outcome.iterations = search.iterations;
+    best.refits = search.refits;
+    if search.evaluations >= max_evaluations && !passes(&best, points) {
         // The search was cut short: the fit reported is the best found, not a converged one.
         best.outcome.converged = false;
         best.outcome.termination = format!(
@@ -194,6 +144,69 @@ pub fn identify_from_best_start(
         );
     }
     Ok(best)
+}
+
+/// The state of a search from other starts: the problem, the limits, what was spent and the
+/// best fit so far.
+struct Search<'a> {
+    rotor: &'a crate::rotor::Rotor,
+    params: &'a [Parameter],
+    points: &'a [RunupPoint],
+    sigma: Vec<f64>,
+    max_iterations: usize,
+    max_evaluations: usize,
+    evaluations: usize,
+    iterations: usize,
+    refits: usize,
+    best: Identification,
+}
+
+impl Search<'_> {
+    /// The starts ordered by their cost (one evaluation each, within the budget); a start where
+    /// a measured mode has no model partner is no start and is left out.
+    fn screen(&mut self, starts: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+        let mut screened: Vec<(f64, Vec<f64>)> = Vec::new();
+        for start in starts {
+            if self.evaluations >= self.max_evaluations {
+                break;
+            }
+            self.evaluations += 1;
+            if let Ok(e) = evaluate(self.rotor, self.params, &start, self.points) {
+                let cost: f64 = (0..self.points.len())
+                    .map(|i| ((e.frequencies_hz[i] - self.points[i].frequency_hz) / self.sigma[i]).powi(2))
+                    .sum();
+                screened.push((cost, start));
+            }
+        }
+        screened.sort_by(|a, b| a.0.total_cmp(&b.0));
+        screened.into_iter().map(|(_, s)| s).collect()
+    }
+
+    /// Fits from each start in turn, within the budget, keeping the best; stops at the first
+    /// fit that passes.
+    fn refit(&mut self, starts: Vec<Vec<f64>>) {
+        for start in starts {
+            if self.evaluations >= self.max_evaluations {
+                break;
+            }
+            self.refits += 1;
+            let rest = self.max_evaluations - self.evaluations;
+            let Ok(id) =
+                identify_within(self.rotor, self.params, self.points, &start, self.max_iterations, rest)
+            else {
+                continue;
+            };
+            self.evaluations += id.outcome.evaluations;
+            self.iterations += id.outcome.iterations;
+            let good = passes(&id, self.points);
+            if id.cost < self.best.cost {
+                self.best = id;
+            }
+            if good {
+                break;
+            }
+        }
+    }
 }
 
 #[cfg(test)]
