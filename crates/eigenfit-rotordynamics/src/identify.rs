@@ -36,6 +36,19 @@ pub struct RunupPoint {
     pub whirl: Option<Whirl>,
 }
 
+impl RunupPoint {
+    /// The scale its residual is divided by: `std_hz`, or without it the measured frequency
+    /// (a relative residual).
+    pub fn sigma_hz(&self) -> f64 {
+        self.std_hz.unwrap_or(self.frequency_hz)
+    }
+}
+
+/// Σ ((f_model − f_measured)/σ)² of an evaluation: the cost every run-up fit minimises.
+pub fn misfit(e: &Evaluation, points: &[RunupPoint]) -> f64 {
+    points.iter().zip(&e.frequencies_hz).map(|(p, f)| ((f - p.frequency_hz) / p.sigma_hz()).powi(2)).sum()
+}
+
 /// Reads a run-up CSV with header `speed_rpm,mode,frequency_hz[,std_hz][,whirl]`.
 pub fn read_runup(path: &Path) -> Result<Vec<RunupPoint>, RotorDynError> {
     let text = std::fs::read_to_string(path)
@@ -193,6 +206,12 @@ impl Parameter {
         } else {
             &mut b.c[self.coefficient - 4]
         }
+    }
+
+    /// Whether it scales a direct stiffness (kxx or kyy): the coefficients that move the
+    /// frequencies most, fitted first and screened by the search from other starts.
+    pub fn is_direct_stiffness(&self) -> bool {
+        matches!(self.coefficient, 0 | 3)
     }
 
     /// The nominal value of this coefficient at speed Ω (rad/s).
@@ -492,7 +511,7 @@ pub fn identify_within(
     max_evaluations: usize,
 ) -> Result<Identification, RotorDynError> {
     let whole = Fit { rotor, params, points, max_iterations, max_evaluations };
-    let direct: Vec<usize> = (0..params.len()).filter(|&i| matches!(params[i].coefficient, 0 | 3)).collect();
+    let direct: Vec<usize> = (0..params.len()).filter(|&i| params[i].is_direct_stiffness()).collect();
     if direct.is_empty() || direct.len() == params.len() {
         return levenberg_marquardt(&whole, initial);
     }
@@ -585,7 +604,7 @@ fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, Rot
             )));
         }
     }
-    let sigma: Vec<f64> = points.iter().map(|p| p.std_hz.unwrap_or(p.frequency_hz)).collect();
+    let sigma: Vec<f64> = points.iter().map(RunupPoint::sigma_hz).collect();
     let weighted = |e: &Evaluation| -> (DVector<f64>, DMatrix<f64>) {
         let r = DVector::from_fn(m, |i, _| (e.frequencies_hz[i] - points[i].frequency_hz) / sigma[i]);
         let j = DMatrix::from_fn(m, np, |i, k| e.jacobian[(i, k)] / sigma[i]);

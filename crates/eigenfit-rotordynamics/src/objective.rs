@@ -106,7 +106,7 @@ impl Objective for RunupObjective<'_> {
         let (m, np) = (self.points.len(), p.len());
         let has_std = self.points.iter().all(|q| q.std_hz.is_some());
         // Weighted by std_hz, or relative (σ = the measured frequency) without.
-        let sigma: Vec<f64> = self.points.iter().map(|q| q.std_hz.unwrap_or(q.frequency_hz)).collect();
+        let sigma: Vec<f64> = self.points.iter().map(RunupPoint::sigma_hz).collect();
         // d f/d p: the factors' columns are d f/d ln s, so divide by s; effects' are d f/d v.
         let df = DMatrix::from_fn(
             m,

@@ -11,7 +11,7 @@
 //! from starts within 10 % of that fit reached it (χ² 48.4 on 32 dof).
 
 use crate::error::RotorDynError;
-use crate::identify::{evaluate, identify_within, Identification, Parameter, RunupPoint};
+use crate::identify::{evaluate, identify_within, misfit, Identification, Parameter, RunupPoint};
 use eigenfit_core::analysis::chi2_upper_tail;
 use eigenfit_core::analysis::verdict::{POOR_FIT_CHI2_NO_DOF, POOR_FIT_P_VALUE};
 
@@ -66,7 +66,7 @@ const PRIMES: [usize; 16] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43,
 /// (kxx, kyy), the rest at `initial`. Beyond 16 direct stiffnesses the remaining ones stay at
 /// `initial` (a Halton sequence in higher bases covers a cube too thinly to help).
 fn screened_starts(params: &[Parameter], initial: &[f64], count: usize, range_ln: f64) -> Vec<Vec<f64>> {
-    let direct: Vec<usize> = (0..params.len()).filter(|&i| matches!(params[i].coefficient, 0 | 3)).collect();
+    let direct: Vec<usize> = (0..params.len()).filter(|&i| params[i].is_direct_stiffness()).collect();
     let spread: Vec<usize> = if direct.is_empty() { (0..params.len()).collect() } else { direct };
     (1..=count)
         .map(|i| {
@@ -104,7 +104,6 @@ pub fn identify_from_best_start(
         rotor,
         params,
         points,
-        sigma: points.iter().map(|p| p.std_hz.unwrap_or(p.frequency_hz)).collect(),
         max_iterations,
         max_evaluations,
         evaluations: best.outcome.evaluations,
@@ -152,7 +151,6 @@ struct Search<'a> {
     rotor: &'a crate::rotor::Rotor,
     params: &'a [Parameter],
     points: &'a [RunupPoint],
-    sigma: Vec<f64>,
     max_iterations: usize,
     max_evaluations: usize,
     evaluations: usize,
@@ -172,10 +170,7 @@ impl Search<'_> {
             }
             self.evaluations += 1;
             if let Ok(e) = evaluate(self.rotor, self.params, &start, self.points) {
-                let cost: f64 = (0..self.points.len())
-                    .map(|i| ((e.frequencies_hz[i] - self.points[i].frequency_hz) / self.sigma[i]).powi(2))
-                    .sum();
-                screened.push((cost, start));
+                screened.push((misfit(&e, self.points), start));
             }
         }
         screened.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -197,7 +197,7 @@ fn fit_quality(id: &Identification, points: &[RunupPoint], values: &[f64]) -> Fi
     let m = points.len();
     let omega = |f: f64| 2.0 * std::f64::consts::PI * f;
     // Residual measured − model in σ, or relative without std (the planar `relative` residual).
-    let sigma = |i: usize| points[i].std_hz.unwrap_or(points[i].frequency_hz);
+    let sigma = |i: usize| points[i].sigma_hz();
     // d f/d p = (d f/d ln s)/p in Hz per N/m (N·s/m); dλ/dp = 2ω·2π d f/d p.
     let df_dp = DMatrix::from_fn(m, values.len(), |i, j| id.jacobian[(i, j)] / values[j]);
     let lin = Linearisation {
