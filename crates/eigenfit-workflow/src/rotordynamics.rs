@@ -236,10 +236,12 @@ pub fn estimate(
     let (estimate, restarts) = match fit_runup(&objective, &params, &initial, max_iterations, refits, &budget)
     {
         Ok(f) => f,
-        Err(_) if budget.exhausted() => return Err(WorkflowError::BudgetExhausted(format!(
+        Err(_) if budget.exhausted() => {
+            return Err(WorkflowError::BudgetExhausted(format!(
             "the budget of {} model evaluations ran out before the fit could start (raise it with --budget)",
             budget.limit()
-        ))),
+        )))
+        }
         Err(e) => return Err(input(format!("{}: {e}", measured.display()))),
     };
     phases.push(("fit", budget.used()));
