@@ -24,12 +24,14 @@
 //! [`MatricesModel`] implements [`StructuralModel`](eigenfit_core::model::StructuralModel); its systems
 //! are stored sparse, for [`SparseSolver`](eigenfit_core::eigen::SparseSolver).
 
+mod condensation;
 mod error;
 mod layout;
 pub mod market;
 mod model;
 mod symmetry;
 
+pub use condensation::MAX_CONDENSED_DOFS;
 pub use error::MatricesError;
 pub use layout::{Dof, DofLayout, DofLayoutError};
 pub use model::MatricesModel;
