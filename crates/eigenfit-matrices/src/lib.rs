@@ -26,6 +26,8 @@
 
 mod condensation;
 mod error;
+pub mod labeled;
+mod labeled_model;
 mod layout;
 pub mod market;
 mod model;

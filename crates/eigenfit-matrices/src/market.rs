@@ -34,18 +34,24 @@ const MIN_ENTRY_BYTES: usize = 6;
 /// file must be a regular file of at most [`MAX_MATRIX_FILE_BYTES`] (a FIFO or a device is
 /// refused before it is opened for reading).
 pub fn read_symmetric(path: &Path, expected: Option<usize>) -> Result<CscSymmetric, MatricesError> {
-    let bytes = eigenfit_core::measurement::measured_csv::read_checked_file(
-        path,
-        MAX_MATRIX_FILE_BYTES,
-        "a Matrix Market file",
-    )
-    .map_err(|detail| MatricesError::Unreadable { detail })?;
-    let matrix = |detail: String| MatricesError::Matrix { path: path.to_path_buf(), detail };
-    let text = std::str::from_utf8(&bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
-        matrix(format!("line {line}: not text (a byte that is not UTF-8): a Matrix Market file is text"))
-    })?;
-    parse_symmetric(text, expected).map_err(|e| matrix(e.detail))
+    let text = read_matrix_text(path)?;
+    parse_symmetric(&text, expected)
+        .map_err(|e| MatricesError::Matrix { path: path.to_path_buf(), detail: e.detail })
+}
+
+/// The text of a matrix file (any format) after the regular-file and size checks.
+pub(crate) fn read_matrix_text(path: &Path) -> Result<String, MatricesError> {
+    let bytes =
+        eigenfit_core::measurement::measured_csv::read_checked_file(path, MAX_MATRIX_FILE_BYTES, "a matrix file")
+            .map_err(|detail| MatricesError::Unreadable { detail })?;
+    String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let line = bytes[..e.utf8_error().valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+        MatricesError::Matrix {
+            path: path.to_path_buf(),
+            detail: format!("line {line}: not text (a byte that is not UTF-8): a matrix file is text"),
+        }
+    })
 }
 
 /// Text that is not a symmetric real Matrix Market matrix. `detail` says what is wrong and
@@ -91,6 +97,17 @@ fn parse(text: &str, expected: Option<usize>) -> Result<CscSymmetric, String> {
         None => return Err(format!("header `{}`: the symmetry field is missing", header.trim())),
     };
     let (n, entries) = read_entries(text, expected, symmetric)?;
+    symmetric_from_entries(n, entries, &|r, c| line_of(text, r, c))
+}
+
+/// The symmetric matrix of `entries` (0-based, as stored): one triangle is mirrored, two must
+/// agree (to 1e-10 of the largest entry), else the first disagreeing pair is named, with its
+/// lines from `line_of`.
+pub(crate) fn symmetric_from_entries(
+    n: usize,
+    entries: Vec<(usize, usize, f64)>,
+    line_of: &dyn Fn(usize, usize) -> Option<usize>,
+) -> Result<CscSymmetric, String> {
     let mut largest = 0.0_f64;
     let (mut lower, mut upper) = (false, false);
     for &(r, c, v) in &entries {
@@ -128,7 +145,7 @@ fn parse(text: &str, expected: Option<usize>) -> Result<CscSymmetric, String> {
     }
     if let Some((r, c, v, w)) = disagreeing {
         let at = |r: usize, c: usize| {
-            line_of(text, r, c).map_or_else(|| " (not in the file)".to_string(), |l| format!(" (line {l})"))
+            line_of(r, c).map_or_else(|| " (not in the file)".to_string(), |l| format!(" (line {l})"))
         };
         return Err(format!(
             "not symmetric: entry ({}, {}) = {v}{} but ({}, {}) = {w}{} (a `general` file must hold one triangle, or two that agree)",

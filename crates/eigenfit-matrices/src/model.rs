@@ -19,10 +19,16 @@ struct ModelFile {
     kind: String,
     #[serde(default)]
     name: Option<String>,
+    /// `mtx` (Matrix Market, the default), `dmig` (Nastran) or `abaqus` (`*MATRIX OUTPUT`).
+    #[serde(default)]
+    format: Option<String>,
     stiffness: Files,
     mass: Files,
     #[serde(default)]
     dofs: Option<PathBuf>,
+    /// Node coordinates (`node,x,y,z`) for the labelled formats' DOF map.
+    #[serde(default)]
+    nodes: Option<PathBuf>,
     #[serde(default)]
     parameter: Vec<TermTable>,
     #[serde(default)]
@@ -133,15 +139,51 @@ impl MatricesModel {
         }
         let dir = path.parent().unwrap_or(Path::new("."));
         let at = |p: &Path| dir.join(p);
+        let labeled = match file.format.as_deref() {
+            None | Some("mtx") | Some("matrix-market") => None,
+            Some(f @ ("dmig" | "abaqus")) => {
+                if file.dofs.is_some() {
+                    return Err(MatricesError::invalid(
+                        path,
+                        format!("format = \"{f}\" takes its DOF map from the files' node and DOF labels: leave out `dofs` (give coordinates with `nodes = \"nodes.csv\"`)"),
+                    ));
+                }
+                let mut every: Vec<&PathBuf> = file.stiffness.paths().iter().chain(file.mass.paths()).collect();
+                for t in file.parameter.iter().chain(&file.candidate) {
+                    for files in [&t.stiffness, &t.mass].into_iter().flatten() {
+                        every.extend(files.paths());
+                    }
+                }
+                Some(crate::labeled_model::read_all(path, dir, f, &every, file.nodes.as_deref())?)
+            }
+            Some(other) => {
+                return Err(MatricesError::invalid(
+                    path,
+                    format!("format = \"{other}\": expected \"mtx\" (Matrix Market, the default), \"dmig\" or \"abaqus\""),
+                ))
+            }
+        };
+        if labeled.is_none() && file.nodes.is_some() {
+            return Err(MatricesError::invalid(
+                path,
+                "`nodes` places the labelled formats' nodes (format = \"dmig\" or \"abaqus\"); a Matrix Market model's DOF map is `dofs`",
+            ));
+        }
+        let read_one = |p: &Path, expected: Option<usize>| -> Result<CscSymmetric, MatricesError> {
+            match &labeled {
+                Some(l) => Ok(l.matrix(p).clone()),
+                None => read_symmetric(&at(p), expected),
+            }
+        };
         let read_sum = |files: &Files, expected: Option<usize>, what: &str| -> Result<CscSymmetric, MatricesError> {
             let paths = files.paths();
             if paths.is_empty() {
                 return Err(MatricesError::invalid(path, format!("{what}: the list of files is empty")));
             }
-            let mut sum = read_symmetric(&at(&paths[0]), expected)?;
+            let mut sum = read_one(&paths[0], expected)?;
             let n = sum.dim();
             for p in &paths[1..] {
-                let next = read_symmetric(&at(p), Some(n))?;
+                let next = read_one(p, Some(n))?;
                 sum = CscSymmetric::combination(1.0, &sum, 1.0, &next);
             }
             Ok(sum)
@@ -215,13 +257,14 @@ impl MatricesModel {
             };
             candidate_matrices.push((table, t.name.clone(), p, plausible, stiffness, mass));
         }
-        let dofs = match &file.dofs {
-            Some(p) => {
+        let dofs = match (&file.dofs, &labeled) {
+            (Some(p), _) => {
                 let map = read_dof_map(&at(p), n)?;
                 DofLayout::new(&map).map_err(|e| MatricesError::invalid(&at(p), e.to_string()))?;
                 Some(map)
             }
-            None => None,
+            (None, Some(l)) => Some(l.dof_map()),
+            (None, None) => None,
         };
         let name = file.name.unwrap_or_else(|| path.display().to_string());
         check_every_dof_used(path, n, &k0, &m0, &derivative_matrices, dofs.as_deref())?;
@@ -229,7 +272,11 @@ impl MatricesModel {
         model.dofs = dofs;
         model.condense_massless().map_err(|e| MatricesError::invalid(path, e))?;
         // A map that fails here was refused above already.
-        model.layout = model.dofs.as_deref().and_then(|d| DofLayout::new(d).ok()).map(|layout| {
+        let layout = match &labeled {
+            Some(l) => l.layout(),
+            None => model.dofs.as_deref().and_then(|d| DofLayout::new(d).ok()),
+        };
+        model.layout = layout.map(|layout| {
             match &model.condensation {
                 Some(c) => layout.renumbered(|j| c.partition.kept_index(j)),
                 None => layout,
