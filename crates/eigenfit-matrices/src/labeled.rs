@@ -53,7 +53,12 @@ fn line_fields(line: &str) -> (String, Vec<String>) {
     }
     let chars: Vec<char> = line.chars().collect();
     let field = |a: usize, b: usize| -> String {
-        chars.get(a.min(chars.len())..b.min(chars.len())).map(|s| s.iter().collect::<String>()).unwrap_or_default().trim().to_string()
+        chars
+            .get(a.min(chars.len())..b.min(chars.len()))
+            .map(|s| s.iter().collect::<String>())
+            .unwrap_or_default()
+            .trim()
+            .to_string()
     };
     let name = field(0, 8);
     if name.ends_with('*') {
@@ -83,11 +88,9 @@ fn cards(text: &str) -> Vec<Card> {
         let continuation = name.is_empty() || name.starts_with('+') || name.starts_with('*');
         match (continuation, out.last_mut()) {
             (true, Some(card)) => card.fields.extend(fields),
-            _ => out.push(Card {
-                name: name.trim_end_matches('*').to_ascii_uppercase(),
-                fields,
-                line: i + 1,
-            }),
+            _ => {
+                out.push(Card { name: name.trim_end_matches('*').to_ascii_uppercase(), fields, line: i + 1 })
+            }
         }
     }
     out
@@ -133,7 +136,10 @@ pub fn parse_dmig(text: &str, name: Option<&str>) -> Result<LabeledMatrix, Strin
         let comp = c.fields.get(k + 1).map(String::as_str).unwrap_or("");
         let comp = if comp.is_empty() { 0 } else { int(c, k + 1, "component")? };
         if g <= 0 || !(0..=6).contains(&comp) {
-            return Err(format!("line {}: DMIG entry at grid {g} component {comp}: grids are positive, components 0–6", c.line));
+            return Err(format!(
+                "line {}: DMIG entry at grid {g} component {comp}: grids are positive, components 0–6",
+                c.line
+            ));
         }
         Ok((g as u64, comp as u8))
     };
@@ -146,7 +152,8 @@ pub fn parse_dmig(text: &str, name: Option<&str>) -> Result<LabeledMatrix, Strin
                     // Coordinates in another system: not placed (measured shapes need them in one).
                     continue;
                 }
-                let x: Vec<f64> = (2..5).map(|k| c.fields.get(k).and_then(|f| nastran_real(f)).unwrap_or(0.0)).collect();
+                let x: Vec<f64> =
+                    (2..5).map(|k| c.fields.get(k).and_then(|f| nastran_real(f)).unwrap_or(0.0)).collect();
                 if id > 0 {
                     out.coordinates.insert(id as u64, [x[0], x[1], x[2]]);
                 }
@@ -161,7 +168,10 @@ pub fn parse_dmig(text: &str, name: Option<&str>) -> Result<LabeledMatrix, Strin
                         ));
                     }
                     if !matches!(tin, 1 | 2) {
-                        return Err(format!("line {}: DMIG {wanted} has TIN = {tin}: only real matrices (1, 2) are read", c.line));
+                        return Err(format!(
+                            "line {}: DMIG {wanted} has TIN = {tin}: only real matrices (1, 2) are read",
+                            c.line
+                        ));
                     }
                     header = true;
                     continue;
@@ -211,8 +221,10 @@ pub fn parse_abaqus(text: &str) -> Result<LabeledMatrix, String> {
             ));
         }
         let label = |n: &str, d: &str| -> Result<Label, String> {
-            let node: i64 = n.parse().map_err(|_| format!("line {}: node `{n}` is not a whole number", i + 1))?;
-            let dof: u8 = d.parse().map_err(|_| format!("line {}: dof `{d}` is not a whole number", i + 1))?;
+            let node: i64 =
+                n.parse().map_err(|_| format!("line {}: node `{n}` is not a whole number", i + 1))?;
+            let dof: u8 =
+                d.parse().map_err(|_| format!("line {}: dof `{d}` is not a whole number", i + 1))?;
             if node <= 0 {
                 return Err(format!(
                     "line {}: node {node}: internal nodes (negative or zero labels) cannot be tied to measured points",
@@ -241,7 +253,14 @@ mod tests {
 
     #[test]
     fn nastran_numbers() {
-        for (s, v) in [("2.", 2.0), ("-1.5", -1.5), ("1.0D+00", 1.0), ("1.5+3", 1500.0), ("-.5-2", -0.005), ("3e2", 300.0)] {
+        for (s, v) in [
+            ("2.", 2.0),
+            ("-1.5", -1.5),
+            ("1.0D+00", 1.0),
+            ("1.5+3", 1500.0),
+            ("-.5-2", -0.005),
+            ("3e2", 300.0),
+        ] {
             assert_eq!(nastran_real(s), Some(v), "{s}");
         }
         assert_eq!(nastran_real("x"), None);
@@ -251,7 +270,10 @@ mod tests {
     fn free_field_and_continuations() {
         let text = "DMIG,K,0,6,1,,,,2\nDMIG,K,10,1,,10,1,2.,,\n+,10,3,-1.,,\nDMIG,K,10,3,,10,3,4.\n";
         let m = parse_dmig(text, None).unwrap();
-        assert_eq!(m.entries, vec![((10, 1), (10, 1), 2.0), ((10, 3), (10, 1), -1.0), ((10, 3), (10, 3), 4.0)]);
+        assert_eq!(
+            m.entries,
+            vec![((10, 1), (10, 1), 2.0), ((10, 3), (10, 1), -1.0), ((10, 3), (10, 3), 4.0)]
+        );
         assert_eq!(m.lines, vec![2, 2, 4]);
     }
 

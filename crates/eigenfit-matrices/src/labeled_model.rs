@@ -68,9 +68,8 @@ pub(crate) fn read_all(
         coordinates.extend(m.coordinates.iter().map(|(&k, &v)| (k, v)));
         let entries: Vec<(usize, usize, f64)> =
             m.entries.iter().map(|&(r, c, v)| (index[&r], index[&c], v)).collect();
-        let line_of = |r: usize, c: usize| {
-            entries.iter().position(|&(a, b, _)| (a, b) == (r, c)).map(|k| m.lines[k])
-        };
+        let line_of =
+            |r: usize, c: usize| entries.iter().position(|&(a, b, _)| (a, b) == (r, c)).map(|k| m.lines[k]);
         // A message names the model's DOFs (from 1, in label order) and the file's lines.
         let matrix = symmetric_from_entries(n, entries.clone(), &line_of)
             .map_err(|detail| MatricesError::Matrix { path: file.clone(), detail })?;
@@ -98,7 +97,10 @@ fn read_nodes(path: &Path) -> Result<HashMap<u64, [f64; 3]>, MatricesError> {
     for (line, row) in reader.deserialize::<Row>().enumerate() {
         let row = row.map_err(|e| MatricesError::invalid(path, format!("line {}: {e}", line + 2)))?;
         if ![row.x, row.y, row.z].iter().all(|c| c.is_finite()) {
-            return Err(MatricesError::invalid(path, format!("line {}: node {}: a coordinate is not finite", line + 2, row.node)));
+            return Err(MatricesError::invalid(
+                path,
+                format!("line {}: node {}: a coordinate is not finite", line + 2, row.node),
+            ));
         }
         out.insert(row.node, [row.x, row.y, row.z]);
     }

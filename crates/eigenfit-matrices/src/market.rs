@@ -41,9 +41,12 @@ pub fn read_symmetric(path: &Path, expected: Option<usize>) -> Result<CscSymmetr
 
 /// The text of a matrix file (any format) after the regular-file and size checks.
 pub(crate) fn read_matrix_text(path: &Path) -> Result<String, MatricesError> {
-    let bytes =
-        eigenfit_core::measurement::measured_csv::read_checked_file(path, MAX_MATRIX_FILE_BYTES, "a matrix file")
-            .map_err(|detail| MatricesError::Unreadable { detail })?;
+    let bytes = eigenfit_core::measurement::measured_csv::read_checked_file(
+        path,
+        MAX_MATRIX_FILE_BYTES,
+        "a matrix file",
+    )
+    .map_err(|detail| MatricesError::Unreadable { detail })?;
     String::from_utf8(bytes).map_err(|e| {
         let bytes = e.as_bytes();
         let line = bytes[..e.utf8_error().valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
@@ -237,7 +240,8 @@ fn read_entries(
         if r == 0 || r > rows || c == 0 || c > cols {
             return Err(format!("line {line}: entry ({r}, {c}) lies outside the {rows}×{cols} matrix"));
         }
-        let v: f64 = v.parse().map_err(|_| format!("line {line}: entry ({r}, {c}): `{v}` is not a number"))?;
+        let v: f64 =
+            v.parse().map_err(|_| format!("line {line}: entry ({r}, {c}): `{v}` is not a number"))?;
         if !v.is_finite() {
             return Err(format!("line {line}: entry ({r}, {c}) is {v}: every entry must be finite"));
         }
@@ -390,7 +394,8 @@ mod tests {
     #[test]
     fn a_declared_size_is_checked_before_anything_is_allocated() {
         // 1e8 × 1e8 with 3 entries: refused from the size line, allocating nothing of that size.
-        let text = "%%MatrixMarket matrix coordinate real general\n100000000 100000000 3\n1 1 1\n2 2 1\n3 3 1\n";
+        let text =
+            "%%MatrixMarket matrix coordinate real general\n100000000 100000000 3\n1 1 1\n2 2 1\n3 3 1\n";
         let e = parse(text, None).unwrap_err();
         assert!(e.contains("line 2: the matrix is 100000000×100000000, more than the 20000000 DOFs"), "{e}");
         // An entry count the file cannot hold.
@@ -399,7 +404,9 @@ mod tests {
         assert!(e.contains("declares 4000000000000 entries but the 6 bytes after it hold at most 1"), "{e}");
         // A second matrix of another size is refused from its size line.
         let text = "%%MatrixMarket matrix coordinate real general\n5 5 1\n1 1 1\n";
-        assert!(parse(text, Some(3)).unwrap_err().contains("line 2: the matrix is 5×5 but the model has 3 DOFs"));
+        assert!(parse(text, Some(3))
+            .unwrap_err()
+            .contains("line 2: the matrix is 5×5 but the model has 3 DOFs"));
         // More entries than declared.
         let text = "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 1 1\n2 2 1\n";
         assert!(parse(text, None).unwrap_err().contains("line 4: more entries than the 1"));

@@ -175,19 +175,20 @@ impl MatricesModel {
                 None => read_symmetric(&at(p), expected),
             }
         };
-        let read_sum = |files: &Files, expected: Option<usize>, what: &str| -> Result<CscSymmetric, MatricesError> {
-            let paths = files.paths();
-            if paths.is_empty() {
-                return Err(MatricesError::invalid(path, format!("{what}: the list of files is empty")));
-            }
-            let mut sum = read_one(&paths[0], expected)?;
-            let n = sum.dim();
-            for p in &paths[1..] {
-                let next = read_one(p, Some(n))?;
-                sum = CscSymmetric::combination(1.0, &sum, 1.0, &next);
-            }
-            Ok(sum)
-        };
+        let read_sum =
+            |files: &Files, expected: Option<usize>, what: &str| -> Result<CscSymmetric, MatricesError> {
+                let paths = files.paths();
+                if paths.is_empty() {
+                    return Err(MatricesError::invalid(path, format!("{what}: the list of files is empty")));
+                }
+                let mut sum = read_one(&paths[0], expected)?;
+                let n = sum.dim();
+                for p in &paths[1..] {
+                    let next = read_one(p, Some(n))?;
+                    sum = CscSymmetric::combination(1.0, &sum, 1.0, &next);
+                }
+                Ok(sum)
+            };
         let k0 = read_sum(&file.stiffness, None, "`stiffness`")?;
         let n = k0.dim();
         let m0 = read_sum(&file.mass, Some(n), "`mass`")?;
@@ -276,11 +277,9 @@ impl MatricesModel {
             Some(l) => l.layout(),
             None => model.dofs.as_deref().and_then(|d| DofLayout::new(d).ok()),
         };
-        model.layout = layout.map(|layout| {
-            match &model.condensation {
-                Some(c) => layout.renumbered(|j| c.partition.kept_index(j)),
-                None => layout,
-            }
+        model.layout = layout.map(|layout| match &model.condensation {
+            Some(c) => layout.renumbered(|j| c.partition.kept_index(j)),
+            None => layout,
         });
         for (table, name, p, plausible, stiffness, mass) in candidate_matrices {
             let candidate = model
@@ -300,10 +299,8 @@ impl MatricesModel {
         let mut masses = vec![&self.mass.matrix];
         masses.extend(self.derivatives.iter().filter_map(|(_, m)| m.as_ref().map(|t| &t.matrix)));
         let nominal = self.params.nominal_values();
-        let m = self.combine(
-            &self.mass,
-            nominal.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.1.as_ref())),
-        );
+        let m =
+            self.combine(&self.mass, nominal.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.1.as_ref())));
         if let Some(j) = (0..n).find(|&j| {
             let (rows, values) = m.column(j);
             let diagonal = rows.iter().zip(values).find(|(&r, _)| r == j).map_or(0.0, |(_, &v)| v);
@@ -344,7 +341,8 @@ impl MatricesModel {
     /// X(p) = K_ss(p)⁻¹K_sm(p) and K_c(p), remembered for the derivatives at `p`.
     fn condense_at(&self, p: &[f64]) -> Result<(CscSymmetric, Arc<DMatrix<f64>>), ModelError> {
         let c = self.condensation.as_ref().expect("a condensed model");
-        let k = self.combine(&self.stiffness, p.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.0.as_ref())));
+        let k =
+            self.combine(&self.stiffness, p.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.0.as_ref())));
         let (kc, x) = c.partition.condense(&k).map_err(|at| {
             ModelError::Invalid(format!(
                 "massless {} is held by no stiffness once the massless DOFs before it are (K_ss, the stiffness \
@@ -414,9 +412,7 @@ impl MatricesModel {
                 };
                 let stiffness = match stiffness {
                     Some(k) => {
-                        let x = self
-                            .condensed_x(&self.params.nominal_values())
-                            .map_err(|e| e.to_string())?;
+                        let x = self.condensed_x(&self.params.nominal_values()).map_err(|e| e.to_string())?;
                         c.partition.project(&k, &x)
                     }
                     None => SparseSymmetric::zeros(n),
@@ -764,9 +760,10 @@ impl StructuralModel for MatricesModel {
                 Some(t) => c.partition.project(&t.matrix, &*self.condensed_x(p)?),
                 None => SparseSymmetric::zeros(n),
             };
-            let mass = dm
-                .as_ref()
-                .map_or_else(|| SparseSymmetric::zeros(n), |t| c.partition.restrict(&t.matrix).to_sparse_symmetric());
+            let mass = dm.as_ref().map_or_else(
+                || SparseSymmetric::zeros(n),
+                |t| c.partition.restrict(&t.matrix).to_sparse_symmetric(),
+            );
             return Ok(SystemDerivative { stiffness, mass });
         }
         let convert = |t: &Option<Term>| {

@@ -49,7 +49,11 @@ fn dmig_and_abaqus_files_read_to_the_matrix_market_models_frequencies() {
         assert_eq!(layout.node_coordinates(), ours.node_coordinates(), "{file}");
         for node in 0..layout.node_coordinates().len() {
             for direction in 1..=6 {
-                assert_eq!(layout.dof(node, direction), ours.dof(node, direction), "{file} {node} {direction}");
+                assert_eq!(
+                    layout.dof(node, direction),
+                    ours.dof(node, direction),
+                    "{file} {node} {direction}"
+                );
             }
         }
     }
@@ -73,14 +77,20 @@ fn bad_labelled_files_are_refused_naming_file_and_line() {
     let e = load(&dir, "kind = \"matrices\"\nformat = \"dmig\"\nstiffness = \"k.pch\"\nmass = \"k.pch\"\n")
         .unwrap_err();
     assert!(e.contains("k.pch: line 1: DMIG K has TIN = 3: only real matrices"), "{e}");
-    std::fs::write(dir.join("two.pch"), "DMIG,K,0,6,1,,,,1\nDMIG,K,1,1,,1,1,2.\nDMIG,M,0,6,1,,,,1\nDMIG,M,1,1,,1,1,3.\n")
-        .unwrap();
-    let e = load(&dir, "kind = \"matrices\"\nformat = \"dmig\"\nstiffness = \"two.pch\"\nmass = \"two.pch#M\"\n")
-        .unwrap_err();
+    std::fs::write(
+        dir.join("two.pch"),
+        "DMIG,K,0,6,1,,,,1\nDMIG,K,1,1,,1,1,2.\nDMIG,M,0,6,1,,,,1\nDMIG,M,1,1,,1,1,3.\n",
+    )
+    .unwrap();
+    let e =
+        load(&dir, "kind = \"matrices\"\nformat = \"dmig\"\nstiffness = \"two.pch\"\nmass = \"two.pch#M\"\n")
+            .unwrap_err();
     assert!(e.contains("two.pch: the file holds the DMIG matrices K, M: name one"), "{e}");
-    let model =
-        load(&dir, "kind = \"matrices\"\nformat = \"dmig\"\nstiffness = \"two.pch#K\"\nmass = \"two.pch#M\"\n")
-            .unwrap();
+    let model = load(
+        &dir,
+        "kind = \"matrices\"\nformat = \"dmig\"\nstiffness = \"two.pch#K\"\nmass = \"two.pch#M\"\n",
+    )
+    .unwrap();
     assert_eq!(model.assemble(&[]).unwrap().stiffness()[(0, 0)], 2.0);
     std::fs::write(dir.join("k.txt"), "1,1, 1,1, 2.0\n2,1, 1,1, oops\n").unwrap();
     let e = load(&dir, "kind = \"matrices\"\nformat = \"abaqus\"\nstiffness = \"k.txt\"\nmass = \"k.txt\"\n")
@@ -94,9 +104,14 @@ fn bad_labelled_files_are_refused_naming_file_and_line() {
 #[test]
 fn files_named_inside_a_model_pass_the_regular_file_and_size_checks() {
     let dir = scratch("files");
-    std::fs::write(dir.join("M.mtx"), "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1\n2 2 1\n").unwrap();
+    std::fs::write(
+        dir.join("M.mtx"),
+        "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1\n2 2 1\n",
+    )
+    .unwrap();
     for device in ["/dev/zero", "/dev/urandom"] {
-        let e = load(&dir, &format!("kind = \"matrices\"\nstiffness = \"{device}\"\nmass = \"M.mtx\"\n")).unwrap_err();
+        let e = load(&dir, &format!("kind = \"matrices\"\nstiffness = \"{device}\"\nmass = \"M.mtx\"\n"))
+            .unwrap_err();
         assert!(e.contains(&format!("{device}: not a regular file")), "{e}");
     }
     // A FIFO would block a reader forever: refused before it is opened.
@@ -105,8 +120,9 @@ fn files_named_inside_a_model_pass_the_regular_file_and_size_checks() {
     if made {
         let e = load(&dir, "kind = \"matrices\"\nstiffness = \"K.fifo\"\nmass = \"M.mtx\"\n").unwrap_err();
         assert!(e.contains("K.fifo: not a regular file"), "{e}");
-        let e = load(&dir, "kind = \"matrices\"\nstiffness = \"M.mtx\"\nmass = \"M.mtx\"\ndofs = \"K.fifo\"\n")
-            .unwrap_err();
+        let e =
+            load(&dir, "kind = \"matrices\"\nstiffness = \"M.mtx\"\nmass = \"M.mtx\"\ndofs = \"K.fifo\"\n")
+                .unwrap_err();
         assert!(e.contains("K.fifo: not a regular file"), "{e}");
     }
     // A size line declaring 10⁸ DOFs with three entries: refused from the size line.
@@ -123,8 +139,11 @@ fn files_named_inside_a_model_pass_the_regular_file_and_size_checks() {
         "%%MatrixMarket matrix coordinate real general\n1000000 1000000 3\n1 1 1\n2 2 1\n3 3 1\n",
     )
     .unwrap();
-    std::fs::write(dir.join("Mbig.mtx"), "%%MatrixMarket matrix coordinate real general\n1000000 1000000 1\n1 1 1\n")
-        .unwrap();
+    std::fs::write(
+        dir.join("Mbig.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n1000000 1000000 1\n1 1 1\n",
+    )
+    .unwrap();
     let e = load(&dir, "kind = \"matrices\"\nstiffness = \"big.mtx\"\nmass = \"Mbig.mtx\"\n").unwrap_err();
     assert!(e.contains("DOF 4 has no entry in any stiffness or mass matrix (999997 of the 1000000"), "{e}");
 }

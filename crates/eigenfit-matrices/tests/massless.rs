@@ -86,7 +86,8 @@ fn sensitivities_are_exact_on_the_expanded_shapes() {
             let (mut up, mut down) = (p, p);
             up[i] += h;
             down[i] -= h;
-            let l = |q: &[f64; 4]| DenseSolver.lowest(&model.assemble(q).unwrap(), 5).unwrap().eigenvalues[mode];
+            let l =
+                |q: &[f64; 4]| DenseSolver.lowest(&model.assemble(q).unwrap(), 5).unwrap().eigenvalues[mode];
             let fd = (l(&up) - l(&down)) / (2.0 * h);
             assert!((ours - fd).abs() < 1e-6 * lambda, "mode {} p{i}: {ours} vs difference {fd}", mode + 1);
         }
@@ -106,8 +107,14 @@ fn the_sensitivities_agree_with_scipys_differences_of_the_full_problem() {
         for (mode, e) in expected.iter().enumerate() {
             let lambda = modes.eigenvalues[mode];
             // df/dp = dλ/dp / (8π² f).
-            let ours = eigenvalue_derivative(&modes, mode, &d) / (8.0 * std::f64::consts::PI.powi(2) * hz(lambda));
-            assert!((ours - e).abs() < 1e-5 * e.abs().max(1e-3), "{} mode {}: {ours} vs scipy {e}", par.name, mode + 1);
+            let ours =
+                eigenvalue_derivative(&modes, mode, &d) / (8.0 * std::f64::consts::PI.powi(2) * hz(lambda));
+            assert!(
+                (ours - e).abs() < 1e-5 * e.abs().max(1e-3),
+                "{} mode {}: {ours} vs scipy {e}",
+                par.name,
+                mode + 1
+            );
         }
     }
 }
@@ -117,8 +124,11 @@ fn write_model(tag: &str, k: &str, m: &str) -> Result<MatricesModel, String> {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("K.mtx"), k).unwrap();
     std::fs::write(dir.join("M.mtx"), m).unwrap();
-    std::fs::write(dir.join("dofs.csv"), "dof,node,direction,x,y,z\n1,10,x,0,0,0\n2,10,rz,0,0,0\n3,11,rz,1,0,0\n")
-        .unwrap();
+    std::fs::write(
+        dir.join("dofs.csv"),
+        "dof,node,direction,x,y,z\n1,10,x,0,0,0\n2,10,rz,0,0,0\n3,11,rz,1,0,0\n",
+    )
+    .unwrap();
     let toml = "kind = \"matrices\"\nstiffness = \"K.mtx\"\nmass = \"M.mtx\"\ndofs = \"dofs.csv\"\n";
     std::fs::write(dir.join("model.toml"), toml).unwrap();
     MatricesModel::from_toml_file(&dir.join("model.toml")).map_err(|e| e.to_string())

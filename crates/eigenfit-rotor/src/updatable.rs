@@ -27,13 +27,13 @@ pub use crate::spec::ParameterSpec;
 
 /// The parameter kinds a `[[parameter]]` table may declare.
 pub const KINDS: [&str; 7] = [
-    "bearing-stiffness",
     "bearing-rotational-stiffness",
     "disk-mass",
     "disk-inertia",
     "point-mass",
     "section-modulus-scale",
     "section-diameter-scale",
+    "bearing-stiffness",
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -335,14 +335,28 @@ fn resolve(rotor: &Rotor, s: &ParameterSpec) -> Result<(Extra, String, &'static 
                     let dof = Rotor::displacement_dof(disks[i].node);
                     m.add(dof, dof, 1.0);
                 }
-                (Kind::DiskMass, members.clone(), v, format!("m_disk_{}", joined(&members)), "kg", absolute(v))
+                (
+                    Kind::DiskMass,
+                    members.clone(),
+                    v,
+                    format!("m_disk_{}", joined(&members)),
+                    "kg",
+                    absolute(v),
+                )
             } else {
                 let v = common("disk", &members, &|i| disks[i].diametral_inertia)?;
                 for &i in &members {
                     let dof = Rotor::rotation_dof(disks[i].node);
                     m.add(dof, dof, 1.0);
                 }
-                (Kind::DiskInertia, members.clone(), v, format!("id_disk_{}", joined(&members)), "kg·m²", absolute(v))
+                (
+                    Kind::DiskInertia,
+                    members.clone(),
+                    v,
+                    format!("id_disk_{}", joined(&members)),
+                    "kg·m²",
+                    absolute(v),
+                )
             }
         }
         "point-mass" => {
@@ -353,7 +367,14 @@ fn resolve(rotor: &Rotor, s: &ParameterSpec) -> Result<(Extra, String, &'static 
                 let dof = Rotor::displacement_dof(masses[i].node);
                 m.add(dof, dof, 1.0);
             }
-            (Kind::PointMass, members.clone(), v, format!("m_point_mass_{}", joined(&members)), "kg", absolute(v))
+            (
+                Kind::PointMass,
+                members.clone(),
+                v,
+                format!("m_point_mass_{}", joined(&members)),
+                "kg",
+                absolute(v),
+            )
         }
         "section-modulus-scale" | "section-diameter-scale" => {
             let sections = match s.index {
@@ -397,8 +418,11 @@ fn resolve(rotor: &Rotor, s: &ParameterSpec) -> Result<(Extra, String, &'static 
                     }
                 }
             }
-            let what =
-                if sections.is_empty() { "shaft".to_string() } else { format!("section_{}", joined(&sections)) };
+            let what = if sections.is_empty() {
+                "shaft".to_string()
+            } else {
+                format!("section_{}", joined(&sections))
+            };
             if diameter {
                 (Kind::DiameterScale, sections, 1.0, format!("d_scale_{what}"), "-", (0.01, 100.0))
             } else {

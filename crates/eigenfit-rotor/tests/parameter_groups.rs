@@ -98,7 +98,8 @@ fn group_derivatives_are_exact_and_move_every_member() {
     let written = m.with_values(&p).unwrap();
     assert!(written.bearings().iter().all(|b| b.stiffness == 3e5));
     assert!(written.disks().iter().all(|d| d.mass == 2.5));
-    let back = UpdatableRotor::new(Rotor::from_toml_str(&written.to_toml_string().unwrap()).unwrap()).unwrap();
+    let back =
+        UpdatableRotor::new(Rotor::from_toml_str(&written.to_toml_string().unwrap()).unwrap()).unwrap();
     let (a, b) = (m.assemble(&p).unwrap(), back.assemble(&back.parameters().nominal_values()).unwrap());
     assert!((a.stiffness() - b.stiffness()).amax() <= 1e-9 * a.stiffness().amax());
     assert!((a.mass() - b.mass()).amax() <= 1e-12 * a.mass().amax());
@@ -106,10 +107,17 @@ fn group_derivatives_are_exact_and_move_every_member() {
 
 #[test]
 fn bad_groups_are_refused_naming_the_table() {
-    let unequal = BASE.replace("name = \"nde\"\nnode = 6\nstiffness = 2e5", "name = \"nde\"\nnode = 6\nstiffness = 3e5");
-    let rotor = Rotor::from_toml_str(&format!("{unequal}[[parameter]]\nkind = \"bearing-stiffness\"\nindex = [0, 1]\n")).unwrap();
+    let unequal = BASE
+        .replace("name = \"nde\"\nnode = 6\nstiffness = 2e5", "name = \"nde\"\nnode = 6\nstiffness = 3e5");
+    let rotor = Rotor::from_toml_str(&format!(
+        "{unequal}[[parameter]]\nkind = \"bearing-stiffness\"\nindex = [0, 1]\n"
+    ))
+    .unwrap();
     let e = UpdatableRotor::new(rotor).unwrap_err().to_string();
-    assert!(e.contains("parameter 0 (bearing-stiffness): bearing 0 has 200000 but bearing 1 has 300000"), "{e}");
+    assert!(
+        e.contains("parameter 0 (bearing-stiffness): bearing 0 has 200000 but bearing 1 has 300000"),
+        "{e}"
+    );
     for (table, expected) in [
         ("kind = \"disk-mass\"\nindex = [0, 0]", "index 0 is listed twice"),
         ("kind = \"disk-mass\"\nindex = [0, 5]", "index 5 but the model has 2 disk(s)"),
