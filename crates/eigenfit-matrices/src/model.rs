@@ -69,12 +69,15 @@ impl Files {
     }
 }
 
+/// A parameter vector p and X(p) = K_ss(p)⁻¹K_sm(p) there.
+type LastCondensation = (Vec<f64>, Arc<DMatrix<f64>>);
+
 /// The static condensation of a model's massless DOFs and the last X = K_ss⁻¹K_sm computed.
 #[derive(Debug)]
 struct Condensation {
     partition: Partition,
     /// (p, X(p)) of the last assembly: the derivatives at p reuse it.
-    last: Mutex<Option<(Vec<f64>, Arc<DMatrix<f64>>)>>,
+    last: Mutex<Option<LastCondensation>>,
 }
 
 impl Clone for Condensation {

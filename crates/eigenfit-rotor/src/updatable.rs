@@ -264,8 +264,12 @@ impl UpdatableRotor {
     }
 }
 
+/// What one `[[parameter]]` resolves to: its unit contribution, default name, unit and default
+/// bounds.
+type Resolved = (Extra, String, &'static str, (f64, f64));
+
 /// The unit contribution, default name, unit and default bounds of one `[[parameter]]`.
-fn resolve(rotor: &Rotor, s: &ParameterSpec) -> Result<(Extra, String, &'static str, (f64, f64)), String> {
+fn resolve(rotor: &Rotor, s: &ParameterSpec) -> Result<Resolved, String> {
     let n = rotor.dofs();
     let (mut k, mut m) = (SparseSymmetric::zeros(n), SparseSymmetric::zeros(n));
     // The members a table names, each within `count`, none twice.
