@@ -188,11 +188,7 @@ fn line_of(text: &str, r: usize, c: usize) -> Option<usize> {
 type Entries = Vec<(usize, usize, f64)>;
 
 /// The size n and the entries (0-based, as stored), every check of [`parse_symmetric`] made.
-fn read_entries(
-    text: &str,
-    expected: Option<usize>,
-    symmetric: bool,
-) -> Result<(usize, Entries), String> {
+fn read_entries(text: &str, expected: Option<usize>, symmetric: bool) -> Result<(usize, Entries), String> {
     let mut lines = data_lines(text);
     let (size_line, size) = lines.next().ok_or("the size line (rows columns entries) is missing")?;
     let fields: Vec<&str> = size.split_ascii_whitespace().collect();

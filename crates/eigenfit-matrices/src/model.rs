@@ -304,11 +304,16 @@ impl MatricesModel {
         let nominal = self.params.nominal_values();
         let m =
             self.combine(&self.mass, nominal.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.1.as_ref())));
+        // Every DOF some mass matrix couples (its row or column), whatever the triangle stored.
+        let mut coupled = vec![false; n];
+        for a in &masses {
+            for (c, t) in coupled.iter_mut().zip(touched(a)) {
+                *c |= t;
+            }
+        }
         if let Some(j) = (0..n).find(|&j| {
-            let (rows, values) = m.column(j);
-            let diagonal = rows.iter().zip(values).find(|(&r, _)| r == j).map_or(0.0, |(_, &v)| v);
-            diagonal < 0.0
-                || (diagonal == 0.0 && masses.iter().any(|a| a.column(j).1.iter().any(|&v| v != 0.0)))
+            let diagonal = m.get(j, j);
+            diagonal < 0.0 || (diagonal == 0.0 && coupled[j])
         }) {
             return Err(format!(
                 "{}: its mass on the diagonal is {} at the nominal values, but M couples it to other DOFs: \

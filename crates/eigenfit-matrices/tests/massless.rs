@@ -145,6 +145,10 @@ fn a_massless_dof_held_by_no_stiffness_is_named() {
     let m = "%%MatrixMarket matrix coordinate real symmetric\n3 3 2\n1 1 1\n2 1 0.5\n";
     let e = write_model("indefinite", k, m).unwrap_err();
     assert!(e.contains("DOF 2 (node 10 direction rz): its mass on the diagonal is 0"), "{e}");
+    // The same with the coupling stored only in a later DOF's column (upper triangle).
+    let m = "%%MatrixMarket matrix coordinate real symmetric\n3 3 3\n2 2 1\n1 2 0.5\n3 3 1\n";
+    let e = write_model("indefinite-upper", k, m).unwrap_err();
+    assert!(e.contains("DOF 1 (node 10 direction x): its mass on the diagonal is 0"), "{e}");
     // A model without a singular K_ss reads, condensing 2 DOFs.
     let k = "%%MatrixMarket matrix coordinate real symmetric\n3 3 5\n1 1 2\n2 1 1\n2 2 3\n3 2 1\n3 3 1\n";
     let m = "%%MatrixMarket matrix coordinate real symmetric\n3 3 1\n1 1 1\n";
