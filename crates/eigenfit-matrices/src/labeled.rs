@@ -215,8 +215,8 @@ pub fn parse_abaqus(text: &str) -> Result<LabeledMatrix, String> {
         let f: Vec<&str> = t.split(',').map(str::trim).collect();
         if f.len() != 5 {
             return Err(format!(
-                "line {}: an entry must be `node, dof, node, dof, value` (Abaqus' matrix input format; \
-                 FORMAT=COORDINATE files have no node labels: read them as Matrix Market)",
+                "line {}: an entry must be `node, dof, node, dof, value` (Abaqus' matrix input format, \
+                 `*MATRIX OUTPUT, FORMAT=MATRIX INPUT`, the default; other formats are not read)",
                 i + 1
             ));
         }
