@@ -113,7 +113,7 @@ fn a_bad_matrix_file_is_bad_input_naming_it() {
     std::fs::write(&model, "kind = \"matrices\"\nstiffness = \"K.mtx\"\nmass = \"M.mtx\"\n").unwrap();
     let (code, _, err) = eigenfit(&["simulate", "--model", model.to_str().unwrap(), "--json"]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("K.mtx: not symmetric: entry (2, 1) = 3 but (1, 2) = 1"), "{err}");
+    assert!(err.contains("K.mtx: not symmetric: entry (2, 1) = 3 (line 4) but (1, 2) = 1 (line 3)"), "{err}");
 }
 
 #[test]
