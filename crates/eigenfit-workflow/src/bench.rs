@@ -406,6 +406,8 @@ pub struct ProblemInfo {
     pub truth: Named<f64>,
     /// Measured frequencies, Hz.
     pub measured_hz: Vec<f64>,
+    /// Their standard deviations, Hz (`null` where not given).
+    pub std_hz: Vec<Option<f64>>,
 }
 
 /// `bench`'s report (the `--json` object).
@@ -613,6 +615,7 @@ pub fn run(request: &BenchRequest) -> Result<BenchReport, WorkflowError> {
                 name: p.name.clone(),
                 truth: Named::new(&p.names(), p.truth.iter().copied()),
                 measured_hz: p.measured.modes().iter().map(|m| m.frequency_hz).collect(),
+                std_hz: p.measured.modes().iter().map(|m| m.std_hz).collect(),
             })
             .collect(),
         strategies: records.iter().fold(Vec::new(), |mut v, r| {
