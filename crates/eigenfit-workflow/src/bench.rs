@@ -3,7 +3,9 @@
 //!
 //! A problem is a model, measured frequencies (with standard deviations), the truth and where
 //! starts are drawn. The built-ins are the paper's Tables 2–5 (the paper rotor, its two lowest
-//! modes rounded to 3 decimals as in its Table 1, with 0.1 % std) and a 3-storey shear frame; a
+//! modes rounded to 3 decimals as in its Table 1, with 0.1 % std; starts log-uniform in
+//! [1e2, 1e8] N/m, the span of the paper's initial guesses; reached within 1 %, Table 4 within
+//! 2 %) and a 3-storey shear frame (three modes, 0.1 % std, starts in [2e6, 2e8] N/m); a
 //! path to a problem file (TOML) is a problem too:
 //!
 //! ```toml
@@ -170,7 +172,7 @@ fn synthetic(
 
 /// A built-in problem by name.
 pub fn builtin(name: &str) -> Option<Result<BenchProblem, WorkflowError>> {
-    let paper = |truth: [f64; 2]| -> Result<BenchProblem, WorkflowError> {
+    let paper = |truth: [f64; 2], tolerance: f64| -> Result<BenchProblem, WorkflowError> {
         let rotor = eigenfit_rotor::UpdatableRotor::new(presets::paper_rotor())
             .map_err(|e| WorkflowError::Failure(e.to_string()))?;
         let model: SharedModel = Arc::new(rotor);
@@ -182,15 +184,17 @@ pub fn builtin(name: &str) -> Option<Result<BenchProblem, WorkflowError>> {
             truth: truth.to_vec(),
             // The paper's initial guesses span 1e2 to 1e8 N/m.
             start_range: vec![(1e2, 1e8); 2],
-            tolerance: 0.01,
+            tolerance,
             solver: "dense".into(),
         })
     };
     Some(match name {
-        "paper-table2" => paper([1e2, 1e2]),
-        "paper-table3" => paper([1e5, 1e5]),
-        "paper-table4" => paper([1e8, 1e8]),
-        "paper-table5" => paper([1e5, 1e3]),
+        "paper-table2" => paper([1e2, 1e2], 0.01),
+        "paper-table3" => paper([1e5, 1e5], 0.01),
+        // Rigid supports barely move the frequencies: the exact solution of the rounded data is
+        // (1.0065e8, 9.897e7), 1.03 % from the truth (the paper's own answer, 1.0508e8, is 5 % off).
+        "paper-table4" => paper([1e8, 1e8], 0.02),
+        "paper-table5" => paper([1e5, 1e3], 0.01),
         "shear-frame" => {
             let model: SharedModel = Arc::new(ShearFrame::new());
             let truth = vec![2e7, 1.8e7, 1.5e7];

@@ -3,13 +3,22 @@
 //! best strategy on that instance) and the ECDF of evaluations (the fraction of instances solved
 //! within N evaluations, COCO's runtime distribution). "Solved" is `reached_truth`.
 
-use super::style::{self, log_tick, px, pxi, strategy_colour};
+use super::style::{self, log_tick, px, pxi, strategy_colour, INK};
 use super::{err, DrawResult, Figure};
 use crate::error::CliError;
 use eigenfit_workflow::bench::BenchReport;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
+
+/// Colours of strategies other than the paper's three (Okabe–Ito, those not taken by them).
+const OTHERS: [RGBColor; 5] = [
+    RGBColor(0, 158, 115),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+    RGBColor(240, 228, 66),
+];
 
 /// Which of the two figures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,16 +117,18 @@ impl Figure for BenchFigure {
             .build_cartesian_2d((lo..hi).log_scale(), 0.0..1.02)
             .map_err(err)?;
         style::grid(style::axes(&mut chart.configure_mesh(), x_desc, "fraction of instances solved"), 0.5)
+            .x_labels(6)
             .x_label_formatter(&log_tick)
             .draw()
             .map_err(err)?;
         let n = self.instances.max(1) as f64;
-        for (i, (name, xs)) in self.curves.iter().enumerate() {
+        let mut others = OTHERS.iter().cycle();
+        for (name, xs) in &self.curves {
             let base = name.split(':').next().unwrap_or_default();
             let c = if matches!(base, "newton" | "p-step" | "damped") {
                 strategy_colour(base)
             } else {
-                style::mode_colour(i + 3)
+                *others.next().unwrap_or(&INK)
             };
             let mut points = vec![(lo, 0.0)];
             for (k, &x) in xs.iter().enumerate() {

@@ -12,13 +12,19 @@ use crate::problem::{Linearisation, Objective, ResidualError};
 pub struct GaussNewtonLineSearch {
     tolerance: f64,
     max_step: f64,
+    recent_cost: f64,
+    stuck_for: usize,
 }
 
 impl Default for GaussNewtonLineSearch {
     fn default() -> Self {
-        Self { tolerance: 1e-10, max_step: 100f64.ln() }
+        Self { tolerance: 1e-10, max_step: 100f64.ln(), recent_cost: f64::INFINITY, stuck_for: 0 }
     }
 }
+
+/// Iterations without a 0.1 % cost reduction after which the run has stalled on a plateau (as
+/// the damped strategy's rule).
+const PLATEAU_ITERATIONS: usize = 12;
 
 /// Halvings of the step before a line search gives up.
 const HALVINGS: usize = 30;
@@ -31,7 +37,7 @@ impl GaussNewtonLineSearch {
         let guard = Guard("Gauss–Newton line search");
         guard.non_negative("tolerance", tolerance)?;
         guard.positive("max_step", max_step)?;
-        Ok(Self { tolerance, max_step })
+        Ok(Self { tolerance, max_step, ..Self::default() })
     }
 }
 
@@ -48,6 +54,8 @@ impl UpdateStrategy for GaussNewtonLineSearch {
                 problem.parameters().len()
             )));
         }
+        self.recent_cost = initial.cost();
+        self.stuck_for = 0;
         Ok(())
     }
 
@@ -93,6 +101,17 @@ impl UpdateStrategy for GaussNewtonLineSearch {
                     } else {
                         StepStatus::Continue
                     };
+                    if next.cost() < 0.999 * self.recent_cost {
+                        self.recent_cost = next.cost();
+                        self.stuck_for = 0;
+                    } else {
+                        self.stuck_for += 1;
+                        if self.stuck_for >= PLATEAU_ITERATIONS && status == StepStatus::Continue {
+                            return Err(UpdateError::Stalled(format!(
+                                "no 0.1 % cost reduction in {PLATEAU_ITERATIONS} iterations (a plateau)"
+                            )));
+                        }
+                    }
                     return Ok(Step { next, status });
                 }
                 Err(e @ ResidualError::BudgetExhausted { .. }) => return Err(UpdateError::Residual(e)),
