@@ -412,6 +412,8 @@ pub struct ProblemInfo {
     pub measured_hz: Vec<f64>,
     /// Their standard deviations, Hz (`null` where not given).
     pub std_hz: Vec<Option<f64>>,
+    /// Relative error within which a run has reached the truth.
+    pub tolerance: f64,
 }
 
 /// `bench`'s report (the `--json` object).
@@ -620,6 +622,7 @@ pub fn run(request: &BenchRequest) -> Result<BenchReport, WorkflowError> {
                 truth: Named::new(&p.names(), p.truth.iter().copied()),
                 measured_hz: p.measured.modes().iter().map(|m| m.frequency_hz).collect(),
                 std_hz: p.measured.modes().iter().map(|m| m.std_hz).collect(),
+                tolerance: p.tolerance,
             })
             .collect(),
         strategies: records.iter().fold(Vec::new(), |mut v, r| {
