@@ -38,15 +38,9 @@ impl Default for TmcmcSettings {
 pub const MAX_STAGES: usize = 60;
 
 /// Transitional MCMC with settings checked when built.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Tmcmc {
     settings: TmcmcSettings,
-}
-
-impl Default for Tmcmc {
-    fn default() -> Self {
-        Self { settings: TmcmcSettings::default() }
-    }
 }
 
 impl Tmcmc {
