@@ -21,8 +21,11 @@ pub struct PosteriorReport {
     pub sampler: String,
     /// The seed of its random numbers (the same seed gives the same samples).
     pub seed: u64,
-    /// One row per sample, values in the order of the report's `parameters`, in their units.
+    /// One row per sample, values in the order of the report's `parameters` keys as the JSON
+    /// prints them (sorted by name: every JSON object's keys are), in the parameters' units.
     pub samples: Vec<Vec<f64>>,
+    /// The parameter of each column of `samples`.
+    pub columns: Vec<String>,
     /// Posterior means.
     pub mean: Named<f64>,
     /// Posterior standard deviations.
@@ -45,10 +48,14 @@ pub struct PosteriorReport {
 impl PosteriorReport {
     /// The report of `post` for parameters `names`.
     pub fn new(names: &[String], sampler: &str, seed: u64, post: &Posterior, evaluations: usize) -> Self {
+        // The JSON's objects list their keys sorted (serde_json's map): the columns follow.
+        let mut order: Vec<usize> = (0..names.len()).collect();
+        order.sort_by(|&a, &b| names[a].cmp(&names[b]));
         Self {
             sampler: sampler.to_string(),
             seed,
-            samples: post.samples.clone(),
+            samples: post.samples.iter().map(|row| order.iter().map(|&i| row[i]).collect()).collect(),
+            columns: order.iter().map(|&i| names[i].clone()).collect(),
             mean: Named::new(names, post.mean.iter().copied()),
             std: Named::new(names, post.std.iter().copied()),
             credible_95: Named::new(names, post.credible_95.iter().copied()),
