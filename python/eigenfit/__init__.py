@@ -16,10 +16,11 @@ modes=6)``.
 Batches on a Dask cluster: :mod:`eigenfit.batch`.
 """
 
-from ._api import EXIT_NOT_CONVERGED, EigenfitError, campbell, compare, discover, estimate, run, simulate
+from ._api import EXIT_NOT_CONVERGED, EigenfitError, bench, campbell, compare, discover, estimate, run, simulate
 from ._native import version as _native_version
 from .matrices import MatricesModel
 from ._results import (
+    BenchResult,
     CampbellResult,
     CompareResult,
     DiscoverResult,
@@ -35,6 +36,7 @@ __all__ = [
     "estimate",
     "discover",
     "compare",
+    "bench",
     "campbell",
     "run",
     "MatricesModel",
@@ -45,6 +47,7 @@ __all__ = [
     "EstimateResult",
     "DiscoverResult",
     "CompareResult",
+    "BenchResult",
     "CampbellResult",
     "__version__",
 ]

@@ -7,7 +7,15 @@ from typing import Any, Mapping, Optional, Sequence, Type, TypeVar, Union
 
 from . import _native
 from ._args import TempFiles, is_ross_rotor, measured_args, model_args, option_args
-from ._results import CampbellResult, CompareResult, DiscoverResult, EstimateResult, Result, SimulateResult
+from ._results import (
+    BenchResult,
+    CampbellResult,
+    CompareResult,
+    DiscoverResult,
+    EstimateResult,
+    Result,
+    SimulateResult,
+)
 
 #: A preset name (``"paper-rotor"``), a model file path, or (once the CLI reads ROSS files) a
 #: ROSS ``Rotor``.
@@ -214,6 +222,35 @@ def compare(
             **options,
         },
     )
+
+
+def bench(
+    problems: Sequence[Union[str, "os.PathLike[str]"]],
+    *,
+    strategies: Optional[Sequence[str]] = None,
+    starts: Optional[int] = None,
+    seed: Optional[int] = None,
+    budget: Optional[int] = None,
+    **options: Any,
+) -> BenchResult:
+    """Strategies × problems × starts, as ``eigenfit bench`` (docs/strategies.md).
+
+    Args:
+        problems: built-in names (``paper-table3``, ``shear-frame``, …) or problem-file paths.
+        strategies: registered names with settings after colons, e.g. ``["damped", "trf",
+            "tmcmc:samples=500"]`` (a strategy registered in this process by a Rust program is
+            found too).
+        starts: starts per problem and strategy; seed: their seed; budget: evaluations per run.
+        **options: any other ``eigenfit bench`` option (``records``, ``plot``, ``max_iterations``).
+
+    Returns:
+        BenchResult (exit code 3 when some problem and strategy never reached the truth).
+    """
+    args = ["bench", "--problems", ",".join(os.fspath(p) for p in problems)]
+    args += option_args(
+        {"strategies": strategies, "starts": starts, "seed": seed, "budget": budget, **options}
+    )
+    return run(args, BenchResult)
 
 
 def campbell(

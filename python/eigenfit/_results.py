@@ -291,6 +291,22 @@ class DiscoverResult(Result):
         return self._data.get("p_value")
 
 
+class BenchResult(Result):
+    """``eigenfit bench``: one record per run, a summary per problem and strategy."""
+
+    command = "bench"
+
+    @property
+    def records(self) -> List[Dict[str, Any]]:
+        """One entry per (problem, strategy, start) run."""
+        return copy.deepcopy(self._data["records"])
+
+    @property
+    def summary(self) -> List[Dict[str, Any]]:
+        """One entry per problem and strategy: success rate, median evaluations, verdicts."""
+        return copy.deepcopy(self._data["summary"])
+
+
 class CompareResult(Result):
     """``eigenfit compare``: strategies over targets and initial guesses."""
 

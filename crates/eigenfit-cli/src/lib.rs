@@ -42,6 +42,9 @@ pub enum Command {
     /// The paper rotor end to end: Table 1, Table 3 case 1 with every strategy, a convergence map
     /// and a discovery, with every plot written to a folder.
     Demo(commands::demo::DemoArgs),
+    /// Strategies × problems × starts in parallel: one record per run, a summary per problem
+    /// and strategy (success rate, evaluations), with --plot performance profiles and ECDFs.
+    Bench(commands::bench::BenchArgs),
     /// Campbell diagram of a two-plane (ROSS) rotor: damped frequencies, whirl and log
     /// decrement against speed in rpm, with the critical speeds.
     Campbell(commands::campbell::CampbellArgs),
@@ -57,6 +60,7 @@ pub fn run(cli: &Cli) -> Result<u8, CliError> {
         Command::Compare(a) => commands::compare::run(a),
         Command::Discover(a) => commands::discover::run(a),
         Command::Demo(a) => commands::demo::run(a).map(|()| error::EXIT_OK),
+        Command::Bench(a) => commands::bench::run(a),
         Command::Campbell(a) => commands::campbell::run(a).map(|()| error::EXIT_OK),
     }
 }

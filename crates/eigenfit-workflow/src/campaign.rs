@@ -11,7 +11,7 @@ use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDat
 use eigenfit_core::analysis::Joint;
 use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
-use eigenfit_core::update::{Budget, Driver, StrategyKind};
+use eigenfit_core::update::{registry, Budget, Driver, Method};
 use eigenfit_rotor::campaign::Campaign;
 use eigenfit_rotor::{Rotor, UpdatableRotor};
 use serde::Serialize;
@@ -109,12 +109,16 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         "dense" => Box::new(DenseSolver),
         other => return Err(input(format!("unknown solver `{other}`; available: banded, dense"))),
     };
-    let strategy_kind = StrategyKind::from_name(&request.strategy).ok_or_else(|| {
-        input(format!(
-            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
-            request.strategy
-        ))
-    })?;
+    let (strategy_name, method) =
+        registry::build(&request.strategy).map_err(|e| input(format!("--strategy: {e}")))?;
+    let mut strategy = match method {
+        Method::Local(s) => s,
+        Method::Sampler(_) => {
+            return Err(input(format!(
+                "--strategy {strategy_name}: a sampler; a campaign is fitted by a local strategy (damped, trf, …)"
+            )))
+        }
+    };
     let mut models = Vec::new();
     let mut data = Vec::new();
     let mut names = Vec::new();
@@ -153,8 +157,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         .map_err(|e| input(format!("{}: {e}", request.campaign.display())))?;
     let has_std = data.iter().all(|d| d.measurement.has_std() && d.sensors.is_none());
     let initial = joint.parameters().nominal_values();
-    progress.begin(&format!("estimating the campaign ({})", strategy_kind.name()), None);
-    let mut strategy = strategy_kind.build();
+    progress.begin(&format!("estimating the campaign ({strategy_name})"), None);
     if request.budget == 0 {
         return Err(input("--budget 0: at least one model evaluation is needed"));
     }

@@ -8,6 +8,7 @@ use crate::outcome::{
 };
 pub use crate::outcome::{AlternativeSolution, ParameterIdentifiability};
 use crate::overrides::{fixed, parameter_vector};
+use crate::posterior::{PosteriorReport, SamplingError};
 use crate::progress::{Progress, StepsObserver};
 use crate::rotordynamics::{self, RunupEstimateReport};
 use crate::simulate::check_roundoff;
@@ -23,7 +24,7 @@ use eigenfit_core::measurement::mac::MacReport;
 use eigenfit_core::measurement::measured_csv::{shown, shown_number};
 use eigenfit_core::model::{ParameterSet, StructuralModel};
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
-use eigenfit_core::update::{Budget, Driver, Estimate, LevenbergMarquardt, StrategyKind};
+use eigenfit_core::update::{registry, Budget, Driver, Estimate, LevenbergMarquardt, Method, UpdateStrategy};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -46,8 +47,14 @@ pub struct EstimateRequest {
     pub measured: PathBuf,
     /// Shapes, sensors and held parameters.
     pub test_data: TestDataOptions,
-    /// Update strategy: newton, p-step or damped.
+    /// Update strategy by its registered name, with settings after colons (`damped`, `trf`,
+    /// `tmcmc:chain=5`, …; [`registry`]).
     pub strategy: String,
+    /// A sampler's (`tmcmc`) number of posterior samples (`None`: its default); refused for
+    /// other strategies.
+    pub samples: Option<usize>,
+    /// A sampler's random seed.
+    pub seed: u64,
     /// Initial values `K1,K2,…` (default: the model's).
     pub initial: Option<String>,
     /// Residual: relative, hz or eigenvalue.
@@ -146,8 +153,13 @@ pub struct EstimateReport {
     /// Other minima found and mirror points, each with its χ², Δχ² and the test's outcome.
     pub alternative_solutions: Vec<AlternativeSolution>,
     /// How σ was taken for the alternatives' test: `std` (given), `residuals` (estimated from the
-    /// estimate's residuals), or `exact` (no σ: only exact fits are equally good).
+    /// estimate's residuals), or `exact` (no σ: only fits at least as good as the estimate are
+    /// equally good).
     pub alternatives_sigma: &'static str,
+    /// A sampler's posterior (`--strategy tmcmc`); the fit and its verdict then start from the
+    /// posterior's best sample.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub posterior: Option<crate::posterior::PosteriorReport>,
     /// Model frequencies at the estimate and measured frequencies (Hz).
     #[serde(flatten)]
     pub frequencies: PairedFrequencies,
@@ -254,12 +266,8 @@ pub fn run(
     }
     notes.extend(data.file_notes.iter().cloned());
     let measurement = data.measurement.clone();
-    let strategy_kind = StrategyKind::from_name(&request.strategy).ok_or_else(|| {
-        input(format!(
-            "unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
-            shown(&request.strategy)
-        ))
-    })?;
+    let (strategy_name, method) = build_strategy(&request.strategy, request.samples)?;
+    let base_name = strategy_name.split(':').next().unwrap_or_default().to_string();
     let kind = match request.residual.as_str() {
         "relative" => ResidualKind::Relative,
         "hz" => ResidualKind::FrequencyHz,
@@ -295,17 +303,17 @@ pub fn run(
             any.dofs()
         )));
     }
-    if matches!(strategy_kind, StrategyKind::Newton | StrategyKind::PStep) && measurement.len() > np {
+    if matches!(base_name.as_str(), "newton" | "p-step") && measurement.len() > np {
         notes.push(format!(
-            "the {} strategy solves the paper's square system: it uses the first {np} of the {} measured modes; \
+            "the {base_name} strategy solves the paper's square system: it uses the first {np} of the {} measured modes; \
              the damped strategy uses all",
-            strategy_kind.name(),
             measurement.len()
         ));
     }
     let has_std = measurement.has_std();
     let mode_numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
     let sigma_max = measurement.modes().iter().filter_map(|m| m.std_hz).reduce(f64::max);
+    let measurement_for_sampling = measurement.clone();
     let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
     let mut fit = Fit::new(problem, &data, options.shape.shape_std);
     let budget = Budget::new(request.budget);
@@ -313,11 +321,49 @@ pub fn run(
     check_reachable(&fit, &mode_numbers, &budget).map_err(|e| input(format!("{measured_name}: {e}")))?;
     // Running totals of evaluations after each phase, reported per phase.
     let mut phases: Vec<(&str, usize)> = vec![("reachability", budget.used())];
+    // A sampler draws the posterior first; the fit (damped) then starts from its best sample.
+    let (mut strategy, posterior) = match method {
+        Method::Local(strategy) => (strategy, None),
+        Method::Sampler(sampler) => {
+            if data.sensors.is_some() {
+                notes
+                    .push(format!("the {base_name} posterior uses the measured frequencies, not the shapes"));
+            }
+            progress.begin(&format!("sampling the posterior ({strategy_name})"), None);
+            let before = budget.used();
+            let post = crate::posterior::sample(
+                &model,
+                solver.as_ref(),
+                &measurement_for_sampling,
+                &measured_name.to_string(),
+                sampler.as_ref(),
+                request.seed,
+                &budget,
+            );
+            progress.end();
+            let post = match post {
+                Ok(p) => p,
+                Err(SamplingError::BudgetExhausted { limit }) => {
+                    return Ok(EstimateOutcome::BudgetExhaustedBeforeFit { limit })
+                }
+                Err(SamplingError::Failed(e)) => return Err(e),
+            };
+            phases.push(("sampling", budget.used()));
+            let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
+            let report =
+                PosteriorReport::new(&names, &strategy_name, request.seed, &post, budget.used() - before);
+            let lm: Box<dyn UpdateStrategy> = Box::new(LevenbergMarquardt::default());
+            (lm, Some((post, report, sampler.name())))
+        }
+    };
     // A start inside the bounds where the model cannot be evaluated (a support so soft its mode
     // is a rigid-body mode to round-off) is no reason to refuse: the damped strategy starts from
     // the best point of its coarse grid instead, and says so.
-    let mut start = initial.clone();
-    if strategy_kind == StrategyKind::LevenbergMarquardt {
+    let mut start = match &posterior {
+        Some((post, _, _)) => post.best_sample().map_or_else(|| initial.clone(), <[f64]>::to_vec),
+        None => initial.clone(),
+    };
+    if base_name == "damped" {
         let budgeted = budget.wrap(&fit);
         if let Err(e) = budgeted.linearise(&initial) {
             if let Some(seed) = LevenbergMarquardt::rank_seeds(&budgeted).first() {
@@ -328,8 +374,7 @@ pub fn run(
             }
         }
     }
-    let mut strategy = strategy_kind.build();
-    progress.begin(&format!("estimating ({})", strategy_kind.name()), None);
+    progress.begin(&format!("estimating ({})", strategy.name()), None);
     let estimate = Driver { max_iterations: request.max_iterations }
         .run_within(&fit, strategy.as_mut(), &start, &budget)
         .map_err(|e| input(e.to_string()));
@@ -460,7 +505,7 @@ pub fn run(
     let held = model.held();
     let report = EstimateReport {
         model: label,
-        strategy: estimate.strategy,
+        strategy: posterior.as_ref().map_or(estimate.strategy, |(_, _, name)| name),
         outcome: Outcome::of(&estimate, converged),
         verdict,
         fit: FitQualityReport::of(&quality, |k| mode_numbers[k]),
@@ -470,6 +515,7 @@ pub fn run(
         at_limit: pinned,
         alternative_solutions: AlternativeSolution::list(&names, &alternatives),
         alternatives_sigma,
+        posterior: posterior.map(|(_, report, _)| report),
         frequencies: PairedFrequencies::of(&estimate.last),
         history: estimate
             .history
@@ -506,6 +552,23 @@ pub fn run(
         acceptable,
         updated_model,
     })))
+}
+
+/// The strategy `spec` names, from the process-wide registry; `samples` is a sampler's
+/// `samples` setting (refused for other strategies).
+pub fn build_strategy(spec: &str, samples: Option<usize>) -> Result<(String, Method), WorkflowError> {
+    let (name, method) = registry::build(spec).map_err(|e| input(format!("--strategy: {e}")))?;
+    let Some(n) = samples else { return Ok((name, method)) };
+    if !matches!(method, Method::Sampler(_)) {
+        return Err(input(format!(
+            "--samples {n}: the strategy `{}` is not a sampler (tmcmc is)",
+            shown(spec)
+        )));
+    }
+    if spec.split(':').skip(1).any(|kv| kv.trim().starts_with("samples")) {
+        return Err(input(format!("--samples {n} and `{}`: give the number of samples once", shown(spec))));
+    }
+    registry::build(&format!("{spec}:samples={n}")).map_err(|e| input(format!("--samples: {e}")))
 }
 
 /// The model's parameter permutations (over `all`, its parameters) that move more than one pair

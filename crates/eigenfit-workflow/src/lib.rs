@@ -21,6 +21,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod bench;
 pub mod campaign;
 pub mod compare;
 pub mod demo;
@@ -31,6 +32,7 @@ pub mod model;
 pub mod named;
 pub mod outcome;
 pub mod overrides;
+pub mod posterior;
 pub mod progress;
 pub mod rotordynamics;
 pub mod simulate;

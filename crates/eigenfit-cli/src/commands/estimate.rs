@@ -24,9 +24,18 @@ pub struct EstimateArgs {
     pub measured: PathBuf,
     #[command(flatten)]
     pub test_data: testdata::TestDataArgs,
-    /// Update strategy: newton, p-step or damped (Levenberg–Marquardt; `levenberg-marquardt` is accepted too).
+    /// Update strategy by name: newton, p-step, damped (Levenberg–Marquardt; `levenberg-marquardt`
+    /// is accepted too), trf, gn-line-search, tmcmc (posterior samples and evidence, then a damped
+    /// fit from the best sample), or one registered by a program; settings after colons
+    /// (`damped:max_trials=50`, `tmcmc:chain=5`), docs/strategies.md.
     #[arg(long, default_value = "damped")]
     pub strategy: String,
+    /// tmcmc: posterior samples (default 1000).
+    #[arg(long, value_name = "N")]
+    pub samples: Option<usize>,
+    /// tmcmc: seed of the random numbers (the same seed gives the same samples).
+    #[arg(long, value_name = "S", default_value_t = 0)]
+    pub seed: u64,
     /// Initial bearing stiffnesses K1,K2,… in N/m (default: the model's values).
     #[arg(long, value_name = "K1,K2,…", allow_hyphen_values = true)]
     pub initial: Option<String>,
@@ -38,8 +47,9 @@ pub struct EstimateArgs {
     pub max_iterations: usize,
     /// Most model evaluations (eigen-solves) the fit, its intervals and the search for other
     /// solutions may spend together; when it runs out the run ends with exit code 3 and says so.
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_EVALUATIONS)]
-    pub budget: usize,
+    /// Default 20000, plus a sampler's most (samples × (1 + 60 stages × chain)).
+    #[arg(long, value_name = "N")]
+    pub budget: Option<usize>,
     /// Starts of the space-filling design refitted locally when searching for other minima
     /// (default: 4 per free parameter and 8 more; 0: no such search; the exchange of like
     /// parameters is still checked). Each is a local fit of several model evaluations: on a
@@ -68,13 +78,26 @@ fn request(args: &EstimateArgs) -> EstimateRequest {
         measured: args.measured.clone(),
         test_data: args.test_data.options(),
         strategy: args.strategy.clone(),
+        samples: args.samples,
+        seed: args.seed,
         initial: args.initial.clone(),
         residual: args.residual.clone(),
         max_iterations: args.max_iterations,
-        budget: args.budget,
+        budget: args.budget.unwrap_or_else(|| default_budget(&args.strategy, args.samples)),
         write_model: args.test_data.write_model.is_some(),
         alternative_starts: args.alternative_starts,
         bearing_parameters: args.parameters.clone(),
+    }
+}
+
+/// The budget when none is given: [`DEFAULT_EVALUATIONS`], plus a sampler's most evaluations
+/// (samples × (1 + its stage limit × chain length)), so a default run never stops mid-sampling.
+fn default_budget(strategy: &str, samples: Option<usize>) -> usize {
+    match estimate::build_strategy(strategy, samples) {
+        Ok((_, eigenfit_core::update::Method::Sampler(s))) => {
+            DEFAULT_EVALUATIONS.saturating_add(s.most_evaluations())
+        }
+        _ => DEFAULT_EVALUATIONS,
     }
 }
 
@@ -153,6 +176,20 @@ fn print_report(est: &Estimation) {
             "{n:<20}{:>16.4e}{value:>16}   {}",
             r.values.initial.0[i].1, r.values.parameter_status.0[i].1
         );
+    }
+    if let Some(post) = &r.posterior {
+        println!(
+            "posterior ({}, {} samples, {} stages, {} evaluations): ln evidence = {:.4}",
+            post.sampler,
+            post.samples.len(),
+            post.stages,
+            post.evaluations,
+            post.log_evidence
+        );
+        println!("{:<20}{:>16}{:>16}   95% credible", "parameter", "mean", "std");
+        for (((n, m), (_, s)), (_, c)) in post.mean.iter().zip(post.std.iter()).zip(post.credible_95.iter()) {
+            println!("{n:<20}{m:>16.4e}{s:>16.4e}   [{:.4e}, {:.4e}]", c[0], c[1]);
+        }
     }
     println!("{:>6}{:>16}{:>16}{:>14}", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]");
     for (k, (m, f)) in r.frequencies.measured_hz.iter().zip(&r.frequencies.frequencies_hz).enumerate() {

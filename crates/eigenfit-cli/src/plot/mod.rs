@@ -10,6 +10,7 @@
 //! [`SUPERSAMPLE`] times larger (every size through [`style::px`]) and average each block of
 //! pixels down to one: the steps shrink to a fraction of a pixel.
 
+pub mod bench;
 pub mod campbell;
 pub mod compare_map;
 pub mod convergence;

@@ -461,7 +461,7 @@ impl LevenbergMarquardt {
 /// same size, and more modes than parameters cannot in general absorb it: a fit to that level is
 /// as exact as the matrices define it, and restarting from it only chases rounding. As many
 /// modes as parameters have an exact solution, which the iteration reaches quadratically.
-pub(crate) fn exact_fit_tolerance(residual_tolerance: f64, lin: &Linearisation, free: usize) -> f64 {
+pub fn exact_fit_tolerance(residual_tolerance: f64, lin: &Linearisation, free: usize) -> f64 {
     if lin.residual.len() > free {
         residual_tolerance.max(2.0 * lin.max_round_off())
     } else {
@@ -470,7 +470,7 @@ pub(crate) fn exact_fit_tolerance(residual_tolerance: f64, lin: &Linearisation, 
 }
 
 /// Scaled lower and upper bounds (±∞ where a bound is infinite).
-fn scaled_bounds(params: &ParameterSet) -> (Vec<f64>, Vec<f64>) {
+pub fn scaled_bounds(params: &ParameterSet) -> (Vec<f64>, Vec<f64>) {
     params
         .iter()
         .map(|p| {
@@ -484,7 +484,7 @@ fn scaled_bounds(params: &ParameterSet) -> (Vec<f64>, Vec<f64>) {
 /// MINPACK's gradient test: the residual is orthogonal to every Jacobian column (cosine below
 /// 1e-10), so no parameter change can reduce it further. A zero column (a parameter the data do
 /// not see) counts as orthogonal.
-fn stationary(js: &DMatrix<f64>, r: &DVector<f64>) -> bool {
+pub fn stationary(js: &DMatrix<f64>, r: &DVector<f64>) -> bool {
     let rn = r.norm();
     if rn == 0.0 {
         return true;

@@ -7,13 +7,18 @@
 mod budget;
 mod counted;
 mod driver;
+mod gauss_newton;
 pub(crate) mod grid;
 pub(crate) mod levenberg_marquardt;
 mod newton;
 mod pstep;
+pub mod registry;
+pub mod sampler;
 mod settings;
 #[cfg(test)]
 mod tests;
+mod tmcmc;
+mod trust_region_reflective;
 
 pub use budget::{Budget, Budgeted, DEFAULT_EVALUATIONS};
 pub use counted::Counted;
@@ -21,11 +26,18 @@ pub use driver::{
     Driver, Estimate, IterationRecord, IterationRecordSink, ObservedDriver, Observer, Outcome, Termination,
     TerminationReport,
 };
+pub use gauss_newton::GaussNewtonLineSearch;
 pub use grid::halton;
-pub use levenberg_marquardt::{LevenbergMarquardt, LevenbergMarquardtSettings};
+pub use levenberg_marquardt::{
+    exact_fit_tolerance, scaled_bounds, stationary, LevenbergMarquardt, LevenbergMarquardtSettings,
+};
 pub use newton::Newton;
 pub use pstep::PStep;
-pub use settings::SettingsError;
+pub use registry::{Method, StrategyError, StrategyFactory, StrategySettings};
+pub use sampler::{Gaussian, LogLikelihood, Posterior, Sampler};
+pub use settings::{Guard, SettingsError};
+pub use tmcmc::{Tmcmc, TmcmcSettings, MAX_STAGES as TMCMC_MAX_STAGES};
+pub use trust_region_reflective::{trust_region_step, TrustRegionReflective};
 
 use crate::problem::{Linearisation, Objective, ResidualError};
 use thiserror::Error;
@@ -93,7 +105,7 @@ pub trait UpdateStrategy {
 
 /// Solves the paper's eq. 28, S Δk = Δλ, on the first N modes (N = number of parameters, as in
 /// eq. 27) with target eigenvalues `target`, and returns k + Δk.
-pub(crate) fn newton_point(
+pub fn newton_point(
     current: &Linearisation,
     target: &nalgebra::DVector<f64>,
 ) -> Result<Vec<f64>, UpdateError> {
@@ -116,7 +128,7 @@ pub(crate) fn newton_point(
 
 /// Largest |f_model − f_measured| (Hz) over the first N modes, N = number of parameters: the
 /// paper's stopping test for its square system.
-pub(crate) fn square_max_diff_hz(lin: &Linearisation) -> f64 {
+pub fn square_max_diff_hz(lin: &Linearisation) -> f64 {
     let n = lin.parameters.len().min(lin.frequencies_hz.len());
     lin.frequencies_hz[..n]
         .iter()
@@ -125,7 +137,7 @@ pub(crate) fn square_max_diff_hz(lin: &Linearisation) -> f64 {
 }
 
 /// Linearises at `p`, turning a point outside the bounds or a failed model into `Diverged`.
-pub(crate) fn evaluate_or_diverge(problem: &dyn Objective, p: &[f64]) -> Result<Linearisation, UpdateError> {
+pub fn evaluate_or_diverge(problem: &dyn Objective, p: &[f64]) -> Result<Linearisation, UpdateError> {
     problem.parameters().check(p).map_err(|e| UpdateError::Diverged(e.to_string()))?;
     problem.linearise(p).map_err(|e| UpdateError::Diverged(e.to_string()))
 }

@@ -18,8 +18,9 @@ pub struct SettingsError {
     pub requirement: &'static str,
 }
 
-/// The checks shared by every settings type, for one `owner`.
-pub(crate) struct Guard(pub(crate) &'static str);
+/// The checks shared by every settings type, for one `owner` (a strategy written outside the
+/// crate uses them too: `Guard("my strategy").positive("tolerance", t)?`).
+pub struct Guard(pub &'static str);
 
 impl Guard {
     fn refuse(
@@ -32,7 +33,7 @@ impl Guard {
     }
 
     /// Finite and > 0 (a tolerance, a step cap).
-    pub(crate) fn positive(&self, setting: &'static str, value: f64) -> Result<(), SettingsError> {
+    pub fn positive(&self, setting: &'static str, value: f64) -> Result<(), SettingsError> {
         if value.is_finite() && value > 0.0 {
             Ok(())
         } else {
@@ -41,7 +42,7 @@ impl Guard {
     }
 
     /// Finite and ≥ 0 (a tolerance that may be zero).
-    pub(crate) fn non_negative(&self, setting: &'static str, value: f64) -> Result<(), SettingsError> {
+    pub fn non_negative(&self, setting: &'static str, value: f64) -> Result<(), SettingsError> {
         if value.is_finite() && value >= 0.0 {
             Ok(())
         } else {
@@ -50,11 +51,7 @@ impl Guard {
     }
 
     /// ≥ 0, +∞ allowed (a threshold that may be switched off).
-    pub(crate) fn non_negative_or_infinite(
-        &self,
-        setting: &'static str,
-        value: f64,
-    ) -> Result<(), SettingsError> {
+    pub fn non_negative_or_infinite(&self, setting: &'static str, value: f64) -> Result<(), SettingsError> {
         if value >= 0.0 {
             Ok(())
         } else {
@@ -63,7 +60,7 @@ impl Guard {
     }
 
     /// A count of at least one.
-    pub(crate) fn at_least_one(&self, setting: &'static str, value: usize) -> Result<(), SettingsError> {
+    pub fn at_least_one(&self, setting: &'static str, value: usize) -> Result<(), SettingsError> {
         if value >= 1 {
             Ok(())
         } else {

@@ -315,3 +315,56 @@ fn a_misfit_well_above_round_off_still_restarts() {
     assert!(est.last.max_rel_diff() > 100.0 * round_off, "misfit {:e}", est.last.max_rel_diff());
     assert_eq!(restarts, 1, "{} evaluations", est.evaluations);
 }
+
+#[test]
+fn every_registered_local_strategy_recovers_the_chain_from_a_nearby_start() {
+    let p = problem(&[3e4, 1e4]);
+    let reg = registry::Registry::builtin();
+    for name in reg.names() {
+        let (_, method) = reg.build(&name).unwrap();
+        let registry::Method::Local(mut strategy) = method else { continue };
+        let est = Driver::default().run(&p, strategy.as_mut(), &[2.5e4, 1.3e4]).unwrap();
+        assert!(est.termination.is_converged(), "{name}: {}", est.termination);
+        let tol = if matches!(name.as_str(), "newton" | "p-step") { 1e-2 } else { 1e-6 };
+        assert!((est.parameters[0] / 3e4 - 1.0).abs() < tol, "{name}: {:?}", est.parameters);
+        assert!((est.parameters[1] / 1e4 - 1.0).abs() < tol, "{name}: {:?}", est.parameters);
+    }
+}
+
+#[test]
+fn trf_and_line_search_keep_every_iterate_within_the_bounds_from_far_starts() {
+    let p = problem(&[3e4, 1e4]);
+    for name in ["trf", "gn-line-search"] {
+        let (_, registry::Method::Local(mut strategy)) = registry::build(name).unwrap() else { panic!() };
+        // Four and five decades off, the first towards the lower bound 1e-3.
+        let est = Driver::default().run(&p, strategy.as_mut(), &[1e0, 1e9]).unwrap();
+        for r in &est.history {
+            assert!(r.parameters.iter().all(|&k| (1e-3..=1e9).contains(&k)), "{name}: {:?}", r.parameters);
+        }
+        assert!(est.evaluations < 200, "{name}: {} evaluations", est.evaluations);
+    }
+}
+
+#[test]
+fn the_registry_refuses_unknown_names_settings_values_and_duplicates() {
+    let err = registry::build("gauss").unwrap_err().to_string();
+    assert!(err.contains("`gauss`") && err.contains("trf") && err.contains("tmcmc"), "{err}");
+    let err = registry::build("damped:max_trails=3").unwrap_err().to_string();
+    assert!(err.contains("max_trails") && err.contains("max_trials"), "{err}");
+    let err = registry::build("damped:max_trials=x").unwrap_err().to_string();
+    assert!(err.contains("max_trials") && err.contains("`x`"), "{err}");
+    let err = registry::build("damped:max_trials=0").unwrap_err().to_string();
+    assert!(err.contains("max_trials") && err.contains("at least 1"), "{err}");
+    let err = registry::build("trf:max_step=-1").unwrap_err().to_string();
+    assert!(err.contains("max_step"), "{err}");
+    let (name, _) = registry::build("levenberg-marquardt:max_trials=4").unwrap();
+    assert_eq!(name, "damped:max_trials=4");
+    let mut reg = registry::Registry::builtin();
+    let dup = registry::FnFactory::new("trf", "again", &[], |_| {
+        Ok(registry::Method::Local(Box::new(Newton::default())))
+    });
+    assert_eq!(
+        reg.register(std::sync::Arc::new(dup)).unwrap_err(),
+        registry::StrategyError::Duplicate("trf".into())
+    );
+}

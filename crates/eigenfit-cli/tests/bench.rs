@@ -1,0 +1,316 @@
+//! Issue 32's contracts end to end through the binary: `estimate --strategy tmcmc` (the
+//! posterior against a quadrature reference computed here, the same seed giving the same
+//! samples) and `eigenfit bench` (records, summary, problem files, JSON lines).
+
+mod common;
+
+use eigenfit_core::eigen::{DenseSolver, EigenSolver};
+use eigenfit_core::model::StructuralModel;
+use eigenfit_rotor::{presets, UpdatableRotor};
+use serde_json::Value;
+use std::process::Command;
+
+fn eigenfit(args: &[&str]) -> (i32, Value, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs");
+    let stdout = String::from_utf8(out.stdout).expect("utf-8");
+    let stderr = String::from_utf8(out.stderr).expect("utf-8");
+    let json = serde_json::from_str(&stdout).unwrap_or(Value::Null);
+    (out.status.code().unwrap_or(-1), json, stderr)
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+/// The paper rotor's lowest three frequencies at `k`, each with std `rel`·f, as CSV text.
+fn paper_csv(k: [f64; 2], rel: f64) -> (String, Vec<f64>, Vec<f64>) {
+    let rotor = UpdatableRotor::new(presets::paper_rotor()).unwrap();
+    let f = DenseSolver.lowest(&rotor.assemble(&k).unwrap(), 3).unwrap().frequencies_hz();
+    let sigma: Vec<f64> = f.iter().map(|f| rel * f).collect();
+    let mut text = "mode,frequency_hz,std_hz\n".to_string();
+    for (i, (f, s)) in f.iter().zip(&sigma).enumerate() {
+        text.push_str(&format!("{},{f},{s}\n", i + 1));
+    }
+    (text, f, sigma)
+}
+
+#[test]
+fn tmcmc_posterior_and_evidence_agree_with_quadrature_on_the_paper_rotor() {
+    let scratch = common::scratch();
+    let (text, measured, sigma) = paper_csv([1e5, 2e5], 0.01);
+    let csv = common::write_in(&scratch, "m.csv", &text);
+    let args =
+        ["estimate", "--preset", "paper-rotor", "--measured", csv.to_str().unwrap(), "--strategy", "tmcmc"];
+    let (code, v, err) = eigenfit(&[&args[..], &["--samples", "1000", "--seed", "5", "--json"]].concat());
+    assert_eq!(code, 0, "{err}");
+    let post = &v["posterior"];
+    let keys: Vec<&String> = v["parameters"].as_object().unwrap().keys().collect();
+    assert_eq!(keys, ["k_K1", "k_K2"]);
+    let samples = post["samples"].as_array().unwrap();
+    assert_eq!(samples.len(), 1000);
+    assert!(samples.iter().all(|s| s.as_array().unwrap().len() == 2));
+
+    // Quadrature over (ln k1, ln k2) on a grid covering the posterior (its mass lies within
+    // ±1 of the truth in each); prior uniform in ln k over the rotor's bounds [1e-6, 1e15].
+    let rotor = UpdatableRotor::new(presets::paper_rotor()).unwrap();
+    let (n, half) = (201, 1.0);
+    let h = 2.0 * half / (n - 1) as f64;
+    let mut cells = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let s = [1e5f64.ln() - half + i as f64 * h, 2e5f64.ln() - half + j as f64 * h];
+            let f = DenseSolver
+                .lowest(&rotor.assemble(&[s[0].exp(), s[1].exp()]).unwrap(), 3)
+                .unwrap()
+                .frequencies_hz();
+            let ll: f64 = (0..3)
+                .map(|k| {
+                    -0.5 * ((measured[k] - f[k]) / sigma[k]).powi(2)
+                        - (sigma[k] * (2.0 * std::f64::consts::PI).sqrt()).ln()
+                })
+                .sum();
+            cells.push((s, ll));
+        }
+    }
+    let max = cells.iter().map(|c| c.1).fold(f64::NEG_INFINITY, f64::max);
+    let mass: f64 = cells.iter().map(|c| (c.1 - max).exp()).sum();
+    let width = 1e15f64.ln() - 1e-6f64.ln();
+    let log_z = max + (mass * h * h).ln() - 2.0 * width.ln();
+    let mut mean = [0.0; 2];
+    for (s, ll) in &cells {
+        let w = (ll - max).exp() / mass;
+        mean[0] += w * s[0].exp();
+        mean[1] += w * s[1].exp();
+    }
+    let mut var = [0.0; 2];
+    for (s, ll) in &cells {
+        let w = (ll - max).exp() / mass;
+        var[0] += w * (s[0].exp() - mean[0]).powi(2);
+        var[1] += w * (s[1].exp() - mean[1]).powi(2);
+    }
+    // Edges of the grid carry nothing: the grid covers the posterior.
+    let edge = cells
+        .iter()
+        .filter(|(s, _)| (s[0] - 1e5f64.ln()).abs() > half - h || (s[1] - 2e5f64.ln()).abs() > half - h)
+        .map(|c| (c.1 - max).exp())
+        .fold(0.0, f64::max);
+    assert!(edge < 1e-6, "the grid does not cover the posterior ({edge})");
+
+    let name = ["k_K1", "k_K2"];
+    for i in 0..2 {
+        let (m, s) = (post["mean"][name[i]].as_f64().unwrap(), post["std"][name[i]].as_f64().unwrap());
+        let sd = var[i].sqrt();
+        eprintln!("{}: tmcmc {m:.1} ± {s:.1}, quadrature {:.1} ± {sd:.1}", name[i], mean[i]);
+        assert!((m - mean[i]).abs() < 0.15 * sd, "{}: mean {m} vs {}", name[i], mean[i]);
+        assert!((s / sd - 1.0).abs() < 0.15, "{}: std {s} vs {sd}", name[i]);
+        let c = numbers(&post["credible_95"][name[i]]);
+        assert!(
+            c[0] < mean[i] && mean[i] < c[1] && (c[1] - c[0]) / sd > 3.2 && (c[1] - c[0]) / sd < 4.6,
+            "{c:?}"
+        );
+    }
+    let got = post["log_evidence"].as_f64().unwrap();
+    eprintln!("ln Z: tmcmc {got:.3}, quadrature {log_z:.3}");
+    assert!((got - log_z).abs() < 0.25, "ln Z {got} vs {log_z}");
+
+    // The same seed, the same samples; another seed, others.
+    let (_, again, _) = eigenfit(&[&args[..], &["--samples", "1000", "--seed", "5", "--json"]].concat());
+    assert_eq!(again["posterior"]["samples"], post["samples"]);
+    let (_, other, _) = eigenfit(&[&args[..], &["--samples", "1000", "--seed", "6", "--json"]].concat());
+    assert_ne!(other["posterior"]["samples"], post["samples"]);
+}
+
+#[test]
+fn tmcmc_needs_std_and_samples_only_for_samplers() {
+    let scratch = common::scratch();
+    let csv = common::write_in(&scratch, "m.csv", "mode,frequency_hz\n1,36.0\n2,150.0\n");
+    let (code, _, err) = eigenfit(&[
+        "estimate",
+        "--preset",
+        "paper-rotor",
+        "--measured",
+        csv.to_str().unwrap(),
+        "--strategy",
+        "tmcmc",
+        "--json",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("std_hz"), "{err}");
+    let (code, _, err) = eigenfit(&[
+        "estimate",
+        "--preset",
+        "paper-rotor",
+        "--measured",
+        csv.to_str().unwrap(),
+        "--samples",
+        "10",
+        "--json",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("not a sampler"), "{err}");
+    let (code, _, err) = eigenfit(&[
+        "estimate",
+        "--preset",
+        "paper-rotor",
+        "--measured",
+        csv.to_str().unwrap(),
+        "--strategy",
+        "gauss",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("unknown strategy `gauss`") && err.contains("trf"), "{err}");
+}
+
+#[test]
+fn bench_prints_records_and_summary_for_builtin_and_file_problems() {
+    let scratch = common::scratch();
+    let model =
+        std::fs::canonicalize(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/rotor.toml")).unwrap();
+    std::fs::copy(&model, scratch.path().join("rotor.toml")).unwrap();
+    // Data for the file problem from the model at its truth, through the CLI.
+    let (_, sim, _) = eigenfit(&[
+        "simulate",
+        "--model",
+        model.to_str().unwrap(),
+        "--stiffness",
+        "3e5,8e4",
+        "--modes",
+        "3",
+        "--json",
+    ]);
+    let mut csv = "mode,frequency_hz,std_hz\n".to_string();
+    for (i, f) in numbers(&sim["frequencies_hz"]).iter().enumerate() {
+        csv.push_str(&format!("{},{f},{}\n", i + 1, 0.002 * f));
+    }
+    common::write_in(&scratch, "data.csv", &csv);
+    let problem = common::write_in(
+        &scratch,
+        "mine.toml",
+        "model = \"rotor.toml\"\nmeasured = \"data.csv\"\ntruth = { k_drive_end = 3e5, k_free_end = 8e4 }\n",
+    );
+    let records = scratch.path().join("runs.jsonl");
+    let problems = format!("paper-table3,{}", problem.display());
+    let (code, v, err) = eigenfit(&[
+        "bench",
+        "--problems",
+        &problems,
+        "--strategies",
+        "newton,p-step,damped,trf,tmcmc:samples=200",
+        "--starts",
+        "3",
+        "--seed",
+        "2",
+        "--records",
+        records.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(code == 0 || code == 3, "{code}: {err}");
+    let recs = v["records"].as_array().unwrap();
+    assert_eq!(recs.len(), 2 * 5 * 3);
+    for r in recs {
+        for key in
+            ["problem", "strategy", "start", "verdict", "evaluations", "final", "chi2", "reached_truth"]
+        {
+            assert!(r.get(key).is_some(), "{key} missing in {r}");
+        }
+    }
+    // Every strategy starts from the same points.
+    let starts = |s: &str| -> Vec<Value> {
+        recs.iter()
+            .filter(|r| r["strategy"] == s && r["problem"] == "paper-table3")
+            .map(|r| r["initial"].clone())
+            .collect()
+    };
+    assert_eq!(starts("newton"), starts("trf"));
+    // The damped strategy reaches both truths; records say where each run ended.
+    let damped: Vec<&Value> = recs.iter().filter(|r| r["strategy"] == "damped").collect();
+    assert!(damped.iter().all(|r| r["reached_truth"] == true), "{damped:?}");
+    let file_run = damped.iter().find(|r| r["problem"] != "paper-table3").unwrap();
+    assert!((file_run["final"]["k_drive_end"].as_f64().unwrap() / 3e5 - 1.0).abs() < 0.01);
+    assert!(file_run["chi2"].as_f64().unwrap() < 1e-6);
+    let summary = v["summary"].as_array().unwrap();
+    assert_eq!(summary.len(), 10);
+    for s in summary {
+        for key in ["problem", "strategy", "success_rate", "median_evaluations"] {
+            assert!(s.get(key).is_some(), "{key} missing in {s}");
+        }
+        let runs: Vec<&Value> =
+            recs.iter().filter(|r| r["problem"] == s["problem"] && r["strategy"] == s["strategy"]).collect();
+        let ok = runs.iter().filter(|r| r["reached_truth"] == true).count() as f64 / runs.len() as f64;
+        assert_eq!(s["success_rate"].as_f64().unwrap(), ok);
+    }
+    let lines = std::fs::read_to_string(&records).unwrap();
+    assert_eq!(lines.lines().count(), recs.len());
+    assert_eq!(serde_json::from_str::<Value>(lines.lines().next().unwrap()).unwrap(), recs[0]);
+    // Exit 3 exactly when some problem and strategy never reached the truth.
+    let never = summary.iter().any(|s| s["success_rate"].as_f64().unwrap() == 0.0);
+    assert_eq!(code, if never { 3 } else { 0 });
+}
+
+#[test]
+fn bench_refuses_unknown_problems_and_strategies() {
+    let (code, _, err) =
+        eigenfit(&["bench", "--problems", "paper-table9", "--strategies", "damped", "--json"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("paper-table9") && err.contains("paper-table3"), "{err}");
+    let (code, _, err) =
+        eigenfit(&["bench", "--problems", "paper-table3", "--strategies", "damped:max_trails=3"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("max_trails") && err.contains("max_trials"), "{err}");
+}
+
+#[test]
+fn posterior_columns_follow_the_json_parameters_keys_whatever_the_model_order() {
+    // Bearings named so the model's order (z first) is not the JSON's (sorted keys).
+    let scratch = common::scratch();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/rotor.toml")).unwrap();
+    let text = text
+        .replace("name = \"drive_end\"", "name = \"z_end\"")
+        .replace("name = \"free_end\"", "name = \"a_end\"");
+    let model = common::write_in(&scratch, "rotor.toml", &text);
+    let (_, sim, _) = eigenfit(&[
+        "simulate",
+        "--model",
+        model.to_str().unwrap(),
+        "--stiffness",
+        "3e5,8e4",
+        "--modes",
+        "3",
+        "--json",
+    ]);
+    let mut csv = "mode,frequency_hz,std_hz\n".to_string();
+    for (i, f) in numbers(&sim["frequencies_hz"]).iter().enumerate() {
+        csv.push_str(&format!("{},{f},{}\n", i + 1, 0.005 * f));
+    }
+    let data = common::write_in(&scratch, "m.csv", &csv);
+    let (code, v, err) = eigenfit(&[
+        "estimate",
+        "--model",
+        model.to_str().unwrap(),
+        "--measured",
+        data.to_str().unwrap(),
+        "--strategy",
+        "tmcmc",
+        "--samples",
+        "300",
+        "--seed",
+        "1",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let keys: Vec<&String> = v["parameters"].as_object().unwrap().keys().collect();
+    assert_eq!(keys, ["k_a_end", "k_z_end"]);
+    let post = &v["posterior"];
+    assert_eq!(post["columns"], serde_json::json!(["k_a_end", "k_z_end"]));
+    for (j, key) in keys.iter().enumerate() {
+        let mut col: Vec<f64> =
+            post["samples"].as_array().unwrap().iter().map(|r| r[j].as_f64().unwrap()).collect();
+        col.sort_by(f64::total_cmp);
+        let median = col[col.len() / 2];
+        let truth = if key.as_str() == "k_a_end" { 8e4 } else { 3e5 };
+        assert!((median / truth - 1.0).abs() < 0.1, "{key}: median {median}, truth {truth}");
+        let c = numbers(&post["credible_95"][key.as_str()]);
+        assert!(c[0] < truth && truth < c[1], "{key}: {c:?} misses {truth}");
+    }
+}
