@@ -17,6 +17,9 @@ It writes into crates/eigenfit-rotordynamics/tests/data/ross3/:
   * frequency_table.toml: a bearing whose coefficients are a table over whirl `frequency` (as a
     magnetic bearing or a squeeze-film damper), beside one over `speed`;
   * grid_table.toml: a bearing with a 2-D table over `speed` and `frequency`;
+  * pchip_speed_start.toml and pchip_speed_runup.csv: the PCHIP rotor with its bearings' kxx,
+    kyy off (DE x0.7, NDE x1.35), and the true rotor's 4 lowest lateral whirl frequencies from
+    2000 to 9000 rpm (ROSS 3's run_modal; std_hz 1e-3 Hz) for `estimate --write-model`;
   * ross3_reference.json: for every file, read back by `Rotor.load`, ROSS 3's damped frequencies
     (Hz), damping ratios and log decrements of the lowest lateral modes at speeds inside and outside
     the tables: `run_modal(sparse=False)` for speed tables; for whirl-frequency and 2-D tables
@@ -96,6 +99,18 @@ def speed_table_rotor(interpolation):
         interpolation=interpolation,
     )
     return rs.Rotor(shafts(), disks(), [b0, b1])
+
+
+def off_rotor(de, nde):
+    """The PCHIP rotor with kxx and kyy of DE times `de`, of NDE times `nde`."""
+    rotor = speed_table_rotor("pchip")
+    bearings = []
+    for b, f in zip(rotor.bearing_elements, [de, nde]):
+        args = {c: list(getattr(b, c)) for c in ["kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx"]}
+        args["kxx"] = [v * f for v in args["kxx"]]
+        args["kyy"] = [v * f for v in args["kyy"]]
+        bearings.append(rs.BearingElement(n=b.n, tag=b.tag, speed=SPEED_AXIS, interpolation="pchip", **args))
+    return rs.Rotor(shafts(), disks(), bearings)
 
 
 # Whirl frequencies (rad/s) of the frequency tables: 50-900 rad/s.
@@ -206,6 +221,16 @@ def main():
             "modes": [modal(loaded, rpm * RPM, matched) for rpm in rpms],
         }
         print(name, "done")
+    # A run-up of the PCHIP rotor and a start with its bearings off.
+    truth = rs.Rotor.load(OUT / "pchip_speed.toml")
+    rows = ["speed_rpm,mode,frequency_hz,std_hz"]
+    for rpm in range(2000, 9001, 1000):
+        for mode, m in enumerate(lateral(truth.run_modal(speed=rpm * RPM, num_modes=40, sparse=False))[:4]):
+            rows.append(f"{rpm},{mode + 1},{m['frequency_hz']!r},0.001")
+    (OUT / "pchip_speed_runup.csv").write_text("\n".join(rows) + "\n")
+    start_path = OUT / "pchip_speed_start.toml"
+    start_path.unlink(missing_ok=True)
+    off_rotor(0.7, 1.35).save(start_path)
     # Campbell diagrams: ROSS 3's run_campbell (its modal results at each speed).
     campbell = {}
     for name, count, matched in [("compressor.toml", 6, False), ("frequency_table.toml", 6, True)]:

@@ -296,3 +296,133 @@ fn simulate_notes_extrapolated_tables_and_unstable_modes_and_nothing_else() {
     let unstable = notes(path.to_str().unwrap(), "0");
     assert!(unstable.iter().any(|n| n.contains("unstable at 0 rpm")), "{unstable:?}");
 }
+
+/// ROSS 3's numbers for the files ROSS 3 saved (`scripts/ross3_reference.py`).
+fn ross3_reference() -> Value {
+    let text = std::fs::read_to_string(data("ross3/ross3_reference.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// The contract on ROSS 3 files: `simulate --speed RPM --modes N --json` gives the same keys as on
+/// ROSS 2 files and ROSS 3's frequencies and log decrements to 1e-6, inside and outside the
+/// tables, for tables over speed (PCHIP, linear), whirl frequency and both.
+#[test]
+fn simulate_on_ross3_files_agrees_with_ross3() {
+    let r = ross3_reference();
+    let ross2 = json(&run(&["simulate", "--model", &data("compressor.toml"), "--speed", "3000", "--modes", "4", "--json"]));
+    let mut worst = 0.0f64;
+    let mut compared = 0;
+    for (file, entry) in r["files"].as_object().unwrap() {
+        for (k, rpm) in entry["speeds_rpm"].as_array().unwrap().iter().enumerate() {
+            let expected = entry["modes"][k].as_array().unwrap();
+            let n = expected.len().min(6);
+            let v = json(&run(&[
+                "simulate",
+                "--model",
+                &data(&format!("ross3/{file}")),
+                "--speed",
+                &rpm.as_f64().unwrap().to_string(),
+                "--modes",
+                &n.to_string(),
+                "--json",
+            ]));
+            let keys = |v: &Value| {
+                let mut k: Vec<String> = v.as_object().unwrap().keys().filter(|k| *k != "notes").cloned().collect();
+                k.sort();
+                k
+            };
+            assert_eq!(keys(&v), keys(&ross2), "{file}");
+            for (i, e) in expected.iter().take(n).enumerate() {
+                let f = v["frequencies_hz"][i].as_f64().unwrap();
+                let ld = v["log_dec"][i].as_f64().unwrap();
+                let (fr, ldr) = (e["frequency_hz"].as_f64().unwrap(), e["log_dec"].as_f64().unwrap());
+                worst = worst.max((f - fr).abs() / fr).max((ld - ldr).abs() / ldr.abs().max(1.0));
+                compared += 1;
+            }
+        }
+    }
+    eprintln!("simulate on ROSS 3 files: {compared} modes, worst difference {worst:.2e}");
+    assert!(compared > 150 && worst < 1e-6, "{compared} modes, worst {worst:.3e}");
+}
+
+/// `campbell --speeds FROM:TO:COUNT --modes N --json` on ROSS 3 files against ROSS 3's run_campbell.
+#[test]
+fn campbell_on_ross3_files_agrees_with_ross3() {
+    let r = ross3_reference();
+    for (file, entry) in r["campbell"].as_object().unwrap() {
+        let modes = entry["modes"].as_u64().unwrap().to_string();
+        let v = json(&run(&[
+            "campbell",
+            "--model",
+            &data(&format!("ross3/{file}")),
+            "--speeds",
+            entry["speeds"].as_str().unwrap(),
+            "--modes",
+            &modes,
+            "--json",
+        ]));
+        let mut worst = 0.0f64;
+        for (k, row) in entry["frequencies_hz"].as_array().unwrap().iter().enumerate() {
+            for (i, f) in row.as_array().unwrap().iter().enumerate() {
+                let f = f.as_f64().unwrap();
+                worst = worst.max((v["frequencies_hz"][k][i].as_f64().unwrap() - f).abs() / f);
+            }
+        }
+        assert!(worst < 1e-6, "{file}: {worst:.3e}");
+        assert!(v["critical_speeds_rpm"].is_array(), "{file}");
+    }
+}
+
+/// `simulate --set kxx_<bearing>=VALUE` sets that coefficient: the result equals a file with the
+/// table replaced by that value; a name that does not exist is refused with exit 2 listing the
+/// names; options that mean nothing for a ROSS rotor are refused with exit 2.
+#[test]
+fn simulate_set_on_a_ross_rotor_sets_what_it_says() {
+    let model = data("ross3/pchip_speed.toml");
+    let freqs = |v: &Value| -> Vec<f64> { v["frequencies_hz"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect() };
+    let base = json(&run(&["simulate", "--model", &model, "--speed", "3000", "--modes", "4", "--json"]));
+    let set = json(&run(&[
+        "simulate", "--model", &model, "--speed", "3000", "--modes", "4", "--set", "kxx_DE=3e6", "--set", "kyy_DE=3e6", "--json",
+    ]));
+    // The same rotor written with constant kxx, kyy of DE.
+    let text = std::fs::read_to_string(&model).unwrap();
+    let mut edited = String::new();
+    let mut in_de = false;
+    for line in text.lines() {
+        if line.starts_with('[') {
+            in_de = line.contains("BearingElement_DE");
+        }
+        if in_de && (line.starts_with("kxx =") || line.starts_with("kyy =")) {
+            edited.push_str(&format!("{} = 3e6\n", &line[..3]));
+        } else {
+            edited.push_str(line);
+            edited.push('\n');
+        }
+    }
+    let scratch = common::scratch();
+    let path = common::write_in(&scratch, "edited.toml", &edited);
+    let file = json(&run(&["simulate", "--model", path.to_str().unwrap(), "--speed", "3000", "--modes", "4", "--json"]));
+    assert_eq!(freqs(&set), freqs(&file));
+    assert_ne!(freqs(&set), freqs(&base));
+    let notes = set["notes"].as_array().unwrap();
+    assert!(notes.iter().any(|n| n.as_str().unwrap().contains("kxx_DE=3000000")), "{notes:?}");
+
+    let out = run(&["simulate", "--model", &model, "--speed", "3000", "--set", "kxx_Nowhere=1e6"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("kxx_Nowhere") && err.contains("kxx_DE") && err.contains("cyy_NDE"), "{err}");
+    for extra in [
+        &["--plot", scratch.path().to_str().unwrap()][..],
+        &["--stiffness", "1e6,1e6"],
+        &["--sweep", "1e5:1e8:5"],
+        &["--effect", "support-mass@1=2"],
+    ] {
+        let mut args = vec!["simulate", "--model", &model, "--speed", "3000"];
+        args.extend_from_slice(extra);
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(extra[0]) && err.contains("ROSS"), "{extra:?}: {err}");
+    }
+    assert!(std::fs::read_dir(scratch.path()).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().ends_with(".svg")));
+}

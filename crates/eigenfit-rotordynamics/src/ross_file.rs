@@ -413,3 +413,81 @@ fn number(v: &Value) -> Option<f64> {
         _ => None,
     }
 }
+
+/// The text of a ROSS rotor file with bearing coefficients multiplied: each `(tag, coefficient,
+/// factor)` multiplies every value of that bearing's table (a number, a list over one axis, or a
+/// 2-D table), leaving everything else — `ross_version`, axes, `interpolation`, other elements —
+/// as the file had it, so the file stays one of its ROSS version. Written in the input's format
+/// (JSON for JSON, TOML otherwise).
+///
+/// A ROSS 3 table (PCHIP or linear) scaled this way is exactly the scaled curve. A ROSS 2 table is
+/// re-smoothed by FITPACK when read, with a smoothing budget that does not scale with the
+/// values, so its curve can differ from the scaled one by up to the smoothing residual.
+pub fn write_scaled(text: &str, changes: &[(String, String, f64)]) -> Result<String, RotorDynError> {
+    let mut root = root_of(text)?;
+    let Value::Object(map) = &mut root else {
+        return Err(RotorDynError::File("expected a table of elements".into()));
+    };
+    for (tag, coefficient, factor) in changes {
+        let table = map
+            .iter_mut()
+            .filter(|(key, _)| !is_metadata(key))
+            .find_map(|(key, value)| {
+                let t = value.as_object_mut()?;
+                let own = t.get("tag").and_then(Value::as_str).map(str::to_string);
+                let key_tag = key.split_once('_').map(|(_, t)| t.to_string());
+                (own.or(key_tag).as_deref() == Some(tag.as_str()) && t.contains_key("kxx")).then_some(t)
+            })
+            .ok_or_else(|| RotorDynError::Model(format!("no bearing `{tag}` in the file")))?;
+        if !table.contains_key(coefficient.as_str()) {
+            // ROSS fills kyy from kxx and cyy from cxx when they are not given.
+            let fallback = match coefficient.as_str() {
+                "kyy" => table.get("kxx").cloned(),
+                "cyy" => table.get("cxx").cloned(),
+                _ => None,
+            };
+            match fallback {
+                Some(v) => {
+                    table.insert(coefficient.clone(), v);
+                }
+                None => continue, // absent: zero, and zero times any factor
+            }
+        }
+        let value = table.get_mut(coefficient.as_str()).expect("present");
+        scale_value(value, *factor)
+            .map_err(|v| RotorDynError::Model(format!("`{tag}` {coefficient}: {v} is not a number")))?;
+    }
+    if text.trim_start().starts_with('{') {
+        serde_json::to_string_pretty(&root).map_err(|e| RotorDynError::File(e.to_string()))
+    } else {
+        toml::to_string(&root).map_err(|e| RotorDynError::File(format!("cannot write TOML: {e}")))
+    }
+}
+
+/// A ROSS rotor file's text in the format ROSS reads for `path` (JSON for `.json`, TOML otherwise;
+/// ROSS's `load_data` goes by the extension).
+pub fn in_format_for(text: &str, path: &Path) -> Result<String, RotorDynError> {
+    let json_out = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let json_in = text.trim_start().starts_with('{');
+    if json_out == json_in {
+        return Ok(text.to_string());
+    }
+    let root = root_of(text)?;
+    if json_out {
+        serde_json::to_string_pretty(&root).map_err(|e| RotorDynError::File(e.to_string()))
+    } else {
+        toml::to_string(&root).map_err(|e| RotorDynError::File(format!("cannot write TOML: {e}")))
+    }
+}
+
+fn scale_value(v: &mut Value, factor: f64) -> Result<(), String> {
+    match v {
+        Value::Array(items) => items.iter_mut().try_for_each(|x| scale_value(x, factor)),
+        Value::Null => Ok(()),
+        other => {
+            let x = number(other).ok_or_else(|| other.to_string())?;
+            *other = serde_json::Number::from_f64(x * factor).map(Value::Number).ok_or_else(|| other.to_string())?;
+            Ok(())
+        }
+    }
+}

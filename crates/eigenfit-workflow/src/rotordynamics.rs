@@ -10,6 +10,7 @@ use eigenfit_rotordynamics::identify::{
     bearing_parameters, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
 };
 use eigenfit_rotordynamics::search::identify_from_best_start;
+use eigenfit_rotordynamics::interpolation::Coefficient;
 use eigenfit_rotordynamics::{campbell, ross_file, rpm_to_rad, Campbell, Rotor, RotorDynError};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -29,6 +30,12 @@ fn to_workflow(e: RotorDynError) -> WorkflowError {
         RotorDynError::Solver(m) => WorkflowError::Failure(m),
         other => input(other.to_string()),
     }
+}
+
+/// A ROSS rotor file's text in the format ROSS reads for `path` (JSON for `.json`, TOML
+/// otherwise).
+pub fn ross_text_for(text: &str, path: &Path) -> Result<String, WorkflowError> {
+    ross_file::in_format_for(text, path).map_err(|e| input(format!("{}: {e}", path.display())))
 }
 
 /// Loads a ROSS rotor, errors naming the file.
@@ -74,9 +81,79 @@ pub struct SpeedReport {
 /// eigen-solver within ±1e-13 of 0 (rotor_example: |ζ| ≤ 6.2e-14 at 0 and 5000 rpm).
 const UNSTABLE_BELOW: f64 = -1e-9;
 
+/// The names `--set` takes on a ROSS rotor: `<coefficient>_<bearing tag>` for every bearing
+/// and seal, the coefficients in ROSS's names (stiffness N/m, damping N·s/m, added mass kg).
+pub fn settable_names(rotor: &Rotor) -> Vec<String> {
+    rotor
+        .bearings
+        .iter()
+        .flat_map(|b| SETTABLE.iter().map(move |c| format!("{c}_{}", b.tag)))
+        .collect()
+}
+
+/// Bearing coefficients `--set` can set, in ROSS's names and [`Bearing`]'s order (k, c, m).
+///
+/// [`Bearing`]: eigenfit_rotordynamics::elements::Bearing
+const SETTABLE: [&str; 12] = ["kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy", "mxx", "mxy", "myx", "myy"];
+
+/// Applies `--set NAME=VALUE` items to a ROSS rotor: the named bearing coefficient becomes VALUE at
+/// every speed and whirl frequency (its table, if any, is replaced). A name that is not one of
+/// [`settable_names`] is refused, listing them.
+pub fn apply_sets(rotor: &mut Rotor, sets: &[String]) -> Result<Vec<String>, WorkflowError> {
+    let mut notes = Vec::new();
+    for item in sets {
+        let (name, value) =
+            item.split_once('=').ok_or_else(|| input(format!("--set `{item}`: expected NAME=VALUE")))?;
+        let name = name.trim();
+        let value: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| input(format!("--set `{item}`: `{}` is not a finite number", value.trim())))?;
+        let hit = rotor.bearings.iter_mut().find_map(|b| {
+            let c = SETTABLE.iter().position(|c| format!("{c}_{}", b.tag) == name)?;
+            let tag = b.tag.clone();
+            let slot = match c {
+                0..=3 => &mut b.k[c],
+                4..=7 => &mut b.c[c - 4],
+                _ => &mut b.m[c - 8],
+            };
+            let was_table = !matches!(slot, Coefficient::Constant(_));
+            *slot = Coefficient::Constant(value);
+            Some((tag, was_table))
+        });
+        match hit {
+            Some((tag, true)) => notes.push(format!(
+                "--set {name}={value}: the table of {tag}'s {} is replaced by this value at every speed",
+                &name[..3]
+            )),
+            Some(_) => {}
+            None => {
+                return Err(input(format!(
+                    "--set: `{name}` is not a bearing coefficient of this rotor; the names are {}",
+                    settable_names(rotor).join(", ")
+                )))
+            }
+        }
+    }
+    Ok(notes)
+}
+
 /// `simulate --model ROSS-FILE [--speed RPM] --modes N`: damped modes at one speed.
 pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize) -> Result<SpeedReport, WorkflowError> {
-    let rotor = load(path)?;
+    simulate_with(path, speed_rpm, modes, &[])
+}
+
+/// [`simulate`] with `--set NAME=VALUE` bearing coefficients (see [`apply_sets`]).
+pub fn simulate_with(
+    path: &Path,
+    speed_rpm: Option<f64>,
+    modes: usize,
+    sets: &[String],
+) -> Result<SpeedReport, WorkflowError> {
+    let mut rotor = load(path)?;
+    let set_notes = apply_sets(&mut rotor, sets)?;
     let rpm = speed_rpm.unwrap_or(0.0);
     check_speed("--speed", rpm)?;
     if modes == 0 || modes > rotor.dofs() {
@@ -90,7 +167,9 @@ pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize) -> Result<Spe
         )));
     }
     let shown = &all[..modes];
-    let mut notes = rotor.extrapolation_notes(&[rpm]);
+    let mut notes = set_notes;
+    notes.extend(rotor.extrapolation_notes(&[rpm]));
+    notes.extend(rotor.whirl_extrapolation_notes(&shown.iter().map(|m| m.eigenvalue.im).collect::<Vec<_>>()));
     let unstable: Vec<String> = (0..modes)
         .filter(|&i| shown[i].damping_ratio() < UNSTABLE_BELOW)
         .map(|i| (i + 1).to_string())
@@ -178,6 +257,10 @@ pub struct RunupEstimateReport {
     /// Intervals, with std only.
     #[serde(flatten)]
     pub with_std: Option<RunupIntervals>,
+    /// With `--write-model`: the input ROSS file, of its version, with the estimated bearing
+    /// coefficients (each table multiplied by its estimated factor).
+    #[serde(skip)]
+    pub updated_model: Option<String>,
 }
 
 /// The part of a run-up estimate that needs standard deviations.
@@ -231,9 +314,112 @@ pub fn estimate(
     refits: usize,
     budget: usize,
 ) -> Result<RunupEstimateReport, WorkflowError> {
+    let options = RunupOptions { selection, initial: None, write_model: false };
+    estimate_with(path, measured, &options, max_iterations, refits, budget)
+}
+
+/// What a run-up estimate may be asked beyond the fit's limits.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunupOptions<'a> {
+    /// `--parameters`: the coefficients to estimate (default kxx, kyy of every bearing).
+    pub selection: Option<&'a str>,
+    /// `--initial`: where the fit starts, in the parameters' units at the lowest measured speed —
+    /// `V1,V2,…` (one per parameter, in order) or `NAME=VALUE,…` (the others at the file's).
+    pub initial: Option<&'a str>,
+    /// `--write-model`: build the ROSS file of the input's version with the estimated tables
+    /// ([`RunupEstimateReport::updated_model`]).
+    pub write_model: bool,
+}
+
+/// Options of `estimate` that a run-up fit on a ROSS rotor has no meaning for: the first given is
+/// refused before any work, naming it.
+pub fn refuse_planar_options(strategy: &str, residual: &str, given: &[(&str, bool)]) -> Result<(), WorkflowError> {
+    if !matches!(strategy, "damped" | "levenberg-marquardt") {
+        return Err(input(format!(
+            "--strategy {strategy}: a run-up fit on a two-plane (ROSS) rotor is Levenberg–Marquardt (damped) only"
+        )));
+    }
+    if residual != "relative" {
+        return Err(input(format!(
+            "--residual {residual}: a run-up fit's residual is set by its CSV (in std_hz when given, relative otherwise)"
+        )));
+    }
+    match given.iter().find(|(_, on)| *on) {
+        Some((flag, _)) => Err(input(format!(
+            "{flag} is not available for two-plane (ROSS) rotors: a run-up fit uses the whirl frequencies of the run-up CSV"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// The starting factors (multiples of the file's coefficients) for `--initial`.
+fn initial_factors(
+    text: Option<&str>,
+    params: &[eigenfit_rotordynamics::identify::Parameter],
+    rotor: &Rotor,
+    w0: f64,
+) -> Result<Vec<f64>, WorkflowError> {
+    let mut factors = vec![1.0; params.len()];
+    let Some(text) = text else { return Ok(factors) };
+    let names = || params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ");
+    let items: Vec<&str> = text.split(',').map(str::trim).filter(|s| !s.is_empty()).collect();
+    let mut values: Vec<(usize, f64)> = Vec::new();
+    if items.iter().any(|i| i.contains('=')) {
+        for item in &items {
+            let (name, value) = item
+                .split_once('=')
+                .ok_or_else(|| input(format!("--initial `{item}`: expected NAME=VALUE like the other items")))?;
+            let i = params.iter().position(|p| p.name == name.trim()).ok_or_else(|| {
+                input(format!("--initial: `{}` is not an estimated parameter; they are {}", name.trim(), names()))
+            })?;
+            values.push((i, crate::overrides::parse_list("--initial", value)?[0]));
+        }
+    } else {
+        let list = crate::overrides::parse_list("--initial", text)?;
+        if list.len() != params.len() {
+            return Err(input(format!(
+                "--initial: {} values given but {} parameters are estimated ({})",
+                list.len(),
+                params.len(),
+                names()
+            )));
+        }
+        values.extend(list.into_iter().enumerate());
+    }
+    for (i, v) in values {
+        let nominal = params[i].nominal(rotor, w0);
+        let factor = v / nominal;
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(input(format!(
+                "--initial: {}={v} must have the sign of the file's value {nominal:.6e} there (the fit scales \
+                 the coefficient's table by a positive factor)",
+                params[i].name
+            )));
+        }
+        factors[i] = factor;
+    }
+    Ok(factors)
+}
+
+/// [`estimate`] with `--initial` and `--write-model` (see [`RunupOptions`]).
+pub fn estimate_with(
+    path: &Path,
+    measured: &Path,
+    options: &RunupOptions<'_>,
+    max_iterations: usize,
+    refits: usize,
+    budget: usize,
+) -> Result<RunupEstimateReport, WorkflowError> {
     let rotor = load(path)?;
+    if rotor.has_whirl_tables() {
+        return Err(input(format!(
+            "{}: a bearing's coefficients are a table over whirl frequency; the run-up fit evaluates \
+             bearings at the rotor speed and is not available for such rotors (simulate and campbell are)",
+            path.display()
+        )));
+    }
     let points = read_runup(measured).map_err(to_workflow)?;
-    let chosen: Vec<&str> = match selection {
+    let chosen: Vec<&str> = match options.selection {
         Some(list) => list.split(',').map(str::trim).filter(|s| !s.is_empty()).collect(),
         None => DEFAULT_COEFFICIENTS.to_vec(),
     };
@@ -241,7 +427,13 @@ pub fn estimate(
     if params.is_empty() {
         return Err(input(format!("{}: the rotor has no bearings to estimate", path.display())));
     }
-    let initial = vec![1.0; params.len()];
+    let w_lowest = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
+    let initial = initial_factors(options.initial, &params, &rotor, w_lowest)?;
+    let text = if options.write_model {
+        Some(std::fs::read_to_string(path).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?)
+    } else {
+        None
+    };
     let id = identify_from_best_start(&rotor, &params, &points, &initial, max_iterations, refits, budget)
         .map_err(to_workflow)?;
     // Report each coefficient at the lowest measured speed (constant bearings: their value).
@@ -283,7 +475,23 @@ pub fn estimate(
         }),
         _ => None,
     };
+    let updated_model = match text {
+        Some(text) => {
+            let changes: Vec<(String, String, f64)> = params
+                .iter()
+                .zip(&id.scales)
+                .map(|(p, s)| {
+                    let b = &rotor.bearings[p.bearing];
+                    let name = eigenfit_rotordynamics::identify::COEFFICIENT_NAMES[p.coefficient];
+                    (b.tag.clone(), name.to_string(), *s)
+                })
+                .collect();
+            Some(ross_file::write_scaled(&text, &changes).map_err(to_workflow)?)
+        }
+        None => None,
+    };
     Ok(RunupEstimateReport {
+        updated_model,
         model: path.display().to_string(),
         outcome: id.outcome.clone(),
         verdict,
@@ -473,6 +681,11 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
     }
     let c = campbell(&rotor, &speeds, modes).map_err(|e| input(format!("{}: {e}", path.display())))?;
     let mut notes = rotor.extrapolation_notes(&speeds);
+    let whirl = c.frequencies_hz.iter().flatten().map(|f| 2.0 * std::f64::consts::PI * f);
+    let (lo, hi) = whirl.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| (a.min(w), b.max(w)));
+    if lo.is_finite() {
+        notes.extend(rotor.whirl_extrapolation_notes(&[lo, hi]));
+    }
     let unstable: Vec<String> = (0..speeds.len())
         .filter(|&k| c.log_dec[k].iter().any(|&d| d < 2.0 * std::f64::consts::PI * UNSTABLE_BELOW))
         .map(|k| format!("{:.0}", speeds[k]))
