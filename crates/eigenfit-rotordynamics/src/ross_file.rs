@@ -116,19 +116,20 @@ impl Version {
     pub fn of(root: &Map<String, Value>) -> Result<Version, RotorDynError> {
         match root.get("ross_version") {
             Some(Value::String(v)) => {
-                let major = v.split('.').next().and_then(|m| m.trim().parse::<u32>().ok()).ok_or_else(|| {
-                    RotorDynError::File(format!("ross_version \"{v}\" is not a version number"))
-                })?;
+                let major =
+                    v.split('.').next().and_then(|m| m.trim().parse::<u32>().ok()).ok_or_else(|| {
+                        RotorDynError::File(format!("ross_version \"{v}\" is not a version number"))
+                    })?;
                 Ok(if major >= 3 { Version::Three } else { Version::Two })
             }
             Some(v) => Err(RotorDynError::File(format!("ross_version {v} is not a version string"))),
-            None => Ok(
-                if root.values().any(|t| t.as_object().is_some_and(|t| t.contains_key("interpolation"))) {
+            None => {
+                Ok(if root.values().any(|t| t.as_object().is_some_and(|t| t.contains_key("interpolation"))) {
                     Version::Three
                 } else {
                     Version::Two
-                },
-            ),
+                })
+            }
         }
     }
 }
@@ -264,16 +265,24 @@ impl Entry<'_> {
                     .map(|v| number(v).ok_or_else(|| self.err(format!("`{name}` item {v} is not a number"))))
                     .collect::<Result<_, _>>()?,
             )),
-            Some(v) => Ok(Some(vec![number(v).ok_or_else(|| self.err(format!("`{name}` {v} is not a number")))?])),
+            Some(v) => {
+                Ok(Some(vec![number(v).ok_or_else(|| self.err(format!("`{name}` {v} is not a number")))?]))
+            }
         }
     }
 
     fn numbers(&self, name: &str, a: &[Value]) -> Result<Vec<f64>, RotorDynError> {
-        a.iter().map(|v| number(v).ok_or_else(|| self.err(format!("{name} item {v} is not a number")))).collect()
+        a.iter()
+            .map(|v| number(v).ok_or_else(|| self.err(format!("{name} item {v} is not a number"))))
+            .collect()
     }
 
     /// A ROSS 2 coefficient: a table over `frequency` (or `speed`) taken at the rotor speed.
-    fn coefficient_v2(&self, name: &str, speeds: Option<&[f64]>) -> Result<Option<Coefficient>, RotorDynError> {
+    fn coefficient_v2(
+        &self,
+        name: &str,
+        speeds: Option<&[f64]>,
+    ) -> Result<Option<Coefficient>, RotorDynError> {
         let what = format!("`{}` {name}", self.key);
         match self.table.get(name) {
             None | Some(Value::Null) => Ok(None),
@@ -350,7 +359,9 @@ impl Entry<'_> {
                     (Some(s), None) => (Axis::Speed, s),
                     (None, Some(f)) => (Axis::Frequency, f),
                     _ => {
-                        return Err(self.err(format!("{name} is a list but the bearing has no `speed`/`frequency` list")))
+                        return Err(self.err(format!(
+                            "{name} is a list but the bearing has no `speed`/`frequency` list"
+                        )))
                     }
                 };
                 Coefficient::from_axis(axis, points, &values, interpolation, &what).map(Some)
@@ -361,7 +372,9 @@ impl Entry<'_> {
     fn bearing(&self, tag: String, class: &str) -> Result<Bearing, RotorDynError> {
         let speed = self.axis("speed")?;
         let frequency = self.axis("frequency")?;
-        let coefficient = |name: &str, fallback: Option<&Coefficient>| -> Result<Coefficient, RotorDynError> {
+        let coefficient = |name: &str,
+                           fallback: Option<&Coefficient>|
+         -> Result<Coefficient, RotorDynError> {
             let c = match self.version {
                 Version::Two => {
                     if speed.is_some() && frequency.is_some() {
@@ -486,7 +499,9 @@ fn scale_value(v: &mut Value, factor: f64) -> Result<(), String> {
         Value::Null => Ok(()),
         other => {
             let x = number(other).ok_or_else(|| other.to_string())?;
-            *other = serde_json::Number::from_f64(x * factor).map(Value::Number).ok_or_else(|| other.to_string())?;
+            *other = serde_json::Number::from_f64(x * factor)
+                .map(Value::Number)
+                .ok_or_else(|| other.to_string())?;
             Ok(())
         }
     }

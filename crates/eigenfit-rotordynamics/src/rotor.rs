@@ -60,13 +60,12 @@ impl Rotor {
     pub fn extrapolation_notes(&self, speeds_rpm: &[f64]) -> Vec<String> {
         let mut ranges: Vec<((f64, f64), Vec<&str>)> = Vec::new();
         for b in &self.bearings {
-            let range = b
-                .k
-                .iter()
-                .chain(&b.c)
-                .chain(&b.m)
-                .find_map(|c| c.speed_range())
-                .map(|(lo, hi)| (crate::rad_to_rpm(lo), crate::rad_to_rpm(hi)));
+            let range =
+                b.k.iter()
+                    .chain(&b.c)
+                    .chain(&b.m)
+                    .find_map(|c| c.speed_range())
+                    .map(|(lo, hi)| (crate::rad_to_rpm(lo), crate::rad_to_rpm(hi)));
             let Some(range) = range else { continue };
             match ranges.iter_mut().find(|(r, _)| *r == range) {
                 Some((_, tags)) => tags.push(&b.tag),

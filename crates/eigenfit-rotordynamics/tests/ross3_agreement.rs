@@ -125,7 +125,8 @@ fn the_files_version_decides_how_tables_are_read() {
     assert_eq!(ross_file::version(&as_two).unwrap(), Version::Two);
     let three = ross_file::parse(&text).unwrap().lowest_modes(rpm_to_rad(3000.0), 6).unwrap();
     let two = ross_file::parse(&as_two).unwrap().lowest_modes(rpm_to_rad(3000.0), 6).unwrap();
-    let differ = three.iter().zip(&two).map(|(a, b)| (a.frequency_hz() - b.frequency_hz()).abs()).fold(0.0, f64::max);
+    let differ =
+        three.iter().zip(&two).map(|(a, b)| (a.frequency_hz() - b.frequency_hz()).abs()).fold(0.0, f64::max);
     assert!(differ > 1e-6, "ROSS 2 and 3 readings agree to {differ:.3e} Hz");
 }
 

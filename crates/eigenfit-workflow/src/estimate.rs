@@ -259,7 +259,11 @@ pub fn run(
         rotordynamics::refuse_planar_options(
             &request.strategy,
             &request.residual,
-            &[("--shapes", t.shapes.is_some()), ("--sensor-map", t.sensor_map.is_some()), ("--fix", !t.fix.is_empty())],
+            &[
+                ("--shapes", t.shapes.is_some()),
+                ("--sensor-map", t.sensor_map.is_some()),
+                ("--fix", !t.fix.is_empty()),
+            ],
         )?;
         progress.begin("fitting the run-up", None);
         let options = rotordynamics::RunupOptions {

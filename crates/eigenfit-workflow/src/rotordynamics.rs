@@ -9,8 +9,8 @@ use eigenfit_core::problem::Linearisation;
 use eigenfit_rotordynamics::identify::{
     bearing_parameters, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
 };
-use eigenfit_rotordynamics::search::identify_from_best_start;
 use eigenfit_rotordynamics::interpolation::Coefficient;
+use eigenfit_rotordynamics::search::identify_from_best_start;
 use eigenfit_rotordynamics::{campbell, ross_file, rpm_to_rad, Campbell, Rotor, RotorDynError};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -84,17 +84,14 @@ const UNSTABLE_BELOW: f64 = -1e-9;
 /// The names `--set` takes on a ROSS rotor: `<coefficient>_<bearing tag>` for every bearing
 /// and seal, the coefficients in ROSS's names (stiffness N/m, damping N·s/m, added mass kg).
 pub fn settable_names(rotor: &Rotor) -> Vec<String> {
-    rotor
-        .bearings
-        .iter()
-        .flat_map(|b| SETTABLE.iter().map(move |c| format!("{c}_{}", b.tag)))
-        .collect()
+    rotor.bearings.iter().flat_map(|b| SETTABLE.iter().map(move |c| format!("{c}_{}", b.tag))).collect()
 }
 
 /// Bearing coefficients `--set` can set, in ROSS's names and [`Bearing`]'s order (k, c, m).
 ///
 /// [`Bearing`]: eigenfit_rotordynamics::elements::Bearing
-const SETTABLE: [&str; 12] = ["kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy", "mxx", "mxy", "myx", "myy"];
+const SETTABLE: [&str; 12] =
+    ["kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy", "mxx", "mxy", "myx", "myy"];
 
 /// Applies `--set NAME=VALUE` items to a ROSS rotor: the named bearing coefficient becomes VALUE at
 /// every speed and whirl frequency (its table, if any, is replaced). A name that is not one of
@@ -333,7 +330,11 @@ pub struct RunupOptions<'a> {
 
 /// Options of `estimate` that a run-up fit on a ROSS rotor has no meaning for: the first given is
 /// refused before any work, naming it.
-pub fn refuse_planar_options(strategy: &str, residual: &str, given: &[(&str, bool)]) -> Result<(), WorkflowError> {
+pub fn refuse_planar_options(
+    strategy: &str,
+    residual: &str,
+    given: &[(&str, bool)],
+) -> Result<(), WorkflowError> {
     if !matches!(strategy, "damped" | "levenberg-marquardt") {
         return Err(input(format!(
             "--strategy {strategy}: a run-up fit on a two-plane (ROSS) rotor is Levenberg–Marquardt (damped) only"
@@ -366,11 +367,15 @@ fn initial_factors(
     let mut values: Vec<(usize, f64)> = Vec::new();
     if items.iter().any(|i| i.contains('=')) {
         for item in &items {
-            let (name, value) = item
-                .split_once('=')
-                .ok_or_else(|| input(format!("--initial `{item}`: expected NAME=VALUE like the other items")))?;
+            let (name, value) = item.split_once('=').ok_or_else(|| {
+                input(format!("--initial `{item}`: expected NAME=VALUE like the other items"))
+            })?;
             let i = params.iter().position(|p| p.name == name.trim()).ok_or_else(|| {
-                input(format!("--initial: `{}` is not an estimated parameter; they are {}", name.trim(), names()))
+                input(format!(
+                    "--initial: `{}` is not an estimated parameter; they are {}",
+                    name.trim(),
+                    names()
+                ))
             })?;
             values.push((i, crate::overrides::parse_list("--initial", value)?[0]));
         }
@@ -430,7 +435,10 @@ pub fn estimate_with(
     let w_lowest = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
     let initial = initial_factors(options.initial, &params, &rotor, w_lowest)?;
     let text = if options.write_model {
-        Some(std::fs::read_to_string(path).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?)
+        Some(
+            std::fs::read_to_string(path)
+                .map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?,
+        )
     } else {
         None
     };
@@ -500,12 +508,31 @@ pub fn estimate_with(
             mode: points[k].mode,
         }),
         reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
-        values: ParameterValues::new(&names, &nominal, &value, status),
+        // `initial`: where the fit started (the file's values, or --initial's).
+        values: ParameterValues::new(
+            &names,
+            &nominal.iter().zip(&initial).map(|(k, f)| k * f).collect::<Vec<_>>(),
+            &value,
+            status,
+        ),
         scales: Named::new(&names, id.scales.iter().copied()),
         cost: id.cost,
         identifiable: id.identifiable,
         refits: id.refits,
-        notes: rotor.extrapolation_notes(&points.iter().map(|p| p.speed_rpm).collect::<Vec<_>>()),
+        notes: {
+            let mut notes = Vec::new();
+            if options.initial.is_some() {
+                let start: Vec<String> = params
+                    .iter()
+                    .zip(&initial)
+                    .zip(&nominal)
+                    .map(|((p, f), k)| format!("{} = {:.6e} (×{f:.6} the file's)", p.name, k * f))
+                    .collect();
+                notes.push(format!("the fit started from --initial: {}", start.join(", ")));
+            }
+            notes.extend(rotor.extrapolation_notes(&points.iter().map(|p| p.speed_rpm).collect::<Vec<_>>()));
+            notes
+        },
         points: points
             .iter()
             .enumerate()

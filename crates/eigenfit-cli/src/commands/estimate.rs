@@ -80,7 +80,9 @@ fn request(args: &EstimateArgs) -> EstimateRequest {
 /// Runs `estimate`; returns the exit code (3 when the run did not converge, the fit is poor, a
 /// parameter sits on a limit or the budget ran out).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
-    if args.plot.is_some() && eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()).is_some() {
+    if args.plot.is_some()
+        && eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()).is_some()
+    {
         return Err(crate::error::input(
             "--plot is not available for a run-up fit on a two-plane (ROSS) rotor: draw the rotor's \
              Campbell diagram with `eigenfit campbell --plot DIR`",
