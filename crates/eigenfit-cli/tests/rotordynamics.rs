@@ -644,3 +644,50 @@ fn estimate_on_a_ross_rotor_refuses_what_it_cannot_do() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("whirl frequency"));
 }
+
+/// `campbell --operating FROM:TO`: one separation margin per critical speed, placed below, inside or
+/// above the range; a bad range exits 2 before any work.
+#[test]
+fn campbell_operating_range_gives_a_separation_margin_per_critical_speed() {
+    let model = data("ross3/pchip_speed.toml");
+    let v = json(&run(&[
+        "campbell",
+        "--model",
+        &model,
+        "--speeds",
+        "0:15000:61",
+        "--modes",
+        "4",
+        "--operating",
+        "4000:8000",
+        "--json",
+    ]));
+    let critical = v["critical_speeds_rpm"].as_array().unwrap();
+    let margins = v["separation_margins"].as_array().unwrap();
+    assert!(!critical.is_empty());
+    assert_eq!(margins.len(), critical.len());
+    for (m, c) in margins.iter().zip(critical) {
+        let rpm = c.as_f64().unwrap();
+        assert_eq!(m["rpm"].as_f64().unwrap(), rpm);
+        let expected = if rpm < 4000.0 {
+            "below"
+        } else if rpm > 8000.0 {
+            "above"
+        } else {
+            "inside"
+        };
+        assert_eq!(m["position"], expected);
+        assert_eq!(
+            m["passes"].as_bool().unwrap(),
+            m["margin_percent"].as_f64().unwrap() >= m["required_margin_percent"].as_f64().unwrap()
+                || m["required_margin_percent"].as_f64().unwrap() == 0.0
+        );
+    }
+    assert_eq!(v["operating_range_rpm"][1].as_f64().unwrap(), 8000.0);
+    let without =
+        json(&run(&["campbell", "--model", &model, "--speeds", "0:15000:61", "--modes", "4", "--json"]));
+    assert!(without.get("separation_margins").is_none());
+    let out = run(&["campbell", "--model", &model, "--speeds", "0:15000:61", "--operating", "8000:4000"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--operating"));
+}

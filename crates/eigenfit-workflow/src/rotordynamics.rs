@@ -684,6 +684,12 @@ pub fn parse_speeds(text: &str) -> Result<Vec<f64>, WorkflowError> {
 /// `frequencies_hz`, `whirl`, `log_dec`, `curves`, `critical_speeds`) and these.
 #[derive(Debug, Clone, Serialize)]
 pub struct CampbellReport {
+    /// `--operating`: the operating range (rpm).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub operating_range_rpm: Option<[f64; 2]>,
+    /// `--operating`: each critical speed's separation margin from the range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub separation_margins: Option<Vec<SeparationMargin>>,
     /// The model file.
     pub model: String,
     /// The diagram.
@@ -730,7 +736,164 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
         campbell: c,
         plots: None,
         notes,
+        operating_range_rpm: None,
+        separation_margins: None,
     })
+}
+
+/// One critical speed against the operating range, API 684 style (API 617's rule for the
+/// required separation margin from the amplification factor).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SeparationMargin {
+    /// The critical speed (rpm).
+    pub rpm: f64,
+    /// Its damping ratio ζ.
+    pub damping_ratio: f64,
+    /// Amplification factor 1/(2ζ) (`null` for ζ ≤ 0: no finite peak, unstable or undamped).
+    pub amplification_factor: Option<f64>,
+    /// Required margin (% of the nearer end of the operating range): none when AF < 2.5
+    /// (critically damped); 5 % below / 15 % above for 2.5 ≤ AF ≤ 3.55; above that
+    /// 16(1 − 1/(AF − 1.5)) % below and 10 + 17(1 − 1/(AF − 1.5)) % above (AF → ∞ for ζ ≤ 0).
+    pub required_margin_percent: f64,
+    /// Actual margin (% of the nearer end: (min − Nc)/min below, (Nc − max)/max above;
+    /// negative inside the operating range).
+    pub margin_percent: f64,
+    /// `below`, `inside` or `above` the operating range.
+    pub position: &'static str,
+    /// Whether the actual margin is at least the required one.
+    pub passes: bool,
+}
+
+/// The separation margins of `critical` against the operating range [lo, hi] rpm.
+pub fn separation_margins(
+    critical: &[eigenfit_rotordynamics::campbell::CriticalSpeed],
+    lo: f64,
+    hi: f64,
+) -> Vec<SeparationMargin> {
+    critical
+        .iter()
+        .map(|k| {
+            // ζ within round-off of 0 (an undamped rotor's come out within ±1e-13): no finite AF.
+            let af = (k.damping_ratio > -UNSTABLE_BELOW).then(|| 1.0 / (2.0 * k.damping_ratio));
+            let a = af.unwrap_or(f64::INFINITY);
+            let (position, margin) = if k.rpm < lo {
+                ("below", 100.0 * (lo - k.rpm) / lo)
+            } else if k.rpm > hi {
+                ("above", 100.0 * (k.rpm - hi) / hi)
+            } else {
+                ("inside", -100.0 * ((k.rpm - lo) / lo.max(1e-300)).min((hi - k.rpm) / hi))
+            };
+            let below = position != "above" && (position == "below" || k.rpm - lo < hi - k.rpm);
+            let required = if a < 2.5 {
+                0.0
+            } else if a <= 3.55 {
+                if below {
+                    5.0
+                } else {
+                    15.0
+                }
+            } else {
+                let r = 1.0 - 1.0 / (a - 1.5);
+                if below {
+                    16.0 * r
+                } else {
+                    10.0 + 17.0 * r
+                }
+            };
+            let passes = required == 0.0 || (position != "inside" && margin >= required);
+            SeparationMargin {
+                rpm: k.rpm,
+                damping_ratio: k.damping_ratio,
+                amplification_factor: af,
+                required_margin_percent: required,
+                margin_percent: margin,
+                position,
+                passes,
+            }
+        })
+        .collect()
+}
+
+/// [`campbell_diagram`] with `--operating FROM:TO` (rpm): each critical speed's API 684-style
+/// separation margin from the operating range.
+pub fn campbell_diagram_with(
+    path: &Path,
+    speeds: &str,
+    modes: usize,
+    operating: Option<&str>,
+) -> Result<CampbellReport, WorkflowError> {
+    let range = match operating {
+        None => None,
+        Some(text) => {
+            let bad = |why: &str| {
+                input(format!("--operating `{text}`: {why} (expected FROM:TO in rpm, e.g. 9000:11000)"))
+            };
+            let (a, b) = text.split_once(':').ok_or_else(|| bad("two fields needed"))?;
+            let a: f64 = a.trim().parse().map_err(|_| bad("FROM is not a number"))?;
+            let b: f64 = b.trim().parse().map_err(|_| bad("TO is not a number"))?;
+            if !(a.is_finite() && b.is_finite() && a > 0.0 && b >= a) {
+                return Err(bad("speeds must be finite with 0 < FROM ≤ TO"));
+            }
+            Some((a, b))
+        }
+    };
+    let mut report = campbell_diagram(path, speeds, modes)?;
+    if let Some((lo, hi)) = range {
+        let swept = report.campbell.speeds_rpm.iter().copied().fold(0.0, f64::max);
+        // The largest margin API 617 can require above the range is 27 %.
+        if swept < hi * 1.27 {
+            report.notes.push(format!(
+                "--operating {lo}:{hi}: the sweep ends at {swept} rpm, below {:.0} rpm (27 % above the range, the \
+                 largest margin required): critical speeds above it are not checked",
+                hi * 1.27
+            ));
+        }
+        report.separation_margins = Some(separation_margins(&report.campbell.critical_speeds, lo, hi));
+        report.operating_range_rpm = Some([lo, hi]);
+    }
+    Ok(report)
+}
+
+#[cfg(test)]
+mod margin_tests {
+    use super::*;
+    use eigenfit_rotordynamics::campbell::CriticalSpeed;
+    use eigenfit_rotordynamics::Whirl;
+
+    fn at(rpm: f64, zeta: f64) -> CriticalSpeed {
+        CriticalSpeed { rpm, curve: 0, whirl: Whirl::Forward, log_dec: 0.0, damping_ratio: zeta }
+    }
+
+    /// API 617's required margins: none below AF 2.5; 5 % below / 15 % above up to AF 3.55;
+    /// 16(1 − 1/(AF − 1.5)) % below and 10 + 17(1 − 1/(AF − 1.5)) % above beyond; AF 1/(2ζ).
+    #[test]
+    fn required_margins_follow_the_amplification_factor() {
+        let m = separation_margins(
+            &[
+                at(5000.0, 0.25),
+                at(8000.0, 1.0 / 6.0),
+                at(9000.0, 1.0 / 11.0),
+                at(14_000.0, 1.0 / 11.0),
+                at(13_000.0, 1e-14),
+            ],
+            10_000.0,
+            12_000.0,
+        );
+        assert_eq!(m[0].required_margin_percent, 0.0); // AF 2
+        assert!(m[0].passes);
+        assert_eq!((m[1].required_margin_percent, m[1].position), (5.0, "below")); // AF 3
+        assert!((m[1].margin_percent - 20.0).abs() < 1e-12 && m[1].passes);
+        assert!((m[2].required_margin_percent - 12.0).abs() < 1e-12); // AF 5.5, below
+        assert!((m[2].margin_percent - 10.0).abs() < 1e-12 && !m[2].passes);
+        assert!((m[3].required_margin_percent - 22.75).abs() < 1e-12); // AF 5.5, above
+        assert!((m[3].margin_percent - 100.0 * 2000.0 / 12_000.0).abs() < 1e-12 && !m[3].passes);
+        assert_eq!(m[4].amplification_factor, None); // undamped: AF infinite
+        assert_eq!((m[4].position, m[4].required_margin_percent), ("above", 27.0));
+        assert!(m[4].margin_percent > 8.3 && !m[4].passes);
+        let inside = separation_margins(&[at(11_000.0, 0.01)], 10_000.0, 12_000.0);
+        assert_eq!(inside[0].position, "inside");
+        assert!(inside[0].margin_percent < 0.0 && !inside[0].passes);
+    }
 }
 
 #[cfg(test)]
