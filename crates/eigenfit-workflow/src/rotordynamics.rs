@@ -712,7 +712,11 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
     if modes == 0 {
         return Err(input("--modes 0: at least one mode"));
     }
-    let c = campbell(&rotor, &speeds, modes).map_err(|e| input(format!("{}: {e}", path.display())))?;
+    let c = campbell(&rotor, &speeds, modes).map_err(|e| match e {
+        // A solver failure (a whirl-frequency fixed point that does not settle) is no input error.
+        RotorDynError::Solver(m) => WorkflowError::Failure(format!("{}: {m}", path.display())),
+        other => input(format!("{}: {other}", path.display())),
+    })?;
     let mut notes = rotor.extrapolation_notes(&speeds);
     let whirl = c.frequencies_hz.iter().flatten().map(|f| 2.0 * std::f64::consts::PI * f);
     let (lo, hi) = whirl.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| (a.min(w), b.max(w)));
