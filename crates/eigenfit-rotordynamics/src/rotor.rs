@@ -368,7 +368,7 @@ impl Rotor {
                 let candidates = solve(whirl)?;
                 let next = candidates
                     .into_iter()
-                    .map(|c| (crate::campbell::mac(&mode.right, &c.right), c))
+                    .map(|c| (crate::modal::mac(&mode.right, &c.right), c))
                     .max_by(|a, b| a.0.total_cmp(&b.0))
                     .map(|(_, c)| c)
                     .ok_or_else(|| RotorDynError::Solver(format!("no oscillating mode at {speed} rad/s")))?;
