@@ -117,11 +117,7 @@ fn main() {
 
 fn cell(run: &CompareRun) -> String {
     if !run.outcome.converged {
-        return format!(
-            "{} after {} it.",
-            run.outcome.termination.split(':').next().unwrap_or_default(),
-            run.outcome.iterations
-        );
+        return format!("{} after {} it.", run.outcome.termination.reason, run.outcome.iterations);
     }
     let alt = if run.alternatives.is_empty() { "" } else { ", ambiguous" };
     format!("{:.4e} / {:.4e} ({} it.{alt})", run.estimate[0], run.estimate[1], run.outcome.iterations)

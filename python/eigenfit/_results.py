@@ -133,6 +133,12 @@ class EstimateResult(Result):
         return bool(self._data.get("acceptable", self._data["converged"]))
 
     @property
+    def unique(self) -> bool:
+        """No other solution found fits the data as well (the exit code is 0 only when the
+        result is ``acceptable`` and ``unique``)."""
+        return bool(self._data.get("unique", True))
+
+    @property
     def verdict(self) -> Optional[str]:
         """The CLI's verdict on the result, in words."""
         return self._data.get("verdict")
@@ -154,8 +160,21 @@ class EstimateResult(Result):
 
     @property
     def termination(self) -> str:
-        """Why the iteration stopped."""
-        return str(self._data["termination"])
+        """Why the iteration stopped, in words (``termination_status`` and
+        ``termination_reason`` give the two parts apart)."""
+        t = self._data["termination"]
+        return str(t["detail"]) if isinstance(t, dict) else str(t)
+
+    @property
+    def termination_status(self) -> str:
+        """``converged``, ``best-found``, ``stopped`` or ``failed``."""
+        return str(self._data["termination"]["status"])
+
+    @property
+    def termination_reason(self) -> str:
+        """``tolerance``, ``exact-fit``, ``stationary``, ``restarts-used``, ``iteration-limit``,
+        ``diverged``, ``stalled`` or ``budget-exhausted``."""
+        return str(self._data["termination"]["reason"])
 
     @property
     def strategy(self) -> str:
@@ -211,7 +230,7 @@ class EstimateResult(Result):
     def identifiable(self) -> Dict[str, bool]:
         """Whether the data determine each parameter (an entry's bound, if any, is in
         ``result["identifiable"]``); empty when no uncertainty was computed."""
-        return {k: v is True for k, v in self._data.get("identifiable", {}).items()}
+        return {k: v is True for k, v in (self._data.get("identifiable") or {}).items()}
 
     @property
     def singular_values(self) -> Optional[np.ndarray]:

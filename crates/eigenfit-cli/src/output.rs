@@ -169,3 +169,62 @@ pub(crate) fn print_misfit(before: &eigenfit_core::discovery::BaseMisfit) {
         before.chi2, before.dof, before.p_value
     );
 }
+
+/// The other solutions, each with its test, and whether the estimate is unique; `sigma` says
+/// where σ came from (`std`, `residuals`, `exact`). Shared by every model kind's estimate.
+pub fn print_alternatives(alternatives: &[eigenfit_workflow::estimate::AlternativeSolution], sigma: &str) {
+    let equal = alternatives.iter().filter(|a| a.equally_good).count();
+    if equal > 0 {
+        println!(
+            "not unique: {equal} other solution{} fit{} the data as well (Δχ² below the 95 % quantile; σ from {}): \
+             the data do not determine the parameters uniquely",
+            if equal == 1 { "" } else { "s" },
+            if equal == 1 { "s" } else { "" },
+            match sigma {
+                "std" => "the given std",
+                "residuals" => "the estimate's residuals",
+                _ => "neither std nor a degree of freedom: only fits at least as good count",
+            }
+        );
+    }
+    for a in alternatives {
+        let values: Vec<String> = a.parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
+        let test = match a.delta_chi2 {
+            Some(d) => format!("Δχ² {}", significant(d)),
+            None => format!("Σr² {}", significant(a.misfit)),
+        };
+        let what = if a.equally_good { "equally good" } else { "worse (the data reject it)" };
+        let cycles: Vec<String> = a
+            .exchanged
+            .iter()
+            .map(|c| match c.as_slice() {
+                [i, j] => format!("{i} ↔ {j}"),
+                _ => format!("{} → {}", c.join(" → "), c[0]),
+            })
+            .collect();
+        if a.mirror {
+            println!(
+                "{what} mirror solution ({} exchanged, a symmetric model; {test}): {}",
+                cycles.join(", "),
+                values.join(", ")
+            );
+        } else if !cycles.is_empty() {
+            println!(
+                "{what} exchanged solution ({} exchanged, a symmetry of the frequencies; {test}): {}",
+                cycles.join(", "),
+                values.join(", ")
+            );
+        } else {
+            println!("{what} other minimum ({test}): {}", values.join(", "));
+        }
+    }
+}
+
+/// Four significant digits, in exponent form outside [1e-3, 1e5).
+pub fn significant(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e5).contains(&v.abs()) {
+        format!("{v:.4}").trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{v:.3e}")
+    }
+}

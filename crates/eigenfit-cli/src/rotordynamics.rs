@@ -1,6 +1,7 @@
 //! Two-plane rotors (files written by ROSS `Rotor.save`) in `simulate`, `estimate` and `discover`: the
 //! tables of the rotordynamics workflow's reports.
 
+use eigenfit_workflow::estimate::ParameterIdentifiability;
 use eigenfit_workflow::rotordynamics::{RunupDiscoverReport, RunupEstimateReport, SpeedReport};
 
 /// `simulate --model ROSS-FILE`: damped modes at one speed.
@@ -42,7 +43,7 @@ pub fn print_estimate(r: &RunupEstimateReport) {
         );
     }
     if !r.outcome.converged {
-        println!("stopped: {}", r.outcome.termination);
+        println!("stopped: {}", r.outcome.termination.detail);
     }
     println!("{:<28}{:>16}{:>16}{:>32}", "parameter", "initial", "estimate", "95% interval / status");
     for (((name, initial), (_, value)), (_, status)) in
@@ -73,12 +74,21 @@ pub fn print_estimate(r: &RunupEstimateReport) {
             r.fit.disagreeing_modes.iter().map(|d| format!("{} rpm mode {}", d.speed_rpm, d.mode)).collect();
         println!("disagreeing by more than 3σ: {}", list.join(", "));
     }
-    if !r.identifiable {
+    let undetermined: Vec<&str> = r
+        .identifiable
+        .iter()
+        .flat_map(|m| m.iter())
+        .filter(|(_, id)| !matches!(id, ParameterIdentifiability::Determined(true)))
+        .map(|(n, _)| n.as_str())
+        .collect();
+    if !undetermined.is_empty() {
         println!(
-            "not identifiable: the frequencies do not determine every parameter separately \
-             (an isotropic rotor's kxx and kyy act alike); no intervals"
+            "not identifiable: {} (the frequencies do not determine every parameter separately, \
+             e.g. a symmetric rotor's two bearings act alike)",
+            undetermined.join(", ")
         );
     }
+    crate::output::print_alternatives(&r.alternative_solutions, r.alternatives_sigma);
 }
 
 /// `discover --model ROSS-FILE --measured RUNUP.csv`: the calibration, the misfit test and the

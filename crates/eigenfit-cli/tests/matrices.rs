@@ -113,7 +113,7 @@ fn a_bad_matrix_file_is_bad_input_naming_it() {
     std::fs::write(&model, "kind = \"matrices\"\nstiffness = \"K.mtx\"\nmass = \"M.mtx\"\n").unwrap();
     let (code, _, err) = eigenfit(&["simulate", "--model", model.to_str().unwrap(), "--json"]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("K.mtx: not symmetric: entry (2, 1) = 3 but (1, 2) = 1"), "{err}");
+    assert!(err.contains("K.mtx: not symmetric: entry (2, 1) = 3 (line 4) but (1, 2) = 1 (line 3)"), "{err}");
 }
 
 #[test]
@@ -311,7 +311,9 @@ fn a_symmetric_structure_reports_the_mirror_that_exchanges_two_pairs_of_zones() 
         "0",
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}\n{v}");
+    // The data cannot tell the structure from its mirror image: not unique, exit 3.
+    assert_eq!(code, 3, "{err}\n{v}");
+    assert_eq!((v["verdict"].as_str(), v["acceptable"].as_bool()), (Some("not-unique"), Some(true)), "{v}");
     let found: Vec<f64> = (1..=4).map(|i| v["parameters"][format!("zone{i}")].as_f64().unwrap()).collect();
     let mirror: Vec<f64> = truth.iter().rev().copied().collect();
     let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x / y - 1.0).abs() < 1e-6);
@@ -324,6 +326,7 @@ fn a_symmetric_structure_reports_the_mirror_that_exchanges_two_pairs_of_zones() 
         .unwrap_or_else(|| panic!("no mirror reported: {v}"));
     assert_eq!(image["exchanged"], serde_json::json!([["zone1", "zone4"], ["zone2", "zone3"]]));
     assert_eq!(image["mirror_of"], Value::Null);
+    assert_eq!((image["mirror"].as_bool(), image["equally_good"].as_bool()), (Some(true), Some(true)));
     let values: Vec<f64> =
         (1..=4).map(|i| image["parameters"][format!("zone{i}")].as_f64().unwrap()).collect();
     assert!(close(&values, other), "mirror {values:?}, expected {other:?}");

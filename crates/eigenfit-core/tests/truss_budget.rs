@@ -16,7 +16,7 @@ fn the_truss_estimate_and_its_intervals_stay_within_the_budget_and_hold_the_trut
     let budget = Budget::new(5_000);
     let fit = truss::estimate(&measured, &budget);
     assert!(budget.used() <= 5_000 && !budget.exhausted(), "{} evaluations", budget.used());
-    assert!(matches!(fit.estimate.termination, Termination::Converged), "{:?}", fit.estimate.termination);
+    assert!(fit.estimate.termination.is_converged(), "{:?}", fit.estimate.termination);
     let intervals = fit.intervals.expect("intervals with std given");
     for (i, name) in GROUPS.iter().enumerate() {
         let [lo, hi] = intervals[i];

@@ -10,6 +10,9 @@ pub enum MatricesError {
     /// A file could not be read.
     #[error("{}: {source}", path.display())]
     Io { path: PathBuf, source: std::io::Error },
+    /// A file is not a regular file, is too large, or cannot be read (the message names it).
+    #[error("{detail}")]
+    Unreadable { detail: String },
     /// The model TOML is malformed (syntax, unknown key, wrong type).
     #[error("{}: {detail}", path.display())]
     Toml { path: PathBuf, detail: String },
@@ -22,10 +25,6 @@ pub enum MatricesError {
 }
 
 impl MatricesError {
-    pub(crate) fn io(path: &Path, source: std::io::Error) -> Self {
-        Self::Io { path: path.to_path_buf(), source }
-    }
-
     pub(crate) fn invalid(path: &Path, detail: impl Into<String>) -> Self {
         Self::Invalid { path: path.to_path_buf(), detail: detail.into() }
     }

@@ -102,6 +102,13 @@ impl DofLayout {
         Ok(layout)
     }
 
+    /// The same nodes with each DOF renumbered by `f` (a DOF `f` maps to `None` is left out:
+    /// a massless DOF condensed out of the model).
+    pub(crate) fn renumbered(mut self, f: impl Fn(usize) -> Option<usize>) -> Self {
+        self.dof_of = self.dof_of.into_iter().filter_map(|(k, d)| f(d).map(|d| (k, d))).collect();
+        self
+    }
+
     /// The FE tool's node number of model node `node`.
     pub fn label(&self, node: usize) -> Option<u64> {
         self.labels.get(node).copied()

@@ -23,13 +23,23 @@
 //!
 //! [`MatricesModel`] implements [`StructuralModel`](eigenfit_core::model::StructuralModel); its systems
 //! are stored sparse, for [`SparseSolver`](eigenfit_core::eigen::SparseSolver).
+//!
+//! A list of files is summed (`stiffness = ["K1.mtx", "K2.mtx"]`, also for one parameter's
+//! derivative); `format = "dmig"` (Nastran DMIG cards, [`labeled`]) or `format = "abaqus"`
+//! (`*MATRIX OUTPUT`) reads the FE codes' own files, their (node, DOF) labels becoming the DOF
+//! map. DOFs without mass (zero rows of M) are condensed out statically, exactly
+//! ([`MatricesModel::massless_dofs`], [`MatricesModel::expand_shape`]).
 
+mod condensation;
 mod error;
+pub mod labeled;
+mod labeled_model;
 mod layout;
 pub mod market;
 mod model;
 mod symmetry;
 
+pub use condensation::MAX_CONDENSED_DOFS;
 pub use error::MatricesError;
 pub use layout::{Dof, DofLayout, DofLayoutError};
 pub use model::MatricesModel;

@@ -12,7 +12,6 @@
 
 use crate::error::MatricesError;
 use eigenfit_core::matrix::CscSymmetric;
-use nalgebra_sparse::io::load_coo_from_matrix_market_str;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -20,15 +19,46 @@ use std::path::Path;
 /// file must agree: exports print 15–17 significant digits, round-off of assembly stays far below.
 const SYMMETRY_TOLERANCE: f64 = 1e-10;
 
-/// Reads the symmetric matrix in `path`; `expected` is the size it must have, if known.
+/// Largest Matrix Market file read (bytes): a 10⁶-DOF solid model's stiffness is a few GB.
+pub const MAX_MATRIX_FILE_BYTES: u64 = 16 << 30;
+
+/// Largest matrix size read: the size line is checked against it before anything is allocated
+/// (every DOF costs the solvers some hundred bytes of vectors).
+pub const MAX_DOFS: usize = 20_000_000;
+
+/// Fewest bytes an entry line takes (`1 1 1` and its line end): the entry count a size line may
+/// declare is bounded by the bytes after it.
+const MIN_ENTRY_BYTES: usize = 6;
+
+/// Reads the symmetric matrix in `path`; `expected` is the size it must have, if known. The
+/// file must be a regular file of at most [`MAX_MATRIX_FILE_BYTES`] (a FIFO or a device is
+/// refused before it is opened for reading).
 pub fn read_symmetric(path: &Path, expected: Option<usize>) -> Result<CscSymmetric, MatricesError> {
-    let text = std::fs::read_to_string(path).map_err(|e| MatricesError::io(path, e))?;
+    let text = read_matrix_text(path)?;
     parse_symmetric(&text, expected)
         .map_err(|e| MatricesError::Matrix { path: path.to_path_buf(), detail: e.detail })
 }
 
+/// The text of a matrix file (any format) after the regular-file and size checks.
+pub(crate) fn read_matrix_text(path: &Path) -> Result<String, MatricesError> {
+    let bytes = eigenfit_core::measurement::measured_csv::read_checked_file(
+        path,
+        MAX_MATRIX_FILE_BYTES,
+        "a matrix file",
+    )
+    .map_err(|detail| MatricesError::Unreadable { detail })?;
+    String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let line = bytes[..e.utf8_error().valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+        MatricesError::Matrix {
+            path: path.to_path_buf(),
+            detail: format!("line {line}: not text (a byte that is not UTF-8): a matrix file is text"),
+        }
+    })
+}
+
 /// Text that is not a symmetric real Matrix Market matrix. `detail` says what is wrong and
-/// where: the header, the size line, or the entry or line (1-based, as in the file).
+/// where: the header, the size line, or the entry and its line (1-based, as in the file).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{detail}")]
 pub struct MarketError {
@@ -36,25 +66,31 @@ pub struct MarketError {
     pub detail: String,
 }
 
-/// [`read_symmetric`] on the file's text.
+/// [`read_symmetric`] on the file's text: one reader whatever the size, one pass over the
+/// lines with the standard library's (correctly rounded) number parsing. The size line is
+/// checked — square, at most [`MAX_DOFS`], the `expected` size, no more entries than the
+/// bytes after it can hold — before anything is allocated; then every entry: three fields,
+/// whole 1-based indices within the size, a finite value, and the count the size line declares.
 pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetric, MarketError> {
-    parse_with(text, expected, text.len() >= LARGE_FILE_BYTES).map_err(|detail| MarketError { detail })
+    parse(text, expected).map_err(|detail| MarketError { detail })
 }
 
-/// [`parse_symmetric`] with the entries read by [`read_entries_streaming`] or by the kept reader.
-fn parse_with(text: &str, expected: Option<usize>, streaming: bool) -> Result<CscSymmetric, String> {
+fn parse(text: &str, expected: Option<usize>) -> Result<CscSymmetric, String> {
     let header = text.lines().next().unwrap_or_default().to_ascii_lowercase();
     if !header.starts_with("%%matrixmarket") {
         return Err("not a Matrix Market file: the first line must start with `%%MatrixMarket`".into());
     }
     let words: Vec<&str> = header.split_whitespace().collect();
+    if words.get(1) != Some(&"matrix") {
+        return Err(format!("header `{}`: the object must be `matrix`", header.trim()));
+    }
     if words.get(2) != Some(&"coordinate") {
         return Err(format!(
             "header `{}`: only the sparse `coordinate` format is read (not `array`)",
             header.trim()
         ));
     }
-    if matches!(words.get(3), Some(&"complex") | Some(&"pattern")) {
+    if !matches!(words.get(3), Some(&"real") | Some(&"integer") | Some(&"double")) {
         return Err(format!("header `{}`: the matrix must be `real` (or `integer`)", header.trim()));
     }
     let symmetric = match words.get(4) {
@@ -63,45 +99,30 @@ fn parse_with(text: &str, expected: Option<usize>, streaming: bool) -> Result<Cs
         Some(other) => return Err(format!("header `{}`: `{other}` matrices cannot be stiffness or mass matrices; use `symmetric` or `general`", header.trim())),
         None => return Err(format!("header `{}`: the symmetry field is missing", header.trim())),
     };
-    let (rows, cols, entries) = if streaming {
-        read_entries_streaming(text)?
-    } else {
-        read_entries_kept(text, symmetric || words.get(3) == Some(&"integer"))?
-    };
-    if rows != cols {
-        return Err(format!("the matrix is {rows}×{cols}: it must be square"));
-    }
-    if let Some(n) = expected {
-        if rows != n {
-            return Err(format!(
-                "the matrix is {rows}×{rows} but the model has {n} DOFs (the size of the stiffness file)"
-            ));
-        }
-    }
-    if rows == 0 {
-        return Err("the matrix has no row".into());
-    }
-    let (mut lower, mut upper) = (false, false);
+    let (n, entries) = read_entries(text, expected, symmetric)?;
+    symmetric_from_entries(n, entries, &|r, c| line_of(text, r, c))
+}
+
+/// The symmetric matrix of `entries` (0-based, as stored): one triangle is mirrored, two must
+/// agree (to 1e-10 of the largest entry), else the first disagreeing pair is named, with its
+/// lines from `line_of`.
+pub(crate) fn symmetric_from_entries(
+    n: usize,
+    entries: Vec<(usize, usize, f64)>,
+    line_of: &dyn Fn(usize, usize) -> Option<usize>,
+) -> Result<CscSymmetric, String> {
     let mut largest = 0.0_f64;
+    let (mut lower, mut upper) = (false, false);
     for &(r, c, v) in &entries {
-        if !v.is_finite() {
-            return Err(format!("entry ({}, {}) is {v}: every entry must be finite", r + 1, c + 1));
-        }
         largest = largest.max(v.abs());
         lower |= r > c;
         upper |= r < c;
     }
-    let n = rows;
     if !(lower && upper) {
         // One triangle (or a diagonal): the other is its mirror.
         return Ok(CscSymmetric::from_triplets(n, entries));
     }
-    if symmetric {
-        return Err(
-            "the header says `symmetric` (one triangle stored) but entries lie in both triangles".into()
-        );
-    }
-    // Both triangles: sum each (i, j) as stored, then compare with (j, i).
+    // Both triangles of a `general` file: sum each (i, j) as stored, then compare with (j, i).
     let mut sums: HashMap<(usize, usize), f64> = HashMap::with_capacity(entries.len());
     for &(r, c, v) in &entries {
         *sums.entry((r, c)).or_insert(0.0) += v;
@@ -126,12 +147,17 @@ fn parse_with(text: &str, expected: Option<usize>, streaming: bool) -> Result<Cs
         }
     }
     if let Some((r, c, v, w)) = disagreeing {
+        let at = |r: usize, c: usize| {
+            line_of(r, c).map_or_else(|| " (not in the file)".to_string(), |l| format!(" (line {l})"))
+        };
         return Err(format!(
-            "not symmetric: entry ({}, {}) = {v} but ({}, {}) = {w} (a `general` file must hold one triangle, or two that agree)",
+            "not symmetric: entry ({}, {}) = {v}{} but ({}, {}) = {w}{} (a `general` file must hold one triangle, or two that agree)",
             r + 1,
             c + 1,
+            at(r, c),
             c + 1,
-            r + 1
+            r + 1,
+            at(c, r)
         ));
     }
     // Symmetric: keep the lower triangle and the diagonal.
@@ -141,69 +167,105 @@ fn parse_with(text: &str, expected: Option<usize>, streaming: bool) -> Result<Cs
     ))
 }
 
-/// Files from this size on are read by [`read_entries_streaming`]: nalgebra-sparse's grammar-based
-/// parser reads about 0.5 M entries per second, 10× slower than scipy's reader on a 10⁵-DOF
-/// model's files (docs/performance.md).
-const LARGE_FILE_BYTES: usize = 1 << 20;
-
-/// Rows, columns and the entries (0-based, as stored).
-type Entries = (usize, usize, Vec<(usize, usize, f64)>);
-
-/// Size and entries by nalgebra-sparse's Matrix Market reader. `as_general`: read a `symmetric`
-/// or `integer` file as `real general` (the triangle logic of [`parse_symmetric`] is the same
-/// for both headers, an upper-triangle `symmetric` file needs no special case, and
-/// nalgebra-sparse reads `integer` entries only into integer types).
-fn read_entries_kept(text: &str, as_general: bool) -> Result<Entries, String> {
-    let text = if as_general {
-        let (_, rest) = text.split_once('\n').unwrap_or((text, ""));
-        std::borrow::Cow::Owned(format!("%%MatrixMarket matrix coordinate real general\n{rest}"))
-    } else {
-        std::borrow::Cow::Borrowed(text)
-    };
-    let coo = load_coo_from_matrix_market_str::<f64>(&text).map_err(|e| e.message().to_string())?;
-    Ok((coo.nrows(), coo.ncols(), coo.triplet_iter().map(|(r, c, &v)| (r, c, v)).collect()))
-}
-
-/// The same as [`read_entries_kept`] for large files, one pass over the lines with the standard
-/// library's number parsing (correctly rounded, as the kept reader's). Written here because no
-/// kept Rust crate reads Matrix Market faster (sprs's reader would add ndarray for this alone);
-/// the unit tests hold both readers to the same entries and the same refusals. Validates what
-/// the kept reader does: the size line, whole 1-based indices within the size, three fields
-/// per entry, the entry count the size line declares.
-fn read_entries_streaming(text: &str) -> Result<Entries, String> {
-    let mut lines = text.lines().enumerate().skip(1).filter(|(_, l)| {
+/// The data lines: (line number from 1, text), comments (`%`) and blank lines left out.
+fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines().enumerate().skip(1).map(|(i, l)| (i + 1, l)).filter(|(_, l)| {
         let l = l.trim_start();
         !l.is_empty() && !l.starts_with('%')
-    });
+    })
+}
+
+/// The line (from 1) of the first entry (r, c) (0-based) in the file, for messages.
+fn line_of(text: &str, r: usize, c: usize) -> Option<usize> {
+    data_lines(text).skip(1).find_map(|(line, l)| {
+        let mut f = l.split_ascii_whitespace();
+        let (a, b) = (f.next()?.parse::<usize>().ok()?, f.next()?.parse::<usize>().ok()?);
+        (a == r + 1 && b == c + 1).then_some(line)
+    })
+}
+
+/// Entries (row, column, value), 0-based, as stored.
+type Entries = Vec<(usize, usize, f64)>;
+
+/// The size n and the entries (0-based, as stored), every check of [`parse_symmetric`] made.
+fn read_entries(text: &str, expected: Option<usize>, symmetric: bool) -> Result<(usize, Entries), String> {
+    let mut lines = data_lines(text);
     let (size_line, size) = lines.next().ok_or("the size line (rows columns entries) is missing")?;
     let fields: Vec<&str> = size.split_ascii_whitespace().collect();
     let number = |s: &str, line: usize, what: &str| {
-        s.parse::<usize>().map_err(|_| format!("line {}: {what} `{s}` is not a whole number", line + 1))
+        s.parse::<usize>().map_err(|_| format!("line {line}: {what} `{s}` is not a whole number"))
     };
     if fields.len() != 3 {
-        return Err(format!("line {}: the size line must hold rows, columns, entries", size_line + 1));
+        return Err(format!("line {size_line}: the size line must hold rows, columns, entries"));
     }
     let rows = number(fields[0], size_line, "rows")?;
     let cols = number(fields[1], size_line, "columns")?;
     let nnz = number(fields[2], size_line, "entries")?;
+    if rows != cols {
+        return Err(format!("line {size_line}: the matrix is {rows}×{cols}: it must be square"));
+    }
+    if rows == 0 {
+        return Err(format!("line {size_line}: the matrix has no row"));
+    }
+    if let Some(n) = expected {
+        if rows != n {
+            return Err(format!(
+                "line {size_line}: the matrix is {rows}×{rows} but the model has {n} DOFs (the size of the stiffness file)"
+            ));
+        }
+    }
+    if rows > MAX_DOFS {
+        return Err(format!(
+            "line {size_line}: the matrix is {rows}×{rows}, more than the {MAX_DOFS} DOFs a model may have"
+        ));
+    }
+    // Bytes after the size line bound the entries the file can hold.
+    let after = text.split_inclusive('\n').skip(size_line).map(str::len).sum::<usize>();
+    let room = (after + 1) / MIN_ENTRY_BYTES;
+    if nnz > room {
+        return Err(format!(
+            "line {size_line}: the size line declares {nnz} entries but the {after} bytes after it hold at most {room}"
+        ));
+    }
     let mut entries = Vec::with_capacity(nnz);
+    // For a `symmetric` header: the first line in each triangle.
+    let (mut first_lower, mut first_upper) = (None, None);
     for (line, entry) in lines {
         let mut f = entry.split_ascii_whitespace();
         let (Some(r), Some(c), Some(v), None) = (f.next(), f.next(), f.next(), f.next()) else {
-            return Err(format!("line {}: an entry must be `row column value`", line + 1));
+            return Err(format!("line {line}: an entry must be `row column value`"));
         };
         let (r, c) = (number(r, line, "row")?, number(c, line, "column")?);
         if r == 0 || r > rows || c == 0 || c > cols {
-            return Err(format!("line {}: entry ({r}, {c}) lies outside the {rows}×{cols} matrix", line + 1));
+            return Err(format!("line {line}: entry ({r}, {c}) lies outside the {rows}×{cols} matrix"));
         }
         let v: f64 =
-            v.parse().map_err(|_| format!("line {}: entry ({r}, {c}): `{v}` is not a number", line + 1))?;
+            v.parse().map_err(|_| format!("line {line}: entry ({r}, {c}): `{v}` is not a number"))?;
+        if !v.is_finite() {
+            return Err(format!("line {line}: entry ({r}, {c}) is {v}: every entry must be finite"));
+        }
+        if entries.len() == nnz {
+            return Err(format!("line {line}: more entries than the {nnz} the size line declares"));
+        }
+        if symmetric {
+            if r > c && first_lower.is_none() {
+                first_lower = Some((line, r, c));
+            } else if r < c && first_upper.is_none() {
+                first_upper = Some((line, r, c));
+            }
+            if let (Some((l1, r1, c1)), Some((l2, r2, c2))) = (first_lower, first_upper) {
+                return Err(format!(
+                    "the header says `symmetric` (one triangle stored) but entries lie in both triangles: \
+                     ({r1}, {c1}) on line {l1}, ({r2}, {c2}) on line {l2}"
+                ));
+            }
+        }
         entries.push((r - 1, c - 1, v));
     }
     if entries.len() != nnz {
         return Err(format!("the size line declares {nnz} entries but the file holds {}", entries.len()));
     }
-    Ok((rows, cols, entries))
+    Ok((rows, entries))
 }
 
 #[cfg(test)]
@@ -249,7 +311,7 @@ mod tests {
             let disagree =
                 "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 4\n1 2 -1\n2 1 -1.5\n3 3 1\n";
             let e = parse(disagree, None).unwrap_err();
-            assert!(e.contains("entry (2, 1) = -1.5 but (1, 2) = -1"), "{e}");
+            assert!(e.contains("entry (2, 1) = -1.5 (line 5) but (1, 2) = -1 (line 4)"), "{e}");
             let lonely =
                 "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 4\n1 2 -1\n3 2 5\n3 3 1\n";
             let e = parse(lonely, None).unwrap_err();
@@ -279,31 +341,73 @@ mod tests {
         });
     }
 
-    /// Runs `check` with the kept reader and with the streaming one: both must agree on every file.
+    /// Runs `check` with the reader (once a kept reader and a streaming one were both checked).
     fn with_both_readers(check: impl Fn(&dyn Fn(&str, Option<usize>) -> Result<CscSymmetric, String>)) {
-        for streaming in [false, true] {
-            check(&|t, e| parse_with(t, e, streaming));
-        }
+        check(&parse);
     }
 
     #[test]
-    fn the_streaming_reader_reads_the_committed_plate_as_the_kept_one() {
+    fn the_reader_reads_the_committed_plate_as_nalgebra_sparse_does() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/plate");
         for name in ["K0.mtx", "K1.mtx", "M0.mtx"] {
             let text = std::fs::read_to_string(dir.join(name)).unwrap();
-            let kept = parse_with(&text, None, false).unwrap();
-            assert!(kept.nnz() > 200, "{name}: {}", kept.nnz());
-            assert_eq!(parse_with(&text, None, true).unwrap(), kept, "{name}");
+            let ours = parse(&text, None).unwrap();
+            assert!(ours.nnz() > 200, "{name}: {}", ours.nnz());
+            // An independent reader (nalgebra-sparse's grammar-based one) on the same text.
+            let coo = nalgebra_sparse::io::load_coo_from_matrix_market_str::<f64>(&text).unwrap();
+            // Ours keeps one triangle of a file holding both (they agree): so does this.
+            let both = coo.triplet_iter().any(|(r, c, _)| r > c) && coo.triplet_iter().any(|(r, c, _)| r < c);
+            let theirs = CscSymmetric::from_triplets(
+                coo.nrows(),
+                coo.triplet_iter().filter(|&(r, c, _)| !both || r >= c).map(|(r, c, &v)| (r, c, v)),
+            );
+            assert_eq!(ours, theirs, "{name}");
         }
     }
 
     #[test]
-    fn the_streaming_reader_names_the_line_at_fault() {
+    fn the_reader_names_the_line_at_fault() {
         let text = "%%MatrixMarket matrix coordinate real general\n% c\n2 2 2\n1 1 4\n2 1 2 7\n";
-        let e = parse_with(text, None, true).unwrap_err();
+        let e = parse(text, None).unwrap_err();
         assert!(e.contains("line 5"), "{e}");
         let text = "%%MatrixMarket matrix coordinate real general\n2 2 1\n3 1 4\n";
-        let e = parse_with(text, None, true).unwrap_err();
+        let e = parse(text, None).unwrap_err();
         assert!(e.contains("line 3: entry (3, 1) lies outside the 2×2 matrix"), "{e}");
+        let text = "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 4\n2 2 inf\n";
+        let e = parse(text, None).unwrap_err();
+        assert!(e.contains("line 4: entry (2, 2) is inf"), "{e}");
+        let text = "%%MatrixMarket matrix coordinate real symmetric\n3 3 3\n1 1 4\n2 1 1\n\n1 3 2\n";
+        let e = parse(text, None).unwrap_err();
+        assert!(e.contains("(2, 1) on line 4, (1, 3) on line 6"), "{e}");
+        let text = "%%MatrixMarket matrix coordinate real general\n2 2 3\n1 1 4\n1 2 -1\n2 1 -2\n";
+        let e = parse(text, None).unwrap_err();
+        assert!(e.contains("entry (2, 1) = -2 (line 5) but (1, 2) = -1 (line 4)"), "{e}");
+    }
+
+    #[test]
+    fn blank_lines_and_comments_anywhere_are_read() {
+        let text = "%%MatrixMarket matrix coordinate real symmetric\n\n% c\n2 2 2\n\n1 1 4\n  \n% d\n2 2 3";
+        assert_eq!(parse(text, None).unwrap().nnz(), 2);
+    }
+
+    #[test]
+    fn a_declared_size_is_checked_before_anything_is_allocated() {
+        // 1e8 × 1e8 with 3 entries: refused from the size line, allocating nothing of that size.
+        let text =
+            "%%MatrixMarket matrix coordinate real general\n100000000 100000000 3\n1 1 1\n2 2 1\n3 3 1\n";
+        let e = parse(text, None).unwrap_err();
+        assert!(e.contains("line 2: the matrix is 100000000×100000000, more than the 20000000 DOFs"), "{e}");
+        // An entry count the file cannot hold.
+        let text = "%%MatrixMarket matrix coordinate real general\n3 3 4000000000000\n1 1 1\n";
+        let e = parse(text, None).unwrap_err();
+        assert!(e.contains("declares 4000000000000 entries but the 6 bytes after it hold at most 1"), "{e}");
+        // A second matrix of another size is refused from its size line.
+        let text = "%%MatrixMarket matrix coordinate real general\n5 5 1\n1 1 1\n";
+        assert!(parse(text, Some(3))
+            .unwrap_err()
+            .contains("line 2: the matrix is 5×5 but the model has 3 DOFs"));
+        // More entries than declared.
+        let text = "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 1 1\n2 2 1\n";
+        assert!(parse(text, None).unwrap_err().contains("line 4: more entries than the 1"));
     }
 }

@@ -46,8 +46,8 @@ fn a_valid_file_assembles_k_of_p() {
 #[test]
 fn mistakes_name_the_file_and_the_place() {
     let cases = [
-        (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\nstiffness = \"bad.mtx\"\n"), "bad.mtx: not symmetric: entry (2, 1) = 3 but (1, 2) = 1"),
-        (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\nstiffness = \"M3.mtx\"\n"), "M3.mtx: the matrix is 3×3 but the model has 2 DOFs"),
+        (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\nstiffness = \"bad.mtx\"\n"), "bad.mtx: not symmetric: entry (2, 1) = 3 (line 4) but (1, 2) = 1 (line 3)"),
+        (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\nstiffness = \"M3.mtx\"\n"), "M3.mtx: line 2: the matrix is 3×3 but the model has 2 DOFs"),
         (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\nstiffness = \"none.mtx\"\n"), "none.mtx"),
         (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 1.0\n"), "[[parameter]] 1 (`k1`): gives neither `stiffness` nor `mass`"),
         (format!("{HEAD}[[parameter]]\nname = \"k1\"\nnominal = 50.0\nupper = 10\nstiffness = \"K1.mtx\"\n"), "nominal = 50 lies outside"),

@@ -74,6 +74,7 @@ pub use error::RotorError;
 pub use file::MAX_TABLES;
 pub use model::{Bearing, Rotor, ShaftElement, MAX_ELEMENTS, STIFFNESS_LOWER, STIFFNESS_UPPER};
 pub use spec::{
-    BearingSpec, Disk, EffectSpec, Material, ParameterSpec, PointMass, RotorSpec, Section, ShaftSpec,
+    BearingSpec, Disk, EffectSpec, Material, MemberIndex, ParameterSpec, PointMass, RotorSpec, Section,
+    ShaftSpec,
 };
 pub use updatable::{UpdatableError, UpdatableRotor};

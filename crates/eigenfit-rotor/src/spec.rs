@@ -223,6 +223,33 @@ pub struct EffectSpec {
     pub elements: Option<[usize; 2]>,
 }
 
+/// The `index` of a `[[parameter]]` table: one member of its kind, or several tied to one
+/// parameter (two bearings that are one physical part).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum MemberIndex {
+    /// `index = 2`.
+    One(usize),
+    /// `index = [0, 1]`.
+    Several(Vec<usize>),
+}
+
+impl MemberIndex {
+    /// The members, in the order given.
+    pub fn members(&self) -> &[usize] {
+        match self {
+            MemberIndex::One(i) => std::slice::from_ref(i),
+            MemberIndex::Several(v) => v,
+        }
+    }
+}
+
+impl From<usize> for MemberIndex {
+    fn from(i: usize) -> Self {
+        MemberIndex::One(i)
+    }
+}
+
 /// A `[[parameter]]` table: one more updatable quantity of the model.
 #[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -230,9 +257,10 @@ pub struct EffectSpec {
 pub struct ParameterSpec {
     /// One of [`KINDS`](crate::updatable::KINDS).
     pub kind: String,
-    /// Which bearing, disk, point mass or `[[shaft.section]]` (0-based, in file order); for the
-    /// section kinds, absent means the whole shaft.
-    pub index: Option<usize>,
+    /// Which bearing, disk, point mass or `[[shaft.section]]` (0-based, in file order), or a
+    /// list of them (`index = [0, 1]`) that the one parameter sets (or scales) together; for
+    /// the section kinds, absent means the whole shaft.
+    pub index: Option<MemberIndex>,
     /// Parameter name; a default is derived from the kind and index when absent.
     pub name: Option<String>,
     /// Lower bound (default: nominal / 100 for scales, nominal·1e-6 otherwise).

@@ -12,14 +12,33 @@
 //! estimate's basin reaches that far on this rotor.
 //!
 //! `cargo run --release -p eigenfit-rotordynamics --example runup_coverage -- [DRAWS] [discover]`
-use eigenfit_core::analysis::chi2_upper_tail;
+use eigenfit_core::analysis::{chi2_upper_tail, uncertainty};
 use eigenfit_core::discovery::{discover_effects, DiscoveryOptions};
 use eigenfit_core::measurement::synthetic::NoiseRng;
+use eigenfit_core::update::{Budget, Estimate};
 use eigenfit_rotordynamics::effects::candidates;
+use eigenfit_rotordynamics::fit::fit_runup;
+use eigenfit_rotordynamics::identify::Parameter;
 use eigenfit_rotordynamics::identify::{read_runup, stiffness_parameters, RunupPoint};
 use eigenfit_rotordynamics::objective::{RunupObjective, RunupSearch, DISCOVERY_FACTOR_RANGE};
-use eigenfit_rotordynamics::search::identify_from_best_start;
+use eigenfit_rotordynamics::Rotor;
 use std::path::Path;
+
+/// The run-up estimate as `estimate` makes it (core's driver with restarts from screened
+/// starts): the estimate, the restarts taken and σ(ln s) from core's covariance.
+fn estimate(
+    rotor: &Rotor,
+    params: &[Parameter],
+    points: &[RunupPoint],
+    start: &[f64],
+) -> (Estimate, usize, Vec<f64>) {
+    let objective = RunupObjective::new(rotor, params.to_vec(), points, None).expect("objective");
+    let (est, restarts) =
+        fit_runup(&objective, params, start, 100, REFITS, &Budget::unlimited()).expect("fit");
+    let u = uncertainty(&objective, &est.last, true).expect("std_hz given: intervals");
+    let sd = (0..params.len()).map(|i| u.covariance[(i, i)].sqrt() / est.parameters[i]).collect();
+    (est, restarts, sd)
+}
 
 const START: [f64; 4] = [1.2, 0.8, 0.8, 1.2];
 const FAR_START: [f64; 4] = [1.4, 0.6, 0.65, 1.45];
@@ -40,12 +59,11 @@ fn main() {
 
     // Noise-free: the estimate should return the truth (ROSS and eigenfit agree to ~1e-6).
     for (what, start) in [("20 % off", START), ("35–45 % off", FAR_START)] {
-        let id = identify_from_best_start(&rotor, &params, &exact, &start, 100, REFITS, usize::MAX)
-            .expect("noise-free fit");
-        let worst = id.scales.iter().map(|s| (s - 1.0).abs()).fold(0.0, f64::max);
+        let (id, restarts, _) = estimate(&rotor, &params, &exact, &start);
+        let worst = id.parameters.iter().map(|s| (s - 1.0).abs()).fold(0.0, f64::max);
         println!(
-            "noise-free, start {what}: converged {}, largest |factor − 1| {worst:.2e}, χ² {:.2e} (std 0.02 Hz), {} refits, {} evaluations",
-            id.outcome.converged, id.cost, id.refits, id.outcome.evaluations
+            "noise-free, start {what}: {}, largest |factor − 1| {worst:.2e}, χ² {:.2e} (std 0.02 Hz), {restarts} restarts, {} evaluations",
+            id.termination, id.last.chi2(), id.evaluations
         );
     }
 
@@ -63,13 +81,11 @@ fn main() {
                 ..p.clone()
             })
             .collect();
-        let id =
-            identify_from_best_start(&rotor, &params, &noisy, &START, 100, REFITS, usize::MAX).expect("fit");
-        evaluations += id.outcome.evaluations;
-        converged += usize::from(id.outcome.converged);
-        let sd = id.ln_std.as_ref().expect("std_hz given: intervals");
+        let (id, _, sd) = estimate(&rotor, &params, &noisy, &START);
+        evaluations += id.evaluations;
+        converged += usize::from(id.termination.is_converged());
         let mut all = true;
-        for (k, (s, sd)) in id.scales.iter().zip(sd).enumerate() {
+        for (k, (s, sd)) in id.parameters.iter().zip(&sd).enumerate() {
             // The reported interval is k·exp(±1.96·sd) in ln k: the truth (factor 1) is inside
             // when |ln s| ≤ 1.96·sd.
             let z = s.ln() / sd;
@@ -80,7 +96,7 @@ fn main() {
             all &= inside;
         }
         all_covered += usize::from(all);
-        significant += usize::from(chi2_upper_tail(id.cost, dof) < 0.05);
+        significant += usize::from(chi2_upper_tail(id.last.chi2(), dof) < 0.05);
         if with_discovery {
             let (lower, upper) = DISCOVERY_FACTOR_RANGE;
             let base = RunupObjective::new(&rotor, params.clone(), &noisy, None)

@@ -1,12 +1,9 @@
-//! Identification at speed: the bearings' kxx and kyy (and, on request, their cross-coupled
-//! stiffness and their damping) from whirl frequencies measured over a run-up. Each parameter
-//! scales one coefficient curve of one bearing (kxx(Ω) → s·kxx(Ω)); a
-//! small Levenberg–Marquardt works in ln s so stiffnesses stay positive and the steps are
-//! relative, with the Jacobian from the analytic eigenvalue sensitivities.
-//!
-//! Own LM rather than core's `update/` strategies: those drive a `StructuralModel` whose
-//! eigen-solve is the symmetric (undamped) problem with sorted real eigenvalues, while here a
-//! "mode" is a damped complex eigenpair at one of many speeds.
+//! Identification at speed, the physics: run-up points (whirl frequencies measured over a
+//! run-up), the bearing coefficient factors that can be estimated from them (each scales one
+//! coefficient curve of one bearing, kxx(Ω) → s·kxx(Ω)), the pairing of measured points with
+//! damped model modes by whirl and frequency, and the evaluation of the frequencies with their
+//! analytic sensitivities. The fitting is core's, on [`crate::objective::RunupObjective`]
+//! ([`crate::fit::fit_runup`]).
 
 use crate::effects::EffectKind;
 use crate::error::RotorDynError;
@@ -15,9 +12,8 @@ use crate::modal::{Mode, Whirl};
 use crate::rotor::Rotor;
 use crate::rpm_to_rad;
 use crate::sensitivity::{eigenvalue_derivatives, MatrixDerivative};
-use eigenfit_core::update::Outcome;
 use faer::Mat;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -42,11 +38,6 @@ impl RunupPoint {
     pub fn sigma_hz(&self) -> f64 {
         self.std_hz.unwrap_or(self.frequency_hz)
     }
-}
-
-/// Σ ((f_model − f_measured)/σ)² of an evaluation: the cost every run-up fit minimises.
-pub fn misfit(e: &Evaluation, points: &[RunupPoint]) -> f64 {
-    points.iter().zip(&e.frequencies_hz).map(|(p, f)| ((f - p.frequency_hz) / p.sigma_hz()).powi(2)).sum()
 }
 
 /// Reads a run-up CSV with header `speed_rpm,mode,frequency_hz[,std_hz][,whirl]`.
@@ -456,145 +447,20 @@ fn pair_modes(measured: &[&RunupPoint], modes: &[Mode]) -> Option<Vec<usize>> {
     Some(out)
 }
 
-/// Result of an identification.
-#[derive(Debug, Clone)]
-pub struct Identification {
-    /// Parameters identified.
-    pub parameters: Vec<Parameter>,
-    /// Estimated scale factors on the nominal curves.
-    pub scales: Vec<f64>,
-    /// Standard deviation of ln s (from the weighted Jacobian; only with std_hz).
-    pub ln_std: Option<Vec<f64>>,
-    /// Model frequencies at the estimate (Hz).
-    pub model_hz: Vec<f64>,
-    /// Model whirl at the estimate.
-    pub model_whirl: Vec<Whirl>,
-    /// d f_i / d ln s_j at the estimate (Hz), unweighted.
-    pub jacobian: DMatrix<f64>,
-    /// Σ r² (weighted by std_hz, or relative residuals without).
-    pub cost: f64,
-    /// Whether the iteration met its tolerance, why it stopped, iterations taken and eigen-solve
-    /// rounds (one per measured speed each).
-    pub outcome: Outcome,
-    /// Whether every parameter is determined by the data (Jacobian of full rank at the
-    /// estimate, singular values above 10⁻¹² of the largest).
-    pub identifiable: bool,
-    /// Fits from other starts run after the fit from the given one did not pass
-    /// ([`crate::search::identify_from_best_start`]); 0 for a single fit.
-    pub refits: usize,
-}
-
-/// Levenberg–Marquardt in ln s from `initial` scales, in stages when the selection holds more
-/// than the direct stiffnesses: first kxx and kyy alone (the rest held at `initial`), then
-/// everything from there. The direct stiffnesses move the frequencies most; fitted together from
-/// a nominal start the weak cross-coupled and damping directions (singular values 10⁴–10⁵
-/// below) pull the iteration into other minima (a 12-parameter ROSS run-up from factors 0.8–1.25
-/// away: stalled; staged: recovered).
-pub fn identify(
+/// Refuses a selection the run-up cannot fit: fewer measured frequencies than parameters, or a
+/// factor on a coefficient that is zero at every measured speed, naming the parameter.
+pub fn check_selection(
     rotor: &Rotor,
     params: &[Parameter],
     points: &[RunupPoint],
-    initial: &[f64],
-    max_iterations: usize,
-) -> Result<Identification, RotorDynError> {
-    identify_within(rotor, params, points, initial, max_iterations, usize::MAX)
-}
-
-/// [`identify`] spending at most `max_evaluations` evaluations (eigen-solve rounds over the
-/// run-up's speeds); when they run out the fit stops, not converged, and says so.
-pub fn identify_within(
-    rotor: &Rotor,
-    params: &[Parameter],
-    points: &[RunupPoint],
-    initial: &[f64],
-    max_iterations: usize,
-    max_evaluations: usize,
-) -> Result<Identification, RotorDynError> {
-    let whole = Fit { rotor, params, points, max_iterations, max_evaluations };
-    let direct: Vec<usize> = (0..params.len()).filter(|&i| params[i].is_direct_stiffness()).collect();
-    if direct.is_empty() || direct.len() == params.len() {
-        return levenberg_marquardt(&whole, initial);
-    }
-    let (held, held_scales): (Vec<Parameter>, Vec<f64>) =
-        (0..params.len()).filter(|i| !direct.contains(i)).map(|i| (params[i].clone(), initial[i])).unzip();
-    let held_rotor = scaled_rotor(rotor, &held, &held_scales);
-    let sub: Vec<Parameter> = direct.iter().map(|&i| params[i].clone()).collect();
-    let sub_start: Vec<f64> = direct.iter().map(|&i| initial[i]).collect();
-    let first = levenberg_marquardt(&Fit { rotor: &held_rotor, params: &sub, ..whole }, &sub_start)?;
-    let mut start = initial.to_vec();
-    for (k, &i) in direct.iter().enumerate() {
-        start[i] = first.scales[k];
-    }
-    if !first.outcome.converged && first.outcome.evaluations >= max_evaluations {
-        return Ok(first_stage_only(first, params, &direct, &start));
-    }
-    let rest = max_evaluations.saturating_sub(first.outcome.evaluations);
-    let mut out = levenberg_marquardt(&Fit { max_evaluations: rest, ..whole }, &start)?;
-    out.outcome.iterations += first.outcome.iterations;
-    out.outcome.evaluations += first.outcome.evaluations;
-    Ok(out)
-}
-
-/// The first stage's fit reported for the whole selection when the budget ran out in it: the
-/// held parameters at their start, without a Jacobian column (zero) or intervals.
-fn first_stage_only(
-    first: Identification,
-    params: &[Parameter],
-    direct: &[usize],
-    start: &[f64],
-) -> Identification {
-    let mut jacobian = DMatrix::zeros(first.jacobian.nrows(), params.len());
-    for (k, &i) in direct.iter().enumerate() {
-        jacobian.set_column(i, &first.jacobian.column(k));
-    }
-    Identification {
-        parameters: params.to_vec(),
-        scales: start.to_vec(),
-        ln_std: None,
-        jacobian,
-        identifiable: false,
-        ..first
-    }
-}
-
-/// One least-squares problem: a rotor, the parameters on it, the run-up, the iteration and
-/// evaluation limits.
-#[derive(Clone, Copy)]
-struct Fit<'a> {
-    rotor: &'a Rotor,
-    params: &'a [Parameter],
-    points: &'a [RunupPoint],
-    max_iterations: usize,
-    max_evaluations: usize,
-}
-
-/// Largest change of any ln s in one step (a trust region): whirl frequencies are sorted at each
-/// speed, so modes that trade places kink the residual, and long steps jump into other basins.
-const MAX_LN_STEP: f64 = 0.2;
-
-/// A fit whose misfit falls by less than [`STALL_GAIN`] (relative) over this many iterations is
-/// stopped, not converged. Near a minimum Levenberg–Marquardt gains orders of magnitude in a few
-/// iterations; one that crawls is stuck on a kinked residual (modes trading partners), and let
-/// run it spent the whole iteration limit: on ROSS's compressor with run-up modes the model
-/// lacked at the start, 1000 iterations, 1794 evaluations, 4 min, for nothing. Stopped, the
-/// search from other starts gets the time.
-const STALL_WINDOW: usize = 100;
-
-/// See [`STALL_WINDOW`]: 0.1 %.
-const STALL_GAIN: f64 = 1e-3;
-
-/// Levenberg–Marquardt in ln s from `initial` scales.
-fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, RotorDynError> {
-    let Fit { rotor, params, points, max_iterations, max_evaluations } = *fit;
-    let m = points.len();
-    let np = params.len();
+) -> Result<(), RotorDynError> {
+    let (m, np) = (points.len(), params.len());
     if m < np {
         return Err(RotorDynError::Data(format!(
             "{m} measured frequencies for {np} parameters ({}): at least {np} are needed",
             params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
         )));
     }
-    // A factor on a curve that is zero wherever measured changes nothing: refuse it by name.
     for p in params {
         if points.iter().all(|pt| p.nominal(rotor, rpm_to_rad(pt.speed_rpm)) == 0.0) {
             return Err(RotorDynError::Data(format!(
@@ -604,136 +470,7 @@ fn levenberg_marquardt(fit: &Fit, initial: &[f64]) -> Result<Identification, Rot
             )));
         }
     }
-    let sigma: Vec<f64> = points.iter().map(RunupPoint::sigma_hz).collect();
-    let weighted = |e: &Evaluation| -> (DVector<f64>, DMatrix<f64>) {
-        let r = DVector::from_fn(m, |i, _| (e.frequencies_hz[i] - points[i].frequency_hz) / sigma[i]);
-        let j = DMatrix::from_fn(m, np, |i, k| e.jacobian[(i, k)] / sigma[i]);
-        (r, j)
-    };
-    let mut theta = DVector::from_iterator(np, initial.iter().map(|s| s.ln()));
-    let mut eval = evaluate(rotor, params, initial, points)?;
-    let mut evaluations = 1;
-    let (mut r, mut jac) = weighted(&eval);
-    let mut cost = r.norm_squared();
-    let mut mu = 1e-3;
-    let mut converged = false;
-    let mut reason = format!("iteration limit {max_iterations} reached");
-    let mut iterations = 0;
-    // Cost at the start of each iteration, to notice a fit that crawls (see STALL_WINDOW).
-    let mut history: Vec<f64> = Vec::new();
-    while iterations < max_iterations {
-        if history.len() >= STALL_WINDOW && cost > (1.0 - STALL_GAIN) * history[history.len() - STALL_WINDOW]
-        {
-            reason = format!(
-                "stalled: the misfit fell less than {} % over the last {STALL_WINDOW} iterations",
-                STALL_GAIN * 100.0
-            );
-            break;
-        }
-        history.push(cost);
-        iterations += 1;
-        let jtj = jac.transpose() * &jac;
-        let g = jac.transpose() * &r;
-        if g.amax() <= 1e-12 * (1.0 + cost) {
-            converged = true;
-            reason = "gradient vanished".into();
-            break;
-        }
-        let mut accepted = false;
-        for _ in 0..60 {
-            let mut a = jtj.clone();
-            for k in 0..np {
-                a[(k, k)] += mu * jtj[(k, k)].max(1e-12);
-            }
-            let Some(step) = a.clone().cholesky().map(|c| c.solve(&(-&g))) else {
-                mu *= 10.0;
-                continue;
-            };
-            // Keep steps within MAX_LN_STEP in ln s by damping more, not by shortening the
-            // Gauss–Newton step: that step is dominated by the poorly determined directions
-            // (a 12-parameter run-up has singular values 10⁴ apart) and, shortened, hardly
-            // descends; a larger μ turns it toward the well-determined ones.
-            if step.amax() > MAX_LN_STEP {
-                mu *= 4.0;
-                continue;
-            }
-            if evaluations >= max_evaluations {
-                break;
-            }
-            let trial = &theta + &step;
-            let scales: Vec<f64> = trial.iter().map(|t| t.exp()).collect();
-            let e = evaluate(rotor, params, &scales, points)?;
-            evaluations += 1;
-            let (r2, j2) = weighted(&e);
-            let c2 = r2.norm_squared();
-            if c2 < cost {
-                let small_step = step.amax() < 1e-9;
-                let small_gain = (cost - c2) <= 1e-12 * cost.max(1e-300);
-                theta = trial;
-                eval = e;
-                r = r2;
-                jac = j2;
-                cost = c2;
-                mu = (mu / 3.0).max(1e-12);
-                accepted = true;
-                if small_step || small_gain || cost < 1e-28 {
-                    converged = true;
-                    reason = "step below tolerance".into();
-                }
-                break;
-            }
-            mu *= 4.0;
-            if step.amax() < 1e-12 {
-                break;
-            }
-        }
-        if converged {
-            break;
-        }
-        if !accepted && evaluations >= max_evaluations {
-            reason = format!("evaluation budget {max_evaluations} reached");
-            break;
-        }
-        if !accepted {
-            // No descent at any damping: a minimum to working precision.
-            converged = true;
-            reason = "no further descent (minimum to working precision)".into();
-            break;
-        }
-    }
-    let has_std = points.iter().all(|p| p.std_hz.is_some());
-    // Covariance (JᵀJ)⁻¹ = V Σ⁻² Vᵀ from the SVD of J: no squared condition number.
-    let svd = jac.clone().svd(false, true);
-    let v_t = svd.v_t.expect("requested");
-    let smax = svd.singular_values.max();
-    let identifiable = smax > 0.0 && svd.singular_values.iter().all(|&s| s > 1e-12 * smax);
-    let ln_std = if has_std {
-        if !identifiable {
-            None
-        } else {
-            Some(
-                (0..np)
-                    .map(|k| {
-                        (0..np).map(|i| (v_t[(i, k)] / svd.singular_values[i]).powi(2)).sum::<f64>().sqrt()
-                    })
-                    .collect(),
-            )
-        }
-    } else {
-        None
-    };
-    Ok(Identification {
-        parameters: params.to_vec(),
-        scales: theta.iter().map(|t| t.exp()).collect(),
-        ln_std,
-        model_hz: eval.frequencies_hz.clone(),
-        model_whirl: eval.whirl.clone(),
-        jacobian: eval.jacobian.clone(),
-        cost,
-        outcome: Outcome { converged, termination: reason, iterations, evaluations },
-        identifiable,
-        refits: 0,
-    })
+    Ok(())
 }
 
 #[cfg(test)]

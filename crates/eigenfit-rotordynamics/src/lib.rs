@@ -11,13 +11,13 @@ pub mod campbell;
 pub mod effects;
 pub mod elements;
 pub mod error;
+pub mod fit;
 pub mod identify;
 pub mod interpolation;
 pub mod modal;
 pub mod objective;
 pub mod ross_file;
 pub mod rotor;
-pub mod search;
 pub mod sensitivity;
 pub mod shift_invert;
 

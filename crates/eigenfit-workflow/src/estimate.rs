@@ -3,35 +3,39 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::{FitQualityReport, Outcome, PairedFrequencies, ParameterValues, Verdict};
+use crate::outcome::{
+    cycles, phase_counts, FitQualityReport, Outcome, PairedFrequencies, ParameterValues, Verdict,
+};
+pub use crate::outcome::{AlternativeSolution, ParameterIdentifiability};
 use crate::overrides::{fixed, parameter_vector};
 use crate::progress::{Progress, StepsObserver};
 use crate::rotordynamics::{self, RunupEstimateReport};
 use crate::simulate::check_roundoff;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
-use eigenfit_core::analysis::verdict::{at_limits, check_reachable, judge, FitQuality, FitVerdict};
-use eigenfit_core::analysis::{
-    alternative_solutions_within, mirror_solutions, permuted_solutions, Identifiability, Uncertainty,
+use eigenfit_core::analysis::alternatives::{
+    better_minimum, like_exchanges, local_minima, mirror_solutions, other_solutions, search_starts,
+    Equivalence, Mirrors, OtherSolution, SAME_MINIMUM,
 };
+use eigenfit_core::analysis::verdict::{at_limits, check_reachable, judge, FitQuality};
+use eigenfit_core::analysis::{Identifiability, Uncertainty};
 use eigenfit_core::measurement::mac::MacReport;
-use eigenfit_core::measurement::measured_csv::shown;
+use eigenfit_core::measurement::measured_csv::{shown, shown_number};
 use eigenfit_core::model::{ParameterSet, StructuralModel};
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
 use eigenfit_core::update::{Budget, Driver, Estimate, LevenbergMarquardt, StrategyKind};
 use serde::Serialize;
 use std::path::PathBuf;
 
-/// Another equally good parameter vector, with the permutation of the parameters (parameter i's
-/// value moved to π\[i\]) when it is a mirror solution.
-type Alternative = (Vec<f64>, Option<Vec<usize>>);
-
 /// Most DOFs of a model updated from measured shapes: their derivatives (Nelson's method) take
 /// a dense factorisation per mode and iteration, seconds each at this size and O(n³) beyond.
 pub const SHAPE_DOF_LIMIT: usize = 2000;
 
-/// Restart-grid points refitted locally when searching for other equally good solutions.
-pub const ALTERNATIVE_STARTS: usize = 6;
+/// Starts of the search for other solutions when not given: a space-filling design sized to the
+/// free parameters ([`search_starts`]: 4 per parameter and 8 more).
+pub fn default_alternative_starts(free: usize) -> usize {
+    search_starts(free)
+}
 
 /// What to estimate, as the command line gives it.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,29 +58,17 @@ pub struct EstimateRequest {
     pub budget: usize,
     /// Also build the updated model file (rotor TOML).
     pub write_model: bool,
-    /// Points of the coarse grid refitted locally when searching for other equally good
-    /// solutions (0: no such search; the exchange of like parameters is still checked; default
-    /// [`ALTERNATIVE_STARTS`]). On a large model most of a run's evaluations.
-    pub alternative_starts: usize,
+    /// Starts of the space-filling design refitted locally when searching for other minima
+    /// (0: no such search; the exchange of like parameters is still checked; `None`: sized to the
+    /// free parameters, [`default_alternative_starts`]). On a large model most of a run's
+    /// evaluations.
+    pub alternative_starts: Option<usize>,
     /// ROSS rotors: the bearing coefficients to estimate (`kxx,kyy,…` or `kxy_<bearing>`; `None`:
     /// kxx and kyy of every bearing). Refused for other models.
     pub bearing_parameters: Option<String>,
 }
 
 pub use crate::outcome::BudgetReport;
-
-/// Another equally good parameter vector.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AlternativeSolution {
-    /// Its values.
-    pub parameters: Named<f64>,
-    /// The exchanged pair when it is a mirror solution of a symmetric model that exchanges one
-    /// pair of parameters (`None` for a symmetry exchanging more: see `exchanged`).
-    pub mirror_of: Option<[String; 2]>,
-    /// A mirror solution's exchanged parameters as cycles (`[["zone1", "zone3"], ["zone2",
-    /// "zone4"]]`: a plate's zones mirrored about its centre line); empty for other solutions.
-    pub exchanged: Vec<Vec<String>>,
-}
 
 /// One iteration of the fit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -91,62 +83,32 @@ pub struct HistoryRecord {
     pub max_abs_diff_hz: f64,
 }
 
-/// What the data say about one parameter: `true`, or `{"identifiable": false}` with the one
-/// bound known.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum ParameterIdentifiability {
-    /// Determined.
-    Determined(bool),
-    /// Not determined; a bound where one is known.
-    Not {
-        /// Always false.
-        identifiable: bool,
-        /// The lower bound, when only that is known.
-        #[serde(skip_serializing_if = "Option::is_none")]
-        lower_bound: Option<f64>,
-        /// The upper bound, when only that is known.
-        #[serde(skip_serializing_if = "Option::is_none")]
-        upper_bound: Option<f64>,
-    },
-}
-
-impl From<&Identifiability> for ParameterIdentifiability {
-    fn from(i: &Identifiability) -> Self {
-        let not = |lower_bound, upper_bound| Self::Not { identifiable: false, lower_bound, upper_bound };
-        match *i {
-            Identifiability::Determined => Self::Determined(true),
-            Identifiability::LowerBoundOnly { lower } => not(Some(lower), None),
-            Identifiability::UpperBoundOnly { upper } => not(None, Some(upper)),
-            Identifiability::Undetermined => not(None, None),
-        }
-    }
-}
-
-/// The intervals part of an estimate report.
+/// The intervals part of an estimate report: every key present, `null` when not computed (a
+/// run that did not converge, or no std and no residual scatter to estimate σ from).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IntervalsReport {
     /// 95 % intervals.
-    pub intervals: Named<[f64; 2]>,
+    pub intervals: Option<Named<[f64; 2]>>,
     /// Identifiability per parameter.
-    pub identifiable: Named<ParameterIdentifiability>,
+    pub identifiable: Option<Named<ParameterIdentifiability>>,
     /// Singular values of the scaled Jacobian.
-    pub singular_values: Vec<f64>,
+    pub singular_values: Option<Vec<f64>>,
     /// Their ratio.
-    pub condition_number: f64,
+    pub condition_number: Option<f64>,
     /// Standard deviations.
-    pub standard_deviations: Named<f64>,
+    pub standard_deviations: Option<Named<f64>>,
 }
 
 impl IntervalsReport {
-    /// The report of `u` for parameters `names`.
-    pub fn new(names: &[String], u: &Uncertainty) -> Self {
+    /// The report of `u` for parameters `names` (all `null` without one).
+    pub fn new(names: &[String], u: Option<&Uncertainty>) -> Self {
         Self {
-            intervals: Named::new(names, u.intervals.iter().copied()),
-            identifiable: Named::new(names, u.identifiability.iter().map(Into::into)),
-            singular_values: u.singular_values.clone(),
-            condition_number: u.condition_number,
-            standard_deviations: Named::new(names, (0..names.len()).map(|i| u.covariance[(i, i)].sqrt())),
+            intervals: u.map(|u| Named::new(names, u.intervals.iter().copied())),
+            identifiable: u.map(|u| Named::new(names, u.identifiability.iter().map(Into::into))),
+            singular_values: u.map(|u| u.singular_values.clone()),
+            condition_number: u.map(|u| u.condition_number),
+            standard_deviations: u
+                .map(|u| Named::new(names, (0..names.len()).map(|i| u.covariance[(i, i)].sqrt()))),
         }
     }
 }
@@ -180,9 +142,12 @@ pub struct EstimateReport {
     pub at_limit: Vec<String>,
     /// Intervals and what the data determine (a converged run with std or scatter).
     #[serde(flatten)]
-    pub uncertainty: Option<IntervalsReport>,
-    /// Other equally good solutions.
+    pub uncertainty: IntervalsReport,
+    /// Other minima found and mirror points, each with its χ², Δχ² and the test's outcome.
     pub alternative_solutions: Vec<AlternativeSolution>,
+    /// How σ was taken for the alternatives' test: `std` (given), `residuals` (estimated from the
+    /// estimate's residuals), or `exact` (no σ: only exact fits are equally good).
+    pub alternatives_sigma: &'static str,
     /// Model frequencies at the estimate and measured frequencies (Hz).
     #[serde(flatten)]
     pub frequencies: PairedFrequencies,
@@ -225,7 +190,8 @@ pub struct Estimation {
     pub unit: String,
     /// The largest measured standard deviation (Hz).
     pub sigma_max: Option<f64>,
-    /// The exit verdict: converged, fit not poor, nothing on a limit, budget left, all paired.
+    /// The exit verdict: converged, fit not poor, nothing on a limit, budget left, all paired, and
+    /// no other solution equally good (the report's `acceptable` and `unique`).
     pub acceptable: bool,
     /// The updated model as TOML, when asked for (or why there is none).
     pub updated_model: Option<Result<String, WorkflowError>>,
@@ -276,7 +242,7 @@ pub fn run(
             &request.measured,
             &options,
             request.max_iterations,
-            request.alternative_starts,
+            request.alternative_starts.unwrap_or(rotordynamics::RUNUP_REFITS),
             request.budget,
         );
         progress.end();
@@ -390,6 +356,44 @@ pub fn run(
         other => other?,
     };
     phases.push(("fit", budget.used()));
+    let mut estimate = estimate;
+    let np_free = np;
+    // The search for other minima runs before the intervals: when it finds a deeper minimum than
+    // the fit, that one is the estimate, and the intervals are drawn around it.
+    let mut mirrors = Mirrors::default();
+    let mut minima = Vec::new();
+    if estimate.termination.is_converged() {
+        progress.begin("searching for other solutions", None);
+        // Exchanges of like parameters, and a structure's symmetries exchanging more than one pair
+        // (a matrices model's mirrored zones) on the parameters left free.
+        let mut exchanges = like_exchanges(&fit);
+        exchanges.extend(free_permutations(
+            &any.parameter_symmetries(),
+            updatable.parameters(),
+            model.parameters(),
+        ));
+        mirrors = mirror_solutions(&fit, &estimate.last, &exchanges, &budget);
+        phases.push(("mirror_solutions", budget.used()));
+        let starts = request.alternative_starts.unwrap_or_else(|| default_alternative_starts(np_free));
+        // Ranking a design alone costs an evaluation per point: skipped with no start.
+        if starts > 0 {
+            minima = local_minima(&fit, starts, &mirrors.asymmetric, &budget);
+        }
+        phases.push(("other_solutions", budget.used()));
+        if let Some(better) = better_minimum(&fit, &estimate.last, &minima).cloned() {
+            notes.push(format!(
+                "the search for other solutions found a deeper minimum than the fit reached (Σr² {} → {}): \
+                 it is the estimate reported",
+                shown_number(estimate.last.chi2()),
+                shown_number(better.chi2())
+            ));
+            minima.push(estimate.last.clone());
+            estimate.parameters = better.parameters.clone();
+            estimate.last = better;
+            mirrors = mirror_solutions(&fit, &estimate.last, &exchanges, &budget);
+        }
+        progress.end();
+    }
     // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
     let system = model.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
     if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
@@ -398,7 +402,7 @@ pub fn run(
     let converged = estimate.termination.is_converged();
     let quality = judge(&estimate.last, np);
     let limits = at_limits(model.parameters(), &estimate.parameters);
-    // Profile bounds done / total through the driver's observer mechanism, then other solutions.
+    // Profile bounds done / total through the driver's observer mechanism.
     let (unc, scatter) = if converged {
         let mut bounds = StepsObserver::new(progress, "interval bounds");
         let unc = fit.uncertainty_within(&estimate.last, has_std, &budget, &mut [&mut bounds]);
@@ -408,48 +412,30 @@ pub fn run(
         (None, None)
     };
     phases.push(("intervals", budget.used()));
-    if converged {
-        progress.begin("searching for other solutions", None);
-    }
     let mac = fit.mac(&estimate.parameters, options.shape.mac_threshold);
-    let mut alternatives: Vec<Alternative> = Vec::new();
-    if converged && quality.verdict != FitVerdict::Poor {
-        for (i, j, p) in mirror_solutions(&fit, &estimate.last, &budget) {
-            let mut swap: Vec<usize> = (0..np).collect();
-            swap.swap(i, j);
-            alternatives.push((p, Some(swap)));
-        }
-        // A structure's symmetries exchanging more than one pair (a matrices model's mirrored
-        // zones), on the parameters left free.
-        let symmetries =
-            free_permutations(&any.parameter_symmetries(), updatable.parameters(), model.parameters());
-        for (k, p) in permuted_solutions(&fit, &estimate.last, &symmetries, &budget) {
-            alternatives.push((p, Some(symmetries[k].clone())));
-        }
-        phases.push(("mirror_solutions", budget.used()));
-        // Ranking the coarse grid alone costs an evaluation per point: skipped with no start.
-        let others = if request.alternative_starts == 0 {
-            Vec::new()
-        } else {
-            alternative_solutions_within(&fit, &estimate.last, request.alternative_starts, &budget)
-        };
-        for p in others {
-            let same = |q: &[f64]| {
-                model
-                    .parameters()
-                    .iter()
-                    .zip(q.iter().zip(&p))
-                    .all(|(par, (&a, &b))| (par.to_scaled(a) - par.to_scaled(b)).abs() <= 0.01)
-            };
-            if !alternatives.iter().any(|(q, _)| same(q)) {
-                alternatives.push((p, None));
-            }
+    // Mirrors first, then the other minima not already listed, each judged against the estimate.
+    let mut alternatives: Vec<OtherSolution> = Vec::new();
+    let same = |a: &[f64], b: &[f64]| {
+        model
+            .parameters()
+            .iter()
+            .zip(a.iter().zip(b))
+            .all(|(par, (&x, &y))| (par.to_scaled(x) - par.to_scaled(y)).abs() <= SAME_MINIMUM)
+    };
+    for o in mirrors.symmetric.into_iter().chain(other_solutions(&fit, &estimate.last, &minima)) {
+        if !alternatives.iter().any(|a| same(&a.parameters, &o.parameters)) {
+            alternatives.push(o);
         }
     }
-    if converged {
-        progress.end();
-    }
-    phases.push(("other_solutions", budget.used()));
+    let equivalence = Equivalence::at(&estimate.last, np);
+    let alternatives_sigma = if has_std {
+        "std"
+    } else if equivalence.sigma_estimated() {
+        "residuals"
+    } else {
+        "exact"
+    };
+    let unique = !alternatives.iter().any(|a| a.judged.equally_good);
     let budget_spent = budget.exhausted();
     let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
     let pinned: Vec<String> = (0..np).filter(|&i| limits[i] != 0).map(|i| names[i].clone()).collect();
@@ -461,8 +447,9 @@ pub fn run(
         quality.verdict,
         !pinned.is_empty(),
         unpaired,
+        unique,
     );
-    let acceptable = verdict.acceptable;
+    let acceptable = verdict.is_answer();
     // What the data say about each parameter, in words.
     let status = |i: usize| -> String {
         let bound = unc.as_ref().map(|u| &u.identifiability[i]);
@@ -496,20 +483,8 @@ pub fn run(
         evaluations_by_phase: phase_counts(&phases),
         values: ParameterValues::new(&names, &initial, &estimate.parameters, status),
         at_limit: pinned,
-        alternative_solutions: alternatives
-            .iter()
-            .map(|(p, mirror)| {
-                let cycles = mirror.as_deref().map(cycles).unwrap_or_default();
-                AlternativeSolution {
-                    parameters: Named::new(&names, p.iter().copied()),
-                    mirror_of: match cycles.as_slice() {
-                        [pair] if pair.len() == 2 => Some([names[pair[0]].clone(), names[pair[1]].clone()]),
-                        _ => None,
-                    },
-                    exchanged: cycles.iter().map(|c| c.iter().map(|&i| names[i].clone()).collect()).collect(),
-                }
-            })
-            .collect(),
+        alternative_solutions: AlternativeSolution::list(&names, &alternatives),
+        alternatives_sigma,
         frequencies: PairedFrequencies::of(&estimate.last),
         history: estimate
             .history
@@ -521,7 +496,7 @@ pub fn run(
                 max_abs_diff_hz: r.max_abs_diff_hz,
             })
             .collect(),
-        uncertainty: unc.as_ref().map(|u| IntervalsReport::new(&names, u)),
+        uncertainty: IntervalsReport::new(&names, unc.as_ref()),
         plots: None,
         test_data: ShapeReport::new(&fit, &data, &estimate, mac.as_ref(), scatter),
         fixed: (!held.is_empty()).then_some(Named(held)),
@@ -548,22 +523,6 @@ pub fn run(
     })))
 }
 
-/// `{phase: evaluations}` from the running totals after each phase (a phase not reached is left
-/// out).
-fn phase_counts(totals: &[(&str, usize)]) -> Named<usize> {
-    let mut before = 0;
-    Named(
-        totals
-            .iter()
-            .map(|&(name, total)| {
-                let n = total - before;
-                before = total;
-                (name.to_string(), n)
-            })
-            .collect(),
-    )
-}
-
 /// The model's parameter permutations (over `all`, its parameters) that move more than one pair
 /// and keep every held parameter in place, over the free parameters `free` (matched by name);
 /// single exchanges are left to `mirror_solutions`, which checks every like pair.
@@ -588,23 +547,4 @@ fn free_permutations(
         })
         .filter(|perm| !matches!(cycles(perm).as_slice(), [pair] if pair.len() == 2))
         .collect()
-}
-
-/// The cycles (two or more parameters each) of a permutation, each from its lowest index.
-fn cycles(perm: &[usize]) -> Vec<Vec<usize>> {
-    let mut seen = vec![false; perm.len()];
-    let mut out = Vec::new();
-    for start in 0..perm.len() {
-        let mut cycle = Vec::new();
-        let mut i = start;
-        while !seen[i] {
-            seen[i] = true;
-            cycle.push(i);
-            i = perm[i];
-        }
-        if cycle.len() > 1 {
-            out.push(cycle);
-        }
-    }
-    out
 }

@@ -3,7 +3,9 @@
 //! the budget are flattened into the report, so their keys stand at its top level.
 
 use crate::named::Named;
+use eigenfit_core::analysis::alternatives::OtherSolution;
 use eigenfit_core::analysis::verdict::FitVerdict;
+use eigenfit_core::analysis::Identifiability;
 use serde::Serialize;
 
 /// `converged`, `termination`, `iterations`, `evaluations`, flattened into every estimating
@@ -112,12 +114,16 @@ impl PairedFrequencies {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Verdict {
     /// Converged, fit not poor, no parameter on a limit, budget not spent, every mode paired: the
-    /// exit verdict.
+    /// fit at the estimate explains the data (as discover's `explained`, at the same level).
     pub acceptable: bool,
     /// The run's stop reason when it did not converge, `budget-exhausted`, `poor-fit`,
-    /// `not-identifiable` (a parameter on a limit), or `converged` (saying so when the fit quality
-    /// could not be judged).
+    /// `not-identifiable` (a parameter on a limit), `not-unique` (another solution is equally
+    /// good: the data do not determine the parameters uniquely), or `converged` (saying so when
+    /// the fit quality could not be judged).
     pub verdict: &'static str,
+    /// No other solution found is equally good. The exit code is 0 only when the estimate is
+    /// `acceptable` and `unique`.
+    pub unique: bool,
 }
 
 impl Verdict {
@@ -130,17 +136,147 @@ impl Verdict {
         fit: FitVerdict,
         on_limit: bool,
         unpaired: bool,
+        unique: bool,
     ) -> Self {
         let verdict = match not_converged {
             Some(reason) => reason,
             None if budget_spent => "budget-exhausted",
             None if fit == FitVerdict::Poor => "poor-fit",
             None if on_limit => "not-identifiable",
+            None if !unique => "not-unique",
             None if fit == FitVerdict::NotJudged => "converged (fit quality not judged: no std)",
             None => "converged",
         };
         let acceptable =
             not_converged.is_none() && fit != FitVerdict::Poor && !on_limit && !budget_spent && !unpaired;
-        Self { acceptable, verdict }
+        Self { acceptable, verdict, unique }
     }
+
+    /// An answer to use as it is: acceptable and unique (exit code 0).
+    pub fn is_answer(&self) -> bool {
+        self.acceptable && self.unique
+    }
+}
+
+/// Another minimum of the misfit (or a symmetric model's mirror point), with the test that says
+/// whether the data can tell it from the estimate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AlternativeSolution {
+    /// Its values.
+    pub parameters: Named<f64>,
+    /// Its χ² (with std; without, Σr²/σ̂² with σ̂ from the estimate's residuals; `null` when σ
+    /// cannot be estimated: no degree of freedom left, or an exact estimate).
+    pub chi2: Option<f64>,
+    /// χ² here − χ² at the estimate (same scaling; `null` as `chi2`).
+    pub delta_chi2: Option<f64>,
+    /// Σr² of the residual (weighted with std): the misfit whatever σ is.
+    pub misfit: f64,
+    /// The data cannot tell it from the estimate: Δχ² below the χ² quantile at 1 − α with as
+    /// many degrees of freedom as free parameters (α = 0.05); without σ, an exact fit as the
+    /// estimate is.
+    pub equally_good: bool,
+    /// A mirror solution: the model has the exchange as a symmetry (checked at two points) and
+    /// the exchanged point is equally good.
+    pub mirror: bool,
+    /// The exchanged pair when it is a mirror solution of a symmetric model that exchanges one
+    /// pair of parameters (`None` for a symmetry exchanging more: see `exchanged`).
+    pub mirror_of: Option<[String; 2]>,
+    /// A mirror solution's exchanged parameters as cycles (`[["zone1", "zone3"], ["zone2",
+    /// "zone4"]]`: a plate's zones mirrored about its centre line); empty for other solutions.
+    pub exchanged: Vec<Vec<String>>,
+}
+
+impl AlternativeSolution {
+    /// The report of `others` for parameters `names` (values in the parameters' own units).
+    pub fn list(names: &[String], others: &[OtherSolution]) -> Vec<Self> {
+        others
+            .iter()
+            .map(|a| {
+                let cycles = a.permutation.as_deref().map(cycles).unwrap_or_default();
+                let mirror = a.is_mirror();
+                AlternativeSolution {
+                    parameters: Named::new(names, a.parameters.iter().copied()),
+                    chi2: a.judged.chi2,
+                    delta_chi2: a.judged.delta_chi2,
+                    misfit: a.misfit,
+                    equally_good: a.judged.equally_good,
+                    mirror,
+                    mirror_of: match cycles.as_slice() {
+                        [pair] if mirror && pair.len() == 2 => {
+                            Some([names[pair[0]].clone(), names[pair[1]].clone()])
+                        }
+                        _ => None,
+                    },
+                    exchanged: cycles.iter().map(|c| c.iter().map(|&i| names[i].clone()).collect()).collect(),
+                }
+            })
+            .collect()
+    }
+}
+
+/// What the data say about one parameter: `true`, or `{"identifiable": false}` with the one
+/// bound known.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum ParameterIdentifiability {
+    /// Determined.
+    Determined(bool),
+    /// Not determined; a bound where one is known.
+    Not {
+        /// Always false.
+        identifiable: bool,
+        /// The lower bound, when only that is known.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        lower_bound: Option<f64>,
+        /// The upper bound, when only that is known.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        upper_bound: Option<f64>,
+    },
+}
+
+impl From<&Identifiability> for ParameterIdentifiability {
+    fn from(i: &Identifiability) -> Self {
+        let not = |lower_bound, upper_bound| Self::Not { identifiable: false, lower_bound, upper_bound };
+        match *i {
+            Identifiability::Determined => Self::Determined(true),
+            Identifiability::LowerBoundOnly { lower } => not(Some(lower), None),
+            Identifiability::UpperBoundOnly { upper } => not(None, Some(upper)),
+            Identifiability::Undetermined => not(None, None),
+        }
+    }
+}
+
+/// The cycles (two or more parameters each) of a permutation, each from its lowest index.
+pub(crate) fn cycles(perm: &[usize]) -> Vec<Vec<usize>> {
+    let mut seen = vec![false; perm.len()];
+    let mut out = Vec::new();
+    for start in 0..perm.len() {
+        let mut cycle = Vec::new();
+        let mut i = start;
+        while !seen[i] {
+            seen[i] = true;
+            cycle.push(i);
+            i = perm[i];
+        }
+        if cycle.len() > 1 {
+            out.push(cycle);
+        }
+    }
+    out
+}
+
+/// `{phase: evaluations}` from the running totals after each phase (a phase not reached is left
+/// out).
+pub(crate) fn phase_counts(totals: &[(&str, usize)]) -> Named<usize> {
+    let mut before = 0;
+    Named(
+        totals
+            .iter()
+            .map(|&(name, total)| {
+                let n = total - before;
+                before = total;
+                (name.to_string(), n)
+            })
+            .collect(),
+    )
 }

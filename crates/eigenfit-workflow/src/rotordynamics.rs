@@ -3,16 +3,21 @@
 
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
-use crate::outcome::{FitQualityReport, Outcome, ParameterValues, Verdict};
-use eigenfit_core::analysis::verdict::{judge, FitQuality};
-use eigenfit_core::problem::Linearisation;
+use crate::outcome::{
+    phase_counts, AlternativeSolution, BudgetReport, FitQualityReport, Outcome, ParameterIdentifiability,
+    ParameterValues, Verdict,
+};
+use eigenfit_core::analysis::alternatives::{like_exchanges, mirror_solutions, Equivalence};
+use eigenfit_core::analysis::verdict::judge;
+use eigenfit_core::analysis::{uncertainty_within, Identifiability};
+use eigenfit_core::update::Budget;
+use eigenfit_rotordynamics::fit::fit_runup;
 use eigenfit_rotordynamics::identify::{
-    bearing_parameters, read_runup, Identification, RunupPoint, DEFAULT_COEFFICIENTS,
+    bearing_parameters, check_selection, evaluate, read_runup, RunupPoint, DEFAULT_COEFFICIENTS,
 };
 use eigenfit_rotordynamics::interpolation::Coefficient;
-use eigenfit_rotordynamics::search::identify_from_best_start;
+use eigenfit_rotordynamics::objective::RunupObjective;
 use eigenfit_rotordynamics::{campbell, ross_file, rpm_to_rad, Campbell, Rotor, RotorDynError};
-use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::path::Path;
 
@@ -216,7 +221,10 @@ pub struct RunupPointId {
     pub mode: usize,
 }
 
-/// Bearing coefficients of a two-plane rotor from run-up frequencies.
+/// Bearing coefficients of a two-plane rotor from run-up frequencies: the keys of every
+/// model kind's estimate (`verdict`, `termination`, `chi2`, `dof`, `p_value`, `acceptable`,
+/// `unique`, `parameters`, `intervals`, `identifiable`, `evaluations_by_phase`,
+/// `alternative_solutions`), and the run-up's points.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunupEstimateReport {
     /// The model file.
@@ -224,13 +232,16 @@ pub struct RunupEstimateReport {
     /// Converged, why it stopped, iterations, eigen-solve rounds.
     #[serde(flatten)]
     pub outcome: Outcome,
-    /// Converged and the fit not poor (the exit verdict); `converged`, `poor-fit`,
-    /// `not-converged` or converged with the quality not judged.
+    /// The verdict, by the rules of every model kind.
     #[serde(flatten)]
     pub verdict: Verdict,
     /// χ², dof, p-value, relative RMS and the run-up points that miss by more than 3σ.
     #[serde(flatten)]
     pub fit: FitQualityReport<RunupPointId>,
+    /// The evaluation budget.
+    pub budget: BudgetReport,
+    /// Evaluations spent in each phase: fit, mirror_solutions, intervals.
+    pub evaluations_by_phase: Named<usize>,
     /// The speed the coefficients are reported at (the lowest measured, rpm).
     pub reference_speed_rpm: f64,
     /// Nominal and estimated coefficients (N/m or N·s/m), each one's interval as text or why
@@ -239,70 +250,42 @@ pub struct RunupEstimateReport {
     pub values: ParameterValues,
     /// Estimated scale factors on the nominal curves.
     pub scales: Named<f64>,
-    /// Σ r².
+    /// Σ r² (weighted by std, or of relative residuals without).
     pub cost: f64,
-    /// Whether every parameter is determined by the data.
-    pub identifiable: bool,
-    /// Fits from screened other starts run because the fit from the file's bearings did not
-    /// pass the χ² test (0: it did, or the search was turned off).
+    /// 95 % intervals of the coefficients (profile likelihood where the linearisation is too
+    /// wide; `null` without std or when the run did not converge).
+    pub intervals: Option<Named<[f64; 2]>>,
+    /// Per coefficient: determined by the data (`true`), or `{"identifiable": false}` with the
+    /// one bound known on its factor (`null` as `intervals`).
+    pub identifiable: Option<Named<ParameterIdentifiability>>,
+    /// Restarts from screened other starts taken because the fit from the file's bearings did
+    /// not pass (0: it did, or none were allowed).
     pub refits: usize,
+    /// Mirror points of a symmetric rotor (exchanged bearings), each with its χ², Δχ² and the
+    /// test's outcome.
+    pub alternative_solutions: Vec<AlternativeSolution>,
+    /// How σ was taken for the alternatives' test: `std`, `residuals` or `exact`.
+    pub alternatives_sigma: &'static str,
     /// The run-up points at the estimate.
     pub points: Vec<RunupPointReport>,
     /// Bearing tables extrapolated at measured speeds.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
-    /// Intervals, with std only.
-    #[serde(flatten)]
-    pub with_std: Option<RunupIntervals>,
     /// With `--write-model`: the input ROSS file, of its version, with the estimated bearing
     /// coefficients (each table multiplied by its estimated factor).
     #[serde(skip)]
     pub updated_model: Option<String>,
 }
 
-/// The part of a run-up estimate that needs standard deviations.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RunupIntervals {
-    /// 95 % intervals (log-normal).
-    pub intervals: Named<[f64; 2]>,
-    /// Standard deviations of ln k.
-    pub standard_deviations_ln: Named<f64>,
-}
-
-/// The fit's quality judged by core's verdict rules, as for the planar model: the run-up's
-/// frequencies and residuals put in a [`Linearisation`] (eigenvalues λ = ω², Jacobians in the
-/// physical units of the parameters).
-fn fit_quality(id: &Identification, points: &[RunupPoint], values: &[f64]) -> FitQuality {
-    let has_std = points.iter().all(|p| p.std_hz.is_some());
-    let m = points.len();
-    let omega = |f: f64| 2.0 * std::f64::consts::PI * f;
-    // Residual measured − model in σ, or relative without std (the planar `relative` residual).
-    let sigma = |i: usize| points[i].sigma_hz();
-    // d f/d p = (d f/d ln s)/p in Hz per N/m (N·s/m); dλ/dp = 2ω·2π d f/d p.
-    let df_dp = DMatrix::from_fn(m, values.len(), |i, j| id.jacobian[(i, j)] / values[j]);
-    let lin = Linearisation {
-        parameters: values.to_vec(),
-        paired_modes: points.iter().map(|p| p.mode - 1).collect(),
-        model_eigenvalues: DVector::from_iterator(m, id.model_hz.iter().map(|&f| omega(f).powi(2))),
-        measured_eigenvalues: DVector::from_iterator(m, points.iter().map(|p| omega(p.frequency_hz).powi(2))),
-        eigenvalue_jacobian: DMatrix::from_fn(m, values.len(), |i, j| {
-            2.0 * omega(id.model_hz[i]) * 2.0 * std::f64::consts::PI * df_dp[(i, j)]
-        }),
-        frequencies_hz: id.model_hz.clone(),
-        measured_hz: points.iter().map(|p| p.frequency_hz).collect(),
-        residual: DVector::from_fn(m, |i, _| (points[i].frequency_hz - id.model_hz[i]) / sigma(i)),
-        jacobian: DMatrix::from_fn(m, values.len(), |i, j| df_dp[(i, j)] / sigma(i)),
-        has_std,
-        round_off: Vec::new(),
-    };
-    judge(&lin, values.len())
-}
+/// Refits from screened other starts a run-up estimate runs at most, when not given.
+pub const RUNUP_REFITS: usize = 6;
 
 /// `estimate --model ROSS-FILE --measured RUNUP.csv [--parameters kxx,kyy,…]`: bearing
 /// coefficients from a run-up (`selection` `None`: kxx and kyy of every bearing, seals left
-/// out). When the fit from the file's bearings fails the χ² test, up to `refits` fits from
-/// screened other starts follow ([`identify_from_best_start`]), all within `budget` evaluations
-/// (one eigen-solve round over the run-up's speeds each).
+/// out), fitted by core's driver on the run-up's objective ([`fit_runup`]: direct stiffnesses
+/// first, up to `refits` restarts from screened starts), judged by core's verdict, with core's
+/// intervals and mirror solutions, all within `budget` evaluations (one eigen-solve round over
+/// the run-up's speeds each).
 pub fn estimate(
     path: &Path,
     measured: &Path,
@@ -442,52 +425,104 @@ pub fn estimate_with(
     } else {
         None
     };
-    let id = identify_from_best_start(&rotor, &params, &points, &initial, max_iterations, refits, budget)
-        .map_err(to_workflow)?;
+    check_selection(&rotor, &params, &points).map_err(to_workflow)?;
+    if budget == 0 {
+        return Err(input("--budget 0: at least one model evaluation is needed"));
+    }
+    let objective = RunupObjective::new(&rotor, params.clone(), &points, None).map_err(to_workflow)?;
+    let np = params.len();
+    let budget = Budget::new(budget);
+    let mut phases: Vec<(&str, usize)> = Vec::new();
+    let (estimate, restarts) = match fit_runup(&objective, &params, &initial, max_iterations, refits, &budget)
+    {
+        Ok(f) => f,
+        Err(_) if budget.exhausted() => {
+            return Err(WorkflowError::BudgetExhausted(format!(
+            "the budget of {} model evaluations ran out before the fit could start (raise it with --budget)",
+            budget.limit()
+        )))
+        }
+        Err(e) => return Err(input(format!("{}: {e}", measured.display()))),
+    };
+    phases.push(("fit", budget.used()));
+    let converged = estimate.termination.is_converged();
+    let lin = &estimate.last;
+    let has_std = lin.has_std;
+    // Mirrors: exchanges of like coefficients the rotor is symmetric under (two bearings alike).
+    let mirrors = if converged {
+        mirror_solutions(&objective, lin, &like_exchanges(&objective), &budget)
+    } else {
+        Default::default()
+    };
+    phases.push(("mirror_solutions", budget.used()));
+    let uncertainty = if converged { uncertainty_within(&objective, lin, has_std, &budget) } else { None };
+    phases.push(("intervals", budget.used()));
+    let quality = judge(lin, np);
+    let equivalence = Equivalence::at(lin, np);
+    let alternatives_sigma = if has_std {
+        "std"
+    } else if equivalence.sigma_estimated() {
+        "residuals"
+    } else {
+        "exact"
+    };
+    let unique = !mirrors.symmetric.iter().any(|m| m.judged.equally_good);
+    let budget_spent = budget.exhausted();
+    let verdict = Verdict::of(
+        (!converged).then(|| estimate.termination.label()),
+        budget_spent,
+        quality.verdict,
+        false,
+        false,
+        unique,
+    );
     // Report each coefficient at the lowest measured speed (constant bearings: their value).
     let w0 = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
     let nominal: Vec<f64> = params.iter().map(|p| p.nominal(&rotor, w0)).collect();
-    let value: Vec<f64> = nominal.iter().zip(&id.scales).map(|(k, s)| k * s).collect();
+    let physical =
+        |factors: &[f64]| -> Vec<f64> { nominal.iter().zip(factors).map(|(k, s)| k * s).collect() };
+    let value = physical(&estimate.parameters);
     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
-    // 95 % intervals, log-normal (the estimate is linearised in ln k); ordered low, high also
-    // for a negative (cross-coupled) coefficient.
-    let intervals: Option<Vec<[f64; 2]>> = id.ln_std.as_ref().map(|sd| {
-        value
+    // Factor intervals on the nominal coefficient, ordered low, high also for a negative
+    // (cross-coupled) one.
+    let intervals: Option<Vec<[f64; 2]>> = uncertainty.as_ref().map(|u| {
+        u.intervals
             .iter()
-            .zip(sd)
-            .map(|(v, s)| {
-                let (a, b) = (v * (-1.96 * s).exp(), v * (1.96 * s).exp());
+            .zip(&nominal)
+            .map(|(iv, k)| {
+                let (a, b) = (iv[0] * k, iv[1] * k);
                 [a.min(b), a.max(b)]
             })
             .collect()
     });
-    let quality = fit_quality(&id, &points, &value);
-    // A run-up fit has no limits or pairing of its own to fail on; its budget can run out.
-    let budget_spent = !id.outcome.converged && id.outcome.evaluations >= budget;
-    let not_converged = (!id.outcome.converged && !budget_spent).then_some("not-converged");
-    let verdict = Verdict::of(not_converged, budget_spent, quality.verdict, false, false);
     let status = |i: usize| -> String {
-        match &intervals {
-            _ if !id.outcome.converged => "(not computed: the run did not converge)".into(),
-            Some(iv) => format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]),
-            None if !id.identifiable => {
+        let id = uncertainty.as_ref().map(|u| &u.identifiability[i]);
+        match (&intervals, id) {
+            _ if !converged => "(not computed: the run did not converge)".into(),
+            (Some(iv), Some(Identifiability::Determined)) => format!("[{:.4e}, {:.4e}]", iv[i][0], iv[i][1]),
+            (_, Some(Identifiability::LowerBoundOnly { lower })) => {
+                format!("not identifiable: factor ≥ {lower:.4e}")
+            }
+            (_, Some(Identifiability::UpperBoundOnly { upper })) => {
+                format!("not identifiable: factor ≤ {upper:.4e}")
+            }
+            (_, Some(_)) => {
                 "not identifiable: the frequencies fix only combinations of the parameters".into()
             }
-            None => "(no std given)".into(),
+            _ => "(no std given)".into(),
         }
     };
-    let with_std = match (&intervals, &id.ln_std) {
-        (Some(iv), Some(sd)) => Some(RunupIntervals {
-            intervals: Named::new(&names, iv.iter().copied()),
-            standard_deviations_ln: Named::new(&names, sd.iter().copied()),
-        }),
-        _ => None,
-    };
+    let mut alternatives = mirrors.symmetric.clone();
+    for a in &mut alternatives {
+        a.parameters = physical(&a.parameters);
+    }
+    // One more evaluation for the whirl of each paired model mode at the estimate.
+    let whirl = evaluate(&rotor, &params, &estimate.parameters, &points).map_err(to_workflow)?.whirl;
     let updated_model = match text {
         Some(text) => {
             let changes: Vec<(String, String, f64)> = params
                 .iter()
-                .zip(&id.scales)
+                .zip(&estimate.parameters)
                 .map(|(p, s)| {
                     let b = &rotor.bearings[p.bearing];
                     let name = eigenfit_rotordynamics::identify::COEFFICIENT_NAMES[p.coefficient];
@@ -501,12 +536,14 @@ pub fn estimate_with(
     Ok(RunupEstimateReport {
         updated_model,
         model: path.display().to_string(),
-        outcome: id.outcome.clone(),
+        outcome: Outcome::of(&estimate, converged),
         verdict,
         fit: FitQualityReport::of(&quality, |k| RunupPointId {
             speed_rpm: points[k].speed_rpm,
             mode: points[k].mode,
         }),
+        budget: BudgetReport::of(&budget),
+        evaluations_by_phase: phase_counts(&phases),
         reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
         // `initial`: where the fit started (the file's values, or --initial's).
         values: ParameterValues::new(
@@ -515,10 +552,15 @@ pub fn estimate_with(
             &value,
             status,
         ),
-        scales: Named::new(&names, id.scales.iter().copied()),
-        cost: id.cost,
-        identifiable: id.identifiable,
-        refits: id.refits,
+        scales: Named::new(&names, estimate.parameters.iter().copied()),
+        cost: lin.chi2(),
+        intervals: intervals.map(|iv| Named::new(&names, iv)),
+        identifiable: uncertainty
+            .as_ref()
+            .map(|u| Named::new(&names, u.identifiability.iter().map(Into::into))),
+        refits: restarts,
+        alternative_solutions: AlternativeSolution::list(&names, &alternatives),
+        alternatives_sigma,
         notes: {
             let mut notes = Vec::new();
             if options.initial.is_some() {
@@ -540,12 +582,11 @@ pub fn estimate_with(
                 speed_rpm: p.speed_rpm,
                 mode: p.mode,
                 measured_hz: p.frequency_hz,
-                model_hz: id.model_hz[i],
-                model_whirl: id.model_whirl[i].name(),
+                model_hz: lin.frequencies_hz[i],
+                model_whirl: whirl[i].name(),
                 measured_whirl: p.whirl.map(|w| w.name()),
             })
             .collect(),
-        with_std,
     })
 }
 

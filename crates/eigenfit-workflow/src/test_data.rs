@@ -384,7 +384,7 @@ pub fn updated_model_toml(
         "# Updated by eigenfit estimate ({} strategy, {}) on {} from {}\n\
          # chi2 = {:.6e} on {} degrees of freedom\n",
         estimate.strategy,
-        estimate.termination,
+        estimate.termination.label(),
         utc_date(),
         data_file.display(),
         estimate.last.chi2(),

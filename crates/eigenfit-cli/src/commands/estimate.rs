@@ -40,13 +40,14 @@ pub struct EstimateArgs {
     /// solutions may spend together; when it runs out the run ends with exit code 3 and says so.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_EVALUATIONS)]
     pub budget: usize,
-    /// Points of the coarse grid refitted locally when searching for other equally good
-    /// solutions (0: no such search; the exchange of like parameters is still checked). Each is
-    /// a local fit of several model evaluations: on a large model most of a run's time
-    /// (`evaluations_by_phase` in --json). ROSS rotors: the most refits from screened starts
-    /// when the fit from the file's bearings fails the χ² test (`refits` in --json).
-    #[arg(long, value_name = "N", default_value_t = eigenfit_workflow::estimate::ALTERNATIVE_STARTS)]
-    pub alternative_starts: usize,
+    /// Starts of the space-filling design refitted locally when searching for other minima
+    /// (default: 4 per free parameter and 8 more; 0: no such search; the exchange of like
+    /// parameters is still checked). Each is a local fit of several model evaluations: on a
+    /// large model most of a run's time (`evaluations_by_phase` in --json). ROSS rotors: the
+    /// most refits from screened starts when the fit from the file's bearings fails the χ² test
+    /// (`refits` in --json; default 6).
+    #[arg(long, value_name = "N")]
+    pub alternative_starts: Option<usize>,
     /// Write the convergence history (convergence.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
@@ -185,9 +186,9 @@ fn print_report(est: &Estimation) {
             } else {
                 "acceptable"
             },
-            significant(chi2),
+            crate::output::significant(chi2),
             r.fit.dof,
-            r.fit.p_value.map_or("n/a (no dof)".to_string(), significant),
+            r.fit.p_value.map_or("n/a (no dof)".to_string(), crate::output::significant),
             if r.fit.disagreeing_modes.is_empty() {
                 String::new()
             } else {
@@ -196,56 +197,20 @@ fn print_report(est: &Estimation) {
         ),
         _ => {}
     }
-    if let Some(u) = &r.uncertainty {
-        let sv: Vec<String> = u.singular_values.iter().map(|v| format!("{v:.3e}")).collect();
-        println!(
-            "scaled Jacobian: singular values [{}], condition number {:.3e}",
-            sv.join(", "),
-            u.condition_number
-        );
+    if let (Some(values), Some(condition)) = (&r.uncertainty.singular_values, r.uncertainty.condition_number)
+    {
+        let sv: Vec<String> = values.iter().map(|v| format!("{v:.3e}")).collect();
+        println!("scaled Jacobian: singular values [{}], condition number {condition:.3e}", sv.join(", "));
     }
     if !r.at_limit.is_empty() {
         println!("at a parameter limit (the data cannot determine it): {}", r.at_limit.join(", "));
     }
-    for a in &r.alternative_solutions {
-        let values: Vec<String> = a.parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
-        match &a.mirror_of {
-            Some([i, j]) => println!(
-                "equally good mirror solution ({i} ↔ {j} exchanged, a symmetric model): {}",
-                values.join(", ")
-            ),
-            None if !a.exchanged.is_empty() => {
-                let cycles: Vec<String> = a
-                    .exchanged
-                    .iter()
-                    .map(|c| match c.as_slice() {
-                        [i, j] => format!("{i} ↔ {j}"),
-                        _ => format!("{} → {}", c.join(" → "), c[0]),
-                    })
-                    .collect();
-                println!(
-                    "equally good mirror solution ({} exchanged, a symmetric model): {}",
-                    cycles.join(", "),
-                    values.join(", ")
-                )
-            }
-            None => println!("equally good other solution: {}", values.join(", ")),
-        }
-    }
+    crate::output::print_alternatives(&r.alternative_solutions, r.alternatives_sigma);
     if r.budget.exhausted {
         println!(
             "the evaluation budget ({} model evaluations) ran out: results are incomplete; raise it with --budget",
             r.budget.limit
         );
-    }
-}
-
-/// Four significant digits, in exponent form outside [1e-3, 1e5).
-fn significant(v: f64) -> String {
-    if v == 0.0 || (1e-3..1e5).contains(&v.abs()) {
-        format!("{v:.4}").trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        format!("{v:.3e}")
     }
 }
 

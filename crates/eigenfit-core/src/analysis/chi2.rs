@@ -12,6 +12,24 @@ pub fn chi2_upper_tail(x: f64, dof: usize) -> f64 {
     1.0 - regularized_lower_gamma(dof as f64 / 2.0, x / 2.0)
 }
 
+/// x with P(χ²_ν > x) = `tail` (bisection on [`chi2_upper_tail`], to 1e-12 relative; `tail` in
+/// (0, 1)): the threshold of a χ² test at significance `tail`.
+pub fn chi2_quantile_upper(tail: f64, dof: usize) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 10.0 + 10.0 * dof as f64);
+    while chi2_upper_tail(hi, dof) > tail {
+        hi *= 2.0;
+    }
+    while hi - lo > 1e-12 * hi {
+        let mid = 0.5 * (lo + hi);
+        if chi2_upper_tail(mid, dof) > tail {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 /// 1.96: the two-sided 95 % quantile of the normal distribution.
 pub(crate) const Z_95: f64 = 1.959_963_984_540_054;
 
@@ -104,6 +122,19 @@ mod tests {
         // 0.025/10 (ten alternatives compared): 2.807; 0.005: 2.576.
         assert!((normal_quantile_upper(0.0025) - 2.807_033_768).abs() < 1e-6);
         assert!((normal_quantile_upper(0.005) - 2.575_829_304).abs() < 1e-6);
+    }
+
+    #[test]
+    fn the_chi2_quantile_matches_its_tables() {
+        // Abramowitz & Stegun table 26.8: χ²_0.95(1) = 3.841, (2) = 5.991, (4) = 9.488, (17) = 27.587.
+        for (dof, q) in [
+            (1, 3.841_458_820_694_124),
+            (2, 5.991_464_547_107_979),
+            (4, 9.487_729_036_781_154),
+            (17, 27.587_111_638_275_33),
+        ] {
+            assert!((chi2_quantile_upper(0.05, dof) - q).abs() < 1e-9 * q, "dof {dof}");
+        }
     }
 
     #[test]

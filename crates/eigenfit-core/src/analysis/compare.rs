@@ -1,20 +1,24 @@
 //! Strategy comparison: targets × initial guesses × strategies on reference data synthesised
 //! from the model itself (the paper's Tables 2–5 and convergence maps).
 
-use crate::analysis::{alternatives_among, local_solutions, uncertainty_within, Identifiability};
+use crate::analysis::alternatives::{local_minima, other_solutions, search_starts};
+use crate::analysis::{uncertainty_within, Identifiability};
 use crate::eigen::EigenSolver;
 use crate::measurement::synthetic::SynthesisError;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::problem::{Linearisation, Objective, Problem};
-use crate::update::{Budget, Driver, LevenbergMarquardt, Outcome, StrategyKind, UpdateStrategy};
+use crate::update::{
+    Budget, Driver, LevenbergMarquardt, Outcome, StrategyKind, TerminationReport, UpdateStrategy,
+};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
 use thiserror::Error;
 
-/// Local fits tried when looking for other solutions of a damped run.
-const ALTERNATIVE_STARTS: usize = 6;
+/// Most evaluations the one-off search for the data's local minima may spend (shared by every
+/// run of a grid).
+const SEARCH_EVALUATIONS: usize = 5_000;
 
 /// How the reference data are made: `modes`, `decimals`, `std_hz`, as a comparison's report
 /// states them (flattened into it).
@@ -131,7 +135,12 @@ impl SharedData {
     pub fn new(problem: &dyn Objective) -> Self {
         Self {
             seeds: LevenbergMarquardt::rank_seeds(problem),
-            solutions: local_solutions(problem, ALTERNATIVE_STARTS),
+            solutions: local_minima(
+                problem,
+                search_starts(problem.parameters().len()),
+                &[],
+                &Budget::new(SEARCH_EVALUATIONS),
+            ),
         }
     }
 
@@ -184,7 +193,11 @@ where
                 .flatten()
                 .map(|u| u.identifiability);
             let alternatives = if converged && strategy == StrategyKind::LevenbergMarquardt {
-                alternatives_among(problem, &est.last, &shared.solutions)
+                other_solutions(problem, &est.last, &shared.solutions)
+                    .into_iter()
+                    .filter(|s| s.judged.equally_good)
+                    .map(|s| s.parameters)
+                    .collect()
             } else {
                 Vec::new()
             };
@@ -205,7 +218,12 @@ where
             strategy,
             target: target.to_vec(),
             initial: initial.to_vec(),
-            outcome: Outcome { converged: false, termination: e.to_string(), iterations: 0, evaluations: 0 },
+            outcome: Outcome {
+                converged: false,
+                termination: TerminationReport::new("failed", "setup", e.to_string()),
+                iterations: 0,
+                evaluations: 0,
+            },
             estimate: initial.to_vec(),
             relative_error: relative_error(initial, target),
             seconds,

@@ -1,10 +1,11 @@
 //! Analysis layer, above the update loop: how well an estimate is determined (uncertainty,
-//! alternative and mirror solutions), the fit [`verdict`] (χ² test, unreachable modes), fits
+//! alternative and mirror solutions, [`alternatives`]), the fit [`verdict`] (χ² test, unreachable modes), fits
 //! with mode shapes ([`ShapeFit`]) and joint campaigns ([`Joint`]) with their intervals, the
 //! strategy comparison ([`compare`]) and Monte Carlo studies ([`monte_carlo`]).
 //!
 //! Depends on [`update`](crate::update) and below.
 
+pub mod alternatives;
 pub(crate) mod chi2;
 pub mod compare;
 pub(crate) mod joint;
@@ -13,11 +14,10 @@ pub(crate) mod shape_fit;
 pub(crate) mod statistics;
 pub mod verdict;
 
-pub use chi2::chi2_upper_tail;
+pub use chi2::{chi2_quantile_upper, chi2_upper_tail};
 pub use joint::{Joint, JointError};
 pub use shape_fit::{ShapeFit, DEFAULT_FREQUENCY_STD_REL, DEFAULT_SHAPE_STD};
 pub use statistics::{
-    alternative_solutions, alternative_solutions_within, alternatives_among, local_solutions,
-    mirror_solutions, permuted_solutions, uncertainty, uncertainty_observed, uncertainty_within,
-    Identifiability, Uncertainty, UNCERTAINTY_EVALUATIONS,
+    uncertainty, uncertainty_observed, uncertainty_within, Identifiability, Uncertainty,
+    UNCERTAINTY_EVALUATIONS,
 };

@@ -42,7 +42,8 @@ pub enum DiscoveryError {
 /// Settings of the workflow.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DiscoveryOptions {
-    /// Significance level of the χ² test (default 0.05).
+    /// Significance level of the χ² test (default [`SIGNIFICANCE`](crate::analysis::verdict::SIGNIFICANCE),
+    /// the one level of every verdict).
     pub significance: f64,
     /// Candidates refitted after screening (default 8; switches are always refitted), and the
     /// most candidates predicting like the leading fit refitted beside it in each round.
@@ -82,7 +83,7 @@ pub const DEFAULT_EVALUATIONS: usize = 10_000;
 impl Default for DiscoveryOptions {
     fn default() -> Self {
         Self {
-            significance: 0.05,
+            significance: crate::analysis::verdict::SIGNIFICANCE,
             refits: 8,
             min_aicc_gain: 6.0,
             assumed_relative_std: 1e-3,

@@ -6,8 +6,15 @@ use crate::problem::{Linearisation, Objective};
 /// Why a run ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Termination {
-    /// The strategy's convergence test holds.
+    /// The strategy's convergence test (a step or frequency tolerance) holds.
     Converged,
+    /// The residual is at its round-off level: an exact fit.
+    ExactFit,
+    /// No step reduces the misfit at a fit the strategy accepts (a stationary point).
+    Stationary,
+    /// The strategy's restarts are used up: the run ends at the best minimum it found, which its
+    /// own acceptance rule did not accept (the verdict's χ² test says whether the data do).
+    RestartsUsed,
     /// The iteration limit was reached first.
     IterationLimit,
     /// The iterate left the physical range, or the model failed there.
@@ -22,20 +29,57 @@ pub enum Termination {
 }
 
 impl Termination {
-    /// True for [`Termination::Converged`].
+    /// True when the run ended at a minimum worth judging: a tolerance test, an exact fit, a
+    /// stationary point, or the best minimum after the restarts ([`Termination::status`] tells
+    /// the last apart).
     pub fn is_converged(&self) -> bool {
-        matches!(self, Termination::Converged)
+        matches!(
+            self,
+            Termination::Converged
+                | Termination::ExactFit
+                | Termination::Stationary
+                | Termination::RestartsUsed
+        )
     }
 
-    /// Short label: `converged`, `iteration-limit`, `diverged`, `stalled`, `budget-exhausted`.
-    pub fn label(&self) -> &'static str {
+    /// The status, apart from the reason: `converged` (tolerance, exact fit, stationary),
+    /// `best-found` (restarts used up: the best minimum found), `stopped` (iteration limit,
+    /// budget) or `failed` (diverged, stalled).
+    pub fn status(&self) -> &'static str {
         match self {
-            Termination::Converged => "converged",
+            Termination::Converged | Termination::ExactFit | Termination::Stationary => "converged",
+            Termination::RestartsUsed => "best-found",
+            Termination::IterationLimit | Termination::BudgetExhausted { .. } => "stopped",
+            Termination::Diverged(_) | Termination::Stalled(_) => "failed",
+        }
+    }
+
+    /// The reason: `tolerance`, `exact-fit`, `stationary`, `restarts-used`, `iteration-limit`,
+    /// `diverged`, `stalled`, `budget-exhausted`.
+    pub fn reason(&self) -> &'static str {
+        match self {
+            Termination::Converged => "tolerance",
+            Termination::ExactFit => "exact-fit",
+            Termination::Stationary => "stationary",
+            Termination::RestartsUsed => "restarts-used",
             Termination::IterationLimit => "iteration-limit",
             Termination::Diverged(_) => "diverged",
             Termination::Stalled(_) => "stalled",
             Termination::BudgetExhausted { .. } => "budget-exhausted",
         }
+    }
+
+    /// Short label: `converged` for every converged reason, else the reason.
+    pub fn label(&self) -> &'static str {
+        match self.status() {
+            "converged" => "converged",
+            _ => self.reason(),
+        }
+    }
+
+    /// The status, the reason and the detail in words, as every report states it.
+    pub fn report(&self) -> TerminationReport {
+        TerminationReport { status: self.status(), reason: self.reason(), detail: self.to_string() }
     }
 }
 
@@ -52,8 +96,40 @@ impl std::fmt::Display for Termination {
                     self.label()
                 )
             }
-            _ => f.write_str(self.label()),
+            Termination::Converged => f.write_str("converged (tolerance test)"),
+            Termination::ExactFit => f.write_str("converged (exact fit)"),
+            Termination::Stationary => f.write_str("converged (stationary point)"),
+            Termination::RestartsUsed => {
+                f.write_str("best-found (restarts used up: the best minimum found is reported)")
+            }
+            Termination::IterationLimit => f.write_str(self.label()),
         }
+    }
+}
+
+/// How a run ended, as the JSON states it: `{"status": …, "reason": …, "detail": …}`
+/// ([`Termination::status`], [`Termination::reason`], the words).
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct TerminationReport {
+    /// `converged`, `best-found`, `stopped` or `failed`.
+    pub status: &'static str,
+    /// `tolerance`, `exact-fit`, `stationary`, `restarts-used`, `iteration-limit`, `diverged`,
+    /// `stalled` or `budget-exhausted`.
+    pub reason: &'static str,
+    /// The same in words, with what caused it.
+    pub detail: String,
+}
+
+impl TerminationReport {
+    /// A termination of a run outside the driver (a run-up search's budget, say).
+    pub fn new(status: &'static str, reason: &'static str, detail: impl Into<String>) -> Self {
+        Self { status, reason, detail: detail.into() }
+    }
+}
+
+impl std::fmt::Display for TerminationReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.detail)
     }
 }
 
@@ -121,8 +197,8 @@ pub struct Estimate {
 pub struct Outcome {
     /// Whether the iteration converged (and, where it applies, every mode was paired).
     pub converged: bool,
-    /// Why it stopped.
-    pub termination: String,
+    /// Why it stopped: status, reason and detail.
+    pub termination: TerminationReport,
     /// Iterations taken.
     pub iterations: usize,
     /// Model evaluations (eigen-solves) spent.
@@ -134,7 +210,7 @@ impl Outcome {
     pub fn of(estimate: &Estimate, converged: bool) -> Self {
         Self {
             converged,
-            termination: estimate.termination.to_string(),
+            termination: estimate.termination.report(),
             iterations: estimate.iterations,
             evaluations: estimate.evaluations,
         }
@@ -243,7 +319,7 @@ impl ObservedDriver<'_, '_> {
             history.push(record);
         };
         let termination = if strategy.converged(&current) {
-            Termination::Converged
+            strategy.start_termination()
         } else {
             loop {
                 if iterations >= self.driver.max_iterations {
@@ -261,8 +337,12 @@ impl ObservedDriver<'_, '_> {
                 match step {
                     Ok(step) => {
                         accept(step.next, &mut current, &mut iterations);
-                        if step.status == StepStatus::Converged {
-                            break Termination::Converged;
+                        match step.status {
+                            StepStatus::Continue => {}
+                            StepStatus::Converged => break Termination::Converged,
+                            StepStatus::ExactFit => break Termination::ExactFit,
+                            StepStatus::Stationary => break Termination::Stationary,
+                            StepStatus::RestartsUsed => break Termination::RestartsUsed,
                         }
                     }
                     Err(UpdateError::Diverged(why)) => break Termination::Diverged(why),

@@ -1,7 +1,7 @@
 //! Damped least squares (Levenberg–Marquardt) in scaled parameters, with bounds and restarts.
 
 use super::settings::{Guard, SettingsError};
-use super::{Step, StepStatus, UpdateError, UpdateStrategy};
+use super::{Step, StepStatus, Termination, UpdateError, UpdateStrategy};
 use crate::model::ParameterSet;
 use crate::problem::{Linearisation, Objective};
 use nalgebra::{DMatrix, DVector};
@@ -152,7 +152,8 @@ impl LevenbergMarquardt {
     }
 
     /// Uses restart seeds ranked once for several runs on the same data ([`LevenbergMarquardt::rank_seeds`]),
-    /// instead of ranking the coarse grid again in every run.
+    /// or a design of the caller's (a run-up's screened starts), instead of ranking the coarse
+    /// grid in every run; held parameters keep their values in every seed.
     pub fn with_seeds(mut self, seeds: Arc<Vec<Vec<f64>>>) -> Self {
         self.shared_seeds = Some(seeds);
         self
@@ -167,10 +168,18 @@ impl LevenbergMarquardt {
     /// This run's seeds (ranked on first use, or copied from shared ones).
     fn seeds(&mut self, problem: &dyn Objective, around: &[f64]) -> &mut Vec<Vec<f64>> {
         if self.seeds.is_none() {
-            let fixed = self.fixed.iter().any(|&f| f);
-            self.seeds = Some(match (&self.shared_seeds, fixed) {
-                (Some(shared), false) => shared.as_ref().clone(),
-                _ => ranked_seeds(problem, around, &self.fixed),
+            self.seeds = Some(match &self.shared_seeds {
+                // Shared seeds with held parameters: the held ones keep this run's values.
+                Some(shared) => shared
+                    .iter()
+                    .map(|s| {
+                        s.iter()
+                            .enumerate()
+                            .map(|(i, &v)| if self.is_free(i) { v } else { around[i] })
+                            .collect()
+                    })
+                    .collect(),
+                None => ranked_seeds(problem, around, &self.fixed),
             });
         }
         self.seeds.as_mut().expect("set above") // proof: assigned just above when None
@@ -234,7 +243,7 @@ impl LevenbergMarquardt {
             }
         }
         let best = self.best.clone().unwrap_or_else(|| current.clone());
-        Ok(Step { next: best, status: StepStatus::Converged })
+        Ok(Step { next: best, status: StepStatus::RestartsUsed })
     }
 }
 
@@ -250,15 +259,7 @@ pub(crate) fn ranked_seeds(problem: &dyn Objective, around: &[f64], fixed: &[boo
             if fixed.get(i).copied().unwrap_or(false) {
                 return vec![around[i]];
             }
-            let (lo, hi) = p.search_range();
-            let t = |k: usize| (k as f64 + 0.5) / per_axis as f64;
-            if lo > 0.0 && hi / lo > 100.0 {
-                // A positive range spanning decades is searched in log spacing, whatever the scale.
-                (0..per_axis).map(|k| (lo.ln() + (hi / lo).ln() * t(k)).exp()).collect()
-            } else {
-                let (a, b) = (p.to_scaled(lo), p.to_scaled(hi));
-                (0..per_axis).map(|k| p.from_scaled(a + (b - a) * t(k))).collect()
-            }
+            (0..per_axis).map(|k| super::grid::search_point(p, (k as f64 + 0.5) / per_axis as f64)).collect()
         })
         .collect();
     let mut ranked: Vec<(f64, Vec<f64>)> = super::grid::tensor_product(&axes, MAX_SEEDS)
@@ -296,6 +297,10 @@ impl UpdateStrategy for LevenbergMarquardt {
         Ok(())
     }
 
+    fn start_termination(&self) -> Termination {
+        Termination::ExactFit
+    }
+
     fn converged(&self, lin: &Linearisation) -> bool {
         // Exact frequencies end the run only when they are the whole residual: with shape rows
         // (testdata::shapes) a mirror solution matches every frequency and still misfits.
@@ -326,7 +331,7 @@ impl UpdateStrategy for LevenbergMarquardt {
             Ok(Some(step)) => {
                 let next = step.next;
                 if self.converged(&next) {
-                    return Ok(Step { next, status: StepStatus::Converged });
+                    return Ok(Step { next, status: StepStatus::ExactFit });
                 }
                 // Plateau watch: a long run of negligible progress on a point that does not fit.
                 if next.cost() < 0.999 * self.recent_cost {
@@ -346,7 +351,7 @@ impl UpdateStrategy for LevenbergMarquardt {
             {
                 self.remember(current);
                 let best = self.best.clone().unwrap_or_else(|| current.clone());
-                Ok(Step { next: best, status: StepStatus::Converged })
+                Ok(Step { next: best, status: StepStatus::Stationary })
             }
             Ok(None) | Err(UpdateError::Stalled(_)) => self.restart(problem, current),
             Err(e) => Err(e),

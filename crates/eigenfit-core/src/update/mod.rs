@@ -19,7 +19,9 @@ pub use budget::{Budget, Budgeted, DEFAULT_EVALUATIONS};
 pub use counted::Counted;
 pub use driver::{
     Driver, Estimate, IterationRecord, IterationRecordSink, ObservedDriver, Observer, Outcome, Termination,
+    TerminationReport,
 };
+pub use grid::halton;
 pub use levenberg_marquardt::{LevenbergMarquardt, LevenbergMarquardtSettings};
 pub use newton::Newton;
 pub use pstep::PStep;
@@ -46,13 +48,20 @@ pub enum UpdateError {
     Residual(#[from] ResidualError),
 }
 
-/// Whether the iterate returned by a step has converged.
+/// Whether the iterate returned by a step ends the run, and why.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StepStatus {
     /// Keep iterating.
     Continue,
-    /// The strategy's convergence test holds at the new iterate.
+    /// The strategy's convergence test (a step or frequency tolerance) holds at the new iterate.
     Converged,
+    /// The residual is at its round-off level: an exact fit.
+    ExactFit,
+    /// No step reduces the misfit (the gradient vanishes) at a fit the strategy accepts.
+    Stationary,
+    /// The strategy's restarts are used up; the new iterate is the best point it found, which
+    /// its own acceptance rule did not accept.
+    RestartsUsed,
 }
 
 /// One accepted step. The evaluations it spent are counted by the [`Driver`], not reported here.
@@ -72,6 +81,12 @@ pub trait UpdateStrategy {
     fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError>;
     /// Whether `lin` already satisfies the convergence test (checked at the start).
     fn converged(&self, lin: &Linearisation) -> bool;
+    /// What [`converged`](Self::converged) holding at the start means: the termination the
+    /// driver reports when the starting point already passes the test (default: the strategy's
+    /// tolerance test, [`Termination::Converged`]).
+    fn start_termination(&self) -> Termination {
+        Termination::Converged
+    }
     /// Takes one step.
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError>;
 }

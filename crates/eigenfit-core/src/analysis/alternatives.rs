@@ -1,0 +1,472 @@
+//! Other solutions: the minima of the misfit a space-filling search finds away from the estimate,
+//! a symmetric model's mirror solutions, and the test that says whether the data can tell each
+//! from the estimate ([`Equivalence`]).
+//!
+//! Every claim is a test at [`SIGNIFICANCE`]: another point is *equally good* when
+//! Δχ² = χ²(other) − χ²(estimate) lies below the χ² quantile of as many degrees of freedom as
+//! there are free parameters at 1 − α (the point lies inside the estimate's joint confidence
+//! region, Press et al., *Numerical Recipes* §15.6). Without standard deviations σ is estimated
+//! from the best fit's residuals, σ̂² = Σr²/dof; with no degree of freedom left (or an exact best
+//! fit) only another exact fit is equally good.
+
+use crate::analysis::chi2::chi2_quantile_upper;
+use crate::analysis::verdict::SIGNIFICANCE;
+use crate::problem::{Linearisation, Objective};
+use crate::update::levenberg_marquardt::exact_fit_tolerance;
+use crate::update::{Budget, Driver, LevenbergMarquardt, LevenbergMarquardtSettings};
+
+/// Iterations of one local fit of the search: a local fit from a start of the design converges
+/// in tens of iterations or sits in a valley the budget should not be spent on.
+const LOCAL_FIT_ITERATIONS: usize = 100;
+/// Largest scaled difference (1 % of a log parameter) within which two minima are the same.
+pub const SAME_MINIMUM: f64 = 0.01;
+/// Scaled distance (10 % of a log parameter) below which an exchanged pair is the same point.
+const MIRROR_DISTANCE: f64 = 0.1;
+/// Relative difference of the model frequencies below which an exchange leaves them unchanged
+/// (the model has that symmetry): far above round-off, far below any misfit a test resolves.
+const SYMMETRY_TOLERANCE: f64 = 1e-7;
+/// Most other solutions listed, best first.
+pub const MOST_LISTED: usize = 10;
+
+/// Starts of the default search for other minima with `free` free parameters: a space-filling
+/// design of 4 per parameter and 8 more, so a small problem is covered densely and a large one
+/// in proportion.
+pub fn search_starts(free: usize) -> usize {
+    4 * free + 8
+}
+
+/// The test of one point against the estimate: whether the data can tell them apart.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equivalence {
+    /// ½χ² (or ½Σr²) at the estimate.
+    best_cost: f64,
+    /// The divisor of Σr² that makes it a χ²: 1 with std, σ̂² without; `None` when σ cannot be
+    /// estimated (no degree of freedom, or an exact best fit): then only exact fits are equal.
+    sigma2: Option<f64>,
+    /// χ² quantile at 1 − [`SIGNIFICANCE`] with as many degrees of freedom as free parameters.
+    threshold: f64,
+    free: usize,
+    weighted: bool,
+}
+
+/// One point judged by [`Equivalence::judge`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Judged {
+    /// χ² of the point (σ̂-scaled without std); `None` when σ cannot be estimated.
+    pub chi2: Option<f64>,
+    /// χ²(point) − χ²(estimate).
+    pub delta_chi2: Option<f64>,
+    /// The data cannot tell the point from the estimate.
+    pub equally_good: bool,
+}
+
+impl Equivalence {
+    /// The test against the estimate `at` with `free` free parameters.
+    pub fn at(at: &Linearisation, free: usize) -> Self {
+        let dof = at.residual.len().saturating_sub(free);
+        let sum = at.residual.norm_squared();
+        let exact = at.max_rel_diff() <= exact_fit_tolerance(residual_tolerance(), at, free)
+            && at.residual.len() == at.frequencies_hz.len();
+        let sigma2 = if at.has_std {
+            Some(1.0)
+        } else if dof > 0 && !exact && sum > 0.0 && sum.is_finite() {
+            Some(sum / dof as f64)
+        } else {
+            None
+        };
+        Self {
+            best_cost: at.cost(),
+            sigma2,
+            threshold: chi2_quantile_upper(SIGNIFICANCE, free.max(1)),
+            free,
+            weighted: at.has_std,
+        }
+    }
+
+    /// True when σ was estimated from the residuals (no std given).
+    pub fn sigma_estimated(&self) -> bool {
+        !self.weighted && self.sigma2.is_some()
+    }
+
+    /// Δχ² below which a point is equally good.
+    pub fn threshold(&self) -> f64 {
+        self.threshold
+    }
+
+    /// Judges `lin` against the estimate.
+    pub fn judge(&self, lin: &Linearisation) -> Judged {
+        match self.sigma2 {
+            Some(s2) => {
+                let chi2 = lin.residual.norm_squared() / s2;
+                let delta = 2.0 * (lin.cost() - self.best_cost) / s2;
+                Judged { chi2: Some(chi2), delta_chi2: Some(delta), equally_good: delta <= self.threshold }
+            }
+            None => {
+                let exact = lin.max_rel_diff() <= exact_fit_tolerance(residual_tolerance(), lin, self.free)
+                    && lin.residual.len() == lin.frequencies_hz.len();
+                // No σ to scale a difference by: as good means no worse, to round-off.
+                let no_worse = lin.cost() <= self.best_cost * (1.0 + 1e-6);
+                Judged { chi2: None, delta_chi2: None, equally_good: exact || no_worse }
+            }
+        }
+    }
+}
+
+fn residual_tolerance() -> f64 {
+    LevenbergMarquardtSettings::default().residual_tolerance
+}
+
+/// Another minimum (or a mirror point) with the test's outcome.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OtherSolution {
+    /// Its parameter values.
+    pub parameters: Vec<f64>,
+    /// Σr² of its residual (weighted with std): the misfit whatever σ is.
+    pub misfit: f64,
+    /// The test against the estimate.
+    pub judged: Judged,
+    /// For a mirror solution, the permutation that maps the estimate onto it (parameter i's value
+    /// moved to π\[i\]); the model has that symmetry.
+    pub permutation: Option<Vec<usize>>,
+}
+
+impl OtherSolution {
+    fn new(lin: &Linearisation, test: &Equivalence, permutation: Option<Vec<usize>>) -> Self {
+        Self {
+            parameters: lin.parameters.clone(),
+            misfit: lin.residual.norm_squared(),
+            judged: test.judge(lin),
+            permutation,
+        }
+    }
+
+    /// A mirror solution the data cannot tell from the estimate.
+    pub fn is_mirror(&self) -> bool {
+        self.permutation.is_some() && self.judged.equally_good
+    }
+}
+
+/// The local minima of `problem` reached from a space-filling (Halton) design of `starts` points
+/// over the parameters' search ranges, and from `extra` starts, by local damped fits without
+/// restarts; every evaluation is charged to `budget` (a spent budget ends the search with what
+/// was found). Distinct minima only, best first.
+pub fn local_minima(
+    problem: &dyn Objective,
+    starts: usize,
+    extra: &[Vec<f64>],
+    budget: &Budget,
+) -> Vec<Linearisation> {
+    let params = problem.parameters();
+    let design = crate::update::grid::halton(starts, params.len());
+    let points = extra.iter().cloned().chain(design.into_iter().map(|t| {
+        params.iter().zip(&t).map(|(p, &ti)| crate::update::grid::search_point(p, ti)).collect::<Vec<f64>>()
+    }));
+    let mut minima: Vec<Linearisation> = Vec::new();
+    for start in points {
+        if budget.exhausted() {
+            break;
+        }
+        if params.check(&start).is_err() {
+            continue;
+        }
+        let mut local = LevenbergMarquardt::default().with_max_restarts(0);
+        let Ok(est) =
+            (Driver { max_iterations: LOCAL_FIT_ITERATIONS }).run_within(problem, &mut local, &start, budget)
+        else {
+            continue;
+        };
+        if !est.termination.is_converged() || !est.last.cost().is_finite() {
+            continue;
+        }
+        match minima
+            .iter_mut()
+            .find(|m| scaled_distance(problem, &m.parameters, &est.last.parameters) <= SAME_MINIMUM)
+        {
+            Some(m) if est.last.cost() < m.cost() => *m = est.last,
+            Some(_) => {}
+            None => minima.push(est.last),
+        }
+    }
+    minima.sort_by(|a, b| a.cost().total_cmp(&b.cost()));
+    minima
+}
+
+/// The minimum of `minima` that fits better than `at`'s own minimum and lies elsewhere (more
+/// than [`SAME_MINIMUM`] away), if any: the search found a deeper minimum than the fit, and that
+/// one is the estimate. `at`'s own minimum is `at` or, when the search reached it too, its
+/// refinement (a strategy that stops at a tolerance, as the paper's Newton, ends near its
+/// minimum, not on it); an exact fit has no deeper minimum.
+pub fn better_minimum<'a>(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    minima: &'a [Linearisation],
+) -> Option<&'a Linearisation> {
+    let free = problem.parameters().len();
+    let exact = |l: &Linearisation| {
+        l.residual.len() == l.frequencies_hz.len()
+            && l.max_rel_diff() <= exact_fit_tolerance(residual_tolerance(), l, free)
+    };
+    let own = minima
+        .iter()
+        .filter(|m| scaled_distance(problem, &m.parameters, &at.parameters) <= SAME_MINIMUM)
+        .chain(std::iter::once(at))
+        .min_by(|a, b| a.cost().total_cmp(&b.cost()))
+        .expect("at least `at`");
+    if exact(own) {
+        return None;
+    }
+    let best = minima
+        .iter()
+        .filter(|m| scaled_distance(problem, &m.parameters, &at.parameters) > SAME_MINIMUM)
+        .min_by(|a, b| a.cost().total_cmp(&b.cost()))?;
+    (best.cost() < own.cost() * (1.0 - 1e-6) && own.cost() - best.cost() > f64::MIN_POSITIVE).then_some(best)
+}
+
+/// The minima of `minima` other than `at` (more than [`SAME_MINIMUM`] away from it), each judged
+/// against it, best first, at most [`MOST_LISTED`].
+pub fn other_solutions(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    minima: &[Linearisation],
+) -> Vec<OtherSolution> {
+    let test = Equivalence::at(at, problem.parameters().len());
+    let mut out: Vec<OtherSolution> = minima
+        .iter()
+        .filter(|m| scaled_distance(problem, &m.parameters, &at.parameters) > SAME_MINIMUM)
+        .map(|m| OtherSolution::new(m, &test, None))
+        .collect();
+    out.sort_by(|a, b| a.misfit.total_cmp(&b.misfit));
+    out.truncate(MOST_LISTED);
+    out
+}
+
+/// The exchanges of two parameters of the same kind (unit, scale and limits), as permutations:
+/// the candidates for a symmetric model's mirror.
+pub fn like_exchanges(problem: &dyn Objective) -> Vec<Vec<usize>> {
+    let params = problem.parameters().as_slice();
+    let mut out = Vec::new();
+    for i in 0..params.len() {
+        for j in i + 1..params.len() {
+            let (a, b) = (&params[i], &params[j]);
+            if a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper {
+                let mut swap: Vec<usize> = (0..params.len()).collect();
+                swap.swap(i, j);
+                out.push(swap);
+            }
+        }
+    }
+    out
+}
+
+/// What the exchanges of [`mirror_solutions`] gave.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mirrors {
+    /// Exchanges the model is symmetric under, each judged against the estimate (a mirror is
+    /// [`OtherSolution::is_mirror`] when the test passes too).
+    pub symmetric: Vec<OtherSolution>,
+    /// Exchanged points of exchanges the model is not symmetric under: no solution by symmetry,
+    /// but starts worth a local fit.
+    pub asymmetric: Vec<Vec<f64>>,
+}
+
+/// `p` with parameter i's value moved to π\[i\].
+fn permuted(p: &[f64], perm: &[usize]) -> Vec<f64> {
+    let mut q = p.to_vec();
+    for (i, &j) in perm.iter().enumerate() {
+        q[j] = p[i];
+    }
+    q
+}
+
+/// The exchanges `permutations` of the estimate `at`: the model has the symmetry when the
+/// exchanged point's frequencies equal the estimate's and those of a second, perturbed point
+/// equal its exchange's (two points, so an accidental equality is not taken for a symmetry).
+/// Costs one to three evaluations per exchange, charged to `budget`.
+pub fn mirror_solutions(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    permutations: &[Vec<usize>],
+    budget: &Budget,
+) -> Mirrors {
+    let budgeted = budget.wrap(problem);
+    let params = problem.parameters();
+    let test = Equivalence::at(at, params.len());
+    let same = |a: &Linearisation, b: &Linearisation| {
+        a.frequencies_hz.len() == b.frequencies_hz.len()
+            && a.frequencies_hz
+                .iter()
+                .zip(&b.frequencies_hz)
+                .all(|(x, y)| (x - y).abs() <= SYMMETRY_TOLERANCE * x.abs().max(y.abs()))
+    };
+    // A second point: every parameter moved by a different amount (5-15 % of a log parameter).
+    let probe: Vec<f64> = params
+        .iter()
+        .zip(&at.parameters)
+        .enumerate()
+        .map(|(k, (p, &v))| {
+            let s = p.to_scaled(v) + 0.05 + 0.1 * (k as f64 * 0.618_033_988_7).fract();
+            p.from_scaled(s).clamp(p.lower, p.upper)
+        })
+        .collect();
+    let mut probe_lin: Option<Option<Linearisation>> = None;
+    let mut out = Mirrors::default();
+    for perm in permutations {
+        let p = permuted(&at.parameters, perm);
+        if scaled_distance(problem, &p, &at.parameters) <= MIRROR_DISTANCE {
+            continue; // (nearly) equal values: the exchange is the same point
+        }
+        let Ok(lin) = budgeted.linearise(&p) else { continue };
+        let symmetric = same(&lin, at) && {
+            let base = probe_lin.get_or_insert_with(|| budgeted.linearise(&probe).ok());
+            match base {
+                Some(b) => budgeted.linearise(&permuted(&probe, perm)).is_ok_and(|e| same(b, &e)),
+                None => false,
+            }
+        };
+        if symmetric {
+            out.symmetric.push(OtherSolution::new(&lin, &test, Some(perm.clone())));
+        } else {
+            out.asymmetric.push(p);
+        }
+    }
+    out
+}
+
+/// Largest scaled difference between two parameter vectors.
+pub(crate) fn scaled_distance(problem: &dyn Objective, a: &[f64], b: &[f64]) -> f64 {
+    let params = problem.parameters();
+    params
+        .iter()
+        .zip(a.iter().zip(b))
+        .map(|(q, (&x, &y))| (q.to_scaled(x) - q.to_scaled(y)).abs())
+        .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eigen::{DenseSolver, EigenSolver};
+    use crate::matrix::System;
+    use crate::measurement::{MeasuredMode, Measurement};
+    use crate::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
+    use crate::problem::Problem;
+    use crate::test_chain::Chain;
+    use nalgebra::{DMatrix, DVector};
+
+    /// ground –k₁– m –k_c– m –k₂– ground with equal masses: symmetric under k₁ ↔ k₂ (k_c fixed).
+    struct Symmetric {
+        params: ParameterSet,
+    }
+
+    impl Symmetric {
+        fn new() -> Self {
+            let k = |n: &str| Parameter::new(n, "N/m", 1e4).with_bounds(1e-3, 1e9).with_scale(Scale::Log);
+            Self { params: ParameterSet::new(vec![k("k1"), k("k2")]).unwrap() }
+        }
+    }
+
+    impl StructuralModel for Symmetric {
+        fn parameters(&self) -> &ParameterSet {
+            &self.params
+        }
+        fn dofs(&self) -> usize {
+            2
+        }
+        fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+            self.params.check(p)?;
+            let kc = 3e3;
+            let k = DMatrix::from_row_slice(2, 2, &[p[0] + kc, -kc, -kc, p[1] + kc]);
+            Ok(System::new(k, DMatrix::from_diagonal(&DVector::from_element(2, 1.0)))?)
+        }
+    }
+
+    fn measured<M: StructuralModel>(model: &M, truth: &[f64], std_rel: Option<f64>) -> Measurement {
+        let f = DenseSolver.lowest(&model.assemble(truth).unwrap(), 2).unwrap().frequencies_hz();
+        Measurement::new(
+            f.iter()
+                .enumerate()
+                .map(|(i, &f)| match std_rel {
+                    Some(r) => MeasuredMode::new(i, f).with_std(r * f),
+                    None => MeasuredMode::new(i, f),
+                })
+                .collect(),
+        )
+        .unwrap()
+    }
+
+    fn fit(problem: &dyn Objective, start: &[f64]) -> Linearisation {
+        let mut lm = LevenbergMarquardt::default().with_max_restarts(0);
+        Driver::default().run(problem, &mut lm, start).unwrap().last
+    }
+
+    #[test]
+    fn the_search_finds_both_exact_solutions_of_a_two_spring_chain() {
+        // Two frequencies, two stiffnesses: trace and determinant of M⁻¹K fix (k₁, k₂) up to the
+        // two roots of a quadratic, both exact fits.
+        let chain = Chain::new(&[1.0, 2.0]);
+        let truth = [4e4, 1e4];
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, None));
+        let at = fit(&problem, &truth);
+        let minima = local_minima(&problem, search_starts(2), &[], &Budget::new(10_000));
+        let others = other_solutions(&problem, &at, &minima);
+        assert_eq!(others.len(), 1, "{others:?}");
+        let other = &others[0];
+        // No std, no dof: only another exact fit is equally good, and it is one.
+        assert!(other.judged.equally_good && other.judged.chi2.is_none(), "{other:?}");
+        // It is a genuine other solution: the truth's frequencies from other stiffnesses.
+        assert!((other.parameters[0] / truth[0] - 1.0).abs() > 0.05, "{other:?}");
+        let f = |p: &[f64]| DenseSolver.lowest(&chain.assemble(p).unwrap(), 2).unwrap().frequencies_hz();
+        for (a, b) in f(&other.parameters).iter().zip(f(&truth)) {
+            assert!((a / b - 1.0).abs() < 1e-8, "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn an_exchange_is_a_mirror_only_on_a_symmetric_model() {
+        let model = Symmetric::new();
+        let truth = [2e4, 5e3];
+        let problem = Problem::new(&model, DenseSolver, measured(&model, &truth, Some(1e-3)));
+        let at = fit(&problem, &[1.9e4, 5.2e3]);
+        let mirrors = mirror_solutions(&problem, &at, &like_exchanges(&problem), &Budget::new(100));
+        assert_eq!(mirrors.symmetric.len(), 1, "{mirrors:?}");
+        let m = &mirrors.symmetric[0];
+        assert!(m.is_mirror() && m.judged.delta_chi2.unwrap().abs() < 1e-6, "{m:?}");
+        assert!((m.parameters[0] / truth[1] - 1.0).abs() < 1e-6, "{m:?}");
+
+        // The chain is not symmetric: its exchanged point is a start, not a mirror.
+        let chain = Chain::new(&[1.0, 2.0]);
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &[4e4, 1e4], Some(1e-3)));
+        let at = fit(&problem, &[4e4, 1e4]);
+        let mirrors = mirror_solutions(&problem, &at, &like_exchanges(&problem), &Budget::new(100));
+        assert!(mirrors.symmetric.is_empty() && mirrors.asymmetric.len() == 1, "{mirrors:?}");
+    }
+
+    #[test]
+    fn equally_good_is_the_chi2_test_at_the_significance_level() {
+        let chain = Chain::new(&[1.0, 2.0]);
+        let truth = [4e4, 1e4];
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let at = problem.linearise(&truth).unwrap();
+        let test = Equivalence::at(&at, 2);
+        // χ²₀.₉₅(2) = 5.99.
+        assert!((test.threshold() - 5.991_464_547_107_979).abs() < 1e-9);
+        // Moving k₁ moves the frequencies: Δχ² grows with the distance; the test follows it.
+        for (scale, expect) in [(1.0005, true), (1.05, false)] {
+            let lin = problem.linearise(&[truth[0] * scale, truth[1]]).unwrap();
+            let j = test.judge(&lin);
+            let delta = j.delta_chi2.unwrap();
+            assert_eq!(j.equally_good, delta <= test.threshold(), "{j:?}");
+            assert_eq!(j.equally_good, expect, "scale {scale}: Δχ² {delta}");
+        }
+        // Without std σ comes from the estimate's residuals (when there are dof).
+        let chain3 = Chain::new(&[1.0, 2.0, 1.5]);
+        let f = DenseSolver.lowest(&chain3.assemble(&[4e4, 1e4, 2e4]).unwrap(), 3).unwrap().frequencies_hz();
+        let noisy = Measurement::from_frequencies(&[f[0] * 1.001, f[1] * 0.999, f[2]]).unwrap();
+        let fixed = crate::model::Fixed::new(&chain3, &[("k3".to_string(), 2e4)]).unwrap();
+        let problem = Problem::new(&fixed, DenseSolver, noisy);
+        let at = fit(&problem, &[4e4, 1e4]);
+        let test = Equivalence::at(&at, 2);
+        assert!(test.sigma_estimated());
+        assert!(test.judge(&at).equally_good && test.judge(&at).delta_chi2.unwrap().abs() < 1e-9);
+    }
+}
