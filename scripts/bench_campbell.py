@@ -2,6 +2,9 @@
 same speeds (50, linear 0-12000 rpm), 6 modes, same machine, one run each after a warm-up.
 
     /work/venvs/rotordyn/bin/python scripts/bench_campbell.py [path/to/eigenfit]
+    # ROSS 3 on the compressor ROSS 3 saved:
+    BENCH_FILE=crates/eigenfit-rotordynamics/tests/data/ross3/compressor.toml \
+        OPENBLAS_NUM_THREADS=1 /work/venvs/ross3/bin/python scripts/bench_campbell.py [path/to/eigenfit]
 
 Prints both wall times, their ratio, and how far eigenfit's frequencies are from ROSS's
 (ROSS's lateral modes, sorted per speed; ROSS also has axial/torsional DOFs whose modes are
@@ -20,7 +23,9 @@ import ross as rs
 
 warnings.filterwarnings("ignore")
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-FILE = ROOT / "crates/eigenfit-rotordynamics/tests/data/compressor.toml"
+import os
+
+FILE = ROOT / os.environ.get("BENCH_FILE", "crates/eigenfit-rotordynamics/tests/data/compressor.toml")
 EIGENFIT = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "target/release/eigenfit")
 RPM = np.linspace(0.0, 12000.0, 50)
 

@@ -6,7 +6,6 @@ use crate::error::RotorDynError;
 use crate::modal::{Mode, Whirl};
 use crate::rotor::Rotor;
 use crate::{rad_to_rpm, rpm_to_rad};
-use faer::c64;
 
 /// Extra modes computed beyond the N shown, so that a followed mode that climbs past another
 /// can still be found at the next speed.
@@ -59,21 +58,8 @@ pub struct CriticalSpeed {
     pub damping_ratio: f64,
 }
 
-/// Modal assurance criterion of two complex shapes.
-pub fn mac(a: &[c64], b: &[c64]) -> f64 {
-    let mut dot = c64::new(0.0, 0.0);
-    let (mut na, mut nb) = (0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        dot += x.conj() * y;
-        na += x.norm_sqr();
-        nb += y.norm_sqr();
-    }
-    if na == 0.0 || nb == 0.0 {
-        0.0
-    } else {
-        dot.norm_sqr() / (na * nb)
-    }
-}
+/// The modal assurance criterion (lives in [`crate::modal`], below the rotor, which also uses it).
+pub use crate::modal::mac;
 
 /// Computes the Campbell diagram of the `n_modes` lowest modes at the given speeds (rpm).
 pub fn campbell(rotor: &Rotor, speeds_rpm: &[f64], n_modes: usize) -> Result<Campbell, RotorDynError> {

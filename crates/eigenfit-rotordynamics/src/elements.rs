@@ -438,6 +438,12 @@ pub struct Bearing {
 impl Bearing {
     /// 2×2 block [[xx, xy], [yx, yy]] of a coefficient set at speed Ω.
     pub fn block(set: &[Coefficient; 4], speed: f64) -> [[f64; 2]; 2] {
-        [[set[0].at(speed), set[1].at(speed)], [set[2].at(speed), set[3].at(speed)]]
+        Self::block_at(set, speed, speed)
+    }
+
+    /// 2×2 block of a coefficient set at speed Ω and whirl frequency ω.
+    pub fn block_at(set: &[Coefficient; 4], speed: f64, whirl: f64) -> [[f64; 2]; 2] {
+        let v = |i: usize| set[i].at_whirl(speed, whirl);
+        [[v(0), v(1)], [v(2), v(3)]]
     }
 }

@@ -1,38 +1,241 @@
-//! Bearing coefficients over speed: a constant, or a table evaluated exactly as ROSS does.
+//! Bearing coefficients over speed and whirl frequency: a constant, or a table evaluated exactly
+//! as the ROSS version that saved the file does.
 //!
-//! ROSS (`BearingElement._process_coefficient`) hands a table of ≥ 4 points to scipy's
+//! **ROSS 2** (files with `ross_version` 2.x, tables over `frequency`, which ROSS 2 evaluates at
+//! the rotor speed): `BearingElement._process_coefficient` hands a table of ≥ 4 points to scipy's
 //! `UnivariateSpline(x, y)` with its defaults: a cubic smoothing spline from FITPACK's `curfit`
 //! with smoothing factor s = number of points (Σ residual² ≤ s, unit weights), evaluated with
 //! extrapolation by the end pieces. Tables of 2 or 3 points (too few for that spline) go to
 //! `interp1d` of degree 1 or 2 with extrapolation: the line or the parabola through them.
-//!
 //! The smoothing spline does not pass through the points: for the compressor example's seals it
 //! is up to 0.2 % away inside the table and much more outside it, which moves frequencies by
 //! ~10⁻³. So the fit here is FITPACK's own algorithm (the `splinefit` crate, a Rust port of
 //! Dierckx's routines) with scipy's arguments, checked against scipy on the compressor's 168
 //! tables (`tests/ross_agreement.rs`, fixture from `scripts/ross_reference.py`).
+//!
+//! **ROSS 3** (`ross_version` 3.x; `BearingCoefficient`, petrobras/ross PR #1371): a table is
+//! over rotor `speed`, over whirl `frequency`, or 2-D over both (rows per speed, columns per
+//! frequency, interpolated along speed first, then along frequency). Along each axis it is
+//! interpolated by PCHIP (scipy's `PchipInterpolator`: Fritsch–Carlson derivatives, Moler's
+//! one-sided ends) or linearly (`interpolation = "linear"`, also any 2-point axis), and
+//! extrapolated linearly from the end slope. Checked against ROSS 3 in
+//! `tests/ross3_agreement.rs` (fixture from `scripts/ross3_reference.py`).
 
 use crate::error::RotorDynError;
 use splinefit::CubicSplineFit;
 
-/// A coefficient as a function of rotor speed Ω (rad/s).
+/// A coefficient as a function of rotor speed Ω and whirl frequency ω (both rad/s).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Coefficient {
     /// The same value at every speed.
     Constant(f64),
-    /// Values at increasing speeds, fitted as ROSS fits them (see the module doc).
+    /// ROSS 2: values at increasing speeds, fitted as ROSS 2 fits them (see the module doc).
     Table(Table),
+    /// ROSS 3: a table over rotor speed, constant in whirl frequency.
+    Speed(Curve),
+    /// ROSS 3: a table over whirl frequency, constant in rotor speed.
+    Frequency(Curve),
+    /// ROSS 3: a 2-D table over rotor speed and whirl frequency.
+    Grid(Grid),
+}
+
+/// How ROSS 3 interpolates a table along an axis (the `interpolation` key of a saved bearing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interpolation {
+    /// Shape-preserving piecewise cubic Hermite (scipy's `PchipInterpolator`); ROSS 3's default.
+    Pchip,
+    /// Piecewise linear.
+    Linear,
+}
+
+impl Interpolation {
+    /// Reads ROSS 3's name (`"pchip"`, `"linear"`).
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "pchip" => Some(Interpolation::Pchip),
+            "linear" => Some(Interpolation::Linear),
+            _ => None,
+        }
+    }
+
+    /// ROSS 3's name, as written in a saved file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Interpolation::Pchip => "pchip",
+            Interpolation::Linear => "linear",
+        }
+    }
+}
+
+/// A ROSS 3 table along one axis: through its points by PCHIP or linearly, and beyond its ends
+/// on the line with the end slope (ROSS 3's `_AxisInterpolator`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curve {
+    axis: Vec<f64>,
+    values: Vec<f64>,
+    /// PCHIP: the derivative at each point; empty for linear interpolation (or one point).
+    slopes: Vec<f64>,
+}
+
+impl Curve {
+    /// Builds the curve; the axis must increase strictly and match the values (checked by the
+    /// callers that read files, see [`Coefficient::from_axis`]).
+    fn new(axis: &[f64], values: &[f64], interpolation: Interpolation) -> Curve {
+        let slopes = if axis.len() >= 3 && interpolation == Interpolation::Pchip {
+            pchip_slopes(axis, values)
+        } else {
+            Vec::new()
+        };
+        Curve { axis: axis.to_vec(), values: values.to_vec(), slopes }
+    }
+
+    /// The value at x.
+    pub fn at(&self, x: f64) -> f64 {
+        let (a, y) = (&self.axis, &self.values);
+        let n = a.len();
+        if n == 1 {
+            return y[0];
+        }
+        if self.slopes.is_empty() {
+            // scipy's interp1d(kind="linear", fill_value="extrapolate"): the segment found by
+            // searchsorted (side left), clipped to the first and last.
+            let hi = a.partition_point(|&v| v < x).clamp(1, n - 1);
+            let lo = hi - 1;
+            let slope = (y[hi] - y[lo]) / (a[hi] - a[lo]);
+            return slope * (x - a[lo]) + y[lo];
+        }
+        let d = &self.slopes;
+        if x < a[0] {
+            return y[0] + (x - a[0]) * d[0];
+        }
+        if x > a[n - 1] {
+            return y[n - 1] + (x - a[n - 1]) * d[n - 1];
+        }
+        // The Hermite cubic on [a[k], a[k+1]] (scipy's CubicHermiteSpline as a PPoly).
+        let k = (a.partition_point(|&v| v <= x).max(1) - 1).min(n - 2);
+        let h = a[k + 1] - a[k];
+        let m = (y[k + 1] - y[k]) / h;
+        let c2 = (3.0 * m - 2.0 * d[k] - d[k + 1]) / h;
+        let c3 = (d[k] + d[k + 1] - 2.0 * m) / (h * h);
+        let t = x - a[k];
+        ((c3 * t + c2) * t + d[k]) * t + y[k]
+    }
+
+    /// The tabulated axis (rad/s).
+    pub fn axis(&self) -> &[f64] {
+        &self.axis
+    }
+
+    /// The tabulated values.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    fn scaled(&self, s: f64) -> Curve {
+        // PCHIP's slopes and its shape rules are linear in the values: scaling them scales the
+        // curve exactly.
+        Curve {
+            axis: self.axis.clone(),
+            values: self.values.iter().map(|v| v * s).collect(),
+            slopes: self.slopes.iter().map(|v| v * s).collect(),
+        }
+    }
+}
+
+/// scipy's `PchipInterpolator._find_derivatives` for ≥ 3 points.
+fn pchip_slopes(x: &[f64], y: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    let h: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
+    let m: Vec<f64> = (0..n - 1).map(|k| (y[k + 1] - y[k]) / h[k]).collect();
+    let mut d = vec![0.0; n];
+    for k in 1..n - 1 {
+        let (m0, m1) = (m[k - 1], m[k]);
+        if sign(m0) != sign(m1) || m0 == 0.0 || m1 == 0.0 {
+            d[k] = 0.0;
+        } else {
+            let w1 = 2.0 * h[k] + h[k - 1];
+            let w2 = h[k] + 2.0 * h[k - 1];
+            d[k] = 1.0 / ((w1 / m0 + w2 / m1) / (w1 + w2));
+        }
+    }
+    d[0] = pchip_edge(h[0], h[1], m[0], m[1]);
+    d[n - 1] = pchip_edge(h[n - 2], h[n - 3], m[n - 2], m[n - 3]);
+    d
+}
+
+/// scipy's `PchipInterpolator._edge_case`: the one-sided three-point slope, kept shape-preserving.
+fn pchip_edge(h0: f64, h1: f64, m0: f64, m1: f64) -> f64 {
+    let d = ((2.0 * h0 + h1) * m0 - h0 * m1) / (h0 + h1);
+    if sign(d) != sign(m0) {
+        0.0
+    } else if sign(m0) != sign(m1) && d.abs() > 3.0 * m0.abs() {
+        3.0 * m0
+    } else {
+        d
+    }
+}
+
+/// numpy's `sign`: −1, 0 or 1.
+fn sign(v: f64) -> i8 {
+    if v > 0.0 {
+        1
+    } else if v < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// A ROSS 3 2-D table: one curve over speed per tabulated frequency; at (Ω, ω) the row at Ω is
+/// interpolated over frequency.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    frequencies: Vec<f64>,
+    /// One curve over speed per frequency (the table's columns).
+    columns: Vec<Curve>,
+    interpolation: Interpolation,
+}
+
+impl Grid {
+    fn at(&self, speed: f64, frequency: f64) -> f64 {
+        let row: Vec<f64> = self.columns.iter().map(|c| c.at(speed)).collect();
+        Curve::new(&self.frequencies, &row, self.interpolation).at(frequency)
+    }
+
+    /// The speed axis (rad/s).
+    pub fn speeds(&self) -> &[f64] {
+        self.columns[0].axis()
+    }
+
+    /// The frequency axis (rad/s).
+    pub fn frequencies(&self) -> &[f64] {
+        &self.frequencies
+    }
+
+    /// The table, one row per speed.
+    pub fn rows(&self) -> Vec<Vec<f64>> {
+        (0..self.speeds().len()).map(|i| self.columns.iter().map(|c| c.values[i]).collect()).collect()
+    }
+}
+
+/// Which axis a ROSS 3 1-D table is over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    /// Rotor speed (`speed = [...]`).
+    Speed,
+    /// Whirl (excitation) frequency (`frequency = [...]`).
+    Frequency,
 }
 
 /// A tabulated coefficient and the curve ROSS evaluates for it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
     speeds: Vec<f64>,
-    curve: Curve,
+    curve: SplineCurve,
 }
 
 #[derive(Debug, Clone, PartialEq)]
-enum Curve {
+enum SplineCurve {
     /// a + b t + c t² with t = Ω − speeds[0] (the line or parabola through 2 or 3 points).
     Polynomial([f64; 3]),
     /// A cubic B-spline: knots (clamped, end knots repeated 4 times) and coefficients.
@@ -45,12 +248,47 @@ const SCIPY_DEFAULT_RMS: f64 = 1.0;
 const DEGREE: usize = 3;
 
 impl Coefficient {
-    /// The value at speed Ω (rad/s).
+    /// The value at speed Ω (rad/s) with the whirl frequency equal to the speed (synchronous,
+    /// ROSS's default evaluation).
     pub fn at(&self, speed: f64) -> f64 {
+        self.at_whirl(speed, speed)
+    }
+
+    /// The value at speed Ω and whirl frequency ω (rad/s).
+    pub fn at_whirl(&self, speed: f64, frequency: f64) -> f64 {
         match self {
             Coefficient::Constant(v) => *v,
             Coefficient::Table(t) => t.at(speed),
+            Coefficient::Speed(c) => c.at(speed),
+            Coefficient::Frequency(c) => c.at(frequency),
+            Coefficient::Grid(g) => g.at(speed, frequency),
         }
+    }
+
+    /// Whether the value depends on the whirl frequency (a ROSS 3 table over `frequency`).
+    pub fn depends_on_frequency(&self) -> bool {
+        matches!(self, Coefficient::Frequency(_) | Coefficient::Grid(_))
+    }
+
+    /// The tabulated speed range (rad/s), if the coefficient is a table over speed.
+    pub fn speed_range(&self) -> Option<(f64, f64)> {
+        let a = match self {
+            Coefficient::Table(t) => t.speeds(),
+            Coefficient::Speed(c) => c.axis(),
+            Coefficient::Grid(g) => g.speeds(),
+            _ => return None,
+        };
+        Some((a[0], a[a.len() - 1]))
+    }
+
+    /// The tabulated whirl-frequency range (rad/s), if the coefficient is a table over frequency.
+    pub fn frequency_range(&self) -> Option<(f64, f64)> {
+        let a = match self {
+            Coefficient::Frequency(c) => c.axis(),
+            Coefficient::Grid(g) => g.frequencies(),
+            _ => return None,
+        };
+        Some((a[0], a[a.len() - 1]))
     }
 
     /// The same coefficient multiplied by `s` (the whole curve over speed).
@@ -58,7 +296,61 @@ impl Coefficient {
         match self {
             Coefficient::Constant(v) => Coefficient::Constant(v * s),
             Coefficient::Table(t) => Coefficient::Table(t.scaled(s)),
+            Coefficient::Speed(c) => Coefficient::Speed(c.scaled(s)),
+            Coefficient::Frequency(c) => Coefficient::Frequency(c.scaled(s)),
+            Coefficient::Grid(g) => Coefficient::Grid(Grid {
+                frequencies: g.frequencies.clone(),
+                columns: g.columns.iter().map(|c| c.scaled(s)).collect(),
+                interpolation: g.interpolation,
+            }),
         }
+    }
+
+    /// A ROSS 3 1-D table over `axis`; `what` names it in errors. A 1-point table, or one whose
+    /// values are all equal, is a constant (as ROSS 3 evaluates it).
+    pub fn from_axis(
+        axis: Axis,
+        points: &[f64],
+        values: &[f64],
+        interpolation: Interpolation,
+        what: &str,
+    ) -> Result<Self, RotorDynError> {
+        check_axis(points, values.len(), what)?;
+        check_finite(values, what)?;
+        if values.iter().all(|v| *v == values[0]) {
+            return Ok(Coefficient::Constant(values[0]));
+        }
+        let curve = Curve::new(points, values, interpolation);
+        Ok(match axis {
+            Axis::Speed => Coefficient::Speed(curve),
+            Axis::Frequency => Coefficient::Frequency(curve),
+        })
+    }
+
+    /// A ROSS 3 2-D table: `rows[i][j]` at `speeds[i]`, `frequencies[j]`.
+    pub fn from_grid(
+        speeds: &[f64],
+        frequencies: &[f64],
+        rows: &[Vec<f64>],
+        interpolation: Interpolation,
+        what: &str,
+    ) -> Result<Self, RotorDynError> {
+        check_axis(speeds, rows.len(), &format!("{what} (rows over `speed`)"))?;
+        for (i, row) in rows.iter().enumerate() {
+            check_axis(frequencies, row.len(), &format!("{what} row {} (over `frequency`)", i + 1))?;
+            check_finite(row, what)?;
+        }
+        let first = rows[0][0];
+        if rows.iter().flatten().all(|v| *v == first) {
+            return Ok(Coefficient::Constant(first));
+        }
+        let columns = (0..frequencies.len())
+            .map(|j| {
+                let column: Vec<f64> = rows.iter().map(|r| r[j]).collect();
+                Curve::new(speeds, &column, interpolation)
+            })
+            .collect();
+        Ok(Coefficient::Grid(Grid { frequencies: frequencies.to_vec(), columns, interpolation }))
     }
 
     /// Builds a coefficient from speeds and values; `what` names it in errors.
@@ -85,16 +377,37 @@ impl Coefficient {
     }
 }
 
+fn check_axis(points: &[f64], count: usize, what: &str) -> Result<(), RotorDynError> {
+    if points.is_empty() {
+        return Err(RotorDynError::Model(format!("{what}: empty list")));
+    }
+    if count != points.len() {
+        return Err(RotorDynError::Model(format!("{what}: {count} values but {} axis points", points.len())));
+    }
+    check_finite(points, what)?;
+    if points.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(RotorDynError::Model(format!("{what}: the axis must increase strictly")));
+    }
+    Ok(())
+}
+
+fn check_finite(values: &[f64], what: &str) -> Result<(), RotorDynError> {
+    match values.iter().find(|v| !v.is_finite()) {
+        Some(v) => Err(RotorDynError::Model(format!("{what}: value {v} is not finite"))),
+        None => Ok(()),
+    }
+}
+
 impl Table {
     fn new(x: &[f64], y: &[f64], what: &str) -> Result<Self, RotorDynError> {
         let curve = match x.len() {
-            2 => Curve::Polynomial([y[0], (y[1] - y[0]) / (x[1] - x[0]), 0.0]),
+            2 => SplineCurve::Polynomial([y[0], (y[1] - y[0]) / (x[1] - x[0]), 0.0]),
             3 => {
                 // The parabola through three points (Newton's divided differences about x[0]).
                 let d0 = (y[1] - y[0]) / (x[1] - x[0]);
                 let d1 = (y[2] - y[1]) / (x[2] - x[1]);
                 let c = (d1 - d0) / (x[2] - x[0]);
-                Curve::Polynomial([y[0], d0 - c * (x[1] - x[0]), c])
+                SplineCurve::Polynomial([y[0], d0 - c * (x[1] - x[0]), c])
             }
             _ => smoothing_spline(x, y, what)?,
         };
@@ -103,19 +416,19 @@ impl Table {
 
     fn at(&self, speed: f64) -> f64 {
         match &self.curve {
-            Curve::Polynomial([a, b, c]) => {
+            SplineCurve::Polynomial([a, b, c]) => {
                 let t = speed - self.speeds[0];
                 a + t * (b + t * c)
             }
-            Curve::Spline { knots, coefficients } => de_boor(knots, coefficients, speed),
+            SplineCurve::Spline { knots, coefficients } => de_boor(knots, coefficients, speed),
         }
     }
 
     /// The same curve multiplied by `s`.
     pub fn scaled(&self, s: f64) -> Table {
         let curve = match &self.curve {
-            Curve::Polynomial(p) => Curve::Polynomial(p.map(|c| c * s)),
-            Curve::Spline { knots, coefficients } => Curve::Spline {
+            SplineCurve::Polynomial(p) => SplineCurve::Polynomial(p.map(|c| c * s)),
+            SplineCurve::Spline { knots, coefficients } => SplineCurve::Spline {
                 knots: knots.clone(),
                 coefficients: coefficients.iter().map(|c| c * s).collect(),
             },
@@ -132,7 +445,7 @@ impl Table {
 /// FITPACK's smoothing spline with scipy's `UnivariateSpline` defaults. When FITPACK does not
 /// reach its tolerance (its ier 1–3, where scipy warns and keeps the last iterate, which
 /// splinefit does not return) the interpolating spline (s = 0) is used instead.
-fn smoothing_spline(x: &[f64], y: &[f64], what: &str) -> Result<Curve, RotorDynError> {
+fn smoothing_spline(x: &[f64], y: &[f64], what: &str) -> Result<SplineCurve, RotorDynError> {
     let fit = CubicSplineFit::new(x.to_vec(), y.to_vec())
         .smoothing_spline(SCIPY_DEFAULT_RMS)
         .or_else(|_| CubicSplineFit::new(x.to_vec(), y.to_vec()).interpolating_spline())
@@ -141,7 +454,7 @@ fn smoothing_spline(x: &[f64], y: &[f64], what: &str) -> Result<Curve, RotorDynE
     if n < 2 * (DEGREE + 1) || fit.c.len() < n - DEGREE - 1 {
         return Err(RotorDynError::Model(format!("{what}: spline fit returned {n} knots")));
     }
-    Ok(Curve::Spline { coefficients: fit.c[..n - DEGREE - 1].to_vec(), knots: fit.t })
+    Ok(SplineCurve::Spline { coefficients: fit.c[..n - DEGREE - 1].to_vec(), knots: fit.t })
 }
 
 /// Value of the cubic B-spline at x by de Boor's recursion; outside the knot range the end

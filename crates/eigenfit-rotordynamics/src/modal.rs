@@ -371,3 +371,19 @@ pub fn whirl_of(x: &[c64], pairs: &[(usize, usize)]) -> Whirl {
 
 /// Orbits flatter than this (|minor/major| below about 10⁻¹⁰) are lines.
 const WHIRL_TOLERANCE: f64 = 2e-10;
+
+/// Modal assurance criterion of two complex shapes.
+pub fn mac(a: &[c64], b: &[c64]) -> f64 {
+    let mut dot = c64::new(0.0, 0.0);
+    let (mut na, mut nb) = (0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        dot += x.conj() * y;
+        na += x.norm_sqr();
+        nb += y.norm_sqr();
+    }
+    if na == 0.0 || nb == 0.0 {
+        0.0
+    } else {
+        dot.norm_sqr() / (na * nb)
+    }
+}

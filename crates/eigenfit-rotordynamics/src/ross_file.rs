@@ -4,13 +4,14 @@
 
 use crate::elements::{Bearing, Disk, Material, PointMass, ShaftElement, ShearMethod};
 use crate::error::RotorDynError;
-use crate::interpolation::Coefficient;
+use crate::interpolation::{Axis, Coefficient, Interpolation};
 use crate::rotor::Rotor;
 use serde_json::{Map, Value};
 use std::path::Path;
 
-/// Element classes read as bearings: each saves its eight coefficients (and added masses) over
-/// `frequency` (ROSS 2) or `speed` (ROSS 3), whatever model produced them.
+/// Element classes read as bearings: each saves its eight coefficients (and added masses) as
+/// tables, whatever model produced them: ROSS 2 over `frequency` (evaluated at the rotor speed),
+/// ROSS 3 over `speed`, whirl `frequency` or both.
 const BEARING_CLASSES: &[&str] = &[
     "BearingElement",
     "SealElement",
@@ -48,18 +49,23 @@ pub fn read(path: &Path) -> Result<Rotor, RotorDynError> {
     })
 }
 
-/// Parses the text of a ROSS rotor file.
-pub fn parse(text: &str) -> Result<Rotor, RotorDynError> {
-    let root: Value = if text.trim_start().starts_with('{') {
-        serde_json::from_str(text).map_err(|e| RotorDynError::File(format!("not valid JSON: {e}")))?
+/// The file's tables as a JSON value (TOML converted).
+pub fn root_of(text: &str) -> Result<Value, RotorDynError> {
+    if text.trim_start().starts_with('{') {
+        serde_json::from_str(text).map_err(|e| RotorDynError::File(format!("not valid JSON: {e}")))
     } else {
         let t: toml::Table =
             toml::from_str(text).map_err(|e| RotorDynError::File(format!("not valid TOML: {e}")))?;
-        serde_json::to_value(t).map_err(|e| RotorDynError::File(e.to_string()))?
-    };
-    let Value::Object(root) = root else {
+        serde_json::to_value(t).map_err(|e| RotorDynError::File(e.to_string()))
+    }
+}
+
+/// Parses the text of a ROSS rotor file.
+pub fn parse(text: &str) -> Result<Rotor, RotorDynError> {
+    let Value::Object(root) = root_of(text)? else {
         return Err(RotorDynError::File("expected a table of elements".into()));
     };
+    let version = Version::of(&root)?;
     let (mut shafts, mut disks, mut bearings, mut masses) = (vec![], vec![], vec![], vec![]);
     for (key, value) in &root {
         if is_metadata(key) {
@@ -73,7 +79,7 @@ pub fn parse(text: &str) -> Result<Rotor, RotorDynError> {
         let Value::Object(t) = value else {
             return Err(RotorDynError::Model(format!("`{key}` must be a table")));
         };
-        let e = Entry { key, table: t };
+        let e = Entry { key, table: t, version };
         let tag = e.string("tag").unwrap_or_else(|| tag.to_string());
         match class {
             "ShaftElement" | "ShaftElement6DoF" => shafts.push(e.shaft(tag)?),
@@ -95,9 +101,51 @@ pub fn parse(text: &str) -> Result<Rotor, RotorDynError> {
     Rotor::new(shafts, disks, bearings, masses)
 }
 
+/// Which ROSS wrote the file: its bearing tables mean different things.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Version {
+    /// ROSS 1 and 2: tables over `frequency` taken at the rotor speed, smoothed by FITPACK.
+    Two,
+    /// ROSS 3: tables over `speed`, whirl `frequency` or both, PCHIP or linear.
+    Three,
+}
+
+impl Version {
+    /// The file's `ross_version` decides (major 3 or above: ROSS 3). A file without it is a
+    /// ROSS 3 file when a bearing carries ROSS 3's `interpolation` key, a ROSS 2 file otherwise.
+    pub fn of(root: &Map<String, Value>) -> Result<Version, RotorDynError> {
+        match root.get("ross_version") {
+            Some(Value::String(v)) => {
+                let major =
+                    v.split('.').next().and_then(|m| m.trim().parse::<u32>().ok()).ok_or_else(|| {
+                        RotorDynError::File(format!("ross_version \"{v}\" is not a version number"))
+                    })?;
+                Ok(if major >= 3 { Version::Three } else { Version::Two })
+            }
+            Some(v) => Err(RotorDynError::File(format!("ross_version {v} is not a version string"))),
+            None => {
+                Ok(if root.values().any(|t| t.as_object().is_some_and(|t| t.contains_key("interpolation"))) {
+                    Version::Three
+                } else {
+                    Version::Two
+                })
+            }
+        }
+    }
+}
+
+/// The version of the ROSS rotor in `text` (see [`Version::of`]).
+pub fn version(text: &str) -> Result<Version, RotorDynError> {
+    match root_of(text)? {
+        Value::Object(root) => Version::of(&root),
+        _ => Err(RotorDynError::File("expected a table of elements".into())),
+    }
+}
+
 struct Entry<'a> {
     key: &'a str,
     table: &'a Map<String, Value>,
+    version: Version,
 }
 
 impl Entry<'_> {
@@ -144,7 +192,7 @@ impl Entry<'_> {
         let odl = self.number("odl")?;
         let material = match self.table.get("material") {
             Some(Value::Object(m)) => {
-                let sub = Entry { key: self.key, table: m };
+                let sub = Entry { key: self.key, table: m, version: self.version };
                 let rho = sub.number("rho")?;
                 let e = sub.number_opt("E")?;
                 let g = sub.number_opt("G_s")?;
@@ -209,46 +257,146 @@ impl Entry<'_> {
         Ok(PointMass { tag, n: self.node("n")?, mx, my })
     }
 
-    fn bearing(&self, tag: String, class: &str) -> Result<Bearing, RotorDynError> {
-        let speeds: Option<Vec<f64>> = match self.table.get("speed").or_else(|| self.table.get("frequency")) {
-            None | Some(Value::Null) => None,
-            Some(Value::Array(a)) => Some(
+    fn axis(&self, name: &str) -> Result<Option<Vec<f64>>, RotorDynError> {
+        match self.table.get(name) {
+            None | Some(Value::Null) => Ok(None),
+            Some(Value::Array(a)) => Ok(Some(
                 a.iter()
-                    .map(|v| {
-                        number(v).ok_or_else(|| self.err(format!("speed/frequency item {v} is not a number")))
-                    })
+                    .map(|v| number(v).ok_or_else(|| self.err(format!("`{name}` item {v} is not a number"))))
                     .collect::<Result<_, _>>()?,
-            ),
+            )),
             Some(v) => {
-                Some(vec![number(v).ok_or_else(|| self.err(format!("speed/frequency {v} is not a number")))?])
+                Ok(Some(vec![number(v).ok_or_else(|| self.err(format!("`{name}` {v} is not a number")))?]))
+            }
+        }
+    }
+
+    fn numbers(&self, name: &str, a: &[Value]) -> Result<Vec<f64>, RotorDynError> {
+        a.iter()
+            .map(|v| number(v).ok_or_else(|| self.err(format!("{name} item {v} is not a number"))))
+            .collect()
+    }
+
+    /// A ROSS 2 coefficient: a table over `frequency` (or `speed`) taken at the rotor speed.
+    fn coefficient_v2(
+        &self,
+        name: &str,
+        speeds: Option<&[f64]>,
+    ) -> Result<Option<Coefficient>, RotorDynError> {
+        let what = format!("`{}` {name}", self.key);
+        match self.table.get(name) {
+            None | Some(Value::Null) => Ok(None),
+            Some(Value::Array(a)) => {
+                let values = self.numbers(name, a)?;
+                if values.len() == 1 {
+                    return Coefficient::from_table(&[0.0], &values, &what).map(Some);
+                }
+                let s = speeds.ok_or_else(|| {
+                    self.err(format!("{name} is a list but the bearing has no `frequency`/`speed` list"))
+                })?;
+                Coefficient::from_table(s, &values, &what).map(Some)
+            }
+            Some(v) => number(v)
+                .filter(|x| x.is_finite())
+                .map(|x| Some(Coefficient::Constant(x)))
+                .ok_or_else(|| self.err(format!("{name} must be a number or a list, not {v}"))),
+        }
+    }
+
+    /// A ROSS 3 coefficient: constant, 1-D over `speed` or `frequency`, or 2-D over both.
+    fn coefficient_v3(
+        &self,
+        name: &str,
+        speed: Option<&[f64]>,
+        frequency: Option<&[f64]>,
+        interpolation: Interpolation,
+    ) -> Result<Option<Coefficient>, RotorDynError> {
+        let what = format!("`{}` {name}", self.key);
+        let list = match self.table.get(name) {
+            None | Some(Value::Null) => return Ok(None),
+            Some(Value::Array(a)) => a,
+            Some(v) => {
+                return number(v)
+                    .filter(|x| x.is_finite())
+                    .map(|x| Some(Coefficient::Constant(x)))
+                    .ok_or_else(|| self.err(format!("{name} must be a number or a list, not {v}")))
             }
         };
+        let two_d = list.iter().any(Value::is_array);
+        match (speed, frequency, two_d) {
+            (Some(s), Some(f), true) => {
+                let rows: Vec<Vec<f64>> = list
+                    .iter()
+                    .map(|row| match row {
+                        Value::Array(r) => self.numbers(name, r),
+                        v => Err(self.err(format!("{name}: row {v} of the 2-D table is not a list"))),
+                    })
+                    .collect::<Result<_, _>>()?;
+                Coefficient::from_grid(s, f, &rows, interpolation, &what).map(Some)
+            }
+            (_, _, true) => Err(self.err(format!(
+                "{name} is a 2-D table but the bearing does not have both `speed` and `frequency` lists"
+            ))),
+            (Some(s), Some(f), false) => {
+                let values = self.numbers(name, list)?;
+                if values.len() == 1 {
+                    return Ok(Some(Coefficient::Constant(values[0])));
+                }
+                Err(self.err(format!(
+                    "{name} is a 1-D list of {} values but the bearing has both `speed` ({} points) and \
+                     `frequency` ({} points): ROSS 3 needs a 2-D table, one row per speed",
+                    values.len(),
+                    s.len(),
+                    f.len()
+                )))
+            }
+            (s, f, false) => {
+                let values = self.numbers(name, list)?;
+                if values.len() == 1 {
+                    return Ok(Some(Coefficient::Constant(values[0])));
+                }
+                let (axis, points) = match (s, f) {
+                    (Some(s), None) => (Axis::Speed, s),
+                    (None, Some(f)) => (Axis::Frequency, f),
+                    _ => {
+                        return Err(self.err(format!(
+                            "{name} is a list but the bearing has no `speed`/`frequency` list"
+                        )))
+                    }
+                };
+                Coefficient::from_axis(axis, points, &values, interpolation, &what).map(Some)
+            }
+        }
+    }
+
+    fn bearing(&self, tag: String, class: &str) -> Result<Bearing, RotorDynError> {
+        let speed = self.axis("speed")?;
+        let frequency = self.axis("frequency")?;
         let coefficient = |name: &str,
                            fallback: Option<&Coefficient>|
          -> Result<Coefficient, RotorDynError> {
-            let what = format!("`{}` {name}", self.key);
-            match self.table.get(name) {
-                None | Some(Value::Null) => Ok(fallback.cloned().unwrap_or(Coefficient::Constant(0.0))),
-                Some(Value::Array(a)) => {
-                    let values: Vec<f64> = a
-                        .iter()
-                        .map(|v| {
-                            number(v).ok_or_else(|| self.err(format!("{name} item {v} is not a number")))
-                        })
-                        .collect::<Result<_, _>>()?;
-                    if values.len() == 1 {
-                        return Coefficient::from_table(&[0.0], &values, &what);
+            let c = match self.version {
+                Version::Two => {
+                    if speed.is_some() && frequency.is_some() {
+                        return Err(self.err(
+                            "has both `speed` and `frequency` lists, which a ROSS 2 file does not have \
+                             (ROSS 3 files say ross_version = \"3…\")"
+                                .into(),
+                        ));
                     }
-                    let s = speeds.as_ref().ok_or_else(|| {
-                        self.err(format!("{name} is a list but the bearing has no `frequency`/`speed` list"))
-                    })?;
-                    Coefficient::from_table(s, &values, &what)
+                    self.coefficient_v2(name, speed.as_deref().or(frequency.as_deref()))?
                 }
-                Some(v) => number(v)
-                    .filter(|x| x.is_finite())
-                    .map(Coefficient::Constant)
-                    .ok_or_else(|| self.err(format!("{name} must be a number or a list, not {v}"))),
-            }
+                Version::Three => {
+                    let interpolation = match self.string("interpolation") {
+                        None => Interpolation::Pchip,
+                        Some(i) => Interpolation::parse(&i).ok_or_else(|| {
+                            self.err(format!("interpolation \"{i}\" is not one ROSS 3 knows (pchip, linear)"))
+                        })?,
+                    };
+                    self.coefficient_v3(name, speed.as_deref(), frequency.as_deref(), interpolation)?
+                }
+            };
+            Ok(c.or_else(|| fallback.cloned()).unwrap_or(Coefficient::Constant(0.0)))
         };
         let kxx = coefficient("kxx", None)?;
         let kyy = coefficient("kyy", Some(&kxx))?;
@@ -276,5 +424,85 @@ fn number(v: &Value) -> Option<f64> {
         // ROSS writes complex or special values as strings at times; only plain numbers pass.
         Value::String(s) => s.trim().parse().ok(),
         _ => None,
+    }
+}
+
+/// The text of a ROSS rotor file with bearing coefficients multiplied: each `(tag, coefficient,
+/// factor)` multiplies every value of that bearing's table (a number, a list over one axis, or a
+/// 2-D table), leaving everything else — `ross_version`, axes, `interpolation`, other elements —
+/// as the file had it, so the file stays one of its ROSS version. Written in the input's format
+/// (JSON for JSON, TOML otherwise).
+///
+/// A ROSS 3 table (PCHIP or linear) scaled this way is exactly the scaled curve. A ROSS 2 table is
+/// re-smoothed by FITPACK when read, with a smoothing budget that does not scale with the
+/// values, so its curve can differ from the scaled one by up to the smoothing residual.
+pub fn write_scaled(text: &str, changes: &[(String, String, f64)]) -> Result<String, RotorDynError> {
+    let mut root = root_of(text)?;
+    let Value::Object(map) = &mut root else {
+        return Err(RotorDynError::File("expected a table of elements".into()));
+    };
+    for (tag, coefficient, factor) in changes {
+        let table = map
+            .iter_mut()
+            .filter(|(key, _)| !is_metadata(key))
+            .find_map(|(key, value)| {
+                let t = value.as_object_mut()?;
+                let own = t.get("tag").and_then(Value::as_str).map(str::to_string);
+                let key_tag = key.split_once('_').map(|(_, t)| t.to_string());
+                (own.or(key_tag).as_deref() == Some(tag.as_str()) && t.contains_key("kxx")).then_some(t)
+            })
+            .ok_or_else(|| RotorDynError::Model(format!("no bearing `{tag}` in the file")))?;
+        if !table.contains_key(coefficient.as_str()) {
+            // ROSS fills kyy from kxx and cyy from cxx when they are not given.
+            let fallback = match coefficient.as_str() {
+                "kyy" => table.get("kxx").cloned(),
+                "cyy" => table.get("cxx").cloned(),
+                _ => None,
+            };
+            match fallback {
+                Some(v) => {
+                    table.insert(coefficient.clone(), v);
+                }
+                None => continue, // absent: zero, and zero times any factor
+            }
+        }
+        let value = table.get_mut(coefficient.as_str()).expect("present");
+        scale_value(value, *factor)
+            .map_err(|v| RotorDynError::Model(format!("`{tag}` {coefficient}: {v} is not a number")))?;
+    }
+    if text.trim_start().starts_with('{') {
+        serde_json::to_string_pretty(&root).map_err(|e| RotorDynError::File(e.to_string()))
+    } else {
+        toml::to_string(&root).map_err(|e| RotorDynError::File(format!("cannot write TOML: {e}")))
+    }
+}
+
+/// A ROSS rotor file's text in the format ROSS reads for `path` (JSON for `.json`, TOML otherwise;
+/// ROSS's `load_data` goes by the extension).
+pub fn in_format_for(text: &str, path: &Path) -> Result<String, RotorDynError> {
+    let json_out = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let json_in = text.trim_start().starts_with('{');
+    if json_out == json_in {
+        return Ok(text.to_string());
+    }
+    let root = root_of(text)?;
+    if json_out {
+        serde_json::to_string_pretty(&root).map_err(|e| RotorDynError::File(e.to_string()))
+    } else {
+        toml::to_string(&root).map_err(|e| RotorDynError::File(format!("cannot write TOML: {e}")))
+    }
+}
+
+fn scale_value(v: &mut Value, factor: f64) -> Result<(), String> {
+    match v {
+        Value::Array(items) => items.iter_mut().try_for_each(|x| scale_value(x, factor)),
+        Value::Null => Ok(()),
+        other => {
+            let x = number(other).ok_or_else(|| other.to_string())?;
+            *other = serde_json::Number::from_f64(x * factor)
+                .map(Value::Number)
+                .ok_or_else(|| other.to_string())?;
+            Ok(())
+        }
     }
 }

@@ -22,6 +22,13 @@ pub struct Rotor {
     extra_nodes: Vec<usize>,
 }
 
+/// Relative change of a mode's whirl frequency at which the fixed point is taken as reached.
+pub const WHIRL_TOLERANCE: f64 = 1e-12;
+/// Iterations per mode before the whirl-frequency fixed point is given up.
+pub const WHIRL_MAX_ITERATIONS: usize = 200;
+/// Modes solved beyond those asked for, so that a mode followed by MAC stays among the solved.
+const WHIRL_SPARE_MODES: usize = 4;
+
 /// The speed-independent part of the matrices, assembled once.
 #[derive(Debug, Clone)]
 struct Fixed {
@@ -53,13 +60,12 @@ impl Rotor {
     pub fn extrapolation_notes(&self, speeds_rpm: &[f64]) -> Vec<String> {
         let mut ranges: Vec<((f64, f64), Vec<&str>)> = Vec::new();
         for b in &self.bearings {
-            let range = b.k.iter().chain(&b.c).chain(&b.m).find_map(|c| match c {
-                crate::interpolation::Coefficient::Table(t) => {
-                    let s = t.speeds();
-                    Some((crate::rad_to_rpm(s[0]), crate::rad_to_rpm(s[s.len() - 1])))
-                }
-                crate::interpolation::Coefficient::Constant(_) => None,
-            });
+            let range =
+                b.k.iter()
+                    .chain(&b.c)
+                    .chain(&b.m)
+                    .find_map(|c| c.speed_range())
+                    .map(|(lo, hi)| (crate::rad_to_rpm(lo), crate::rad_to_rpm(hi)));
             let Some(range) = range else { continue };
             match ranges.iter_mut().find(|(r, _)| *r == range) {
                 Some((_, tags)) => tags.push(&b.tag),
@@ -232,17 +238,55 @@ impl Rotor {
     /// The matrices at speed Ω (rad/s); bearing coefficients are taken at that speed (ROSS's
     /// default: excitation frequency = speed).
     pub fn matrices(&self, speed: f64) -> Matrices {
-        self.matrices_from(&self.fixed(), speed)
+        self.matrices_from(&self.fixed(), speed, speed)
     }
 
-    fn matrices_from(&self, f: &Fixed, speed: f64) -> Matrices {
+    /// The matrices at speed Ω with the bearing coefficients at whirl frequency ω (rad/s).
+    pub fn matrices_at(&self, speed: f64, whirl: f64) -> Matrices {
+        self.matrices_from(&self.fixed(), speed, whirl)
+    }
+
+    /// Whether a bearing's coefficients depend on the whirl frequency (ROSS 3 tables over
+    /// `frequency`, 2-D tables): then each mode is solved at its own whirl frequency.
+    pub fn has_whirl_tables(&self) -> bool {
+        self.bearings.iter().any(|b| b.k.iter().chain(&b.c).chain(&b.m).any(|c| c.depends_on_frequency()))
+    }
+
+    /// Notes for whirl frequencies (rad/s) outside the frequency tables of the bearings: there
+    /// the coefficients are extrapolated linearly from the end slope (as ROSS 3 does).
+    pub fn whirl_extrapolation_notes(&self, whirl: &[f64]) -> Vec<String> {
+        let mut notes = Vec::new();
+        for b in &self.bearings {
+            let Some((lo, hi)) = b.k.iter().chain(&b.c).chain(&b.m).find_map(|c| c.frequency_range()) else {
+                continue;
+            };
+            let outside: Vec<f64> =
+                whirl.iter().copied().filter(|&w| w < lo * (1.0 - 1e-9) || w > hi * (1.0 + 1e-9)).collect();
+            if outside.is_empty() {
+                continue;
+            }
+            let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
+            let listed: Vec<String> = outside.iter().map(|&w| format!("{:.4} Hz", hz(w))).collect();
+            notes.push(format!(
+                "whirl frequencies {} lie outside the {:.4}–{:.4} Hz frequency table of {}: its coefficients \
+                 there are extrapolated linearly from the end slope (as ROSS 3 does)",
+                listed.join(", "),
+                hz(lo),
+                hz(hi),
+                b.tag
+            ));
+        }
+        notes
+    }
+
+    fn matrices_from(&self, f: &Fixed, speed: f64, whirl: f64) -> Matrices {
         let mut m = f.m.clone();
         let mut k = f.k.clone();
         let mut d = f.c.clone();
         for b in &self.bearings {
-            self.add_bearing_block(&mut k, b, Bearing::block(&b.k, speed));
-            self.add_bearing_block(&mut d, b, Bearing::block(&b.c, speed));
-            self.add_bearing_block(&mut m, b, Bearing::block(&b.m, speed));
+            self.add_bearing_block(&mut k, b, Bearing::block_at(&b.k, speed, whirl));
+            self.add_bearing_block(&mut d, b, Bearing::block_at(&b.c, speed, whirl));
+            self.add_bearing_block(&mut m, b, Bearing::block_at(&b.m, speed, whirl));
         }
         let n = self.dofs();
         for j in 0..n {
@@ -271,22 +315,82 @@ impl Rotor {
     }
 
     /// The `count` lowest modes at speed Ω (rad/s), by the fastest exact route for the size.
+    /// With whirl-frequency tables each mode is solved at its own whirl frequency
+    /// ([`Rotor::matched_modes`]).
     pub fn lowest_modes(&self, speed: f64, count: usize) -> Result<Vec<Mode>, RotorDynError> {
-        let mats = self.matrices(speed);
-        modal::solve_lowest(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count, false)
+        self.lowest_modes_over(&[speed], count).map(|mut all| all.remove(0))
     }
 
     /// The `count` lowest modes at several speeds, assembling the speed-independent part once.
     pub fn lowest_modes_over(&self, speeds: &[f64], count: usize) -> Result<Vec<Vec<Mode>>, RotorDynError> {
         let f = self.fixed();
         let pairs = self.translation_pairs();
+        let whirl = self.has_whirl_tables();
         speeds
             .iter()
             .map(|&s| {
-                let mats = self.matrices_from(&f, s);
+                if whirl {
+                    return self.matched_from(&f, &pairs, s, count);
+                }
+                let mats = self.matrices_from(&f, s, s);
                 modal::solve_lowest(&mats.m, &mats.d, &mats.k, &pairs, count, false)
             })
             .collect()
+    }
+
+    /// The `count` lowest modes at speed Ω (rad/s), each with the bearing coefficients at its own
+    /// whirl frequency (its damped natural frequency): from the synchronous solution, each mode is
+    /// re-solved with the coefficients at its last frequency and followed by MAC until the
+    /// frequency changes by less than [`WHIRL_TOLERANCE`] (ROSS 3's `matched_whirl=True`, whose
+    /// default tolerance 1e-3 stops short of the fixed point). Sorted by frequency.
+    pub fn matched_modes(&self, speed: f64, count: usize) -> Result<Vec<Mode>, RotorDynError> {
+        self.matched_from(&self.fixed(), &self.translation_pairs(), speed, count)
+    }
+
+    fn matched_from(
+        &self,
+        f: &Fixed,
+        pairs: &[(usize, usize)],
+        speed: f64,
+        count: usize,
+    ) -> Result<Vec<Mode>, RotorDynError> {
+        let solve = |whirl: f64| {
+            let mats = self.matrices_from(f, speed, whirl);
+            modal::solve_lowest(&mats.m, &mats.d, &mats.k, pairs, count + WHIRL_SPARE_MODES, false)
+        };
+        let start = solve(speed)?;
+        let mut out = Vec::with_capacity(count);
+        for (i, first) in start.iter().take(count).enumerate() {
+            let mut mode = first.clone();
+            let mut converged = false;
+            for _ in 0..WHIRL_MAX_ITERATIONS {
+                let whirl = mode.eigenvalue.im;
+                let candidates = solve(whirl)?;
+                let next = candidates
+                    .into_iter()
+                    .map(|c| (crate::modal::mac(&mode.right, &c.right), c))
+                    .max_by(|a, b| a.0.total_cmp(&b.0))
+                    .map(|(_, c)| c)
+                    .ok_or_else(|| RotorDynError::Solver(format!("no oscillating mode at {speed} rad/s")))?;
+                let change = (next.eigenvalue.im - whirl).abs();
+                mode = next;
+                if change <= WHIRL_TOLERANCE * whirl.abs().max(mode.eigenvalue.im.abs()).max(1e-12) {
+                    converged = true;
+                    break;
+                }
+            }
+            if !converged {
+                return Err(RotorDynError::Solver(format!(
+                    "mode {} at {:.6} rpm: the whirl frequency did not settle within {WHIRL_MAX_ITERATIONS} \
+                     iterations (the bearing tables over frequency make it jump between modes)",
+                    i + 1,
+                    crate::rad_to_rpm(speed)
+                )));
+            }
+            out.push(mode);
+        }
+        out.sort_by(|a, b| a.eigenvalue.im.total_cmp(&b.eigenvalue.im));
+        Ok(out)
     }
 }
 

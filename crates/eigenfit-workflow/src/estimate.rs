@@ -233,11 +233,26 @@ pub fn run(
     if let Some(path) = rotordynamics::ross_model(request.source.model.as_deref()) {
         // A run-up fit on a large rotor takes minutes (each evaluation solves every speed):
         // a spinner with the elapsed time shows it is working.
+        let t = &request.test_data;
+        rotordynamics::refuse_planar_options(
+            &request.strategy,
+            &request.residual,
+            &[
+                ("--shapes", t.shapes.is_some()),
+                ("--sensor-map", t.sensor_map.is_some()),
+                ("--fix", !t.fix.is_empty()),
+            ],
+        )?;
         progress.begin("fitting the run-up", None);
-        let report = rotordynamics::estimate(
+        let options = rotordynamics::RunupOptions {
+            selection: request.bearing_parameters.as_deref(),
+            initial: request.initial.as_deref(),
+            write_model: request.write_model,
+        };
+        let report = rotordynamics::estimate_with(
             path,
             &request.measured,
-            request.bearing_parameters.as_deref(),
+            &options,
             request.max_iterations,
             request.alternative_starts.unwrap_or(rotordynamics::RUNUP_REFITS),
             request.budget,

@@ -15,6 +15,7 @@ use eigenfit_rotordynamics::fit::fit_runup;
 use eigenfit_rotordynamics::identify::{
     bearing_parameters, check_selection, evaluate, read_runup, RunupPoint, DEFAULT_COEFFICIENTS,
 };
+use eigenfit_rotordynamics::interpolation::Coefficient;
 use eigenfit_rotordynamics::objective::RunupObjective;
 use eigenfit_rotordynamics::{campbell, ross_file, rpm_to_rad, Campbell, Rotor, RotorDynError};
 use serde::Serialize;
@@ -34,6 +35,12 @@ fn to_workflow(e: RotorDynError) -> WorkflowError {
         RotorDynError::Solver(m) => WorkflowError::Failure(m),
         other => input(other.to_string()),
     }
+}
+
+/// A ROSS rotor file's text in the format ROSS reads for `path` (JSON for `.json`, TOML
+/// otherwise).
+pub fn ross_text_for(text: &str, path: &Path) -> Result<String, WorkflowError> {
+    ross_file::in_format_for(text, path).map_err(|e| input(format!("{}: {e}", path.display())))
 }
 
 /// Loads a ROSS rotor, errors naming the file.
@@ -79,9 +86,76 @@ pub struct SpeedReport {
 /// eigen-solver within ±1e-13 of 0 (rotor_example: |ζ| ≤ 6.2e-14 at 0 and 5000 rpm).
 const UNSTABLE_BELOW: f64 = -1e-9;
 
+/// The names `--set` takes on a ROSS rotor: `<coefficient>_<bearing tag>` for every bearing
+/// and seal, the coefficients in ROSS's names (stiffness N/m, damping N·s/m, added mass kg).
+pub fn settable_names(rotor: &Rotor) -> Vec<String> {
+    rotor.bearings.iter().flat_map(|b| SETTABLE.iter().map(move |c| format!("{c}_{}", b.tag))).collect()
+}
+
+/// Bearing coefficients `--set` can set, in ROSS's names and [`Bearing`]'s order (k, c, m).
+///
+/// [`Bearing`]: eigenfit_rotordynamics::elements::Bearing
+const SETTABLE: [&str; 12] =
+    ["kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy", "mxx", "mxy", "myx", "myy"];
+
+/// Applies `--set NAME=VALUE` items to a ROSS rotor: the named bearing coefficient becomes VALUE at
+/// every speed and whirl frequency (its table, if any, is replaced). A name that is not one of
+/// [`settable_names`] is refused, listing them.
+pub fn apply_sets(rotor: &mut Rotor, sets: &[String]) -> Result<Vec<String>, WorkflowError> {
+    let mut notes = Vec::new();
+    for item in sets {
+        let (name, value) =
+            item.split_once('=').ok_or_else(|| input(format!("--set `{item}`: expected NAME=VALUE")))?;
+        let name = name.trim();
+        let value: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| input(format!("--set `{item}`: `{}` is not a finite number", value.trim())))?;
+        let hit = rotor.bearings.iter_mut().find_map(|b| {
+            let c = SETTABLE.iter().position(|c| format!("{c}_{}", b.tag) == name)?;
+            let tag = b.tag.clone();
+            let slot = match c {
+                0..=3 => &mut b.k[c],
+                4..=7 => &mut b.c[c - 4],
+                _ => &mut b.m[c - 8],
+            };
+            let was_table = !matches!(slot, Coefficient::Constant(_));
+            *slot = Coefficient::Constant(value);
+            Some((tag, was_table))
+        });
+        match hit {
+            Some((tag, true)) => notes.push(format!(
+                "--set {name}={value}: the table of {tag}'s {} is replaced by this value at every speed",
+                &name[..3]
+            )),
+            Some(_) => {}
+            None => {
+                return Err(input(format!(
+                    "--set: `{name}` is not a bearing coefficient of this rotor; the names are {}",
+                    settable_names(rotor).join(", ")
+                )))
+            }
+        }
+    }
+    Ok(notes)
+}
+
 /// `simulate --model ROSS-FILE [--speed RPM] --modes N`: damped modes at one speed.
 pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize) -> Result<SpeedReport, WorkflowError> {
-    let rotor = load(path)?;
+    simulate_with(path, speed_rpm, modes, &[])
+}
+
+/// [`simulate`] with `--set NAME=VALUE` bearing coefficients (see [`apply_sets`]).
+pub fn simulate_with(
+    path: &Path,
+    speed_rpm: Option<f64>,
+    modes: usize,
+    sets: &[String],
+) -> Result<SpeedReport, WorkflowError> {
+    let mut rotor = load(path)?;
+    let set_notes = apply_sets(&mut rotor, sets)?;
     let rpm = speed_rpm.unwrap_or(0.0);
     check_speed("--speed", rpm)?;
     if modes == 0 || modes > rotor.dofs() {
@@ -95,7 +169,9 @@ pub fn simulate(path: &Path, speed_rpm: Option<f64>, modes: usize) -> Result<Spe
         )));
     }
     let shown = &all[..modes];
-    let mut notes = rotor.extrapolation_notes(&[rpm]);
+    let mut notes = set_notes;
+    notes.extend(rotor.extrapolation_notes(&[rpm]));
+    notes.extend(rotor.whirl_extrapolation_notes(&shown.iter().map(|m| m.eigenvalue.im).collect::<Vec<_>>()));
     let unstable: Vec<String> = (0..modes)
         .filter(|&i| shown[i].damping_ratio() < UNSTABLE_BELOW)
         .map(|i| (i + 1).to_string())
@@ -195,6 +271,10 @@ pub struct RunupEstimateReport {
     /// Bearing tables extrapolated at measured speeds.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// With `--write-model`: the input ROSS file, of its version, with the estimated bearing
+    /// coefficients (each table multiplied by its estimated factor).
+    #[serde(skip)]
+    pub updated_model: Option<String>,
 }
 
 /// Refits from screened other starts a run-up estimate runs at most, when not given.
@@ -214,9 +294,120 @@ pub fn estimate(
     refits: usize,
     budget: usize,
 ) -> Result<RunupEstimateReport, WorkflowError> {
+    let options = RunupOptions { selection, initial: None, write_model: false };
+    estimate_with(path, measured, &options, max_iterations, refits, budget)
+}
+
+/// What a run-up estimate may be asked beyond the fit's limits.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunupOptions<'a> {
+    /// `--parameters`: the coefficients to estimate (default kxx, kyy of every bearing).
+    pub selection: Option<&'a str>,
+    /// `--initial`: where the fit starts, in the parameters' units at the lowest measured speed —
+    /// `V1,V2,…` (one per parameter, in order) or `NAME=VALUE,…` (the others at the file's).
+    pub initial: Option<&'a str>,
+    /// `--write-model`: build the ROSS file of the input's version with the estimated tables
+    /// ([`RunupEstimateReport::updated_model`]).
+    pub write_model: bool,
+}
+
+/// Options of `estimate` that a run-up fit on a ROSS rotor has no meaning for: the first given is
+/// refused before any work, naming it.
+pub fn refuse_planar_options(
+    strategy: &str,
+    residual: &str,
+    given: &[(&str, bool)],
+) -> Result<(), WorkflowError> {
+    if !matches!(strategy, "damped" | "levenberg-marquardt") {
+        return Err(input(format!(
+            "--strategy {strategy}: a run-up fit on a two-plane (ROSS) rotor is Levenberg–Marquardt (damped) only"
+        )));
+    }
+    if residual != "relative" {
+        return Err(input(format!(
+            "--residual {residual}: a run-up fit's residual is set by its CSV (in std_hz when given, relative otherwise)"
+        )));
+    }
+    match given.iter().find(|(_, on)| *on) {
+        Some((flag, _)) => Err(input(format!(
+            "{flag} is not available for two-plane (ROSS) rotors: a run-up fit uses the whirl frequencies of the run-up CSV"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// The starting factors (multiples of the file's coefficients) for `--initial`.
+fn initial_factors(
+    text: Option<&str>,
+    params: &[eigenfit_rotordynamics::identify::Parameter],
+    rotor: &Rotor,
+    w0: f64,
+) -> Result<Vec<f64>, WorkflowError> {
+    let mut factors = vec![1.0; params.len()];
+    let Some(text) = text else { return Ok(factors) };
+    let names = || params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ");
+    let items: Vec<&str> = text.split(',').map(str::trim).filter(|s| !s.is_empty()).collect();
+    let mut values: Vec<(usize, f64)> = Vec::new();
+    if items.iter().any(|i| i.contains('=')) {
+        for item in &items {
+            let (name, value) = item.split_once('=').ok_or_else(|| {
+                input(format!("--initial `{item}`: expected NAME=VALUE like the other items"))
+            })?;
+            let i = params.iter().position(|p| p.name == name.trim()).ok_or_else(|| {
+                input(format!(
+                    "--initial: `{}` is not an estimated parameter; they are {}",
+                    name.trim(),
+                    names()
+                ))
+            })?;
+            values.push((i, crate::overrides::parse_list("--initial", value)?[0]));
+        }
+    } else {
+        let list = crate::overrides::parse_list("--initial", text)?;
+        if list.len() != params.len() {
+            return Err(input(format!(
+                "--initial: {} values given but {} parameters are estimated ({})",
+                list.len(),
+                params.len(),
+                names()
+            )));
+        }
+        values.extend(list.into_iter().enumerate());
+    }
+    for (i, v) in values {
+        let nominal = params[i].nominal(rotor, w0);
+        let factor = v / nominal;
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(input(format!(
+                "--initial: {}={v} must have the sign of the file's value {nominal:.6e} there (the fit scales \
+                 the coefficient's table by a positive factor)",
+                params[i].name
+            )));
+        }
+        factors[i] = factor;
+    }
+    Ok(factors)
+}
+
+/// [`estimate`] with `--initial` and `--write-model` (see [`RunupOptions`]).
+pub fn estimate_with(
+    path: &Path,
+    measured: &Path,
+    options: &RunupOptions<'_>,
+    max_iterations: usize,
+    refits: usize,
+    budget: usize,
+) -> Result<RunupEstimateReport, WorkflowError> {
     let rotor = load(path)?;
+    if rotor.has_whirl_tables() {
+        return Err(input(format!(
+            "{}: a bearing's coefficients are a table over whirl frequency; the run-up fit evaluates \
+             bearings at the rotor speed and is not available for such rotors (simulate and campbell are)",
+            path.display()
+        )));
+    }
     let points = read_runup(measured).map_err(to_workflow)?;
-    let chosen: Vec<&str> = match selection {
+    let chosen: Vec<&str> = match options.selection {
         Some(list) => list.split(',').map(str::trim).filter(|s| !s.is_empty()).collect(),
         None => DEFAULT_COEFFICIENTS.to_vec(),
     };
@@ -224,13 +415,22 @@ pub fn estimate(
     if params.is_empty() {
         return Err(input(format!("{}: the rotor has no bearings to estimate", path.display())));
     }
+    let w_lowest = rpm_to_rad(points.iter().map(|p| p.speed_rpm).fold(f64::INFINITY, f64::min));
+    let initial = initial_factors(options.initial, &params, &rotor, w_lowest)?;
+    let text = if options.write_model {
+        Some(
+            std::fs::read_to_string(path)
+                .map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?,
+        )
+    } else {
+        None
+    };
     check_selection(&rotor, &params, &points).map_err(to_workflow)?;
     if budget == 0 {
         return Err(input("--budget 0: at least one model evaluation is needed"));
     }
     let objective = RunupObjective::new(&rotor, params.clone(), &points, None).map_err(to_workflow)?;
     let np = params.len();
-    let initial = vec![1.0; np];
     let budget = Budget::new(budget);
     let mut phases: Vec<(&str, usize)> = Vec::new();
     let (estimate, restarts) = match fit_runup(&objective, &params, &initial, max_iterations, refits, &budget)
@@ -318,7 +518,23 @@ pub fn estimate(
     }
     // One more evaluation for the whirl of each paired model mode at the estimate.
     let whirl = evaluate(&rotor, &params, &estimate.parameters, &points).map_err(to_workflow)?.whirl;
+    let updated_model = match text {
+        Some(text) => {
+            let changes: Vec<(String, String, f64)> = params
+                .iter()
+                .zip(&estimate.parameters)
+                .map(|(p, s)| {
+                    let b = &rotor.bearings[p.bearing];
+                    let name = eigenfit_rotordynamics::identify::COEFFICIENT_NAMES[p.coefficient];
+                    (b.tag.clone(), name.to_string(), *s)
+                })
+                .collect();
+            Some(ross_file::write_scaled(&text, &changes).map_err(to_workflow)?)
+        }
+        None => None,
+    };
     Ok(RunupEstimateReport {
+        updated_model,
         model: path.display().to_string(),
         outcome: Outcome::of(&estimate, converged),
         verdict,
@@ -329,7 +545,13 @@ pub fn estimate(
         budget: BudgetReport::of(&budget),
         evaluations_by_phase: phase_counts(&phases),
         reference_speed_rpm: w0 * 30.0 / std::f64::consts::PI,
-        values: ParameterValues::new(&names, &nominal, &value, status),
+        // `initial`: where the fit started (the file's values, or --initial's).
+        values: ParameterValues::new(
+            &names,
+            &nominal.iter().zip(&initial).map(|(k, f)| k * f).collect::<Vec<_>>(),
+            &value,
+            status,
+        ),
         scales: Named::new(&names, estimate.parameters.iter().copied()),
         cost: lin.chi2(),
         intervals: intervals.map(|iv| Named::new(&names, iv)),
@@ -339,7 +561,20 @@ pub fn estimate(
         refits: restarts,
         alternative_solutions: AlternativeSolution::list(&names, &alternatives),
         alternatives_sigma,
-        notes: rotor.extrapolation_notes(&points.iter().map(|p| p.speed_rpm).collect::<Vec<_>>()),
+        notes: {
+            let mut notes = Vec::new();
+            if options.initial.is_some() {
+                let start: Vec<String> = params
+                    .iter()
+                    .zip(&initial)
+                    .zip(&nominal)
+                    .map(|((p, f), k)| format!("{} = {:.6e} (×{f:.6} the file's)", p.name, k * f))
+                    .collect();
+                notes.push(format!("the fit started from --initial: {}", start.join(", ")));
+            }
+            notes.extend(rotor.extrapolation_notes(&points.iter().map(|p| p.speed_rpm).collect::<Vec<_>>()));
+            notes
+        },
         points: points
             .iter()
             .enumerate()
@@ -490,6 +725,12 @@ pub fn parse_speeds(text: &str) -> Result<Vec<f64>, WorkflowError> {
 /// `frequencies_hz`, `whirl`, `log_dec`, `curves`, `critical_speeds`) and these.
 #[derive(Debug, Clone, Serialize)]
 pub struct CampbellReport {
+    /// `--operating`: the operating range (rpm).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub operating_range_rpm: Option<[f64; 2]>,
+    /// `--operating`: each critical speed's separation margin from the range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub separation_margins: Option<Vec<SeparationMargin>>,
     /// The model file.
     pub model: String,
     /// The diagram.
@@ -512,8 +753,17 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
     if modes == 0 {
         return Err(input("--modes 0: at least one mode"));
     }
-    let c = campbell(&rotor, &speeds, modes).map_err(|e| input(format!("{}: {e}", path.display())))?;
+    let c = campbell(&rotor, &speeds, modes).map_err(|e| match e {
+        // A solver failure (a whirl-frequency fixed point that does not settle) is no input error.
+        RotorDynError::Solver(m) => WorkflowError::Failure(format!("{}: {m}", path.display())),
+        other => input(format!("{}: {other}", path.display())),
+    })?;
     let mut notes = rotor.extrapolation_notes(&speeds);
+    let whirl = c.frequencies_hz.iter().flatten().map(|f| 2.0 * std::f64::consts::PI * f);
+    let (lo, hi) = whirl.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| (a.min(w), b.max(w)));
+    if lo.is_finite() {
+        notes.extend(rotor.whirl_extrapolation_notes(&[lo, hi]));
+    }
     let unstable: Vec<String> = (0..speeds.len())
         .filter(|&k| c.log_dec[k].iter().any(|&d| d < 2.0 * std::f64::consts::PI * UNSTABLE_BELOW))
         .map(|k| format!("{:.0}", speeds[k]))
@@ -531,7 +781,164 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
         campbell: c,
         plots: None,
         notes,
+        operating_range_rpm: None,
+        separation_margins: None,
     })
+}
+
+/// One critical speed against the operating range, API 684 style (API 617's rule for the
+/// required separation margin from the amplification factor).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SeparationMargin {
+    /// The critical speed (rpm).
+    pub rpm: f64,
+    /// Its damping ratio ζ.
+    pub damping_ratio: f64,
+    /// Amplification factor 1/(2ζ) (`null` for ζ ≤ 0: no finite peak, unstable or undamped).
+    pub amplification_factor: Option<f64>,
+    /// Required margin (% of the nearer end of the operating range): none when AF < 2.5
+    /// (critically damped); 5 % below / 15 % above for 2.5 ≤ AF ≤ 3.55; above that
+    /// 16(1 − 1/(AF − 1.5)) % below and 10 + 17(1 − 1/(AF − 1.5)) % above (AF → ∞ for ζ ≤ 0).
+    pub required_margin_percent: f64,
+    /// Actual margin (% of the nearer end: (min − Nc)/min below, (Nc − max)/max above;
+    /// negative inside the operating range).
+    pub margin_percent: f64,
+    /// `below`, `inside` or `above` the operating range.
+    pub position: &'static str,
+    /// Whether the actual margin is at least the required one.
+    pub passes: bool,
+}
+
+/// The separation margins of `critical` against the operating range [lo, hi] rpm.
+pub fn separation_margins(
+    critical: &[eigenfit_rotordynamics::campbell::CriticalSpeed],
+    lo: f64,
+    hi: f64,
+) -> Vec<SeparationMargin> {
+    critical
+        .iter()
+        .map(|k| {
+            // ζ within round-off of 0 (an undamped rotor's come out within ±1e-13): no finite AF.
+            let af = (k.damping_ratio > -UNSTABLE_BELOW).then(|| 1.0 / (2.0 * k.damping_ratio));
+            let a = af.unwrap_or(f64::INFINITY);
+            let (position, margin) = if k.rpm < lo {
+                ("below", 100.0 * (lo - k.rpm) / lo)
+            } else if k.rpm > hi {
+                ("above", 100.0 * (k.rpm - hi) / hi)
+            } else {
+                ("inside", -100.0 * ((k.rpm - lo) / lo.max(1e-300)).min((hi - k.rpm) / hi))
+            };
+            let below = position != "above" && (position == "below" || k.rpm - lo < hi - k.rpm);
+            let required = if a < 2.5 {
+                0.0
+            } else if a <= 3.55 {
+                if below {
+                    5.0
+                } else {
+                    15.0
+                }
+            } else {
+                let r = 1.0 - 1.0 / (a - 1.5);
+                if below {
+                    16.0 * r
+                } else {
+                    10.0 + 17.0 * r
+                }
+            };
+            let passes = required == 0.0 || (position != "inside" && margin >= required);
+            SeparationMargin {
+                rpm: k.rpm,
+                damping_ratio: k.damping_ratio,
+                amplification_factor: af,
+                required_margin_percent: required,
+                margin_percent: margin,
+                position,
+                passes,
+            }
+        })
+        .collect()
+}
+
+/// [`campbell_diagram`] with `--operating FROM:TO` (rpm): each critical speed's API 684-style
+/// separation margin from the operating range.
+pub fn campbell_diagram_with(
+    path: &Path,
+    speeds: &str,
+    modes: usize,
+    operating: Option<&str>,
+) -> Result<CampbellReport, WorkflowError> {
+    let range = match operating {
+        None => None,
+        Some(text) => {
+            let bad = |why: &str| {
+                input(format!("--operating `{text}`: {why} (expected FROM:TO in rpm, e.g. 9000:11000)"))
+            };
+            let (a, b) = text.split_once(':').ok_or_else(|| bad("two fields needed"))?;
+            let a: f64 = a.trim().parse().map_err(|_| bad("FROM is not a number"))?;
+            let b: f64 = b.trim().parse().map_err(|_| bad("TO is not a number"))?;
+            if !(a.is_finite() && b.is_finite() && a > 0.0 && b >= a) {
+                return Err(bad("speeds must be finite with 0 < FROM ≤ TO"));
+            }
+            Some((a, b))
+        }
+    };
+    let mut report = campbell_diagram(path, speeds, modes)?;
+    if let Some((lo, hi)) = range {
+        let swept = report.campbell.speeds_rpm.iter().copied().fold(0.0, f64::max);
+        // The largest margin API 617 can require above the range is 27 %.
+        if swept < hi * 1.27 {
+            report.notes.push(format!(
+                "--operating {lo}:{hi}: the sweep ends at {swept} rpm, below {:.0} rpm (27 % above the range, the \
+                 largest margin required): critical speeds above it are not checked",
+                hi * 1.27
+            ));
+        }
+        report.separation_margins = Some(separation_margins(&report.campbell.critical_speeds, lo, hi));
+        report.operating_range_rpm = Some([lo, hi]);
+    }
+    Ok(report)
+}
+
+#[cfg(test)]
+mod margin_tests {
+    use super::*;
+    use eigenfit_rotordynamics::campbell::CriticalSpeed;
+    use eigenfit_rotordynamics::Whirl;
+
+    fn at(rpm: f64, zeta: f64) -> CriticalSpeed {
+        CriticalSpeed { rpm, curve: 0, whirl: Whirl::Forward, log_dec: 0.0, damping_ratio: zeta }
+    }
+
+    /// API 617's required margins: none below AF 2.5; 5 % below / 15 % above up to AF 3.55;
+    /// 16(1 − 1/(AF − 1.5)) % below and 10 + 17(1 − 1/(AF − 1.5)) % above beyond; AF 1/(2ζ).
+    #[test]
+    fn required_margins_follow_the_amplification_factor() {
+        let m = separation_margins(
+            &[
+                at(5000.0, 0.25),
+                at(8000.0, 1.0 / 6.0),
+                at(9000.0, 1.0 / 11.0),
+                at(14_000.0, 1.0 / 11.0),
+                at(13_000.0, 1e-14),
+            ],
+            10_000.0,
+            12_000.0,
+        );
+        assert_eq!(m[0].required_margin_percent, 0.0); // AF 2
+        assert!(m[0].passes);
+        assert_eq!((m[1].required_margin_percent, m[1].position), (5.0, "below")); // AF 3
+        assert!((m[1].margin_percent - 20.0).abs() < 1e-12 && m[1].passes);
+        assert!((m[2].required_margin_percent - 12.0).abs() < 1e-12); // AF 5.5, below
+        assert!((m[2].margin_percent - 10.0).abs() < 1e-12 && !m[2].passes);
+        assert!((m[3].required_margin_percent - 22.75).abs() < 1e-12); // AF 5.5, above
+        assert!((m[3].margin_percent - 100.0 * 2000.0 / 12_000.0).abs() < 1e-12 && !m[3].passes);
+        assert_eq!(m[4].amplification_factor, None); // undamped: AF infinite
+        assert_eq!((m[4].position, m[4].required_margin_percent), ("above", 27.0));
+        assert!(m[4].margin_percent > 8.3 && !m[4].passes);
+        let inside = separation_margins(&[at(11_000.0, 0.01)], 10_000.0, 12_000.0);
+        assert_eq!(inside[0].position, "inside");
+        assert!(inside[0].margin_percent < 0.0 && !inside[0].passes);
+    }
 }
 
 #[cfg(test)]

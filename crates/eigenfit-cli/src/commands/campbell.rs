@@ -5,7 +5,7 @@ use crate::error::CliError;
 use crate::plot;
 use crate::plot::campbell::CampbellPlot;
 use clap::Args;
-use eigenfit_workflow::rotordynamics::campbell_diagram;
+use eigenfit_workflow::rotordynamics::campbell_diagram_with;
 use std::path::PathBuf;
 
 /// Arguments of `campbell`.
@@ -20,6 +20,10 @@ pub struct CampbellArgs {
     /// Number of modes (lowest damped frequencies) per speed.
     #[arg(long, default_value_t = 6)]
     pub modes: usize,
+    /// Operating speed range FROM:TO in rpm: each critical speed's separation margin from it, API
+    /// 684 style (the margin required from the amplification factor 1/(2ζ)).
+    #[arg(long, value_name = "FROM:TO")]
+    pub operating: Option<String>,
     /// Write the diagram (campbell.svg/.png) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
@@ -31,7 +35,7 @@ pub struct CampbellArgs {
 
 /// Runs `campbell`.
 pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
-    let mut report = campbell_diagram(&args.model, &args.speeds, args.modes)?;
+    let mut report = campbell_diagram_with(&args.model, &args.speeds, args.modes, args.operating.as_deref())?;
     crate::commands::simulate::print_notes(&report.notes);
     let plots = match &args.plot {
         Some(dir) => {
@@ -79,6 +83,23 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
                 "not a critical speed: {:.1} rpm, where a mode with damping ratio {:.3} (|ζ| ≥ 1/√2: no resonance peak) crosses 1×",
                 k.rpm, k.damping_ratio
             );
+        }
+        if let (Some([lo, hi]), Some(margins)) = (report.operating_range_rpm, &report.separation_margins) {
+            println!("separation margins from the operating range {lo:.0}–{hi:.0} rpm (API 684 style):");
+            if margins.is_empty() {
+                println!("  no critical speed in the sweep");
+            }
+            for m in margins {
+                let af = m.amplification_factor.map_or("∞".to_string(), |a| format!("{a:.2}"));
+                println!(
+                    "  {:.1} rpm {}: AF {af}, margin {:.1} %, required {:.1} % — {}",
+                    m.rpm,
+                    m.position,
+                    m.margin_percent,
+                    m.required_margin_percent,
+                    if m.passes { "passes" } else { "FAILS" }
+                );
+            }
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     });

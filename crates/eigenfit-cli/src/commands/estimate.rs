@@ -104,6 +104,14 @@ fn default_budget(strategy: &str, samples: Option<usize>) -> usize {
 /// Runs `estimate`; returns the exit code (3 when the run did not converge, the fit is poor, a
 /// parameter sits on a limit or the budget ran out).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
+    if args.plot.is_some()
+        && eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()).is_some()
+    {
+        return Err(crate::error::input(
+            "--plot is not available for a run-up fit on a two-plane (ROSS) rotor: draw the rotor's \
+             Campbell diagram with `eigenfit campbell --plot DIR`",
+        ));
+    }
     let mut notes = Vec::new();
     let outcome = estimate::run(&request(args), &mut notes, &mut Bars::new(args.report.quiet));
     print_notes(&notes);
@@ -111,7 +119,15 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         EstimateOutcome::Runup(report) => {
             print_notes(&report.notes);
             let code = if report.verdict.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
+            crate::error::set_exit_on_closed_pipe(code);
             crate::output::report(args.report.json, &*report, crate::rotordynamics::print_estimate);
+            if let (Some(path), Some(text)) = (&args.test_data.write_model, &report.updated_model) {
+                let text = eigenfit_workflow::rotordynamics::ross_text_for(text, path)?;
+                crate::output::write_atomically(path, text.as_bytes())?;
+                if !args.report.json {
+                    println!("wrote {}", path.display());
+                }
+            }
             return Ok(code);
         }
         // No result to print: an error with exit code 3 (also through the Python package).

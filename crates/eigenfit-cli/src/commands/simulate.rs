@@ -62,11 +62,36 @@ pub struct SimulateArgs {
     pub report: crate::output::ReportArgs,
 }
 
+/// The options `simulate` has for planar rotors that a ROSS rotor has no meaning for: refused
+/// before any work, naming the option and what to use instead.
+fn refuse_for_ross(args: &SimulateArgs) -> Result<(), CliError> {
+    let refused = [
+        (
+            args.stiffness.is_some(),
+            "--stiffness",
+            "set a bearing's coefficients with --set kxx_<bearing>=VALUE",
+        ),
+        (!args.effects.is_empty(), "--effect", "the what-if effects are defined on planar rotors"),
+        (args.sweep.is_some(), "--sweep", "draw the modes over speed with `eigenfit campbell`"),
+        (args.plot.is_some(), "--plot", "draw the Campbell diagram with `eigenfit campbell --plot DIR`"),
+        (args.uff.is_some(), "--uff", "the universal-file export is written for planar rotors"),
+        (args.model.solver != "auto", "--solver", "a ROSS rotor has its own damped gyroscopic solver"),
+    ];
+    match refused.iter().find(|(given, _, _)| *given) {
+        Some((_, flag, instead)) => {
+            Err(input(format!("{flag} is not available for two-plane (ROSS) rotors: {instead}")))
+        }
+        None => Ok(()),
+    }
+}
+
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
-        let report = eigenfit_workflow::rotordynamics::simulate(path, args.speed, args.modes)?;
+        refuse_for_ross(args)?;
+        let report =
+            eigenfit_workflow::rotordynamics::simulate_with(path, args.speed, args.modes, &args.sets)?;
         print_notes(&report.notes);
         crate::output::report(args.report.json, &report, |report| {
             crate::rotordynamics::print_speed(report);
