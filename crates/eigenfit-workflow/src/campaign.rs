@@ -122,6 +122,9 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     for conf in &campaign.configurations {
         let name = conf.name.clone().unwrap_or_default();
         crate::model::check_model_file(&conf.model).map_err(|e| input(format!("{name}: {e}")))?;
+        if let Some(e) = crate::model::other_kind(&conf.model, "a campaign") {
+            return Err(input(format!("{name}: {e}")));
+        }
         let rotor = Rotor::from_toml_file(&conf.model).map_err(|e| input(format!("{name}: {e}")))?;
         let options = TestDataOptions {
             shapes: conf.shapes.clone(),

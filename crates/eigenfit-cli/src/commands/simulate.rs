@@ -66,6 +66,14 @@ pub struct SimulateArgs {
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
+        // Outputs this path does not write are refused, never silently dropped.
+        for (given, flag) in [(args.uff.is_some(), "--uff"), (args.plot.is_some(), "--plot")] {
+            if given {
+                return Err(input(format!(
+                    "{flag} applies to planar rotor models; for a ROSS rotor use `eigenfit campbell --plot DIR`"
+                )));
+            }
+        }
         let report = eigenfit_workflow::rotordynamics::simulate(path, args.speed, args.modes)?;
         print_notes(&report.notes);
         crate::output::report(args.report.json, &report, |report| {
@@ -75,6 +83,13 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
     if args.speed.is_some() {
         return Err(input("--speed applies to two-plane rotors (files saved by ROSS); this model is planar"));
+    }
+    // Every output is checked writable before any work.
+    if let Some(path) = &args.uff {
+        crate::output::check_writable(path, "--uff")?;
+    }
+    if let Some(dir) = &args.plot {
+        crate::output::check_writable_dir(dir, "--plot")?;
     }
     let (model, label) = args.model.load_any()?;
     let mut rotor = match model {
@@ -173,6 +188,8 @@ fn simulate_matrices(
         (!args.effects.is_empty(), "--effect"),
         (args.sweep.is_some(), "--sweep"),
         (args.plot.is_some(), "--plot"),
+        // A universal file carries node coordinates, which a matrices model does not have.
+        (args.uff.is_some(), "--uff"),
     ] {
         if given {
             return Err(input(format!(
