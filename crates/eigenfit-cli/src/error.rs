@@ -59,4 +59,3 @@ pub static EXIT_ON_CLOSED_PIPE: std::sync::atomic::AtomicU8 = std::sync::atomic:
 pub fn set_exit_on_closed_pipe(code: u8) {
     EXIT_ON_CLOSED_PIPE.store(code, std::sync::atomic::Ordering::Relaxed);
 }
-

@@ -52,7 +52,8 @@ pub fn check_writable(path: &Path, flag: &str) -> Result<(), CliError> {
 /// Checks, before any work, that plots can be written into `dir` (created if missing): a folder
 /// that takes a new file.
 pub fn check_writable_dir(dir: &Path, flag: &str) -> Result<(), CliError> {
-    std::fs::create_dir_all(dir).map_err(|e| input(format!("{flag} {}: cannot create: {e}", dir.display())))?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| input(format!("{flag} {}: cannot create: {e}", dir.display())))?;
     check_writable(&dir.join("probe"), flag)
 }
 
@@ -173,10 +174,12 @@ impl Stream {
             }
             Err(e) => return Err(input(format!("{}: cannot lock: {e}", path.display()))),
         }
-        let length = whole_lines(&file).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
+        let length =
+            whole_lines(&file).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
         let size = file.metadata().map_err(|e| input(format!("{}: {e}", path.display())))?.len();
         if length < size {
-            file.set_len(length).map_err(|e| input(format!("{}: cannot cut a torn line: {e}", path.display())))?;
+            file.set_len(length)
+                .map_err(|e| input(format!("{}: cannot cut a torn line: {e}", path.display())))?;
             eprintln!(
                 "eigenfit: note: {}: its last line was torn ({} bytes without a newline, an earlier run cut short): removed",
                 path.display(),

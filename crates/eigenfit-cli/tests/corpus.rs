@@ -25,12 +25,15 @@ fn text(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr)
 }
 
-/// One case: arguments, expected exit code, fragments stdout+stderr must contain.
+/// One case: arguments, expected exit code, fragments stdout+stderr must contain; with
+/// `no_results`, nothing on stdout (refused before any fitting, so no result was printed).
 #[derive(serde::Deserialize)]
 struct Case {
     args: Vec<String>,
     exit: i32,
     says: Vec<String>,
+    #[serde(default)]
+    no_results: bool,
 }
 
 #[derive(serde::Deserialize)]
@@ -62,8 +65,16 @@ fn every_corpus_case_ends_with_its_exit_code_and_message() {
         let all = text(&out);
         clean(&format!("{:?}", case.args), &all);
         if out.status.code() != Some(case.exit) {
-            failures.push(format!("{:?}: exit {:?}, expected {}:\n{all}", case.args, out.status.code(), case.exit));
+            failures.push(format!(
+                "{:?}: exit {:?}, expected {}:\n{all}",
+                case.args,
+                out.status.code(),
+                case.exit
+            ));
             continue;
+        }
+        if case.no_results && !out.stdout.is_empty() {
+            failures.push(format!("{:?}: results printed, so it was not refused first:\n{all}", case.args));
         }
         for fragment in &case.says {
             if !all.contains(fragment) {
@@ -71,26 +82,33 @@ fn every_corpus_case_ends_with_its_exit_code_and_message() {
             }
         }
     }
-    assert!(failures.is_empty(), "{} of {} cases failed:\n{}", failures.len(), cases.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
 }
 
-/// Every file of the corpus folder is used by a case (or is the script that made it).
+/// Every file of the corpus folder is used: named by a case, by a model or campaign file of the
+/// corpus, or by a test of this file.
 #[test]
 fn every_corpus_file_is_used() {
-    let cases = cases();
-    for entry in std::fs::read_dir(corpus()).expect("corpus folder") {
-        let name = entry.expect("entry").file_name().to_string_lossy().into_owned();
-        if name == "cases.toml" || name == "make_uff.py" || name == "rotor.toml" {
+    let mut naming =
+        std::fs::read_to_string(corpus().join("cases.toml")).unwrap() + include_str!("corpus.rs");
+    let names: Vec<String> = std::fs::read_dir(corpus())
+        .expect("corpus folder")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    for name in names.iter().filter(|n| n.ends_with(".toml") && *n != "cases.toml") {
+        naming += &std::fs::read_to_string(corpus().join(name)).unwrap();
+    }
+    for name in &names {
+        if name == "cases.toml" || name == "make_uff.py" {
             continue;
         }
-        let used = cases.iter().any(|c| c.args.iter().any(|a| a == &name))
-            || std::fs::read_to_string(corpus().join("cases.toml")).unwrap().contains(&name)
-            || cases
-                .iter()
-                .flat_map(|c| &c.args)
-                .filter(|a| a.ends_with(".toml"))
-                .any(|a| std::fs::read_to_string(corpus().join(a)).is_ok_and(|t| t.contains(&name)));
-        assert!(used, "{name}: in tests/corpus but used by no case");
+        assert!(naming.contains(name.as_str()), "{name}: in tests/corpus but used by no case");
     }
 }
 
@@ -113,10 +131,9 @@ fn with_a_broken_pipe(args: &[&str]) -> Output {
 #[cfg(unix)]
 #[test]
 fn a_broken_pipe_is_not_a_success() {
-    for args in [
-        &["simulate", "--preset", "paper-rotor"][..],
-        &["simulate", "--preset", "paper-rotor", "--json"][..],
-    ] {
+    for args in
+        [&["simulate", "--preset", "paper-rotor"][..], &["simulate", "--preset", "paper-rotor", "--json"][..]]
+    {
         let out = with_a_broken_pipe(args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         clean(&format!("{args:?}"), &stderr);
@@ -187,7 +204,17 @@ fn a_stream_never_appends_onto_a_torn_line() {
     let stream = scratch.path().join("runs.jsonl");
     std::fs::write(&stream, "{\"whole\":1}\n{\"torn\":").unwrap();
     let s = stream.to_str().unwrap();
-    let out = eigenfit(&["compare", "--preset", "paper-rotor", "--targets", "2e5:5e4", "--initials", "1e5:1e5", "--stream", s]);
+    let out = eigenfit(&[
+        "compare",
+        "--preset",
+        "paper-rotor",
+        "--targets",
+        "2e5:5e4",
+        "--initials",
+        "1e5:1e5",
+        "--stream",
+        s,
+    ]);
     let all = text(&out);
     clean("torn stream", &all);
     assert!(all.contains("its last line was torn"), "{all}");
@@ -239,7 +266,8 @@ fn newton_and_p_step_converge_on_a_slow_structure() {
         ]);
         let all = text(&out);
         clean(strategy, &all);
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {all}"));
+        let v: serde_json::Value =
+            serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {all}"));
         assert!(v["iterations"].as_u64().unwrap() >= 1, "{strategy}: {v}");
         for (name, truth) in [("ground", 1500.0), ("coupling", 800.0)] {
             let p = v["parameters"][name].as_f64().unwrap();

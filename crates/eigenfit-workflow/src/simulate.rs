@@ -34,15 +34,18 @@ pub fn check_roundoff_of(
 ) -> Result<Option<String>, WorkflowError> {
     let levels = relative_roundoff(system, modes);
     let checked = |j: &usize| only.is_none_or(|o| o.contains(&(j + 1)));
-    match (0..levels.len()).filter(checked).find(|&j| levels[j].is_nan() || levels[j] > MAX_RELATIVE_ROUNDOFF) {
-        None => Ok((0..levels.len()).filter(checked).find(|&j| levels[j] > NOTE_RELATIVE_ROUNDOFF).map(|j| {
-            format!(
+    match (0..levels.len()).filter(checked).find(|&j| levels[j].is_nan() || levels[j] > MAX_RELATIVE_ROUNDOFF)
+    {
+        None => {
+            Ok((0..levels.len()).filter(checked).find(|&j| levels[j] > NOTE_RELATIVE_ROUNDOFF).map(|j| {
+                format!(
                 "mode {}: round-off may reach {:.1e} of its eigenvalue (a fine mesh or an extreme value); \
                  the trailing digits are not significant",
                 j + 1,
                 levels[j]
             )
-        })),
+            }))
+        }
         Some(j) => {
             let lambda = modes.eigenvalues[j];
             // An eigenvalue at or below zero is a rigid-body motion as likely as a lost digit.
@@ -94,8 +97,12 @@ pub fn check_stable(
         let (k_abs, m_abs) = if phi.is_empty() { system.amax() } else { system.abs_quadratic(&phi) };
         let bound = f64::EPSILON * (k_abs + lambda.abs() * m_abs);
         if -lambda > UNSTABLE_MARGIN * bound {
-            let values: Vec<String> =
-                model.parameters().iter().zip(p).map(|(q, v)| format!("{} = {}", q.name, readable(*v))).collect();
+            let values: Vec<String> = model
+                .parameters()
+                .iter()
+                .zip(p)
+                .map(|(q, v)| format!("{} = {}", q.name, readable(*v)))
+                .collect();
             return Err(input(format!(
                 "the model is unstable at {}: mode {} has a negative eigenvalue λ = {} (rad/s)², \
                  so K(p) is not positive semi-definite — a divergent mode, not a vibration (a \

@@ -112,10 +112,7 @@ pub const RELATIVE_FREQUENCY_TOLERANCE: f64 = 1e-4;
 /// absolute tolerance keeps the paper's behaviour, the relative one makes the test scale-free.
 pub(crate) fn square_converged(lin: &Linearisation, tolerance_hz: f64) -> bool {
     let n = lin.parameters.len().min(lin.frequencies_hz.len());
-    lin.frequencies_hz[..n]
-        .iter()
-        .zip(&lin.measured_hz[..n])
-        .all(|(f, m)| within(*f, *m, tolerance_hz))
+    lin.frequencies_hz[..n].iter().zip(&lin.measured_hz[..n]).all(|(f, m)| within(*f, *m, tolerance_hz))
 }
 
 /// |f − target| below both `tolerance_hz` and [`RELATIVE_FREQUENCY_TOLERANCE`]·|target|.

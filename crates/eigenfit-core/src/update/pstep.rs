@@ -2,8 +2,8 @@
 
 use super::settings::{Guard, SettingsError};
 use super::{
-    evaluate_or_diverge, newton_point, square_converged, square_max_diff_hz, within as frequency_within, Step, StepStatus,
-    UpdateError, UpdateStrategy,
+    evaluate_or_diverge, newton_point, square_converged, square_max_diff_hz, within as frequency_within,
+    Step, StepStatus, UpdateError, UpdateStrategy,
 };
 use crate::problem::{Linearisation, Objective};
 use crate::units::eigenvalue_to_hz;
