@@ -32,3 +32,5 @@ write("uff_no_modes.unv", head)
 write("uff_empty.unv", [])
 # Only blank lines.
 write("uff_blank.unv", ["\n", "   \n"])
+# Mode 3 numbered 999999999999 (record 7 of its dataset 55).
+write("uff_huge_mode_number.unv", head + m1 + m2 + m3[:8] + ["         2         4         1 999999999999\n"] + m3[9:])
