@@ -275,3 +275,35 @@ fn newton_and_p_step_converge_on_a_slow_structure() {
         }
     }
 }
+
+/// The `uff_file` fuzz target's properties (fuzz/fuzz_targets/uff_property.rs), built on stable.
+mod uff_fuzz {
+    include!("../../../fuzz/fuzz_targets/uff_property.rs");
+}
+
+/// The fuzz target's properties hold on its seeds and on deterministic mutations of them: every
+/// prefix cut at a line end, every single line deleted, every line duplicated.
+#[test]
+fn the_uff_fuzz_properties_hold_on_the_seeds_and_their_mutations() {
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/uff_file");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&seeds).expect("the uff_file seeds") {
+        let text = std::fs::read_to_string(entry.expect("entry").path()).expect("a text seed");
+        let lines: Vec<&str> = text.split_inclusive('\n').collect();
+        uff_fuzz::check(text.as_bytes());
+        for k in 0..lines.len() {
+            uff_fuzz::check(lines[..k].concat().as_bytes());
+            let without: String =
+                lines.iter().enumerate().filter(|&(i, _)| i != k).map(|(_, l)| *l).collect();
+            uff_fuzz::check(without.as_bytes());
+            let doubled: String = lines
+                .iter()
+                .enumerate()
+                .flat_map(|(i, l)| if i == k { vec![*l, *l] } else { vec![*l] })
+                .collect();
+            uff_fuzz::check(doubled.as_bytes());
+            count += 3;
+        }
+    }
+    assert!(count > 500, "too few inputs checked: {count}");
+}
