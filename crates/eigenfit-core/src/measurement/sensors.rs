@@ -290,8 +290,8 @@ fn build(
     Ok(set)
 }
 
-/// The measured modes of `file` at `sensors`: frequencies and shapes (value × sign, divided by
-/// the mode's largest value; a node a mode does not list counts as an error naming both). Modes keep the file's numbers when they
+/// The measured modes of `file` at `sensors`: frequencies and shapes (value × sign; a node a
+/// mode does not list counts as an error naming both). Modes keep the file's numbers when they
 /// are distinct and ≥ 1, else they are numbered 1, 2, … in file order (with a note).
 ///
 /// A mode that moves (almost) only in directions the model lacks — an x-plane mode of a rotor
@@ -371,9 +371,6 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<(Measurement, 
             ));
             continue;
         }
-        // Shapes are unit-free (MAC, unit-length residuals): scaled by their largest value, so
-        // 1e-300 units neither underflow to a zero shape nor 1e300 overflow its norm.
-        let shape = shape.into_iter().map(|v| v / scale).collect();
         modes.push((
             m.line,
             MeasuredMode {
