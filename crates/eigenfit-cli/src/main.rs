@@ -1,11 +1,12 @@
 //! `eigenfit`: finite-element model updating from the command line. The commands live in the
 //! library (`lib.rs`), which the Python package calls too.
 //!
-//! Exit codes: 0 success, 1 internal failure, 2 bad input (arguments, files, data),
-//! 3 an estimation that did not converge (its results are still printed).
+//! Exit codes: 0 an answer, 1 internal failure (or results that could not all be written to
+//! standard output), 2 bad input refused before any fitting (arguments, files, data), 3 no acceptable answer or the budget used up (its results are still printed).
 
 use clap::Parser;
 use eigenfit_cli::{error, Cli};
+use std::io::Write;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -31,10 +32,16 @@ fn quiet_panics() {
             .map(String::as_str)
             .or_else(|| info.payload().downcast_ref::<&str>().copied())
             .unwrap_or("unknown");
-        if msg.contains("Broken pipe") {
-            std::process::exit(i32::from(
-                error::EXIT_ON_CLOSED_PIPE.load(std::sync::atomic::Ordering::Relaxed),
-            ));
+        // Results that could not all be written (`eigenfit … | head -1`, a full disk under a
+        // redirect) are not an answer: the decided code if it is not 0, else 1.
+        if msg.contains("failed printing to stdout") || msg.contains("Broken pipe") {
+            let decided = error::EXIT_ON_CLOSED_PIPE.load(std::sync::atomic::Ordering::Relaxed);
+            let _ = writeln!(
+                std::io::stderr(),
+                "eigenfit: the results could not all be written to standard output ({})",
+                msg.trim_start_matches("failed printing to stdout: ")
+            );
+            std::process::exit(i32::from(decided.max(error::EXIT_FAILURE)));
         }
         eprintln!("eigenfit: internal error: {msg} (please report this with the input that caused it)");
         std::process::exit(i32::from(error::EXIT_FAILURE));

@@ -5,18 +5,62 @@ use clap::Args;
 use std::io::Write;
 use std::path::Path;
 
-/// Writes `bytes` to a temporary file beside `path`, syncs it, then renames it over `path`.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
-    let fail = |e: std::io::Error| input(format!("{}: cannot write: {e}", path.display()));
+/// The temporary file [`write_atomically`] writes before renaming it over `path`.
+fn temporary(path: &Path) -> Result<std::path::PathBuf, CliError> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let name = path.file_name().ok_or_else(|| input(format!("{}: not a file name", path.display())))?;
-    let tmp = dir.join(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
+    Ok(dir.join(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id())))
+}
+
+/// Writes `bytes` to a temporary file beside `path`, syncs it, then renames it over `path`; on
+/// any failure the temporary file is removed, so a full disk leaves neither half a file nor a
+/// `.tmp` behind.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
+    let fail = |e: std::io::Error| input(format!("{}: cannot write: {e}", path.display()));
+    let tmp = temporary(path)?;
     let mut f = std::fs::File::create(&tmp).map_err(fail)?;
-    f.write_all(bytes).and_then(|()| f.sync_all()).map_err(fail)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        fail(e)
-    })
+    let written = f.write_all(bytes).and_then(|()| f.sync_all());
+    drop(f);
+    match written.and_then(|()| std::fs::rename(&tmp, path)) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(fail(e))
+        }
+    }
+}
+
+/// Checks, before any work, that `path` can be written by [`write_atomically`] (`flag` names the
+/// option in the message): not a folder, and its folder takes a new file (probed by creating and
+/// removing the temporary file the write will use). Refused as bad input (exit code 2), so a fit
+/// never runs for an output it cannot save.
+pub fn check_writable(path: &Path, flag: &str) -> Result<(), CliError> {
+    if path.is_dir() {
+        return Err(input(format!("{flag} {}: is a folder, not a file", path.display())));
+    }
+    let tmp = temporary(path).map_err(|e| input(format!("{flag} {e}")))?;
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp) {
+        Ok(f) => {
+            drop(f);
+            let _ = std::fs::remove_file(&tmp);
+            Ok(())
+        }
+        Err(e) => Err(input(format!("{flag} {}: cannot write: {e}", path.display()))),
+    }
+}
+
+/// Checks, before any work, that plots can be written into `dir` (created if missing): a folder
+/// that takes a new file.
+pub fn check_writable_dir(dir: &Path, flag: &str) -> Result<(), CliError> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| input(format!("{flag} {}: cannot create: {e}", dir.display())))?;
+    check_writable(&dir.join("probe"), flag)
+}
+
+/// A write after the answer (an updated model, plots): on failure the message says what was lost
+/// and that the answer above stands; the command keeps its own exit code (issue 28).
+pub fn report_lost(what: &str, e: &CliError) {
+    eprintln!("eigenfit: {e}; {what} was not written (the results above stand)");
 }
 
 /// `--quiet` and `--json`, shared by every command that reports and may take a while.
@@ -89,10 +133,14 @@ pub(crate) fn capture_json<T>(f: impl FnOnce() -> T) -> (T, Option<serde_json::V
 
 /// A JSON-lines file that runs are appended to as they finish (`--stream`): opened for appending
 /// (a second run never deletes the first one's lines), held under an exclusive advisory lock for
-/// the whole run (two runs at once would interleave half lines), flushed line by line.
+/// the whole run (two runs at once would interleave half lines), one write per whole line. A line
+/// that fails part-way (a full disk) is cut off again, so the file only ever holds whole lines and
+/// the count reported is the count the file holds.
 pub struct Stream {
     path: std::path::PathBuf,
     file: std::fs::File,
+    /// Bytes of whole lines in the file.
+    length: u64,
     saved: usize,
     error: Option<std::io::Error>,
 }
@@ -100,6 +148,8 @@ pub struct Stream {
 impl Stream {
     /// Opens `path` for appending, creating it; refuses an existing path that is not a regular
     /// file (a FIFO would block, a device swallow or refuse the lines) and a file another run holds.
+    /// A torn last line left by an earlier run (killed, or a disk that filled) is cut off, with a
+    /// note, so the next line does not glue onto it.
     pub fn open(path: &Path) -> Result<Self, CliError> {
         match std::fs::metadata(path) {
             Ok(meta) if !meta.is_file() => {
@@ -108,6 +158,7 @@ impl Stream {
             _ => {}
         }
         let file = std::fs::OpenOptions::new()
+            .read(true)
             .append(true)
             .create(true)
             .open(path)
@@ -123,7 +174,19 @@ impl Stream {
             }
             Err(e) => return Err(input(format!("{}: cannot lock: {e}", path.display()))),
         }
-        Ok(Self { path: path.to_path_buf(), file, saved: 0, error: None })
+        let length =
+            whole_lines(&file).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
+        let size = file.metadata().map_err(|e| input(format!("{}: {e}", path.display())))?.len();
+        if length < size {
+            file.set_len(length)
+                .map_err(|e| input(format!("{}: cannot cut a torn line: {e}", path.display())))?;
+            eprintln!(
+                "eigenfit: note: {}: its last line was torn ({} bytes without a newline, an earlier run cut short): removed",
+                path.display(),
+                size - length
+            );
+        }
+        Ok(Self { path: path.to_path_buf(), file, length, saved: 0, error: None })
     }
 
     /// Appends one line; after the first failure nothing more is written (see [`Stream::finish`]).
@@ -131,33 +194,70 @@ impl Stream {
         if self.error.is_some() {
             return;
         }
-        // One write call per line, so a line is never split between two writers' bytes.
+        // One write call per whole line, so a line is never split between two writers' bytes.
         let mut bytes = Vec::with_capacity(line.len() + 1);
         bytes.extend_from_slice(line.as_bytes());
         bytes.push(b'\n');
-        match self.file.write_all(&bytes).and_then(|()| self.file.flush()) {
-            Ok(()) => self.saved += 1,
-            Err(e) => self.error = Some(e),
+        match self.file.write_all(&bytes) {
+            Ok(()) => {
+                self.saved += 1;
+                self.length += bytes.len() as u64;
+            }
+            Err(e) => {
+                // Part of the line may have reached the file: cut back to the last whole line.
+                if let Err(cut) = self.file.set_len(self.length) {
+                    self.error = Some(std::io::Error::new(
+                        e.kind(),
+                        format!("{e}, and the torn line could not be removed ({cut})"),
+                    ));
+                } else {
+                    self.error = Some(e);
+                }
+            }
         }
     }
 
-    /// Ok when every line was written; otherwise an error saying how many of `total` were saved.
-    pub fn finish(self, total: usize) -> Result<(), CliError> {
+    /// How many lines this run appended.
+    pub fn saved(&self) -> usize {
+        self.saved
+    }
+
+    /// None when every line was written and synced; otherwise what was lost, saying how many of
+    /// `total` runs the file holds. The command keeps its own exit code (its results are printed);
+    /// the caller prints this.
+    pub fn finish(self, total: usize) -> Option<String> {
         match self.error {
-            None => self.file.sync_all().map_err(|e| {
-                CliError::Failure(format!(
-                    "{}: cannot sync: {e}; {} of {total} runs written",
-                    self.path.display(),
-                    self.saved
-                ))
+            None => self.file.sync_all().err().map(|e| {
+                format!("{}: cannot sync: {e}; {} of {total} runs written", self.path.display(), self.saved)
             }),
-            Some(e) => Err(CliError::Failure(format!(
-                "{}: writing failed: {e}; {} of {total} runs were saved",
+            Some(e) => Some(format!(
+                "{}: writing failed: {e}; {} of {total} runs were saved (whole lines; the rest are lost)",
                 self.path.display(),
                 self.saved
-            ))),
+            )),
         }
     }
+}
+
+/// The length of `file` up to and including its last newline (0 for an empty file or one
+/// without any), read backwards in blocks.
+fn whole_lines(file: &std::fs::File) -> std::io::Result<u64> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = file;
+    let size = f.metadata()?.len();
+    let mut end = size;
+    let mut block = vec![0u8; 64 * 1024];
+    while end > 0 {
+        let start = end.saturating_sub(block.len() as u64);
+        let n = (end - start) as usize;
+        f.seek(SeekFrom::Start(start))?;
+        f.read_exact(&mut block[..n])?;
+        if let Some(i) = block[..n].iter().rposition(|&b| b == b'\n') {
+            return Ok(start + i as u64 + 1);
+        }
+        end = start;
+    }
+    Ok(0)
 }
 
 /// The base model's misfit test, one line (planar, matrices and ROSS rotors alike).

@@ -10,6 +10,7 @@ use crate::progress::Progress;
 use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDataOptions};
 use eigenfit_core::analysis::Joint;
 use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
+use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
 use eigenfit_core::update::{registry, Budget, Driver, Method};
 use eigenfit_rotor::campaign::Campaign;
@@ -126,6 +127,9 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     for conf in &campaign.configurations {
         let name = conf.name.clone().unwrap_or_default();
         crate::model::check_model_file(&conf.model).map_err(|e| input(format!("{name}: {e}")))?;
+        if let Some(e) = crate::model::other_kind(&conf.model, "a campaign") {
+            return Err(input(format!("{name}: {e}")));
+        }
         let rotor = Rotor::from_toml_file(&conf.model).map_err(|e| input(format!("{name}: {e}")))?;
         let options = TestDataOptions {
             shapes: conf.shapes.clone(),
@@ -135,6 +139,15 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         };
         let d = test_data::read(&conf.measured, Some(&rotor), &options)
             .map_err(|e| input(format!("{name}: {e}")))?;
+        // The check estimate makes, before anything is solved for that many modes.
+        if d.measurement.modes_needed() > rotor.dofs() {
+            return Err(input(format!(
+                "{name}: {}: mode {} measured but the model has only {} modes",
+                conf.measured.display(),
+                d.measurement.modes_needed(),
+                rotor.dofs()
+            )));
+        }
         file_notes.extend(d.file_notes.iter().cloned());
         let updatable = UpdatableRotor::new(rotor)
             .map(|r| Updatable::Rotor(Box::new(r)))

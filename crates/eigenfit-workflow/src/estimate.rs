@@ -11,7 +11,7 @@ use crate::overrides::{fixed, parameter_vector};
 use crate::posterior::{PosteriorReport, SamplingError};
 use crate::progress::{Progress, StepsObserver};
 use crate::rotordynamics::{self, RunupEstimateReport};
-use crate::simulate::check_roundoff;
+use crate::simulate::check_roundoff_of;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
@@ -333,7 +333,13 @@ pub fn run(
     let mut fit = Fit::new(problem, &data, options.shape.shape_std);
     let budget = Budget::new(request.budget);
     // Data no parameter value can produce is refused before any fitting.
-    check_reachable(&fit, &mode_numbers, &budget).map_err(|e| input(format!("{measured_name}: {e}")))?;
+    if let Err(e) = check_reachable(&fit, &mode_numbers, &budget) {
+        // A reach cut short by the budget says nothing about the data.
+        if budget.exhausted() {
+            return Ok(EstimateOutcome::BudgetExhaustedBeforeFit { limit: budget.limit() });
+        }
+        return Err(input(format!("{measured_name}: {e}")));
+    }
     // Running totals of evaluations after each phase, reported per phase.
     let mut phases: Vec<(&str, usize)> = vec![("reachability", budget.used())];
     // A sampler draws the posterior first; the fit (damped) then starts from its best sample.
@@ -442,7 +448,7 @@ pub fn run(
     // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
     let system = model.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
     if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
-        notes.extend(check_roundoff(&system, &modes)?);
+        notes.extend(check_roundoff_of(&system, &modes, Some(&mode_numbers))?);
     }
     let converged = estimate.termination.is_converged();
     let quality = judge(&estimate.last, np);
@@ -518,12 +524,12 @@ pub fn run(
         }
     };
     let held = model.held();
-    let report = EstimateReport {
+    let mut report = EstimateReport {
         model: label,
         strategy: posterior.as_ref().map_or(estimate.strategy, |(_, _, name)| name),
         outcome: Outcome::of(&estimate, converged),
         verdict,
-        fit: FitQualityReport::of(&quality, |k| mode_numbers[k]),
+        fit: FitQualityReport::of(&quality, |k| k),
         budget: BudgetReport { limit: budget.limit(), used: budget.used(), exhausted: budget_spent },
         evaluations_by_phase: phase_counts(&phases),
         values: ParameterValues::new(&names, &initial, &estimate.parameters, status),
@@ -547,6 +553,12 @@ pub fn run(
         test_data: ShapeReport::new(&fit, &data, &estimate, mac.as_ref(), scatter),
         fixed: (!held.is_empty()).then_some(Named(held)),
     };
+    // A residual row is a frequency or, with shapes, a sensor of a mode: named by its mode, once.
+    report.fit.disagreeing_modes = test_data::modes_of_rows(
+        &quality.disagreeing,
+        &mode_numbers,
+        data.sensors.as_ref().map_or(0, |s| s.sensors.len()),
+    );
     let updated_model =
         request.write_model.then(|| updated_model_toml(&request.measured, &model, &estimate, unc.as_ref()));
     let unit = any.parameters().iter().next().map_or(String::new(), |p| p.unit.clone());

@@ -131,6 +131,46 @@ pub fn is_matrices_file(path: &Path) -> bool {
         && std::fs::read_to_string(path).is_ok_and(|text| eigenfit_matrices::is_matrices_file(&text))
 }
 
+/// Why the file at `path`, about to be read as a planar rotor, is a model of another kind, or
+/// None: a top-level `kind = …` naming no kind eigenfit knows (a typo of `"matrices"`), a
+/// matrices model or a ROSS rotor where only a planar rotor is taken (`what` names the place).
+/// Said as such rather than as the rotor reader's "unknown field `kind`".
+pub fn other_kind(path: &Path, what: &str) -> Option<WorkflowError> {
+    let text = std::fs::read_to_string(path).ok()?;
+    if eigenfit_rotordynamics::ross_file::looks_like_ross(&text) {
+        return Some(input(format!(
+            "{}: a ROSS rotor file (two-plane, saved by ROSS), but {what} takes a planar rotor \
+             (docs/rotor-model.md); ROSS rotors are read by `simulate`, `estimate` and `campbell`",
+            path.display()
+        )));
+    }
+    if eigenfit_matrices::is_matrices_file(&text) {
+        return Some(input(format!(
+            "{}: a `kind = \"matrices\"` model, but {what} takes a planar rotor (docs/rotor-model.md)",
+            path.display()
+        )));
+    }
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        if t.starts_with('[') {
+            break;
+        }
+        let Some(rest) = ["kind", "\"kind\"", "'kind'"].iter().find_map(|k| t.strip_prefix(k)) else {
+            continue;
+        };
+        let Some(value) = rest.trim_start().strip_prefix('=') else { continue };
+        let value = value.split('#').next().unwrap_or_default().trim();
+        return Some(input(format!(
+            "{}: line {}: kind = {} is not a kind of model eigenfit knows: `kind = \"matrices\"` for K(p) \
+             from Matrix Market files (docs/matrices.md), or no `kind` for a planar rotor",
+            path.display(),
+            i + 1,
+            value.chars().take(40).collect::<String>()
+        )));
+    }
+    None
+}
+
 /// Loads a matrices model; every error is bad input naming the file.
 pub fn load_matrices(path: &Path) -> Result<MatricesModel, WorkflowError> {
     MatricesModel::from_toml_file(path).map_err(|e| input(e.to_string()))

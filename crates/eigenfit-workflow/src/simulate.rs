@@ -19,25 +19,112 @@ pub const MAX_SWEEP_POINTS: usize = 100_000;
 
 /// Never a frequency lost to round-off without a word (issue 13): a fine mesh or an extreme
 /// value whose lowest eigenvalue the matrices cannot resolve is refused, saying why; a level
-/// worth knowing about is returned as a note.
+/// worth knowing about is returned as a note. Every mode of `modes` is checked.
 pub fn check_roundoff(system: &System, modes: &Modes) -> Result<Option<String>, WorkflowError> {
+    check_roundoff_of(system, modes, None)
+}
+
+/// [`check_roundoff`] of the modes numbered `only` (from 1) when given: a fit checks the modes it
+/// pairs with measured ones, so a free–free model's rigid-body modes, which no measured mode
+/// pairs with, are no reason to refuse it.
+pub fn check_roundoff_of(
+    system: &System,
+    modes: &Modes,
+    only: Option<&[usize]>,
+) -> Result<Option<String>, WorkflowError> {
     let levels = relative_roundoff(system, modes);
-    match levels.iter().position(|&r| r.is_nan() || r > MAX_RELATIVE_ROUNDOFF) {
-        None => Ok(levels.iter().position(|&r| r > NOTE_RELATIVE_ROUNDOFF).map(|j| {
-            format!(
+    let checked = |j: &usize| only.is_none_or(|o| o.contains(&(j + 1)));
+    match (0..levels.len()).filter(checked).find(|&j| levels[j].is_nan() || levels[j] > MAX_RELATIVE_ROUNDOFF)
+    {
+        None => {
+            Ok((0..levels.len()).filter(checked).find(|&j| levels[j] > NOTE_RELATIVE_ROUNDOFF).map(|j| {
+                format!(
                 "mode {}: round-off may reach {:.1e} of its eigenvalue (a fine mesh or an extreme value); \
                  the trailing digits are not significant",
                 j + 1,
                 levels[j]
             )
-        })),
-        Some(j) => Err(input(format!(
-            "mode {} cannot be trusted: round-off in the matrices (ε·(‖K‖/λ + ‖M‖)·‖φ‖² ≈ {:.1e}) exceeds {MAX_RELATIVE_ROUNDOFF:e} \
-             of its eigenvalue; the mesh is too fine or a value too extreme for double precision (use fewer elements, \
-             or values closer to the rest of the model)",
-            j + 1,
-            levels[j]
-        ))),
+            }))
+        }
+        Some(j) => {
+            let lambda = modes.eigenvalues[j];
+            // An eigenvalue at or below zero is a rigid-body motion as likely as a lost digit.
+            let rigid = if lambda <= 0.0 || levels[j].is_infinite() {
+                format!(
+                    " — or mode {} is a rigid-body mode (λ = {} (rad/s)², zero to round-off): nothing holds \
+                     the model in that motion (a free–free structure, a rotor without bearings); give it \
+                     supports, or number measured modes from the first elastic one",
+                    j + 1,
+                    readable(lambda)
+                )
+            } else {
+                String::new()
+            };
+            Err(input(format!(
+                "mode {} cannot be trusted: round-off in the matrices (ε·(‖K‖/λ + ‖M‖)·‖φ‖² ≈ {:.1e}) exceeds {MAX_RELATIVE_ROUNDOFF:e} \
+                 of its eigenvalue; the mesh is too fine or a value too extreme for double precision (use fewer elements, \
+                 or values closer to the rest of the model){rigid}",
+                j + 1,
+                levels[j]
+            )))
+        }
+    }
+}
+
+/// How far below zero, in units of its round-off bound ε·(max|Kᵢⱼ| + |λ| max|Mᵢⱼ|)·‖φ‖², an
+/// eigenvalue must lie to be a divergent mode rather than a zero computed with round-off. A
+/// backward-stable solver moves an eigenvalue by up to ε‖K‖‖φ‖² (see `eigen::roundoff`); the
+/// margin absorbs the row count between the largest entry and the norm, so a rigid-body mode or
+/// an extreme value drowned in round-off (a support of 1e50 N·m/rad) is never called unstable.
+const UNSTABLE_MARGIN: f64 = 1e3;
+
+/// Refuses an unstable model: a negative eigenvalue beyond round-off means K(p) is not positive
+/// semi-definite, a divergent mode, not a vibration at 0 Hz (a rigid-body mode is zero to
+/// round-off). The message names the mode, its eigenvalue and the parameter values.
+pub fn check_stable(
+    model: &dyn StructuralModel,
+    system: &System,
+    modes: &Modes,
+    p: &[f64],
+) -> Result<(), WorkflowError> {
+    let (k_max, m_max) = system.amax();
+    for j in 0..modes.count() {
+        let lambda = modes.eigenvalues[j];
+        if lambda.is_nan() {
+            return Err(failure(format!("mode {}: the eigen-solver returned NaN", j + 1)));
+        }
+        if lambda >= 0.0 {
+            continue;
+        }
+        let phi2 = if modes.shapes.ncols() > j { modes.shapes.column(j).norm_squared() } else { 1.0 };
+        let bound = f64::EPSILON * (k_max + lambda.abs() * m_max) * phi2;
+        if -lambda > UNSTABLE_MARGIN * bound {
+            let values: Vec<String> = model
+                .parameters()
+                .iter()
+                .zip(p)
+                .map(|(q, v)| format!("{} = {}", q.name, readable(*v)))
+                .collect();
+            return Err(input(format!(
+                "the model is unstable at {}: mode {} has a negative eigenvalue λ = {} (rad/s)², \
+                 so K(p) is not positive semi-definite — a divergent mode, not a vibration (a \
+                 rigid-body mode is zero to round-off); no natural frequency exists there",
+                if values.is_empty() { "its nominal values".to_string() } else { values.join(", ") },
+                j + 1,
+                readable(lambda)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A number as a person reads it: the shortest text that reads back to it, in exponent form
+/// outside [1e-3, 1e6), so that `f64::MAX` is `1.7976931348623157e308`, not 309 digits.
+pub fn readable(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-3..1e6).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
     }
 }
 
@@ -51,6 +138,7 @@ pub fn frequencies(
 ) -> Result<Vec<f64>, WorkflowError> {
     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
     let m = solver.lowest(&system, modes).map_err(|e| solver_failure(&system, e))?;
+    check_stable(model, &system, &m, p)?;
     notes.extend(check_roundoff(&system, &m)?);
     Ok(m.frequencies_hz())
 }
@@ -204,8 +292,9 @@ pub fn at_point(
     let mut notes = Vec::new();
     let (f, sens) = match Sensitivities::compute(model, solver, p, modes) {
         Ok(s) => {
+            let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
+            check_stable(model, &system, &s.modes, p)?;
             if check == SweepCheck::RefuseRoundoff {
-                let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
                 notes.extend(check_roundoff(&system, &s.modes)?);
             }
             (s.modes.frequencies_hz(), Ok(s.frequencies_hz))
@@ -215,7 +304,9 @@ pub fn at_point(
                 SweepCheck::RefuseRoundoff => frequencies(model, solver, p, modes, &mut notes)?,
                 SweepCheck::None => {
                     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-                    solver.lowest(&system, modes).map_err(failure)?.frequencies_hz()
+                    let m = solver.lowest(&system, modes).map_err(failure)?;
+                    check_stable(model, &system, &m, p)?;
+                    m.frequencies_hz()
                 }
             };
             (f, Err(e.to_string()))

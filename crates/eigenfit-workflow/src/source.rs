@@ -84,6 +84,9 @@ impl ModelSource {
         }
         if let Some(path) = &self.model {
             model::check_model_file(path)?;
+            if let Some(e) = model::other_kind(path, "this command") {
+                return Err(e);
+            }
             let rotor = Rotor::from_toml_file(path).map_err(|e| match e {
                 // These already name the file (and the line where it could be placed).
                 RotorError::Io { .. }

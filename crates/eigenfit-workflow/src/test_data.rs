@@ -134,8 +134,13 @@ pub fn read(
         return Err(input("--shapes applies to a CSV --measured; a universal file carries its own shapes"));
     }
     let at = |e: String| input(format!("{}: {e}", path.display()));
-    let mut file = uff::parse(&read_text(path)?)
-        .map_err(|e| input(format!("{}:{}: {}", path.display(), e.line, e.message)))?;
+    let text = read_text(path)?;
+    let mut file =
+        uff::parse(&text).map_err(|e| input(format!("{}:{}: {}", path.display(), e.line, e.message)))?;
+    // Before tying nodes to the model: a file without modes is said to be one.
+    if file.modes.is_empty() {
+        return Err(at(no_modes(&text, &file)));
+    }
     let set = match &options.sensor_map {
         Some(map) => sensors::map_explicit(&file, rotor()?, &read_text(map)?)
             .map_err(|e| input(format!("{}: {e}", map.display())))?,
@@ -170,6 +175,26 @@ pub fn read(
         notes.push(format!("dataset {id} at line {line} skipped (not used by eigenfit)"));
     }
     Ok(TestData { measurement, sensors: Some(set), notes, file_notes: Vec::new() })
+}
+
+/// Why a universal file gives no measured mode, in words: empty, or which datasets it holds.
+fn no_modes(text: &str, file: &uff::UffFile) -> String {
+    if text.trim().is_empty() {
+        return "empty file: a universal file with one dataset 55 (data at nodes) per measured mode was expected"
+            .into();
+    }
+    let mut held: Vec<String> = Vec::new();
+    if !file.nodes.is_empty() {
+        held.push(format!("{} node coordinates", file.nodes.len()));
+    }
+    if file.length_factor.is_some() {
+        held.push("units (164)".into());
+    }
+    held.extend(file.skipped.iter().map(|(id, line)| format!("dataset {id} at line {line}")));
+    format!(
+        "no measured mode: the file has no dataset 55 (data at nodes, one per mode){}",
+        if held.is_empty() { String::new() } else { format!("; it holds {}", held.join(", ")) }
+    )
 }
 
 type RotorProblem<'a> = Problem<&'a Fixed<&'a Updatable<'a>>, &'a dyn EigenSolver>;
@@ -265,6 +290,23 @@ impl Objective for Fit<'_> {
             Fit::Shapes(s) => Objective::cost(s, p),
         }
     }
+}
+
+/// The measured modes (numbers from 1, `mode_numbers` in the data's order) that the residual
+/// rows `rows` belong to, each once, in the order of `rows`: the first `mode_numbers.len()` rows
+/// are the frequencies, then `sensors` shape rows per mode (a shape fit).
+pub fn modes_of_rows(rows: &[usize], mode_numbers: &[usize], sensors: usize) -> Vec<usize> {
+    let m = mode_numbers.len();
+    let mut out: Vec<usize> = Vec::new();
+    for &k in rows {
+        let index = if k < m { Some(k) } else { (k - m).checked_div(sensors) };
+        if let Some(&mode) = index.and_then(|i| mode_numbers.get(i)) {
+            if !out.contains(&mode) {
+                out.push(mode);
+            }
+        }
+    }
+    out
 }
 
 /// Measured mode number → model mode number, both from 1.

@@ -163,8 +163,11 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     });
-    // A write failure ends the command non-zero after the results are printed.
-    stream.map_or(Ok(()), |w| w.finish(report.runs.len()))?;
+    // A write failure after the results are printed says what was lost; the code stays the
+    // comparison's own.
+    if let Some(lost) = stream.and_then(|w| w.finish(report.runs.len())) {
+        eprintln!("eigenfit: {lost}");
+    }
     Ok(code)
 }
 

@@ -60,6 +60,13 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
         crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
         return Ok(code);
     }
+    // Every output is checked writable before the search.
+    if let Some(path) = &args.write_model {
+        crate::output::check_writable(path, "--write-model")?;
+    }
+    if let Some(dir) = &args.plot {
+        crate::output::check_writable_dir(dir, "--plot")?;
+    }
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
     let mut notes = Vec::new();
@@ -79,12 +86,18 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
     crate::error::set_exit_on_closed_pipe(code);
     if let Some(path) = &args.write_model {
         let text = discover::augmented_model_toml(&found, &model)?;
-        write_atomically(path, text.as_bytes())?;
-        report.written.push(path.display().to_string());
+        // A write that fails after the search says what was lost; the exit code stays its own.
+        match write_atomically(path, text.as_bytes()) {
+            Ok(()) => report.written.push(path.display().to_string()),
+            Err(e) => crate::output::report_lost("the augmented model", &e),
+        }
     }
     if let Some(dir) = &args.plot {
         let figure = DiscoveryPlot::from_report(&label, &found.report);
-        report.written.extend(plot::names(&plot::write(&figure, dir, "discovery")?));
+        match plot::write(&figure, dir, "discovery") {
+            Ok(w) => report.written.extend(plot::names(&w)),
+            Err(e) => crate::output::report_lost("the discovery plot", &e),
+        }
     }
     crate::output::report(args.report.json, &report, |report| {
         let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();

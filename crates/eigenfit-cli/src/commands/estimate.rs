@@ -112,6 +112,13 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
              Campbell diagram with `eigenfit campbell --plot DIR`",
         ));
     }
+    // Every output is checked writable before the fit: a fit never runs for nothing.
+    if let Some(path) = &args.test_data.write_model {
+        crate::output::check_writable(path, "--write-model")?;
+    }
+    if let Some(dir) = &args.plot {
+        crate::output::check_writable_dir(dir, "--plot")?;
+    }
     let mut notes = Vec::new();
     let outcome = estimate::run(&request(args), &mut notes, &mut Bars::new(args.report.quiet));
     print_notes(&notes);
@@ -138,6 +145,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         }
         EstimateOutcome::Done(est) => est,
     };
+    let code = if est.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
     let plots = match &args.plot {
         Some(dir) => {
             let r = &est.report;
@@ -150,15 +158,22 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 tolerance_hz: Some(0.01),
                 sigma_hz: est.sigma_max,
             };
-            let mut written = plot::write(&figure, dir, "convergence")?;
+            // A plot that fails after the fit is lost, said so; the fit's exit code stands.
+            let mut written = Vec::new();
+            match plot::write(&figure, dir, "convergence") {
+                Ok(w) => written.extend(w),
+                Err(e) => crate::output::report_lost("the convergence plot", &e),
+            }
             if let Some(m) = &est.mac {
-                written.extend(plot::write(&plot::mac_matrix::MacMatrix::new(&r.model, m), dir, "mac")?);
+                match plot::write(&plot::mac_matrix::MacMatrix::new(&r.model, m), dir, "mac") {
+                    Ok(w) => written.extend(w),
+                    Err(e) => crate::output::report_lost("the MAC plot", &e),
+                }
             }
             written
         }
         None => Vec::new(),
     };
-    let code = if est.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
     crate::error::set_exit_on_closed_pipe(code);
     est.report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
     crate::output::report(args.report.json, &est.report, |_| {
@@ -167,9 +182,10 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     });
     if let (Some(path), Some(text)) = (&args.test_data.write_model, est.updated_model.take()) {
-        crate::output::write_atomically(path, text?.as_bytes())?;
-        if !args.report.json {
-            println!("wrote {}", path.display());
+        match text.map_err(CliError::from).and_then(|t| crate::output::write_atomically(path, t.as_bytes())) {
+            Ok(()) if !args.report.json => println!("wrote {}", path.display()),
+            Ok(()) => {}
+            Err(e) => crate::output::report_lost("the updated model", &e),
         }
     }
     Ok(code)

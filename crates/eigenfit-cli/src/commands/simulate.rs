@@ -89,6 +89,7 @@ fn refuse_for_ross(args: &SimulateArgs) -> Result<(), CliError> {
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
+        // Outputs this path does not write are refused, never silently dropped.
         refuse_for_ross(args)?;
         let report =
             eigenfit_workflow::rotordynamics::simulate_with(path, args.speed, args.modes, &args.sets)?;
@@ -100,6 +101,13 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
     if args.speed.is_some() {
         return Err(input("--speed applies to two-plane rotors (files saved by ROSS); this model is planar"));
+    }
+    // Every output is checked writable before any work.
+    if let Some(path) = &args.uff {
+        crate::output::check_writable(path, "--uff")?;
+    }
+    if let Some(dir) = &args.plot {
+        crate::output::check_writable_dir(dir, "--plot")?;
     }
     let (model, label) = args.model.load_any()?;
     let mut rotor = match model {
@@ -198,6 +206,8 @@ fn simulate_matrices(
         (!args.effects.is_empty(), "--effect"),
         (args.sweep.is_some(), "--sweep"),
         (args.plot.is_some(), "--plot"),
+        // A universal file carries node coordinates, which a matrices model does not have.
+        (args.uff.is_some(), "--uff"),
     ] {
         if given {
             return Err(input(format!(

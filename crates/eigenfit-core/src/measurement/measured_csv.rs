@@ -306,40 +306,11 @@ impl LineCounter<'_> {
 }
 
 /// Natural frequencies increase with mode number (the model's modes are sorted): a row that
-/// breaks the order is a swapped row or a typing slip, and no stiffness can fit it.
+/// breaks the order is a swapped row or a typing slip, and no stiffness can fit it. The same
+/// check as every other measured-data reader's ([`super::check_frequency_order`]).
 fn check_order(modes: &[(usize, MeasuredMode)]) -> Result<(), CsvError> {
-    let mut sorted: Vec<&(usize, MeasuredMode)> = modes.iter().collect();
-    sorted.sort_by_key(|(_, m)| m.mode);
-    for pair in sorted.windows(2) {
-        let ((l0, a), (l1, b)) = (pair[0], pair[1]);
-        let later = l0.max(l1);
-        if b.frequency_hz == a.frequency_hz {
-            return Err(at(
-                *later,
-                format!(
-                    "mode {} has the same frequency as mode {} ({} Hz, lines {l0} and {l1}): \
-                 the model's modes are distinct, so the two cannot both be paired",
-                    b.mode + 1,
-                    a.mode + 1,
-                    a.frequency_hz
-                ),
-            ));
-        }
-        if b.frequency_hz < a.frequency_hz {
-            return Err(at(
-                *later,
-                format!(
-                    "mode {} ({} Hz, line {l1}) is below mode {} ({} Hz, line {l0}): natural \
-                 frequencies increase with mode number (a swapped row or a typing slip?)",
-                    b.mode + 1,
-                    b.frequency_hz,
-                    a.mode + 1,
-                    a.frequency_hz
-                ),
-            ));
-        }
-    }
-    Ok(())
+    let lines: Vec<(usize, &MeasuredMode)> = modes.iter().map(|(l, m)| (*l, m)).collect();
+    super::check_frequency_order(&lines).map_err(|e| at(e.line, e.message))
 }
 
 #[cfg(test)]

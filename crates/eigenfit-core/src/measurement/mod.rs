@@ -143,6 +143,57 @@ impl Measurement {
     }
 }
 
+/// A measured mode's order breaks what any model can produce; `line` is where the later of the
+/// two modes was read.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("{message}")]
+pub struct OrderError {
+    /// The line (of whatever file the modes came from) the message is about.
+    pub line: usize,
+    /// What is wrong, naming both modes and both lines.
+    pub message: String,
+}
+
+/// The check every measured-data reader makes before any fit, whatever the file format (the
+/// frequency CSV, universal files, each configuration of a campaign): the model's modes are
+/// distinct and sorted, so two measured modes at the same frequency cannot both be paired, and a
+/// frequency below a lower-numbered mode's is a swapped row or a typing slip. `modes` are the
+/// modes with the line each was read from.
+pub fn check_frequency_order(modes: &[(usize, &MeasuredMode)]) -> Result<(), OrderError> {
+    let mut sorted: Vec<&(usize, &MeasuredMode)> = modes.iter().collect();
+    sorted.sort_by_key(|(_, m)| m.mode);
+    for pair in sorted.windows(2) {
+        let (&(l0, a), &(l1, b)) = (pair[0], pair[1]);
+        let later = l0.max(l1);
+        if b.frequency_hz == a.frequency_hz {
+            return Err(OrderError {
+                line: later,
+                message: format!(
+                    "mode {} has the same frequency as mode {} ({} Hz, lines {l0} and {l1}): \
+                     the model's modes are distinct, so the two cannot both be paired",
+                    b.mode + 1,
+                    a.mode + 1,
+                    a.frequency_hz
+                ),
+            });
+        }
+        if b.frequency_hz < a.frequency_hz {
+            return Err(OrderError {
+                line: later,
+                message: format!(
+                    "mode {} ({} Hz, line {l1}) is below mode {} ({} Hz, line {l0}): natural \
+                     frequencies increase with mode number (a swapped row or a typing slip?)",
+                    b.mode + 1,
+                    b.frequency_hz,
+                    a.mode + 1,
+                    a.frequency_hz
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

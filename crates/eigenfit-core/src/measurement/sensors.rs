@@ -292,14 +292,35 @@ fn build(
 
 /// The measured modes of `file` at `sensors`: frequencies and shapes (value × sign; a node a
 /// mode does not list counts as an error naming both). Modes keep the file's numbers when they
-/// are distinct and ≥ 1, else they are numbered 1, 2, … in file order.
+/// are distinct and ≥ 1, else they are numbered 1, 2, … in file order (with a note).
 ///
 /// A mode that moves (almost) only in directions the model lacks — an x-plane mode of a rotor
 /// exported from a 3-D model, for the planar rotor — is left out, with a note (the second
 /// value): its motion at the sensors is below 1e-3 of its motion overall.
+///
+/// The modes pass the checks every measured-data reader makes (see
+/// [`check_frequency_order`](super::check_frequency_order)): a dataset repeated verbatim, two
+/// modes at the same frequency, a frequency below a lower-numbered mode's and a shape that is
+/// zero at every node are refused, naming the datasets' lines.
 pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<(Measurement, Vec<String>), SensorError> {
     if file.modes.is_empty() {
-        return Err(SensorError::Measurement("the file has no mode (dataset 55)".into()));
+        return Err(SensorError::Measurement(
+            "the file has no mode: no dataset 55 (data at nodes), which holds one measured mode each".into(),
+        ));
+    }
+    // A dataset repeated verbatim (an export run twice into one file) is named as such.
+    let mut first: HashMap<(i64, u64), usize> = HashMap::new();
+    for (k, m) in file.modes.iter().enumerate() {
+        if let Some(&j) = first.get(&(m.number, m.frequency_hz.to_bits())) {
+            if file.modes[j].values == m.values {
+                return Err(SensorError::Measurement(format!(
+                    "dataset 55 at line {} repeats the one at line {} (mode {}, {} Hz) verbatim: \
+                     each measured mode once",
+                    m.line, file.modes[j].line, m.number, m.frequency_hz
+                )));
+            }
+        }
+        first.entry((m.number, m.frequency_hz.to_bits())).or_insert(k);
     }
     let mut numbers: Vec<i64> = file.modes.iter().map(|m| m.number).collect();
     let distinct = {
@@ -308,11 +329,15 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<(Measurement, 
         s.dedup();
         s.len() == numbers.len() && s[0] >= 1
     };
+    let mut notes = Vec::new();
     if !distinct {
         numbers = (1..=file.modes.len() as i64).collect();
+        notes.push(
+            "the mode numbers of the datasets 55 are not distinct numbers ≥ 1: modes numbered 1, 2, … in file order"
+                .to_string(),
+        );
     }
     let mut modes = Vec::with_capacity(file.modes.len());
-    let mut notes = Vec::new();
     for (m, &number) in file.modes.iter().zip(&numbers) {
         let shape = sensors
             .sensors
@@ -328,11 +353,14 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<(Measurement, 
                 })
             })
             .collect::<Result<Vec<f64>, _>>()?;
-        let at_sensors: f64 = shape.iter().map(|v| v * v).sum();
-        let overall: f64 = m.values.iter().flat_map(|(_, v)| v.iter()).map(|v| v * v).sum();
-        if overall == 0.0 {
+        // Squares of values scaled by the largest, so tiny units (1e-200) neither underflow nor
+        // make a moving mode look still.
+        let scale = m.values.iter().flat_map(|(_, v)| v.iter()).fold(0.0_f64, |a, v| a.max(v.abs()));
+        let at_sensors: f64 = shape.iter().map(|v| (v / scale).powi(2)).sum();
+        let overall: f64 = m.values.iter().flat_map(|(_, v)| v.iter()).map(|v| (v / scale).powi(2)).sum();
+        if scale == 0.0 {
             return Err(SensorError::Measurement(format!(
-                "mode {} (dataset 55 at line {}) is zero at every node",
+                "mode {} (dataset 55 at line {}) is zero at every node: a mode shape moves somewhere",
                 m.number, m.line
             )));
         }
@@ -343,17 +371,24 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<(Measurement, 
             ));
             continue;
         }
-        modes.push(MeasuredMode {
-            mode: (number - 1) as usize,
-            frequency_hz: m.frequency_hz,
-            std_hz: None,
-            shape: Some(shape),
-        });
+        modes.push((
+            m.line,
+            MeasuredMode {
+                mode: (number - 1) as usize,
+                frequency_hz: m.frequency_hz,
+                std_hz: None,
+                shape: Some(shape),
+            },
+        ));
     }
     if modes.is_empty() {
         return Err(SensorError::Measurement("no mode moves in a direction the model has".into()));
     }
-    Ok((Measurement::new(modes).map_err(|e| SensorError::Measurement(e.to_string()))?, notes))
+    let lines: Vec<(usize, &MeasuredMode)> = modes.iter().map(|(l, m)| (*l, m)).collect();
+    super::check_frequency_order(&lines).map_err(|e| SensorError::Measurement(e.message))?;
+    let measurement = Measurement::new(modes.into_iter().map(|(_, m)| m).collect())
+        .map_err(|e| SensorError::Measurement(e.to_string()))?;
+    Ok((measurement, notes))
 }
 
 /// Adds measured shapes from CSV text to frequency data: header `mode,node,direction,value`,

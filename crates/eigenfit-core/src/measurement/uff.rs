@@ -385,8 +385,8 @@ pub fn write(title: &str, nodes: &[UffNode], modes: &[UffMode]) -> String {
         let [x, y, z] = n.coordinates;
         let _ = writeln!(
             s,
-            "{:>10}{:>10}{:>10}{:>10}{:>13}{:>13}{:>13}",
-            n.label,
+            "{}{:>10}{:>10}{:>10}{:>13}{:>13}{:>13}",
+            i10(n.label),
             0,
             0,
             11,
@@ -405,7 +405,7 @@ pub fn write(title: &str, nodes: &[UffNode], modes: &[UffMode]) -> String {
         }
         let per_node = m.values.iter().map(|(_, v)| v.len()).max().unwrap_or(6).max(1);
         let _ = writeln!(s, "{:>10}{:>10}{:>10}{:>10}{:>10}{:>10}", 1, 2, 3, 8, 2, 6.max(per_node));
-        let _ = writeln!(s, "{:>10}{:>10}{:>10}{:>10}", 2, 4, 1, m.number);
+        let _ = writeln!(s, "{:>10}{:>10}{:>10}{}", 2, 4, 1, i10(m.number));
         let _ = writeln!(
             s,
             "{:>13}{:>13}{:>13}{:>13}",
@@ -415,7 +415,7 @@ pub fn write(title: &str, nodes: &[UffNode], modes: &[UffMode]) -> String {
             e13(0.0)
         );
         for (node, v) in &m.values {
-            let _ = writeln!(s, "{node:>10}");
+            let _ = writeln!(s, "{}", i10(*node));
             let line: String =
                 (0..6).map(|i| format!("{:>13}", e13(v.get(i).copied().unwrap_or(0.0)))).collect();
             let _ = writeln!(s, "{line}");
@@ -423,6 +423,18 @@ pub fn write(title: &str, nodes: &[UffNode], modes: &[UffMode]) -> String {
         let _ = writeln!(s, "{:>6}", -1);
     }
     s
+}
+
+/// An integer in the standard's I10 field; one too wide for it keeps a space before it, so the
+/// reader (whitespace-separated tokens) never glues it to the field before (a mode number of 12
+/// digits read back as part of another).
+fn i10(v: i64) -> String {
+    let t = format!("{v:>10}");
+    if t.starts_with(' ') {
+        t
+    } else {
+        format!(" {v}")
+    }
 }
 
 /// `%13.5E`-like with 6 significant digits kept (the standard's E13.5), as `1.23456E+02`.
@@ -464,6 +476,25 @@ mod tests {
         assert_eq!(back.modes[0].values, modes[0].values);
         assert_eq!(back.modes[0].frequency_hz, 12.5);
         assert!(back.skipped.is_empty() && back.warnings.is_empty());
+    }
+
+    #[test]
+    fn wide_labels_and_mode_numbers_read_back() {
+        let nodes = vec![UffNode { label: 12_345_678_901, coordinates: [0.0, 0.0, 0.0] }];
+        let modes = vec![UffMode {
+            number: 999_999_999_999,
+            frequency_hz: 321.841,
+            modal_mass: 0.0,
+            damping_ratio: 0.0,
+            values: vec![(12_345_678_901, vec![0.0, 1.0, 0.0])],
+            complex: false,
+            realness: 1.0,
+            line: 0,
+        }];
+        let back = parse(&write("wide", &nodes, &modes)).unwrap();
+        assert_eq!(back.nodes, nodes);
+        assert_eq!(back.modes[0].number, 999_999_999_999);
+        assert_eq!(back.modes[0].values[0].0, 12_345_678_901);
     }
 
     #[test]

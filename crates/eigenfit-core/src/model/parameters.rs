@@ -132,13 +132,13 @@ pub enum ParameterError {
     #[error("parameter {0} has an empty name")]
     EmptyName(usize),
     /// Bounds are NaN or reversed, or a log parameter allows values ≤ 0.
-    #[error("parameter `{name}`: bounds [{lower}, {upper}] are invalid ({why})")]
+    #[error("parameter `{name}`: bounds [{}, {}] are invalid ({why})", shown(*lower), shown(*upper))]
     BadBounds { name: String, lower: f64, upper: f64, why: &'static str },
     /// A value is NaN or infinite.
-    #[error("parameter `{name}` = {value}: must be finite")]
+    #[error("parameter `{name}` = {}: must be finite", shown(*value))]
     NonFinite { name: String, value: f64 },
     /// A value lies outside its bounds.
-    #[error("parameter `{name}` = {value} lies outside its bounds [{lower}, {upper}]")]
+    #[error("parameter `{name}` = {} lies outside its bounds [{}, {}]", shown(*value), shown(*lower), shown(*upper))]
     OutOfBounds { name: String, value: f64, lower: f64, upper: f64 },
     /// A parameter vector has the wrong length.
     #[error("expected {expected} parameter values, got {got}")]
@@ -146,6 +146,17 @@ pub enum ParameterError {
     /// No parameter has this name.
     #[error("no parameter named `{0}`")]
     UnknownName(String),
+}
+
+/// A bound or value as a person reads it: exponent form where plain digits would run to hundreds
+/// (a log-scale parameter's default lower bound, `f64::MIN_POSITIVE`, is `2.2250738585072014e-308`).
+fn shown(v: f64) -> String {
+    // Plain within [1e-6, 1e16), the range of every documented bound (1e-6 … 1e15 N/m).
+    if v.is_finite() && v != 0.0 && !(1e-6..1e16).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
 }
 
 /// An ordered, validated list of parameters (validated once at construction, then trusted).

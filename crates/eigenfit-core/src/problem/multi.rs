@@ -30,14 +30,17 @@ impl Objective for Stacked<'_> {
     }
 }
 
-/// One linearisation holding the rows of all of `parts`, in order.
+/// One linearisation holding the rows of all of `parts`, in order. Each field is stacked to its
+/// own length: with shapes a part has more residual rows (a frequency and the sensors of every
+/// mode) than eigenvalues (one per mode), so one row count for all would not fit.
 pub fn stack(p: &[f64], parts: &[Linearisation]) -> Linearisation {
-    let rows: usize = parts.iter().map(|l| l.residual.len()).sum();
     let np = p.len();
     let vec = |f: &dyn Fn(&Linearisation) -> &DVector<f64>| {
+        let rows: usize = parts.iter().map(|l| f(l).len()).sum();
         DVector::from_iterator(rows, parts.iter().flat_map(|l| f(l).iter().copied()))
     };
     let mat = |f: &dyn Fn(&Linearisation) -> &DMatrix<f64>| {
+        let rows: usize = parts.iter().map(|l| f(l).nrows()).sum();
         let mut m = DMatrix::zeros(rows, np);
         let mut r = 0;
         for l in parts {

@@ -126,6 +126,25 @@ pub fn newton_point(
     Ok(current.parameters.iter().zip(dk.iter()).map(|(k, d)| k + d).collect())
 }
 
+/// Relative convergence of the paper's strategies: a frequency counts as matched when it is
+/// within this fraction of the measured one (the paper's 0.01 Hz at 100 Hz), whatever the units
+/// or the scale of the structure — a model whose modes lie near 6e-4 Hz is not "converged" at the
+/// start because every difference is below an absolute 0.01 Hz.
+pub const RELATIVE_FREQUENCY_TOLERANCE: f64 = 1e-4;
+
+/// True when every paired frequency of the square system (as many modes as parameters) is within
+/// `tolerance_hz` of its measured value and within [`RELATIVE_FREQUENCY_TOLERANCE`] of it: the
+/// absolute tolerance keeps the paper's behaviour, the relative one makes the test scale-free.
+pub(crate) fn square_converged(lin: &Linearisation, tolerance_hz: f64) -> bool {
+    let n = lin.parameters.len().min(lin.frequencies_hz.len());
+    lin.frequencies_hz[..n].iter().zip(&lin.measured_hz[..n]).all(|(f, m)| within(*f, *m, tolerance_hz))
+}
+
+/// |f − target| below both `tolerance_hz` and [`RELATIVE_FREQUENCY_TOLERANCE`]·|target|.
+pub(crate) fn within(f: f64, target: f64, tolerance_hz: f64) -> bool {
+    (f - target).abs() < tolerance_hz.min(RELATIVE_FREQUENCY_TOLERANCE * target.abs())
+}
+
 /// Largest |f_model − f_measured| (Hz) over the first N modes, N = number of parameters: the
 /// paper's stopping test for its square system.
 pub fn square_max_diff_hz(lin: &Linearisation) -> f64 {

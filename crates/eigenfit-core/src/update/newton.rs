@@ -2,7 +2,7 @@
 
 use super::settings::{Guard, SettingsError};
 use super::{
-    evaluate_or_diverge, newton_point, square_max_diff_hz, Step, StepStatus, UpdateError, UpdateStrategy,
+    evaluate_or_diverge, newton_point, square_converged, Step, StepStatus, UpdateError, UpdateStrategy,
 };
 use crate::problem::{Linearisation, Objective};
 
@@ -21,8 +21,9 @@ impl Default for Newton {
 }
 
 impl Newton {
-    /// Converged when every |f_model − f_measured| is below `tolerance_hz` (the paper: 0.01 Hz);
-    /// refused unless a finite number greater than zero.
+    /// Converged when every |f_model − f_measured| is below `tolerance_hz` (the paper: 0.01 Hz)
+    /// and below [`RELATIVE_FREQUENCY_TOLERANCE`](super::RELATIVE_FREQUENCY_TOLERANCE) of
+    /// f_measured (scale-free); refused unless a finite number greater than zero.
     pub fn new(tolerance_hz: f64) -> Result<Self, SettingsError> {
         Guard("Newton").positive("tolerance_hz", tolerance_hz)?;
         Ok(Self { tolerance_hz })
@@ -44,7 +45,7 @@ impl UpdateStrategy for Newton {
     }
 
     fn converged(&self, lin: &Linearisation) -> bool {
-        square_max_diff_hz(lin) < self.tolerance_hz
+        square_converged(lin, self.tolerance_hz)
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {

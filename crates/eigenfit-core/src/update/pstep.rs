@@ -2,7 +2,8 @@
 
 use super::settings::{Guard, SettingsError};
 use super::{
-    evaluate_or_diverge, newton_point, square_max_diff_hz, Step, StepStatus, UpdateError, UpdateStrategy,
+    evaluate_or_diverge, newton_point, square_converged, square_max_diff_hz, within as frequency_within,
+    Step, StepStatus, UpdateError, UpdateStrategy,
 };
 use crate::problem::{Linearisation, Objective};
 use crate::units::eigenvalue_to_hz;
@@ -15,7 +16,8 @@ use nalgebra::DVector;
 /// The paper does not state its tol2 and p; the defaults here (5 Hz, 5 parts) are ours.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PStep {
-    /// tol1: convergence of each stage and of the whole, Hz (the paper: 0.01 Hz).
+    /// tol1: convergence of each stage and of the whole, Hz (the paper: 0.01 Hz), together with
+    /// the relative [`RELATIVE_FREQUENCY_TOLERANCE`](super::RELATIVE_FREQUENCY_TOLERANCE).
     tolerance_hz: f64,
     /// tol2: split when the largest starting difference exceeds this, Hz.
     split_above_hz: f64,
@@ -69,7 +71,7 @@ impl PStep {
             .iter()
             .zip(target.iter())
             .take(lin.parameters.len())
-            .all(|(f, &l)| (f - eigenvalue_to_hz(l)).abs() < self.tolerance_hz)
+            .all(|(f, &l)| frequency_within(*f, eigenvalue_to_hz(l), self.tolerance_hz))
     }
 }
 
@@ -87,7 +89,7 @@ impl UpdateStrategy for PStep {
     }
 
     fn converged(&self, lin: &Linearisation) -> bool {
-        square_max_diff_hz(lin) < self.tolerance_hz
+        square_converged(lin, self.tolerance_hz)
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {

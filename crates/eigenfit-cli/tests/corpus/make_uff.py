@@ -1,0 +1,36 @@
+#!/usr/bin/env python3
+"""Derives the corpus's broken universal files from tests/data/uff/symmetric_rotor.unv (an
+independent pyuff export, see tests/data/uff/generate.py): each one a single edit a test system or
+a hand edit could make. Run from this folder: python3 make_uff.py"""
+from pathlib import Path
+
+src = Path("../../../../tests/data/uff/symmetric_rotor.unv").read_text().splitlines(keepends=True)
+# Lines 1-21: units and nodes; then one dataset 55 per mode, each from its opening `-1`.
+head, m1, m2, m3 = src[:21], src[21:42], src[42:63], src[63:84]
+
+def mode(block, freq=None, zero=False):
+    out = list(block)
+    if freq is not None:
+        out[9] = out[9].replace("3.77460e+01", freq).replace("8.13242e+01", freq)
+    if zero:
+        for i in range(11, len(out) - 1, 2):
+            out[i] = "  0.00000e+00  0.00000e+00  0.00000e+00\n"
+    return out
+
+def write(name, lines):
+    Path(name).write_text("".join(lines))
+
+# Mode 2 at mode 1's frequency.
+write("uff_same_frequency.unv", head + m1 + mode(m2, freq="3.77460e+01") + m3)
+# Mode 2's shape zero at every node.
+write("uff_zero_shape.unv", head + m1 + mode(m2, zero=True) + m3)
+# Mode 1's dataset twice, verbatim.
+write("uff_repeated_dataset.unv", head + m1 + m1 + m2 + m3)
+# No dataset 55: units and nodes only.
+write("uff_no_modes.unv", head)
+# Empty file.
+write("uff_empty.unv", [])
+# Only blank lines.
+write("uff_blank.unv", ["\n", "   \n"])
+# Mode 3 numbered 999999999999 (record 7 of its dataset 55).
+write("uff_huge_mode_number.unv", head + m1 + m2 + m3[:8] + ["         2         4         1 999999999999\n"] + m3[9:])
