@@ -478,14 +478,7 @@ pub fn run(
             alternatives.push(o);
         }
     }
-    let equivalence = Equivalence::at(&estimate.last, np);
-    let alternatives_sigma = if has_std {
-        "std"
-    } else if equivalence.sigma_estimated() {
-        "residuals"
-    } else {
-        "exact"
-    };
+    let alternatives_sigma = Equivalence::at(&estimate.last, np).sigma_source();
     let unique = !alternatives.iter().any(|a| a.judged.equally_good);
     let budget_spent = budget.exhausted();
     let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();

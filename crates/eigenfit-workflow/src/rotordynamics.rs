@@ -458,14 +458,7 @@ pub fn estimate_with(
     let uncertainty = if converged { uncertainty_within(&objective, lin, has_std, &budget) } else { None };
     phases.push(("intervals", budget.used()));
     let quality = judge(lin, np);
-    let equivalence = Equivalence::at(lin, np);
-    let alternatives_sigma = if has_std {
-        "std"
-    } else if equivalence.sigma_estimated() {
-        "residuals"
-    } else {
-        "exact"
-    };
+    let alternatives_sigma = Equivalence::at(lin, np).sigma_source();
     let unique = !mirrors.symmetric.iter().any(|m| m.judged.equally_good);
     let budget_spent = budget.exhausted();
     let verdict = Verdict::of(

@@ -88,6 +88,16 @@ impl Equivalence {
         !self.weighted && self.sigma2.is_some()
     }
 
+    /// Where σ came from, as the reports say it: `std` (given), `residuals` (estimated from the
+    /// estimate's residuals) or `exact` (neither: only a fit at least as good is equal).
+    pub fn sigma_source(&self) -> &'static str {
+        match (self.weighted, self.sigma2.is_some()) {
+            (true, _) => "std",
+            (false, true) => "residuals",
+            (false, false) => "exact",
+        }
+    }
+
     /// Δχ² below which a point is equally good.
     pub fn threshold(&self) -> f64 {
         self.threshold

@@ -47,13 +47,7 @@ impl UpdateStrategy for GaussNewtonLineSearch {
     }
 
     fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
-        if initial.residual.len() < problem.parameters().len() {
-            return Err(UpdateError::Setup(format!(
-                "Gauss–Newton needs at least as many residuals as parameters: {} for {}",
-                initial.residual.len(),
-                problem.parameters().len()
-            )));
-        }
+        super::require_enough_residuals("Gauss–Newton", problem, initial)?;
         self.recent_cost = initial.cost();
         self.stuck_for = 0;
         Ok(())

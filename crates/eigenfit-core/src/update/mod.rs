@@ -155,6 +155,23 @@ pub fn square_max_diff_hz(lin: &Linearisation) -> f64 {
         .fold(0.0, |m, (a, b)| f64::max(m, (a - b).abs()))
 }
 
+/// Refuses a start with fewer residuals than parameters, naming the strategy (`who`): a
+/// least-squares step needs at least as many rows as unknowns.
+pub fn require_enough_residuals(
+    who: &str,
+    problem: &dyn Objective,
+    initial: &Linearisation,
+) -> Result<(), UpdateError> {
+    if initial.residual.len() < problem.parameters().len() {
+        return Err(UpdateError::Setup(format!(
+            "{who} needs at least as many residuals as parameters: {} for {}",
+            initial.residual.len(),
+            problem.parameters().len()
+        )));
+    }
+    Ok(())
+}
+
 /// Linearises at `p`, turning a point outside the bounds or a failed model into `Diverged`.
 pub fn evaluate_or_diverge(problem: &dyn Objective, p: &[f64]) -> Result<Linearisation, UpdateError> {
     problem.parameters().check(p).map_err(|e| UpdateError::Diverged(e.to_string()))?;

@@ -119,13 +119,7 @@ impl UpdateStrategy for TrustRegionReflective {
     }
 
     fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
-        if initial.residual.len() < problem.parameters().len() {
-            return Err(UpdateError::Setup(format!(
-                "trust-region reflective needs at least as many residuals as parameters: {} for {}",
-                initial.residual.len(),
-                problem.parameters().len()
-            )));
-        }
+        super::require_enough_residuals("trust-region reflective", problem, initial)?;
         self.radius = self.max_step;
         Ok(())
     }
