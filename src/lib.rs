@@ -2,8 +2,11 @@
 //!
 //! Finite-element model updating by eigenvalue sensitivity. This facade re-exports the crates
 //! as modules — [`core`] (models, eigen-solvers, sensitivities, estimation, in layers),
-//! [`rotor`] (the rotor plugin) and, with the `lapack` feature, [`lapack`] (the LAPACK
+//! [`rotor`] (the planar rotor plugin), and behind features (on by default): `matrices` (models
+//! from any FE tool's matrices), `rotordynamics` (two-plane rotors at speed, ROSS files) and
+//! `workflow` (the jobs as library calls); with the `lapack` feature, `lapack` (the LAPACK
 //! eigen-solver backend) — plus a [`prelude`] and the matching [`nalgebra`].
+//! `default-features = false` is the lean library: core and the planar rotor.
 //!
 //! ```
 //! use eigenfit::nalgebra::DMatrix;
@@ -19,8 +22,13 @@ pub use eigenfit_core as core;
 pub use eigenfit_core::nalgebra;
 #[cfg(feature = "lapack")]
 pub use eigenfit_lapack as lapack;
+#[cfg(feature = "matrices")]
+pub use eigenfit_matrices as matrices;
 pub use eigenfit_rotor as rotor;
-/// Whole jobs (simulate, estimate, compare, discover, campbell, campaign) with serde reports.
+#[cfg(feature = "rotordynamics")]
+pub use eigenfit_rotordynamics as rotordynamics;
+/// Whole jobs (simulate, estimate, compare, discover, campbell, campaign, bench) with serde reports.
+#[cfg(feature = "workflow")]
 pub use eigenfit_workflow as workflow;
 
 /// The items most programs need: the core prelude and the rotor model.

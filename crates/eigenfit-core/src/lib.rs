@@ -28,6 +28,8 @@
 //! ```
 
 pub mod units;
+// Finite-difference references for plugins' derivative tests (uses nothing of core).
+pub mod testing;
 
 pub mod matrix;
 

@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 /// from all of them, so it sits on top.
 const CORE_LAYERS: &[&str] = &[
     "units",
+    "testing",
     "matrix",
     "model",
     "eigen",

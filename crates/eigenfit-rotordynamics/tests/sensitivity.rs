@@ -2,6 +2,7 @@
 //! anisotropic and cross-coupled damped bearings, and at Ω = 0 on an isotropic rotor where the
 //! forward/backward pairs coincide.
 
+use eigenfit_core::testing::ridders;
 use eigenfit_rotordynamics::elements::{Bearing, Disk, Material, ShaftElement, ShearMethod};
 use eigenfit_rotordynamics::identify::{
     bearing_parameters, evaluate, stiffness_parameters, Parameter, RunupPoint, COEFFICIENT_NAMES,
@@ -58,42 +59,6 @@ fn rotor(k: [f64; 4], d: [f64; 4], k2: [f64; 4]) -> Rotor {
 fn check(rotor: &Rotor, rpm: f64, modes: usize, one_sided: bool) -> f64 {
     let difference = if one_sided { Difference::OneSided(1e-6) } else { Difference::Central(1e-6) };
     check_parameters(rotor, &stiffness_parameters(rotor), rpm, modes, difference)
-}
-
-/// Ridders' method (Ridders 1982; Press et al., Numerical Recipes §5.7) for every component of
-/// a vector-valued central difference `central(h)`: row 0 of the tableau holds central
-/// differences at shrinking steps, row k their k-th extrapolation in h²; per component the
-/// entry with the least error estimate wins, and the search stops once higher extrapolations
-/// grow worse (round-off took over). Returns each component's value and error estimate.
-fn ridders(central: &dyn Fn(f64) -> Vec<f64>, h: f64, components: usize) -> Vec<(f64, f64)> {
-    const SHRINK: f64 = 1.4;
-    const LEVELS: usize = 8;
-    let columns: Vec<Vec<f64>> = (0..LEVELS).map(|i| central(h / SHRINK.powi(i as i32))).collect();
-    (0..components)
-        .map(|c| {
-            let mut table = vec![vec![0.0; LEVELS]; LEVELS];
-            table[0][0] = columns[0][c];
-            let (mut best, mut error) = (table[0][0], f64::INFINITY);
-            for i in 1..LEVELS {
-                table[0][i] = columns[i][c];
-                let mut factor = SHRINK * SHRINK;
-                for k in 1..=i {
-                    table[k][i] = (table[k - 1][i] * factor - table[k - 1][i - 1]) / (factor - 1.0);
-                    factor *= SHRINK * SHRINK;
-                    let estimate =
-                        (table[k][i] - table[k - 1][i]).abs().max((table[k][i] - table[k - 1][i - 1]).abs());
-                    if estimate <= error {
-                        error = estimate;
-                        best = table[k][i];
-                    }
-                }
-                if (table[i][i] - table[i - 1][i - 1]).abs() >= 2.0 * error {
-                    break;
-                }
-            }
-            (best, error)
-        })
-        .collect()
 }
 
 /// Ridders' tableau from a first step `h` and from `h`/10, per component the value whose error

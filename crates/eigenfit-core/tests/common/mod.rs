@@ -328,25 +328,7 @@ pub const MIN_RELATIVE_GAP: f64 = 1e-3;
 /// Relative steps of the finite-difference sweep (× |pᵢ|).
 pub const STEPS: [f64; 8] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6];
 
-/// Richardson-extrapolated central difference of a vector-valued function of pᵢ:
-/// R = (4·D(h/2) − D(h)) / 3 with D(h) = (f(p + h) − f(p − h)) / 2h; truncation error O(h⁴).
-pub fn richardson<F>(p: &[f64], i: usize, h_rel: f64, mut f: F) -> DVector<f64>
-where
-    F: FnMut(&[f64]) -> DVector<f64>,
-{
-    let h = h_rel * p[i].abs();
-    let mut central = |h: f64| {
-        let mut q = p.to_vec();
-        q[i] = p[i] + h;
-        let up = f(&q);
-        q[i] = p[i] - h;
-        let down = f(&q);
-        (up - down) / (2.0 * h)
-    };
-    let d1 = central(h);
-    let d2 = central(0.5 * h);
-    (d2 * 4.0 - d1) / 3.0
-}
+pub use eigenfit_core::testing::richardson;
 
 /// Richardson estimates of df/dpᵢ for every step of [`STEPS`] (f returns all modes at once, so
 /// one sweep serves every mode).
