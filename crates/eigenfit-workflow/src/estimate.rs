@@ -15,8 +15,8 @@ use crate::simulate::check_roundoff_of;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
-    better_minimum, like_exchanges, local_minima, mirror_solutions, other_solutions, search_starts,
-    Equivalence, Mirrors, OtherSolution, SAME_MINIMUM,
+    better_minimum, like_exchanges, local_minima, mirror_solutions, other_solutions, scaled_distance,
+    search_starts, Equivalence, Mirrors, OtherSolution, SAME_MINIMUM,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Uncertainty};
@@ -408,7 +408,6 @@ pub fn run(
     };
     phases.push(("fit", budget.used()));
     let mut estimate = estimate;
-    let np_free = np;
     // The search for other minima runs before the intervals: when it finds a deeper minimum than
     // the fit, that one is the estimate, and the intervals are drawn around it.
     let mut mirrors = Mirrors::default();
@@ -425,7 +424,7 @@ pub fn run(
         ));
         mirrors = mirror_solutions(&fit, &estimate.last, &exchanges, &budget);
         phases.push(("mirror_solutions", budget.used()));
-        let starts = request.alternative_starts.unwrap_or_else(|| default_alternative_starts(np_free));
+        let starts = request.alternative_starts.unwrap_or_else(|| default_alternative_starts(np));
         // Ranking a design alone costs an evaluation per point: skipped with no start.
         if starts > 0 {
             minima = local_minima(&fit, starts, &mirrors.asymmetric, &budget);
@@ -466,13 +465,7 @@ pub fn run(
     let mac = fit.mac(&estimate.parameters, options.shape.mac_threshold);
     // Mirrors first, then the other minima not already listed, each judged against the estimate.
     let mut alternatives: Vec<OtherSolution> = Vec::new();
-    let same = |a: &[f64], b: &[f64]| {
-        model
-            .parameters()
-            .iter()
-            .zip(a.iter().zip(b))
-            .all(|(par, (&x, &y))| (par.to_scaled(x) - par.to_scaled(y)).abs() <= SAME_MINIMUM)
-    };
+    let same = |a: &[f64], b: &[f64]| scaled_distance(&fit, a, b) <= SAME_MINIMUM;
     for o in mirrors.symmetric.into_iter().chain(other_solutions(&fit, &estimate.last, &minima)) {
         if !alternatives.iter().any(|a| same(&a.parameters, &o.parameters)) {
             alternatives.push(o);

@@ -65,8 +65,7 @@ impl Equivalence {
     pub fn at(at: &Linearisation, free: usize) -> Self {
         let dof = at.residual.len().saturating_sub(free);
         let sum = at.residual.norm_squared();
-        let exact = at.max_rel_diff() <= exact_fit_tolerance(residual_tolerance(), at, free)
-            && at.residual.len() == at.frequencies_hz.len();
+        let exact = exact_fit(at, free);
         let sigma2 = if at.has_std {
             Some(1.0)
         } else if dof > 0 && !exact && sum > 0.0 && sum.is_finite() {
@@ -112,8 +111,7 @@ impl Equivalence {
                 Judged { chi2: Some(chi2), delta_chi2: Some(delta), equally_good: delta <= self.threshold }
             }
             None => {
-                let exact = lin.max_rel_diff() <= exact_fit_tolerance(residual_tolerance(), lin, self.free)
-                    && lin.residual.len() == lin.frequencies_hz.len();
+                let exact = exact_fit(lin, self.free);
                 // No σ to scale a difference by: as good means no worse, to round-off.
                 let no_worse = lin.cost() <= self.best_cost * (1.0 + 1e-6);
                 Judged { chi2: None, delta_chi2: None, equally_good: exact || no_worse }
@@ -122,8 +120,12 @@ impl Equivalence {
     }
 }
 
-fn residual_tolerance() -> f64 {
-    LevenbergMarquardtSettings::default().residual_tolerance
+/// An exact fit, by the damped strategy's own rule: the frequencies are the whole residual and
+/// every one is within the exact-fit tolerance (with `free` fitted parameters).
+fn exact_fit(lin: &Linearisation, free: usize) -> bool {
+    let tolerance = LevenbergMarquardtSettings::default().residual_tolerance;
+    lin.residual.len() == lin.frequencies_hz.len()
+        && lin.max_rel_diff() <= exact_fit_tolerance(tolerance, lin, free)
 }
 
 /// Another minimum (or a mirror point) with the test's outcome.
@@ -212,17 +214,13 @@ pub fn better_minimum<'a>(
     minima: &'a [Linearisation],
 ) -> Option<&'a Linearisation> {
     let free = problem.parameters().len();
-    let exact = |l: &Linearisation| {
-        l.residual.len() == l.frequencies_hz.len()
-            && l.max_rel_diff() <= exact_fit_tolerance(residual_tolerance(), l, free)
-    };
     let own = minima
         .iter()
         .filter(|m| scaled_distance(problem, &m.parameters, &at.parameters) <= SAME_MINIMUM)
         .chain(std::iter::once(at))
         .min_by(|a, b| a.cost().total_cmp(&b.cost()))
         .expect("at least `at`");
-    if exact(own) {
+    if exact_fit(own, free) {
         return None;
     }
     let best = minima
@@ -342,8 +340,9 @@ pub fn mirror_solutions(
     out
 }
 
-/// Largest scaled difference between two parameter vectors.
-pub(crate) fn scaled_distance(problem: &dyn Objective, a: &[f64], b: &[f64]) -> f64 {
+/// Largest scaled difference between two parameter vectors of `problem` (two points are the same
+/// minimum when it is at most [`SAME_MINIMUM`]).
+pub fn scaled_distance(problem: &dyn Objective, a: &[f64], b: &[f64]) -> f64 {
     let params = problem.parameters();
     params
         .iter()
