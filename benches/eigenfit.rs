@@ -6,7 +6,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use eigenfit::core::analysis::monte_carlo;
 use eigenfit::core::analysis::{
     compare::log_space, compare::run_grid, compare::run_grid_serial, compare::tensor_grid,
-    compare::CompareSettings, compare::ReferenceSettings,
+    compare::CompareSettings, compare::ReferenceSettings, compare::DEFAULT_STRATEGIES,
 };
 use eigenfit::core::discovery::{discover, DiscoveryOptions};
 use eigenfit::core::eigen::{BandedSolver, DenseSolver, EigenSolver};
@@ -15,7 +15,7 @@ use eigenfit::core::measurement::{MeasuredMode, Measurement};
 use eigenfit::core::model::StructuralModel;
 use eigenfit::core::problem::Problem;
 use eigenfit::core::sensitivity::Sensitivities;
-use eigenfit::core::update::{Driver, LevenbergMarquardt, StrategyKind};
+use eigenfit::core::update::{registry, Driver, LevenbergMarquardt};
 use eigenfit::rotor::{presets::paper_rotor, presets::uniform_rotor, Rotor};
 use std::hint::black_box;
 use std::time::Duration;
@@ -110,10 +110,11 @@ fn estimation(c: &mut Criterion) {
     let mut g = c.benchmark_group("estimate_table3_case1");
     g.sample_size(20).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
     let problem = paper_problem(BandedSolver::default());
-    for kind in StrategyKind::ALL {
-        g.bench_function(kind.name(), |b| {
+    let registry = registry::registry();
+    for name in DEFAULT_STRATEGIES {
+        g.bench_function(name, |b| {
             b.iter(|| {
-                let mut s = kind.build();
+                let mut s = registry::build_local(&registry, name).unwrap().1;
                 Driver::default().run(&problem, s.as_mut(), black_box(&[1e2, 1e2])).unwrap()
             })
         });
@@ -144,7 +145,7 @@ fn compare_grid(c: &mut Criterion) {
     let rotor = paper_rotor();
     let targets = vec![vec![1e5, 1e5]];
     let initials = tensor_grid(&log_space(1e1, 1e9, 5), 2);
-    let strategies = StrategyKind::ALL;
+    let strategies: Vec<String> = DEFAULT_STRATEGIES.map(String::from).to_vec();
     let settings = CompareSettings {
         reference: ReferenceSettings { modes: 2, decimals: None, std_hz: None },
         max_iterations: 1000,

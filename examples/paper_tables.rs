@@ -5,11 +5,11 @@
 
 use eigenfit::core::analysis::{
     compare::reference_measurement, compare::run_case, compare::CompareRun, compare::CompareSettings,
-    compare::ReferenceSettings, compare::SharedData,
+    compare::ReferenceSettings, compare::SharedData, compare::DEFAULT_STRATEGIES,
 };
 use eigenfit::core::eigen::DenseSolver;
 use eigenfit::core::problem::Problem;
-use eigenfit::core::update::StrategyKind;
+use eigenfit::core::update::registry;
 use eigenfit::rotor::presets;
 
 /// One case of a paper table: the initial guess and what the paper reports.
@@ -98,15 +98,27 @@ fn main() {
             println!("| case | initial [N/m] | paper | newton | p-step | damped |");
             println!("|---|---|---|---|---|---|");
             let problem = Problem::new(&rotor, DenseSolver, measured);
-            let shared = SharedData::new(&problem);
+            let registry = registry::registry();
+            let strategies: Vec<String> = DEFAULT_STRATEGIES.map(String::from).to_vec();
+            let shared = SharedData::for_runs(&problem, &registry, &strategies).expect("built-in strategies");
             for (i, case) in cases.iter().enumerate() {
                 let paper = match case.paper {
                     Some((k, loops)) => format!("{:.4e} / {:.4e} ({loops} it.)", k[0], k[1]),
                     None => "no convergence".to_string(),
                 };
-                let cells: Vec<String> = StrategyKind::ALL
+                let cells: Vec<String> = strategies
                     .iter()
-                    .map(|&s| cell(&run_case(&problem, &shared, target, &[case.initial; 2], s, &settings)))
+                    .map(|s| {
+                        cell(&run_case(
+                            &problem,
+                            &shared,
+                            &registry,
+                            target,
+                            &[case.initial; 2],
+                            s,
+                            &settings,
+                        ))
+                    })
                     .collect();
                 println!("| {} | {:.1e} | {paper} | {} |", i + 1, case.initial, cells.join(" | "));
             }

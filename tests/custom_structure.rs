@@ -9,7 +9,6 @@ mod example;
 
 use eigenfit::core::model::{finite_difference_derivative, ModelError, StructuralModel};
 
-use eigenfit::core::update::StrategyKind;
 use example::model::ShearBuilding;
 use example::{
     building, chi2_95, discover_storey_mass, measurements, problems, update_all, Noise, Run, DESIGN,
@@ -24,7 +23,7 @@ fn inside(run: &Run) -> Vec<bool> {
 }
 
 fn damped(runs: &[Run]) -> &Run {
-    runs.iter().find(|r| r.strategy == StrategyKind::LevenbergMarquardt).expect("damped ran")
+    runs.iter().find(|r| r.strategy == "damped").expect("damped ran")
 }
 
 #[test]
@@ -39,14 +38,14 @@ fn model_code_is_under_100_lines() {
 #[test]
 fn every_strategy_converges_on_clean_data() {
     let runs = update_all(&problems(measurements(false, None)));
-    assert_eq!(runs.len(), StrategyKind::ALL.len());
+    assert_eq!(runs.len(), 3);
     for run in &runs {
         let e = &run.estimate;
-        assert!(e.termination.is_converged(), "{}: {}", run.strategy.name(), e.termination);
+        assert!(e.termination.is_converged(), "{}: {}", run.strategy, e.termination);
         let err = e.parameters.iter().zip(TRUTH).map(|(k, t)| (k / t - 1.0).abs()).fold(0.0, f64::max);
         // Newton and p-step stop at 1e-4 Hz; damped fits to round-off.
-        let tol = if run.strategy == StrategyKind::LevenbergMarquardt { 1e-6 } else { 1e-3 };
-        assert!(err < tol, "{}: relative error {err:e}", run.strategy.name());
+        let tol = if run.strategy == "damped" { 1e-6 } else { 1e-3 };
+        assert!(err < tol, "{}: relative error {err:e}", run.strategy);
     }
 }
 
@@ -60,7 +59,7 @@ fn damped_recovers_the_storey_stiffnesses_within_their_intervals() {
     assert_eq!(dof, 10);
     assert!(chi2 < chi2_95(dof), "χ² {chi2} on {dof}");
     for run in &runs {
-        assert!(run.estimate.termination.is_converged(), "{}", run.strategy.name());
+        assert!(run.estimate.termination.is_converged(), "{}", run.strategy);
     }
 }
 

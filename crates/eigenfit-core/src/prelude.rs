@@ -9,6 +9,4 @@ pub use crate::measurement::{MeasuredMode, Measurement};
 pub use crate::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 pub use crate::problem::{Linearisation, Objective, Pairing, Problem};
 pub use crate::units::{eigenvalue_to_hz, hz_to_eigenvalue};
-pub use crate::update::{
-    Driver, Estimate, LevenbergMarquardt, Newton, PStep, StrategyKind, Termination, UpdateStrategy,
-};
+pub use crate::update::{Driver, Estimate, LevenbergMarquardt, Newton, PStep, Termination, UpdateStrategy};

@@ -9,12 +9,12 @@
 use crate::error::{input, WorkflowError};
 use crate::overrides::{parse_list, points};
 use eigenfit_core::analysis::compare::{
-    log_space, run_grid, tensor_grid, CompareRun, CompareSettings, ReferenceSettings,
+    checked_strategies, log_space, run_grid, tensor_grid, CompareRun, CompareSettings, ReferenceSettings,
 };
 use eigenfit_core::analysis::Identifiability;
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
-use eigenfit_core::update::StrategyKind;
+use eigenfit_core::update::registry;
 use serde::Serialize;
 
 /// Relative error within which a converged run counts in the summary's `converged_within_1e-6`.
@@ -63,8 +63,8 @@ pub struct ComparePlan {
     pub targets: Vec<Vec<f64>>,
     /// Initial guesses.
     pub initials: Vec<Vec<f64>>,
-    /// Strategies.
-    pub strategies: Vec<StrategyKind>,
+    /// Strategies, as the registry names them (settings kept, aliases replaced).
+    pub strategies: Vec<String>,
     /// Reference-data settings.
     pub settings: CompareSettings,
     /// Include each run's wall-clock time in the report.
@@ -106,18 +106,9 @@ pub fn plan(request: &CompareRequest, np: usize) -> Result<ComparePlan, Workflow
         }
         _ => return Err(input("give --grid N (N ≥ 2) or --initials K1:K2,…")),
     };
-    let strategies = request
-        .strategies
-        .split(',')
-        .map(|s| {
-            StrategyKind::from_name(s.trim()).ok_or_else(|| {
-                input(format!(
-                    "--strategies: unknown strategy `{}`; available: newton, p-step, damped (alias levenberg-marquardt)",
-                    s.trim()
-                ))
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let named: Vec<String> = request.strategies.split(',').map(|s| s.trim().to_string()).collect();
+    let strategies =
+        checked_strategies(&registry::registry(), &named).map_err(|e| input(format!("--strategies: {e}")))?;
     // Beyond ±15 decimals rounding either changes nothing a double holds or overflows to NaN.
     if let Some(d) = request.decimals.filter(|d| !(-15..=15).contains(d)) {
         return Err(input(format!(
@@ -187,13 +178,13 @@ impl From<&Identifiability> for RunIdentifiability {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunReport {
     /// Strategy name.
-    pub strategy: &'static str,
+    pub strategy: String,
     /// Target, initial guess, outcome, iterations, evaluations, estimate, relative error.
     #[serde(flatten)]
     pub run: CompareRun,
     /// Wall-clock time, when asked for.
     pub seconds: Option<f64>,
-    /// Other equally good solutions (converged damped runs).
+    /// Other equally good solutions (converged runs).
     pub alternative_solutions: Option<Vec<Vec<f64>>>,
     /// Identifiability of each parameter (with a reference std).
     pub identifiable: Option<Vec<RunIdentifiability>>,
@@ -203,11 +194,10 @@ impl RunReport {
     /// The report of `r`, with its time when `timing`.
     pub fn new(r: &CompareRun, timing: bool) -> Self {
         Self {
-            strategy: r.strategy.name(),
+            strategy: r.strategy.clone(),
             run: r.clone(),
             seconds: timing.then_some(r.seconds),
-            alternative_solutions: (r.strategy == StrategyKind::LevenbergMarquardt && r.outcome.converged)
-                .then(|| r.alternatives.clone()),
+            alternative_solutions: r.outcome.converged.then(|| r.alternatives.clone()),
             identifiable: r.identifiability.as_ref().map(|ids| ids.iter().map(Into::into).collect()),
         }
     }
@@ -219,7 +209,7 @@ pub struct Summary {
     /// Target parameters.
     pub target: Vec<f64>,
     /// Strategy name.
-    pub strategy: &'static str,
+    pub strategy: String,
     /// Runs.
     pub runs: usize,
     /// Converged runs.
@@ -227,8 +217,8 @@ pub struct Summary {
     /// Converged runs within [`WITHIN_1E6`] of the target.
     #[serde(rename = "converged_within_1e-6")]
     pub converged_within_1e6: usize,
-    /// Converged damped runs whose data also fit another solution (None: not checked).
-    pub ambiguous: Option<usize>,
+    /// Converged runs whose data also fit another, equally good solution.
+    pub ambiguous: usize,
     /// Median iterations of the converged runs.
     pub median_iterations: Option<usize>,
     /// Most iterations of the converged runs.
@@ -240,23 +230,22 @@ pub struct Summary {
 }
 
 /// The summary of `runs` per target and strategy.
-pub fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKind]) -> Vec<Summary> {
+pub fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[String]) -> Vec<Summary> {
     let mut out = Vec::new();
     for t in targets {
-        for &s in strategies {
-            let group: Vec<&CompareRun> = runs.iter().filter(|r| &r.target == t && r.strategy == s).collect();
+        for s in strategies {
+            let group: Vec<&CompareRun> =
+                runs.iter().filter(|r| &r.target == t && &r.strategy == s).collect();
             let conv: Vec<&&CompareRun> = group.iter().filter(|r| r.outcome.converged).collect();
             let mut iters: Vec<usize> = conv.iter().map(|r| r.outcome.iterations).collect();
             iters.sort_unstable();
             out.push(Summary {
                 target: t.clone(),
-                strategy: s.name(),
+                strategy: s.clone(),
                 runs: group.len(),
                 converged: conv.len(),
                 converged_within_1e6: conv.iter().filter(|r| r.relative_error <= WITHIN_1E6).count(),
-                // Only damped runs are checked for other solutions: a 0 elsewhere would mean nothing.
-                ambiguous: (s == StrategyKind::LevenbergMarquardt)
-                    .then(|| conv.iter().filter(|r| !r.alternatives.is_empty()).count()),
+                ambiguous: conv.iter().filter(|r| !r.alternatives.is_empty()).count(),
                 median_iterations: (!iters.is_empty()).then(|| iters[iters.len() / 2]),
                 max_iterations: iters.last().copied(),
                 max_relative_error: conv.iter().map(|r| r.relative_error).fold(0.0, f64::max),
@@ -271,7 +260,7 @@ pub fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[Strate
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Basin {
     /// Strategy name.
-    pub strategy: &'static str,
+    pub strategy: String,
     /// Runs.
     pub runs: usize,
     /// Converged runs.
@@ -281,13 +270,13 @@ pub struct Basin {
 }
 
 /// The basin of each strategy over `runs` (one target).
-pub fn basins(runs: &[CompareRun], strategies: &[StrategyKind]) -> Vec<Basin> {
+pub fn basins(runs: &[CompareRun], strategies: &[String]) -> Vec<Basin> {
     strategies
         .iter()
-        .map(|&s| {
-            let group: Vec<_> = runs.iter().filter(|r| r.strategy == s).collect();
+        .map(|s| {
+            let group: Vec<_> = runs.iter().filter(|r| &r.strategy == s).collect();
             Basin {
-                strategy: s.name(),
+                strategy: s.clone(),
                 runs: group.len(),
                 converged: group.iter().filter(|r| r.outcome.converged).count(),
                 at_target: group

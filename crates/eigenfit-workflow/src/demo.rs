@@ -8,13 +8,14 @@ use crate::error::{failure, WorkflowError};
 use crate::progress::Progress;
 use eigenfit_core::analysis::compare::{
     log_space, reference_measurement, run_grid, tensor_grid, CompareRun, CompareSettings, ReferenceSettings,
+    DEFAULT_STRATEGIES,
 };
 use eigenfit_core::discovery::{discover, DiscoveryOptions, DiscoveryReport, Fit};
 use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 use eigenfit_core::measurement::measured_csv;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::Problem;
-use eigenfit_core::update::{Driver, Estimate, Outcome, StrategyKind};
+use eigenfit_core::update::{Driver, Estimate, Outcome};
 use eigenfit_rotor::presets::{self, PAPER_TABLE_1};
 use serde::Serialize;
 
@@ -129,7 +130,7 @@ pub struct Demo {
     /// The targets of the grid.
     pub targets: Vec<Vec<f64>>,
     /// The strategies of the grid.
-    pub strategies: Vec<StrategyKind>,
+    pub strategies: Vec<String>,
     /// The discovery.
     pub discovery: DiscoveryReport,
 }
@@ -167,8 +168,9 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
     let reference_hz: Vec<f64> = measured.modes().iter().map(|m| m.frequency_hz).collect();
     let problem = Problem::new(&rotor, &solver, measured);
     let mut estimates = Vec::new();
-    for kind in StrategyKind::ALL {
-        let mut strategy = kind.build();
+    let registry = eigenfit_core::update::registry::registry();
+    for name in DEFAULT_STRATEGIES {
+        let mut strategy = eigenfit_core::update::registry::build_local(&registry, name).map_err(failure)?.1;
         estimates.push(
             Driver { max_iterations: 1000 }.run(&problem, strategy.as_mut(), &INITIAL).map_err(failure)?,
         );
@@ -176,7 +178,7 @@ pub fn run(grid: usize, progress: &mut dyn Progress) -> Result<Demo, WorkflowErr
     // 3. Where each strategy converges from: a grid of initial guesses.
     let initials = tensor_grid(&log_space(1e1, 1e9, grid), 2);
     let targets = vec![TARGET.to_vec()];
-    let strategies = StrategyKind::ALL.to_vec();
+    let strategies: Vec<String> = DEFAULT_STRATEGIES.map(String::from).to_vec();
     progress.begin("convergence map", Some((initials.len() * strategies.len()) as u64));
     let runs = run_grid(&rotor, &solver, &targets, &initials, &strategies, &settings, |_| progress.step());
     progress.end();

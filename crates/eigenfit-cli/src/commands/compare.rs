@@ -8,7 +8,6 @@ use crate::{plot, progress};
 use clap::Args;
 use eigenfit_core::analysis::compare::CompareRun;
 use eigenfit_core::model::StructuralModel;
-use eigenfit_core::update::StrategyKind;
 use eigenfit_workflow::compare::{self, CompareRequest, WITHIN_1E6};
 use std::path::{Path, PathBuf};
 
@@ -30,7 +29,9 @@ pub struct CompareArgs {
     /// Explicit initial guesses `K1:K2` separated by commas, instead of a grid.
     #[arg(long, value_name = "K1:K2,…")]
     pub initials: Option<String>,
-    /// Strategies, comma-separated: newton, p-step, damped.
+    /// Strategies, comma-separated, by their registered names (`eigenfit bench --list` lists
+    /// them), settings after colons: newton, p-step, damped, trf, gn-line-search,
+    /// damped:max_trials=50, or a strategy a library user registered.
     #[arg(long, default_value = "newton,p-step,damped")]
     pub strategies: String,
     /// Round the reference frequencies to this many decimals (the paper's Table 1: 3).
@@ -125,8 +126,9 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
             plan.strategies.len(),
             report.reference.modes
         );
+        let width = report.summary.iter().map(|s| s.strategy.chars().count() + 1).fold(9, usize::max);
         println!(
-            "{:<16}{:<9}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",
+            "{:<16}{:<width$}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",
             "target [N/m]",
             "strategy",
             "converged",
@@ -140,7 +142,7 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
             let target: Vec<String> = s.target.iter().map(|v| format!("{v:.0e}")).collect();
             let fmt = |v: Option<usize>| v.map_or("-".to_string(), |v| v.to_string());
             println!(
-                "{:<16}{:<9}{:>11}{:>12}{:>9}{:>9}{:>15.2e}{:>11}",
+                "{:<16}{:<width$}{:>11}{:>12}{:>9}{:>9}{:>15.2e}{:>11}",
                 target.join(":"),
                 s.strategy,
                 format!("{}/{}", s.converged, s.runs),
@@ -148,10 +150,10 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
                 fmt(s.median_iterations),
                 fmt(s.max_iterations),
                 s.max_relative_error,
-                fmt(s.ambiguous)
+                s.ambiguous
             );
         }
-        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged damped runs whose data also fit another solution, - where not checked)");
+        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged runs whose data also fit another, equally good solution)");
         if cut > 0 {
             println!(
                 "{cut} run(s) ran out of their evaluation budget ({} model evaluations each): their results are incomplete; raise it with --budget",
@@ -179,7 +181,7 @@ pub fn write_maps(
     names: &[String],
     runs: &[CompareRun],
     targets: &[Vec<f64>],
-    strategies: &[StrategyKind],
+    strategies: &[String],
 ) -> Result<Vec<PathBuf>, CliError> {
     if names.len() != 2 {
         eprintln!("eigenfit: --plot: compare maps need a model with two parameters; none written");
@@ -204,7 +206,7 @@ pub fn write_maps(
 }
 
 /// Convergence maps: one character per initial guess, K1 down the rows, K2 across.
-fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyKind]) {
+fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[String]) {
     let mut k1: Vec<f64> = runs.iter().map(|r| r.initial[0]).collect();
     k1.sort_by(f64::total_cmp);
     k1.dedup();
@@ -212,11 +214,11 @@ fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyK
         "\nmaps: ● converged to the target (rel. error ≤ 1e-6), ○ converged elsewhere, · no convergence"
     );
     for t in targets {
-        for &s in strategies {
+        for s in strategies {
             let target: Vec<String> = t.iter().map(|v| format!("{v:.0e}")).collect();
             println!(
                 "\n{} from K1 (rows, {:.0e} → {:.0e}) × K2 (columns), target {}",
-                s.name(),
+                s,
                 k1[0],
                 k1[k1.len() - 1],
                 target.join(":")
@@ -224,7 +226,7 @@ fn print_maps(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[StrategyK
             for &a in &k1 {
                 let row: String = runs
                     .iter()
-                    .filter(|r| &r.target == t && r.strategy == s && r.initial[0] == a)
+                    .filter(|r| &r.target == t && &r.strategy == s && r.initial[0] == a)
                     .map(|r| match (r.outcome.converged, r.relative_error <= WITHIN_1E6) {
                         (true, true) => '●',
                         (true, false) => '○',

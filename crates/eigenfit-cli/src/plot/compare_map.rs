@@ -5,7 +5,6 @@
 use super::style::{self, log_tick, short_sci, strategy_colour, Swatch, INK, LIGHT};
 use super::{err, DrawResult, Figure};
 use eigenfit_core::analysis::compare::CompareRun;
-use eigenfit_core::update::StrategyKind;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -80,7 +79,7 @@ impl CompareMaps {
         names: [String; 2],
         runs: &[CompareRun],
         targets: &[Vec<f64>],
-        strategies: &[StrategyKind],
+        strategies: &[String],
         kind: MapKind,
     ) -> Option<Self> {
         if targets.iter().any(|t| t.len() != 2) || runs.len() < 4 * targets.len() * strategies.len() {
@@ -88,10 +87,10 @@ impl CompareMaps {
         }
         let mut panels = Vec::new();
         for t in targets {
-            for &s in strategies {
+            for s in strategies {
                 let cells = runs
                     .iter()
-                    .filter(|r| &r.target == t && r.strategy == s)
+                    .filter(|r| &r.target == t && &r.strategy == s)
                     .map(|r| Cell {
                         initial: [r.initial[0], r.initial[1]],
                         outcome: match (r.outcome.converged, r.relative_error <= AT_TARGET) {
@@ -102,7 +101,7 @@ impl CompareMaps {
                         iterations: r.outcome.iterations,
                     })
                     .collect();
-                panels.push(Panel { strategy: s.name().to_string(), target: [t[0], t[1]], cells });
+                panels.push(Panel { strategy: s.clone(), target: [t[0], t[1]], cells });
             }
         }
         Some(Self { title: title.to_string(), names, panels, columns: strategies.len().max(1), kind })

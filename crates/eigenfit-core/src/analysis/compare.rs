@@ -8,9 +8,8 @@ use crate::measurement::synthetic::SynthesisError;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::StructuralModel;
 use crate::problem::{Linearisation, Objective, Problem};
-use crate::update::{
-    Budget, Driver, LevenbergMarquardt, Outcome, StrategyKind, TerminationReport, UpdateStrategy,
-};
+use crate::update::registry::{build_local, Registry, StrategyError};
+use crate::update::{Budget, Driver, LevenbergMarquardt, Outcome, TerminationReport};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
@@ -19,6 +18,9 @@ use thiserror::Error;
 /// Most evaluations the one-off search for the data's local minima may spend (shared by every
 /// run of a grid).
 const SEARCH_EVALUATIONS: usize = 5_000;
+
+/// The strategies a comparison runs when none are named: the paper's two and the damped one.
+pub const DEFAULT_STRATEGIES: [&str; 3] = ["newton", "p-step", "damped"];
 
 /// How the reference data are made: `modes`, `decimals`, `std_hz`, as a comparison's report
 /// states them (flattened into it).
@@ -49,9 +51,9 @@ pub struct CompareSettings {
 /// shows as they are; the strategy, time and statistics are reported by name or on request).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct CompareRun {
-    /// Strategy.
+    /// Strategy, as the registry names it (with any settings: `damped:max_trials=50`).
     #[serde(skip)]
-    pub strategy: StrategyKind,
+    pub strategy: String,
     /// True parameters.
     pub target: Vec<f64>,
     /// Initial guess.
@@ -67,11 +69,11 @@ pub struct CompareRun {
     /// Wall-clock time of the run (s); for reports, never for tests.
     #[serde(skip)]
     pub seconds: f64,
-    /// Per parameter, whether the data determine it (damped runs with `std_hz` only).
+    /// Per parameter, whether the data determine it (converged runs with `std_hz` only).
     #[serde(skip)]
     pub identifiability: Option<Vec<Identifiability>>,
-    /// Other parameter vectors that fit the data equally well (damped runs only): when not
-    /// empty, the data cannot choose between them and the estimate.
+    /// Other parameter vectors that fit the data equally well (converged runs, any strategy):
+    /// when not empty, the data cannot choose between them and the estimate.
     #[serde(skip)]
     pub alternatives: Vec<Vec<f64>>,
     /// True when the run's budget ([`CompareSettings::budget`]) ran out: its fit or its
@@ -87,6 +89,9 @@ pub enum CompareError {
     /// The reference data of a target could not be computed.
     #[error(transparent)]
     Reference(#[from] SynthesisError),
+    /// A strategy name the registry cannot build, or a sampler.
+    #[error(transparent)]
+    Strategy(#[from] StrategyError),
     /// A worker thread panicked (a bug; the other runs are lost with it).
     #[error("a comparison run panicked")]
     RunPanicked,
@@ -122,19 +127,21 @@ where
     Ok(Measurement::new(measured)?)
 }
 
-/// What every damped run on the same reference data shares, computed once: the coarse grid of
-/// restart seeds ranked by residual, and the local solutions of the data (for the check for
-/// alternative solutions). Both depend on the data only, not on the initial guess.
+/// What every run on the same reference data shares, computed once: the coarse grid of restart
+/// seeds ranked by residual (for strategies that restart from them) and the local solutions of
+/// the data (for the check for alternative solutions). Both depend on the data only, not on the
+/// initial guess.
 pub struct SharedData {
     seeds: Arc<Vec<Vec<f64>>>,
     solutions: Vec<Linearisation>,
 }
 
 impl SharedData {
-    /// Ranks the seeds and finds the local solutions of `problem`'s data.
-    pub fn new(problem: &dyn Objective) -> Self {
+    /// Finds the local solutions of `problem`'s data and, when `rank_seeds`, ranks the
+    /// restart seeds.
+    pub fn new(problem: &dyn Objective, rank_seeds: bool) -> Self {
         Self {
-            seeds: LevenbergMarquardt::rank_seeds(problem),
+            seeds: if rank_seeds { LevenbergMarquardt::rank_seeds(problem) } else { Arc::new(Vec::new()) },
             solutions: local_minima(
                 problem,
                 search_starts(problem.parameters().len()),
@@ -144,30 +151,39 @@ impl SharedData {
         }
     }
 
-    /// What runs of `strategies` on `problem` share: the seeds and local solutions when one of
-    /// them is damped, nothing otherwise.
-    pub fn for_runs(problem: &dyn Objective, strategies: &[StrategyKind]) -> Self {
-        if strategies.contains(&StrategyKind::LevenbergMarquardt) {
-            Self::new(problem)
-        } else {
-            Self::none()
+    /// What runs of `strategies` (registry names) on `problem` share: the local solutions, and
+    /// the ranked seeds when one of them restarts from ranked starts.
+    pub fn for_runs(
+        problem: &dyn Objective,
+        registry: &Registry,
+        strategies: &[String],
+    ) -> Result<Self, StrategyError> {
+        let mut rank = false;
+        for spec in strategies {
+            rank |= build_local(registry, spec)?.1.uses_ranked_starts();
         }
-    }
-
-    /// Nothing shared (for grids without a damped run).
-    pub fn none() -> Self {
-        Self { seeds: Arc::new(Vec::new()), solutions: Vec::new() }
+        Ok(Self::new(problem, rank))
     }
 }
 
-/// Runs one strategy from one initial guess against reference data made at `target`. A damped
-/// run uses `shared`'s seeds, so its `evaluations` leave out the one-off ranking of the grid.
+/// Checks that every name in `strategies` builds a strategy that runs from a start, and returns
+/// the names as the registry reports them (aliases replaced, settings kept).
+pub fn checked_strategies(registry: &Registry, strategies: &[String]) -> Result<Vec<String>, StrategyError> {
+    strategies.iter().map(|spec| build_local(registry, spec).map(|(name, _)| name)).collect()
+}
+
+/// Runs one strategy (a registry name, checked by [`checked_strategies`]) from one initial guess
+/// against reference data made at `target`. A strategy that restarts from ranked starts uses
+/// `shared`'s, so its `evaluations` leave out the one-off ranking of the grid. Every converged
+/// run, whatever its strategy, gets the same identifiability flags and check for other
+/// solutions: a comparison judges the answers, not who found them.
 pub fn run_case<M, S>(
     problem: &Problem<M, S>,
     shared: &SharedData,
+    registry: &Registry,
     target: &[f64],
     initial: &[f64],
-    strategy: StrategyKind,
+    strategy: &str,
     settings: &CompareSettings,
 ) -> CompareRun
 where
@@ -175,24 +191,25 @@ where
     S: EigenSolver,
 {
     let start = Instant::now();
-    let mut s: Box<dyn UpdateStrategy> = match strategy {
-        StrategyKind::LevenbergMarquardt if !shared.seeds.is_empty() => {
-            Box::new(LevenbergMarquardt::default().with_seeds(shared.seeds.clone()))
-        }
-        _ => strategy.build(),
-    };
     let budget = Budget::new(settings.budget);
-    let outcome =
-        Driver { max_iterations: settings.max_iterations }.run_within(problem, s.as_mut(), initial, &budget);
+    let outcome = build_local(registry, strategy).map_err(|e| e.to_string()).and_then(|(_, mut s)| {
+        if s.uses_ranked_starts() && !shared.seeds.is_empty() {
+            s.share_ranked_starts(shared.seeds.clone());
+        }
+        Driver { max_iterations: settings.max_iterations }
+            .run_within(problem, s.as_mut(), initial, &budget)
+            .map_err(|e| e.to_string())
+    });
     let seconds = start.elapsed().as_secs_f64();
+    let strategy = strategy.to_string();
     match outcome {
         Ok(est) => {
             let converged = est.termination.is_converged();
-            let identifiability = (converged && strategy == StrategyKind::LevenbergMarquardt)
+            let identifiability = converged
                 .then(|| uncertainty_within(problem, &est.last, problem.measured.has_std(), &budget))
                 .flatten()
                 .map(|u| u.identifiability);
-            let alternatives = if converged && strategy == StrategyKind::LevenbergMarquardt {
+            let alternatives = if converged {
                 other_solutions(problem, &est.last, &shared.solutions)
                     .into_iter()
                     .filter(|s| s.judged.equally_good)
@@ -220,7 +237,7 @@ where
             initial: initial.to_vec(),
             outcome: Outcome {
                 converged: false,
-                termination: TerminationReport::new("failed", "setup", e.to_string()),
+                termination: TerminationReport::new("failed", "setup", e),
                 iterations: 0,
                 evaluations: 0,
             },
@@ -243,7 +260,7 @@ pub fn run_grid<M, S>(
     solver: &S,
     targets: &[Vec<f64>],
     initials: &[Vec<f64>],
-    strategies: &[StrategyKind],
+    strategies: &[String],
     settings: &CompareSettings,
     mut on_run: impl FnMut(&CompareRun),
 ) -> Result<Vec<CompareRun>, CompareError>
@@ -251,23 +268,38 @@ where
     M: StructuralModel + Sync,
     S: EigenSolver + Sync,
 {
+    let registry = crate::update::registry::registry();
+    let strategies = checked_strategies(&registry, strategies)?;
     let problems = targets
         .iter()
         .map(|target| {
             Ok(Problem::new(model, solver, reference_measurement(model, solver, target, settings)?))
         })
         .collect::<Result<Vec<_>, CompareError>>()?;
-    let shared: Vec<SharedData> = problems.iter().map(|p| SharedData::for_runs(p, strategies)).collect();
-    let cases: Vec<(usize, &Vec<f64>, StrategyKind)> = (0..targets.len())
-        .flat_map(|t| initials.iter().flat_map(move |i| strategies.iter().map(move |&s| (t, i, s))))
+    let shared = problems
+        .iter()
+        .map(|p| SharedData::for_runs(p, &registry, &strategies))
+        .collect::<Result<Vec<_>, _>>()?;
+    let strategies = &strategies;
+    let cases: Vec<(usize, &Vec<f64>, &str)> = (0..targets.len())
+        .flat_map(|t| initials.iter().flat_map(move |i| strategies.iter().map(move |s| (t, i, s.as_str()))))
         .collect();
+    let registry = &registry;
     let (sender, receiver) = std::sync::mpsc::channel::<CompareRun>();
     std::thread::scope(|scope| {
         let worker = scope.spawn(move || {
             cases
                 .par_iter()
                 .map_with(sender, |sender, &(t, initial, strategy)| {
-                    let run = run_case(&problems[t], &shared[t], &targets[t], initial, strategy, settings);
+                    let run = run_case(
+                        &problems[t],
+                        &shared[t],
+                        registry,
+                        &targets[t],
+                        initial,
+                        strategy,
+                        settings,
+                    );
                     // The receiver lives until every run is sent; a failed send only loses progress.
                     let _ = sender.send(run.clone());
                     run
@@ -287,7 +319,7 @@ pub fn run_grid_serial<M, S>(
     solver: &S,
     targets: &[Vec<f64>],
     initials: &[Vec<f64>],
-    strategies: &[StrategyKind],
+    strategies: &[String],
     settings: &CompareSettings,
     mut on_run: impl FnMut(&CompareRun),
 ) -> Result<Vec<CompareRun>, CompareError>
@@ -295,14 +327,16 @@ where
     M: StructuralModel,
     S: EigenSolver,
 {
+    let registry = crate::update::registry::registry();
+    let strategies = checked_strategies(&registry, strategies)?;
     let mut runs = Vec::with_capacity(targets.len() * initials.len() * strategies.len());
     for target in targets {
         let measured = reference_measurement(model, solver, target, settings)?;
         let problem = Problem::new(model, solver, measured);
-        let shared = SharedData::for_runs(&problem, strategies);
+        let shared = SharedData::for_runs(&problem, &registry, &strategies)?;
         for initial in initials {
-            for &strategy in strategies {
-                let run = run_case(&problem, &shared, target, initial, strategy, settings);
+            for strategy in &strategies {
+                let run = run_case(&problem, &shared, &registry, target, initial, strategy, settings);
                 on_run(&run);
                 runs.push(run);
             }
@@ -340,7 +374,7 @@ mod tests {
         let chain = Chain::new(&[1.0, 2.0, 1.5]);
         let targets = vec![vec![3e4, 1e4, 2e4], vec![1e3, 5e4, 1e4]];
         let initials = tensor_grid(&log_space(1e2, 1e6, 3), 3);
-        let strategies = StrategyKind::ALL;
+        let strategies: Vec<String> = DEFAULT_STRATEGIES.map(String::from).to_vec();
         let settings = CompareSettings {
             reference: ReferenceSettings { modes: 3, decimals: Some(3), std_hz: Some(0.01) },
             max_iterations: 100,

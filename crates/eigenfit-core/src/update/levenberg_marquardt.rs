@@ -276,6 +276,14 @@ impl UpdateStrategy for LevenbergMarquardt {
         "damped"
     }
 
+    fn uses_ranked_starts(&self) -> bool {
+        self.settings.max_restarts > 0
+    }
+
+    fn share_ranked_starts(&mut self, starts: Arc<Vec<Vec<f64>>>) {
+        self.shared_seeds = Some(starts);
+    }
+
     fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
         let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
         if initial.residual.len() < free {

@@ -101,6 +101,15 @@ pub trait UpdateStrategy {
     }
     /// Takes one step.
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError>;
+    /// Whether the strategy restarts from starts ranked by residual over the whole range, so
+    /// that many runs on the same data (a comparison grid) can rank them once
+    /// ([`share_ranked_starts`](Self::share_ranked_starts)). Default: it does not.
+    fn uses_ranked_starts(&self) -> bool {
+        false
+    }
+    /// Restart starts ranked once for every run on the same data, used instead of ranking its
+    /// own; ignored by a strategy that does not restart (the default).
+    fn share_ranked_starts(&mut self, _starts: std::sync::Arc<Vec<Vec<f64>>>) {}
 }
 
 /// Solves the paper's eq. 28, S Δk = Δλ, on the first N modes (N = number of parameters, as in
@@ -176,48 +185,4 @@ pub fn require_enough_residuals(
 pub fn evaluate_or_diverge(problem: &dyn Objective, p: &[f64]) -> Result<Linearisation, UpdateError> {
     problem.parameters().check(p).map_err(|e| UpdateError::Diverged(e.to_string()))?;
     problem.linearise(p).map_err(|e| UpdateError::Diverged(e.to_string()))
-}
-
-/// The built-in strategies, by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum StrategyKind {
-    /// [`Newton`], the paper's plain method.
-    Newton,
-    /// [`PStep`], the paper's Fig. 1.
-    PStep,
-    /// [`LevenbergMarquardt`] least squares.
-    LevenbergMarquardt,
-}
-
-impl StrategyKind {
-    /// Every built-in strategy.
-    pub const ALL: [StrategyKind; 3] =
-        [StrategyKind::Newton, StrategyKind::PStep, StrategyKind::LevenbergMarquardt];
-
-    /// The name used on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            StrategyKind::Newton => "newton",
-            StrategyKind::PStep => "p-step",
-            StrategyKind::LevenbergMarquardt => "damped",
-        }
-    }
-
-    /// Looks a strategy up by [`name`](Self::name), or by the descriptive
-    /// `levenberg-marquardt` for the strategy whose reports keep the name `damped`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        if name == "levenberg-marquardt" {
-            return Some(StrategyKind::LevenbergMarquardt);
-        }
-        Self::ALL.into_iter().find(|k| k.name() == name)
-    }
-
-    /// A fresh strategy with default settings.
-    pub fn build(self) -> Box<dyn UpdateStrategy> {
-        match self {
-            StrategyKind::Newton => Box::new(Newton::default()),
-            StrategyKind::PStep => Box::new(PStep::default()),
-            StrategyKind::LevenbergMarquardt => Box::new(LevenbergMarquardt::default()),
-        }
-    }
 }

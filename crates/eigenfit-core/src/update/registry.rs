@@ -76,6 +76,9 @@ pub enum StrategyError {
     /// A second strategy under a registered name.
     #[error("a strategy named `{0}` is already registered")]
     Duplicate(String),
+    /// A sampler where a strategy stepping from a start is needed (a comparison grid's runs).
+    #[error("`{0}` is a sampler: it explores the whole prior and does not run from an initial guess")]
+    NotLocal(String),
 }
 
 /// The `key=value` settings given after a strategy's name, read by its factory.
@@ -318,6 +321,17 @@ impl Registry {
         }
         let method = factory.build(&StrategySettings::new(factory.name(), values))?;
         Ok((canonical, method))
+    }
+}
+
+/// Builds `spec` from `registry` as a strategy that runs from a start; a sampler is refused.
+pub fn build_local(
+    registry: &Registry,
+    spec: &str,
+) -> Result<(String, Box<dyn UpdateStrategy>), StrategyError> {
+    match registry.build(spec)? {
+        (name, Method::Local(strategy)) => Ok((name, strategy)),
+        (name, Method::Sampler(_)) => Err(StrategyError::NotLocal(name)),
     }
 }
 
