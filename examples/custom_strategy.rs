@@ -9,8 +9,7 @@ use eigenfit::core::nalgebra::{DMatrix, DVector};
 use eigenfit::core::problem::{Linearisation, Objective};
 use eigenfit::core::update::registry::{self, FnFactory, Method};
 use eigenfit::core::update::{
-    evaluate_or_diverge, exact_fit_tolerance, scaled_bounds, Guard, SettingsError, Step, StepStatus,
-    UpdateError, UpdateStrategy,
+    evaluate_or_diverge, scaled_bounds, Guard, SettingsError, Step, StepStatus, UpdateError, UpdateStrategy,
 };
 use eigenfit::workflow::bench::{self, BenchRequest};
 
@@ -43,7 +42,7 @@ impl UpdateStrategy for TikhonovGaussNewton {
     }
 
     fn converged(&self, lin: &Linearisation) -> bool {
-        lin.max_rel_diff() <= exact_fit_tolerance(1e-10, lin, lin.parameters.len())
+        lin.is_exact_fit(1e-10, lin.parameters.len())
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {

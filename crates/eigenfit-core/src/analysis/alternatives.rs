@@ -12,7 +12,6 @@
 use crate::analysis::chi2::chi2_quantile_upper;
 use crate::analysis::verdict::SIGNIFICANCE;
 use crate::problem::{Linearisation, Objective};
-use crate::update::levenberg_marquardt::exact_fit_tolerance;
 use crate::update::{Budget, Driver, LevenbergMarquardt, LevenbergMarquardtSettings};
 
 /// Iterations of one local fit of the search: a local fit from a start of the design converges
@@ -124,8 +123,7 @@ impl Equivalence {
 /// every one is within the exact-fit tolerance (with `free` fitted parameters).
 fn exact_fit(lin: &Linearisation, free: usize) -> bool {
     let tolerance = LevenbergMarquardtSettings::default().residual_tolerance;
-    lin.residual.len() == lin.frequencies_hz.len()
-        && lin.max_rel_diff() <= exact_fit_tolerance(tolerance, lin, free)
+    lin.is_exact_fit(tolerance, free)
 }
 
 /// Another minimum (or a mirror point) with the test's outcome.

@@ -127,6 +127,37 @@ impl Linearisation {
             .zip(&self.measured_hz)
             .fold(0.0, |m, (a, b)| f64::max(m, ((a - b) / b).abs()))
     }
+
+    /// The relative misfit below which this fit is exact: `tolerance`, or, with more residuals
+    /// than `free` fitted parameters, twice the round-off of the model frequencies when larger (a
+    /// fine mesh). Measured values computed by another solver from the same matrices carry a
+    /// round-off of the same size, and more modes than parameters cannot in general absorb it: a
+    /// fit to that level is as exact as the matrices define it, and restarting from it only
+    /// chases rounding. As many modes as parameters have an exact solution, which an iteration
+    /// reaches quadratically.
+    pub fn exact_fit_level(&self, tolerance: f64, free: usize) -> f64 {
+        if self.residual.len() > free {
+            tolerance.max(2.0 * self.max_round_off())
+        } else {
+            tolerance
+        }
+    }
+
+    /// Whether this is an exact fit with `free` fitted parameters: the frequencies are the whole
+    /// residual (with shape rows a mirror solution matches every frequency and still misfits)
+    /// and every one is within [`exact_fit_level`](Self::exact_fit_level). The one rule every
+    /// strategy and the search for other solutions apply.
+    ///
+    /// ```
+    /// # use eigenfit_core::problem::Linearisation;
+    /// # fn check(lin: &Linearisation) -> bool {
+    /// lin.is_exact_fit(1e-10, lin.parameters.len())
+    /// # }
+    /// ```
+    pub fn is_exact_fit(&self, tolerance: f64, free: usize) -> bool {
+        self.residual.len() == self.frequencies_hz.len()
+            && self.max_rel_diff() <= self.exact_fit_level(tolerance, free)
+    }
 }
 
 /// A model, a solver, measured modes, and how to compare them.

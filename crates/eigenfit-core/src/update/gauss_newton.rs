@@ -2,7 +2,7 @@
 //! Jacobian gives the minimum-norm step), capped, projected onto the bounds, halved until the
 //! Armijo condition holds.
 
-use super::levenberg_marquardt::{exact_fit_tolerance, scaled_bounds};
+use super::levenberg_marquardt::scaled_bounds;
 use super::settings::{Guard, SettingsError};
 use super::{Step, StepStatus, UpdateError, UpdateStrategy};
 use crate::problem::{Linearisation, Objective, ResidualError};
@@ -54,8 +54,7 @@ impl UpdateStrategy for GaussNewtonLineSearch {
     }
 
     fn converged(&self, lin: &Linearisation) -> bool {
-        lin.residual.len() == lin.frequencies_hz.len()
-            && lin.max_rel_diff() <= exact_fit_tolerance(self.tolerance, lin, lin.parameters.len())
+        lin.is_exact_fit(self.tolerance, lin.parameters.len())
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {

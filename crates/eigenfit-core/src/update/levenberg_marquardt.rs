@@ -313,8 +313,7 @@ impl UpdateStrategy for LevenbergMarquardt {
         // Exact frequencies end the run only when they are the whole residual: with shape rows
         // (testdata::shapes) a mirror solution matches every frequency and still misfits.
         let free = (0..lin.parameters.len()).filter(|&i| self.is_free(i)).count();
-        lin.max_rel_diff() <= exact_fit_tolerance(self.settings.residual_tolerance, lin, free)
-            && lin.residual.len() == lin.frequencies_hz.len()
+        lin.is_exact_fit(self.settings.residual_tolerance, free)
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
@@ -460,20 +459,6 @@ impl LevenbergMarquardt {
     fn reject(&mut self) {
         self.mu *= self.nu;
         self.nu *= 2.0;
-    }
-}
-
-/// The relative misfit below which a fit is exact: `residual_tolerance`, or, with more modes than
-/// `free` parameters, twice the round-off of the model frequencies when larger (a fine mesh).
-/// Measured values computed by another solver from the same matrices carry a round-off of the
-/// same size, and more modes than parameters cannot in general absorb it: a fit to that level is
-/// as exact as the matrices define it, and restarting from it only chases rounding. As many
-/// modes as parameters have an exact solution, which the iteration reaches quadratically.
-pub fn exact_fit_tolerance(residual_tolerance: f64, lin: &Linearisation, free: usize) -> f64 {
-    if lin.residual.len() > free {
-        residual_tolerance.max(2.0 * lin.max_round_off())
-    } else {
-        residual_tolerance
     }
 }
 

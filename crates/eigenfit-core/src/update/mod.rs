@@ -28,9 +28,7 @@ pub use driver::{
 };
 pub use gauss_newton::GaussNewtonLineSearch;
 pub use grid::halton;
-pub use levenberg_marquardt::{
-    exact_fit_tolerance, scaled_bounds, stationary, LevenbergMarquardt, LevenbergMarquardtSettings,
-};
+pub use levenberg_marquardt::{scaled_bounds, stationary, LevenbergMarquardt, LevenbergMarquardtSettings};
 pub use newton::Newton;
 pub use pstep::PStep;
 pub use registry::{Method, StrategyError, StrategyFactory, StrategySettings};

@@ -9,7 +9,7 @@
 //! θ = max(0.995, 1 − ‖g‖)), and the radius grows or shrinks with the ratio of actual to
 //! predicted reduction.
 
-use super::levenberg_marquardt::{exact_fit_tolerance, scaled_bounds};
+use super::levenberg_marquardt::scaled_bounds;
 use super::settings::{Guard, SettingsError};
 use super::{Step, StepStatus, UpdateError, UpdateStrategy};
 use crate::problem::{Linearisation, Objective};
@@ -125,8 +125,7 @@ impl UpdateStrategy for TrustRegionReflective {
     }
 
     fn converged(&self, lin: &Linearisation) -> bool {
-        lin.residual.len() == lin.frequencies_hz.len()
-            && lin.max_rel_diff() <= exact_fit_tolerance(self.tolerance, lin, lin.parameters.len())
+        lin.is_exact_fit(self.tolerance, lin.parameters.len())
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
