@@ -196,8 +196,7 @@ pub fn update_all(problems: &[Problem<ShearBuilding, DenseSolver>]) -> Vec<Run> 
             let damped = strategy == "damped";
             let data: &dyn Objective = if damped { &all } else { &problems[0] };
             let estimate = Driver::default().run(data, s.as_mut(), &DESIGN).expect("runs");
-            let intervals =
-                damped.then(|| uncertainty(data, &estimate.last, true)).flatten().map(|u| u.intervals);
+            let intervals = damped.then(|| uncertainty(data, &estimate.last)).flatten().map(|u| u.intervals);
             let dof = estimate.last.residual.len().saturating_sub(DESIGN.len());
             Run { strategy, chi2: (2.0 * estimate.last.cost(), dof), estimate, intervals }
         })

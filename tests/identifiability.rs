@@ -37,7 +37,7 @@ fn stiff_support_gets_a_one_sided_profile_bound() {
     let data = [(59.029, 0.06), (203.444, 0.2), (670.711, 0.6)];
     let (problem, est) = fit_paper_rotor(&data);
     assert!(est.termination.is_converged());
-    let u = uncertainty(&problem, &est.last, true).unwrap();
+    let u = uncertainty(&problem, &est.last).unwrap();
     let Identifiability::LowerBoundOnly { lower } = u.identifiability[1] else {
         panic!("K2 should be bounded below only: {:?}", u.identifiability)
     };
@@ -57,7 +57,7 @@ fn stiff_support_gets_a_one_sided_profile_bound() {
 fn soft_supports_are_determined_with_tight_intervals() {
     let data = [(36.107, 0.036), (84.066, 0.084), (305.649, 0.31)];
     let (problem, est) = fit_paper_rotor(&data);
-    let u = uncertainty(&problem, &est.last, true).unwrap();
+    let u = uncertainty(&problem, &est.last).unwrap();
     assert!(u.identifiability.iter().all(Identifiability::is_determined), "{:?}", u.identifiability);
     for iv in &u.intervals {
         assert!(iv[1] / iv[0] < 1.5, "interval {iv:?} too wide for 0.1% data at 1e5 N/m");
@@ -82,10 +82,10 @@ fn the_interval_phase_reports_bounds_done_to_its_observers() {
     let mut steps = Steps::default();
     let budget = eigenfit::core::update::Budget::new(eigenfit::core::analysis::UNCERTAINTY_EVALUATIONS);
     let observed =
-        eigenfit::core::analysis::uncertainty_observed(&problem, &est.last, true, &budget, &mut [&mut steps])
+        eigenfit::core::analysis::uncertainty_observed(&problem, &est.last, &budget, &mut [&mut steps])
             .unwrap();
     // Same answer as without an observer, and one report per profiled bound: 0, 1, …, total.
-    assert_eq!(observed.identifiability, uncertainty(&problem, &est.last, true).unwrap().identifiability);
+    assert_eq!(observed.identifiability, uncertainty(&problem, &est.last).unwrap().identifiability);
     let total = steps.0.first().expect("K2 is profiled, so progress is reported").1;
     assert!(total >= 2 && total % 2 == 0, "{:?}", steps.0);
     let expected: Vec<(usize, usize)> = (0..=total).map(|d| (d, total)).collect();

@@ -204,7 +204,7 @@ pub fn estimate(measured: &Measurement, budget: &Budget) -> Fitted {
     let estimate = Driver::default()
         .run_within(&problem, &mut LevenbergMarquardt::default(), &DESIGN, budget)
         .expect("the fit runs");
-    let u = uncertainty_within(&problem, &estimate.last, true, budget);
+    let u = uncertainty_within(&problem, &estimate.last, budget);
     let intervals_cut = u.as_ref().is_some_and(|u| u.budget_exhausted);
     Fitted { estimate, intervals: u.map(|u| u.intervals), intervals_cut }
 }

@@ -126,7 +126,7 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
     let mut damped = LevenbergMarquardt::default();
     let est = Driver::default().run(&fit, &mut damped as &mut dyn UpdateStrategy, &start).unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
-    let u = uncertainty(&fit, &est.last, true).unwrap();
+    let u = uncertainty(&fit, &est.last).unwrap();
     for (i, name) in ["drive_end", "free_end"].iter().enumerate() {
         let [lo, hi] = u.intervals[i];
         assert!(lo <= TRUTH[i] && TRUTH[i] <= hi, "{name}: truth {} outside [{lo}, {hi}]", TRUTH[i]);

@@ -35,7 +35,7 @@ fn estimate(
     let objective = RunupObjective::new(rotor, params.to_vec(), points, None).expect("objective");
     let (est, restarts) =
         fit_runup(&objective, params, start, 100, REFITS, &Budget::unlimited()).expect("fit");
-    let u = uncertainty(&objective, &est.last, true).expect("std_hz given: intervals");
+    let u = uncertainty(&objective, &est.last).expect("std_hz given: intervals");
     let sd = (0..params.len()).map(|i| u.covariance[(i, i)].sqrt() / est.parameters[i]).collect();
     (est, restarts, sd)
 }

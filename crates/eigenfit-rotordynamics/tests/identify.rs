@@ -40,8 +40,7 @@ fn fit(
     let budget = Budget::new(budget);
     let (estimate, restarts) =
         fit_runup(&objective, params, start, max_iterations, restarts, &budget).map_err(|e| e.to_string())?;
-    let has_std = estimate.last.has_std;
-    let u = uncertainty(&objective, &estimate.last, has_std);
+    let u = uncertainty(&objective, &estimate.last);
     // A Jacobian of full rank: a finite linearised covariance (the profile bounds may still be
     // one-sided for a weak coefficient).
     let identifiable =

@@ -455,7 +455,7 @@ pub fn run(
     // Profile bounds done / total through the driver's observer mechanism.
     let (unc, scatter) = if converged {
         let mut bounds = StepsObserver::new(progress, "interval bounds");
-        let unc = fit.uncertainty_within(&estimate.last, has_std, &budget, &mut [&mut bounds]);
+        let unc = fit.uncertainty_within(&estimate.last, &budget, &mut [&mut bounds]);
         bounds.finish();
         unc
     } else {

@@ -447,7 +447,6 @@ pub fn estimate_with(
     phases.push(("fit", budget.used()));
     let converged = estimate.termination.is_converged();
     let lin = &estimate.last;
-    let has_std = lin.has_std;
     // Mirrors: exchanges of like coefficients the rotor is symmetric under (two bearings alike).
     let mirrors = if converged {
         mirror_solutions(&objective, lin, &like_exchanges(&objective), &budget)
@@ -455,7 +454,7 @@ pub fn estimate_with(
         Default::default()
     };
     phases.push(("mirror_solutions", budget.used()));
-    let uncertainty = if converged { uncertainty_within(&objective, lin, has_std, &budget) } else { None };
+    let uncertainty = if converged { uncertainty_within(&objective, lin, &budget) } else { None };
     phases.push(("intervals", budget.used()));
     let quality = judge(lin, np);
     let alternatives_sigma = Equivalence::at(lin, np).sigma_source();

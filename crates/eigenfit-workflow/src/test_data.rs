@@ -229,9 +229,9 @@ impl<'a> Fit<'a> {
 
     /// Intervals (None without std for frequencies only) and the scatter σ̂ they were scaled by
     /// (1 when the data carry standard deviations).
-    pub fn uncertainty(&mut self, at: &Linearisation, has_std: bool) -> Option<(Uncertainty, f64)> {
+    pub fn uncertainty(&mut self, at: &Linearisation) -> Option<(Uncertainty, f64)> {
         match self {
-            Fit::Frequencies(p) => eigenfit_core::analysis::uncertainty(p, at, has_std).map(|u| (u, 1.0)),
+            Fit::Frequencies(p) => eigenfit_core::analysis::uncertainty(p, at).map(|u| (u, 1.0)),
             Fit::Shapes(s) => s.uncertainty(at),
         }
     }
@@ -242,13 +242,12 @@ impl<'a> Fit<'a> {
     pub fn uncertainty_within(
         &mut self,
         at: &Linearisation,
-        has_std: bool,
         budget: &Budget,
         observers: &mut [&mut dyn Observer],
     ) -> (Option<Uncertainty>, Option<f64>) {
         match self {
             Fit::Frequencies(p) => {
-                (eigenfit_core::analysis::uncertainty_observed(p, at, has_std, budget, observers), None)
+                (eigenfit_core::analysis::uncertainty_observed(p, at, budget, observers), None)
             }
             Fit::Shapes(s) => {
                 s.uncertainty_within(at, budget).map_or((None, None), |(u, sc)| (Some(u), Some(sc)))

@@ -206,7 +206,7 @@ where
         Ok(est) => {
             let converged = est.termination.is_converged();
             let identifiability = converged
-                .then(|| uncertainty_within(problem, &est.last, problem.measured.has_std(), &budget))
+                .then(|| uncertainty_within(problem, &est.last, &budget))
                 .flatten()
                 .map(|u| u.identifiability);
             let alternatives = if converged {

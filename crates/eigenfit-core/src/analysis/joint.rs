@@ -93,8 +93,9 @@ impl<'a> Joint<'a> {
         self.parts.is_empty()
     }
 
-    /// 95 % intervals at `at`: from the weights when `has_std`, else from the residual scatter
-    /// σ̂ = √(‖r‖²/dof) as in [`ShapeFit::uncertainty`](super::ShapeFit::uncertainty).
+    /// 95 % intervals at `at`: from the weights when `has_std` (every part's data carry their own
+    /// std: a part fitted with shapes is weighted by default shape std, so it does not), else from
+    /// the residual scatter σ̂ = √(‖r‖²/dof) as in [`ShapeFit::uncertainty`](super::ShapeFit::uncertainty).
     pub fn uncertainty(&mut self, at: &Linearisation, has_std: bool) -> Option<(Uncertainty, f64)> {
         self.uncertainty_within(at, has_std, &Budget::new(UNCERTAINTY_EVALUATIONS))
     }

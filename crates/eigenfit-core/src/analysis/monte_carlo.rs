@@ -162,7 +162,7 @@ where
         let est = driver
             .run(&problem, &mut LevenbergMarquardt::default(), &settings.initial)
             .map_err(|e| e.to_string())?;
-        let intervals = uncertainty(&problem, &est.last, true).map(|u| u.intervals);
+        let intervals = uncertainty(&problem, &est.last).map(|u| u.intervals);
         Ok(TrialEstimate {
             chi2: est.last.chi2(),
             converged: est.termination.is_converged(),

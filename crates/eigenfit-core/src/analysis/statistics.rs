@@ -62,10 +62,11 @@ pub struct Uncertainty {
 pub const UNCERTAINTY_EVALUATIONS: usize = 2_000;
 
 /// Uncertainty at the estimate `at` (a converged linearisation whose residual is weighted by
-/// the measurement standard deviations). Returns `None` when the data carry no std. Profile
-/// refits spend at most [`UNCERTAINTY_EVALUATIONS`]; see [`uncertainty_within`] to set the budget.
-pub fn uncertainty(problem: &dyn Objective, at: &Linearisation, has_std: bool) -> Option<Uncertainty> {
-    uncertainty_within(problem, at, has_std, &Budget::new(UNCERTAINTY_EVALUATIONS))
+/// the measurement standard deviations). Returns `None` when the data carry no std
+/// ([`Linearisation::has_std`], set by the objective from its measurement). Profile refits spend
+/// at most [`UNCERTAINTY_EVALUATIONS`]; see [`uncertainty_within`] to set the budget.
+pub fn uncertainty(problem: &dyn Objective, at: &Linearisation) -> Option<Uncertainty> {
+    uncertainty_within(problem, at, &Budget::new(UNCERTAINTY_EVALUATIONS))
 }
 
 /// [`uncertainty`] charging every profile refit to `budget` (shared with the fit, so one limit
@@ -73,13 +74,13 @@ pub fn uncertainty(problem: &dyn Objective, at: &Linearisation, has_std: bool) -
 pub fn uncertainty_within(
     problem: &dyn Objective,
     at: &Linearisation,
-    has_std: bool,
     budget: &Budget,
 ) -> Option<Uncertainty> {
-    uncertainty_observed(problem, at, has_std, budget, &mut [])
+    uncertainty_observed(problem, at, budget, &mut [])
 }
 
-/// 95 % intervals at `at`: from the weights when `has_std`; without, from the residual scatter:
+/// 95 % intervals at `at`: from the weights when `has_std` (the data's own std: a shape fit's rows
+/// are always weighted, by defaults where none were given); without, from the residual scatter:
 /// every row is divided by σ̂ = √(‖r‖²/dof) (through `scale`, the objective's row divisor), the
 /// usual regression estimate. `None` when there are no more rows than parameters. Profile refits
 /// are charged to `budget`. Returns the intervals and σ̂ (1 with given std). Shared by [`ShapeFit`](super::ShapeFit) and
@@ -92,7 +93,7 @@ pub(crate) fn scatter_uncertainty<P: Objective>(
     budget: &Budget,
 ) -> Option<(Uncertainty, f64)> {
     if has_std {
-        return uncertainty_within(problem, at, true, budget).map(|u| (u, 1.0));
+        return weighted_uncertainty(problem, at, budget, &mut []).map(|u| (u, 1.0));
     }
     let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
     let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
@@ -104,7 +105,8 @@ pub(crate) fn scatter_uncertainty<P: Objective>(
     let result = problem
         .linearise(&at.parameters)
         .ok()
-        .and_then(|lin| uncertainty_within(problem, &lin, true, budget))
+        // The rescaled rows are in noise units, as weights from std would put them.
+        .and_then(|lin| weighted_uncertainty(problem, &lin, budget, &mut []))
         .map(|u| (u, scatter));
     *scale(problem) = old;
     result
@@ -115,13 +117,22 @@ pub(crate) fn scatter_uncertainty<P: Objective>(
 pub fn uncertainty_observed(
     problem: &dyn Objective,
     at: &Linearisation,
-    has_std: bool,
     budget: &Budget,
     observers: &mut [&mut dyn Observer],
 ) -> Option<Uncertainty> {
-    if !has_std {
+    if !at.has_std {
         return None;
     }
+    weighted_uncertainty(problem, at, budget, observers)
+}
+
+/// The intervals of a residual in noise units (weighted by std, or rescaled by σ̂).
+fn weighted_uncertainty(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    budget: &Budget,
+    observers: &mut [&mut dyn Observer],
+) -> Option<Uncertainty> {
     let params = problem.parameters();
     let np = params.len();
     let js = at.scaled_jacobian(params);
