@@ -68,6 +68,12 @@ def _unit(units: Dict[str, Any], name: str) -> str:
     return "–" if unit in ("", "-") else str(unit)
 
 
+def _effect_label(effect: Dict[str, Any]) -> str:
+    """``kind@location`` as the CLI names an effect (``kind`` alone without a location)."""
+    location = effect.get("location")
+    return str(effect.get("kind")) + ("" if location is None else f"@{location}")
+
+
 def _verdict_html(word: str, good: bool) -> str:
     colour = "#009e73" if good else "#d55e00"
     return (
@@ -417,7 +423,7 @@ class DiscoverResult(Result):
             value = e.get("value")
             effects.append(
                 [
-                    _cell(e.get("label")),
+                    _cell(e.get("label") or _effect_label(e)),
                     _cell(e.get("unit") if isinstance(value, (int, float)) else "–"),
                     _cell(value, 5) if isinstance(value, (int, float)) else _cell("on"),
                     _cell(iv[0], 4),

@@ -103,7 +103,8 @@ def test_a_discovery_shows_the_named_effect_and_the_parameters(cli, examples: Pa
     data, code = cli(["discover", "--preset", "paper-rotor", "--measured", str(examples / "measured_hidden_effect.csv")])
     shown = _parse(DiscoverResult(data, code)._repr_html_())
     assert shown.verdict == ("explained" if data["explained"] else "not explained")
-    assert shown.tables["effects"][0][0][0] == data["missing_effect"]["label"]
+    effect = data["missing_effect"]
+    assert shown.tables["effects"][0][0][0] == f"{effect['kind']}@{effect['location']}"
     assert [(r[0][0], r[2][1]) for r in shown.tables["parameters"]] == list(data["calibrated_parameters"].items())
 
 

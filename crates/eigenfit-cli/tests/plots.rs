@@ -140,7 +140,7 @@ fn estimate_plots_its_convergence_history() {
             "k_K1",
             "k_K2",
             "newton (converged,",
-            "newton's tolerance (the paper's), 0.01 Hz",
+            "newton tolerance, 0.01 Hz (as in the paper)",
         ],
     );
 }
@@ -158,6 +158,19 @@ fn campbell_ticks_are_whole_rpm() {
         .collect();
     assert!(ticks.iter().any(|t| t.ends_with("000")), "no thousands on the speed axis: {ticks:?}");
     assert!(!ticks.iter().any(|t| t.ends_with(".0")), "a tick printed with a trailing .0: {ticks:?}");
+    // Every tick mark (a 5 px black stroke off an axis) carries a number.
+    let marks = svg
+        .split("<polyline")
+        .skip(1)
+        .map(|l| l.split("/>").next().unwrap_or(""))
+        .filter(|l| l.contains("stroke=\"#000000\""))
+        .filter_map(|l| l.split("points=\"").nth(1).and_then(|p| p.split('"').next()))
+        .filter(|p| {
+            let xy: Vec<i32> = p.split([' ', ',']).filter_map(|v| v.parse().ok()).collect();
+            matches!(xy[..], [x1, y1, x2, y2] if (y1 == y2 && (x2 - x1).abs() == 5) || (x1 == x2 && (y2 - y1).abs() == 5))
+        })
+        .count();
+    assert_eq!(marks, ticks.len(), "tick marks without a number: {ticks:?}");
 }
 
 /// The parameter axis carries numbers over its whole range: from 1e6 down to the 5e4 N/m the

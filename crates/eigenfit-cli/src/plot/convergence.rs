@@ -106,9 +106,9 @@ pub fn strategy_tolerance(strategy: &str, setting: &str) -> Option<(f64, String)
     let given = setting.split(':').skip(1).find_map(|s| s.trim().strip_prefix("tolerance_hz="));
     let tol = given.and_then(|v| v.trim().parse::<f64>().ok()).unwrap_or(0.01);
     Some(if tol == 0.01 {
-        (tol, format!("{strategy}'s tolerance (the paper's), 0.01 Hz"))
+        (tol, format!("{strategy} tolerance, 0.01 Hz (as in the paper)"))
     } else {
-        (tol, format!("{strategy}'s tolerance, {tol} Hz"))
+        (tol, format!("{strategy} tolerance, {tol} Hz"))
     })
 }
 
@@ -277,9 +277,9 @@ mod tests {
     #[test]
     fn the_tolerance_line_is_drawn_only_for_the_strategies_that_stop_on_it() {
         let newton = crate::plot::to_svg(&figure("newton", 2, "newton")).unwrap();
-        assert!(newton.contains("newton's tolerance (the paper's), 0.01 Hz"));
+        assert!(newton.contains("newton tolerance, 0.01 Hz (as in the paper)"));
         let set = crate::plot::to_svg(&figure("p-step", 2, "p-step:tolerance_hz=0.002")).unwrap();
-        assert!(set.contains("p-step's tolerance, 0.002 Hz"));
+        assert!(set.contains("p-step tolerance, 0.002 Hz"));
         for strategy in ["damped", "trf", "gn-line-search"] {
             let svg = crate::plot::to_svg(&figure(strategy, 2, strategy)).unwrap();
             assert!(!svg.contains("tolerance"), "{strategy}'s plot carries a tolerance line");

@@ -254,6 +254,30 @@ mod tests {
             .collect()
     }
 
+    /// The tick marks of the SVG: black two-point strokes 5 px long, (horizontal ones: the
+    /// y axis's, vertical ones: the x axis's).
+    pub(crate) fn tick_marks(svg: &str) -> (usize, usize) {
+        let (mut horizontal, mut vertical) = (0, 0);
+        for line in svg.split("<polyline").skip(1) {
+            let line = line.split("/>").next().unwrap_or("");
+            if !line.contains("stroke=\"#000000\"") {
+                continue;
+            }
+            let Some(points) = line.split("points=\"").nth(1).and_then(|p| p.split('"').next()) else {
+                continue;
+            };
+            let xy: Vec<i32> = points.split([' ', ',']).filter_map(|v| v.parse().ok()).collect();
+            if let [x1, y1, x2, y2] = xy[..] {
+                if y1 == y2 && (x2 - x1).abs() == 5 {
+                    horizontal += 1;
+                } else if x1 == x2 && (y2 - y1).abs() == 5 {
+                    vertical += 1;
+                }
+            }
+        }
+        (horizontal, vertical)
+    }
+
     /// Every displacement tick carries its number: ticks only at −1 … 1 in halves (the axis
     /// reaches past ±1 only to make room for the labels of disks and bearings).
     #[test]
@@ -270,8 +294,11 @@ mod tests {
         for beyond in ["1.5", "2", "-1.5"] {
             assert!(!labels.iter().any(|l| l == beyond), "a `{beyond}` tick: {labels:?}");
         }
-        // One tick mark per label on the y axis: plotters draws a mark for each key point, and
-        // the key points are exactly the five labelled values.
+        // Every tick mark (a 5 px black stroke off an axis) carries a number: as many marks as
+        // numeric labels, five of them on the displacement axis.
+        let (across, up) = tick_marks(&svg);
+        assert_eq!(across, 5, "tick marks on the displacement axis");
+        assert_eq!(across + up, labels.len(), "tick marks without a number: {labels:?}");
         assert!(!svg.contains("(the lowest"), "all 4 modes asked are drawn: no note");
     }
 

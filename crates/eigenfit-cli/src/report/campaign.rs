@@ -1,6 +1,8 @@
 //! The `campaign` report: the jointly estimated parameters, each configuration's frequencies.
 
 use super::{number, Cell, Report, Table};
+use eigenfit_core::analysis::chi2_upper_tail;
+use eigenfit_core::analysis::verdict::POOR_FIT_P_VALUE;
 use eigenfit_workflow::campaign::CampaignReport;
 
 /// Fills `html` with a joint estimate; `units` per parameter (the report's JSON `units`, when
@@ -8,7 +10,17 @@ use eigenfit_workflow::campaign::CampaignReport;
 pub fn fill(html: &mut Report, r: &CampaignReport, units: &[Option<String>]) {
     html.title = format!("{}: joint estimate from {} configurations", r.campaign, r.configurations.len());
     let unpaired = r.configurations.iter().any(|c| c.unpaired.as_ref().is_some_and(|u| !u.is_empty()));
-    let good = r.outcome.converged && !r.budget.exhausted && !unpaired;
+    // With std in every configuration (and no shapes) χ² is a test statistic: judged at the
+    // level every estimate's fit is.
+    let p_value = (r.has_std && r.dof > 0).then(|| chi2_upper_tail(r.chi2, r.dof));
+    let poor = p_value.is_some_and(|p| p < POOR_FIT_P_VALUE);
+    let good = r.outcome.converged && !r.budget.exhausted && !unpaired && !poor;
+    let test = match p_value {
+        Some(p) => {
+            format!("χ² = {} on {} degrees of freedom, p = {}", number(r.chi2, 4), r.dof, number(p, 3))
+        }
+        None => format!("χ² = {} on {} degrees of freedom", number(r.chi2, 4), r.dof),
+    };
     let meaning = if r.budget.exhausted {
         "The evaluation budget ran out: the results are incomplete (raise it with --budget).".to_string()
     } else if !r.outcome.converged {
@@ -21,16 +33,31 @@ pub fn fill(html: &mut Report, r: &CampaignReport, units: &[Option<String>]) {
         "The joint fit converged, but a measured mode of some configuration could not be paired with a model \
          mode (MAC below the threshold): the result is not acceptable as it is."
             .to_string()
+    } else if poor {
+        format!(
+            "No one set of parameters explains every configuration within the noise ({test}): the models \
+             miss something, or the configurations disagree."
+        )
+    } else if p_value.is_some() {
+        format!(
+            "One set of parameters explains every configuration together within the noise ({test}, tested \
+             at the 5 % level); the intervals below use {}.",
+            r.interval_basis.as_deref().unwrap_or("no σ (none could be computed)")
+        )
     } else {
         format!(
-            "One set of parameters fits every configuration together (χ² = {} on {} degrees of freedom); \
-             the intervals below use {}.",
-            number(r.chi2, 4),
-            r.dof,
+            "The joint fit converged ({test}), but without std in every configuration whether the misfit \
+             is within the noise cannot be tested; the intervals below use {}.",
             r.interval_basis.as_deref().unwrap_or("no σ (none could be computed)")
         )
     };
-    let word = if good { "converged".to_string() } else { r.outcome.termination.to_string() };
+    let word = if poor {
+        "poor-fit".to_string()
+    } else if r.outcome.converged && !r.budget.exhausted {
+        "converged".to_string()
+    } else {
+        r.outcome.termination.to_string()
+    };
     html.verdict(good, word, meaning);
 
     let s = html.section("Parameters");
