@@ -83,7 +83,7 @@ fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
             "support stiffness k [N/m]",
             "natural frequency f [Hz]",
             "model, mode 1",
-            "model, mode 4",
+            "model, mode 3",
             "paper, Table 1 (modes 1–2)",
         ],
     );
@@ -94,13 +94,18 @@ fn simulate_plots_the_critical_speed_map_with_table_1_and_the_mode_shapes() {
             "position along the shaft x [m]",
             "displacement (normalised to the largest) [–]",
             "mode 1: 36.107 Hz",
-            "mode 4:",
+            "mode 3:",
             "disk 1.35 kg",
             "disk 0.4 kg",
             "K1 = 1e5 N/m",
             "K2 = 1e5 N/m",
         ],
     );
+    // What is drawn is what was asked: three modes, not a fixed four.
+    for stem in ["critical-speed-map", "mode-shapes"] {
+        let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap();
+        assert!(!svg.contains("mode 4"), "{stem}.svg draws a mode that was not asked for");
+    }
 }
 
 #[test]
@@ -315,4 +320,16 @@ fn demo_json_lists_the_results_and_the_plots() {
     }
     assert_eq!(v["discovery"]["kind"], "disk-rotary-inertia");
     assert_eq!(v["plots"].as_array().unwrap().len(), 12);
+}
+
+/// Asked for more modes than a plot can tell apart, both plots draw the lowest six and say so.
+#[test]
+fn plots_of_fewer_modes_than_asked_say_so() {
+    let (scratch, _) = plotted(&["simulate", "--preset", "paper-rotor", "--modes", "8", "--quiet"]);
+    let map = std::fs::read_to_string(scratch.path().join("critical-speed-map.svg")).unwrap();
+    assert!(map.contains("(the lowest 6 of the 8 modes asked)"), "the map does not say it drew 6 of 8");
+    assert!(map.contains("model, mode 6") && !map.contains("model, mode 7"));
+    let shapes = std::fs::read_to_string(scratch.path().join("mode-shapes.svg")).unwrap();
+    assert!(shapes.contains("(the lowest 6 of the 8 modes asked: more would not be told apart)"));
+    assert!(shapes.contains("mode 6:") && !shapes.contains("mode 7:"));
 }

@@ -287,6 +287,7 @@ pub fn write_plots(
     if plain && is_paper_rotor(rotor) {
         map = map.with_paper_table_1();
     }
+    map.asked = asked;
     let mut written = plot::write(&map, dir, "critical-speed-map")?;
     let mut shapes = ModeShapes::of_rotor(label, rotor, solver, p, modes)?;
     shapes.asked = asked;
