@@ -216,8 +216,10 @@ fn an_estimate_report_shows_the_verdict_every_parameter_with_its_unit_the_plots_
     let params = v["parameters"].as_object().unwrap();
     let table = rows(dom, "parameters");
     assert_eq!(table.len(), params.len());
-    for (row, (name, value)) in table.iter().zip(params) {
-        assert_eq!(&row[0].0, name);
+    // JSON objects come sorted by name; the page keeps the model's order.
+    for row in &table {
+        let name = &row[0].0;
+        let value = &params[name];
         assert_eq!(row[1].0, "N/m", "{name}'s unit");
         let value = value.as_f64().unwrap();
         assert!(same(row[3].1, Some(value)), "{name}: the exact estimate in data-value");
@@ -347,8 +349,13 @@ fn discover_writes_a_report_naming_the_missing_effect() {
     assert!(effects[0][0].0.starts_with(kind), "{:?} is not the {kind}", effects[0][0]);
     assert!(same(effects[0][2].1, v["missing_effect"]["value"].as_f64()));
     let params = rows(&r.dom, "parameters");
-    for (row, (name, value)) in params.iter().zip(v["calibrated_parameters"].as_object().unwrap()) {
-        assert_eq!((&row[0].0, row[1].0.as_str()), (name, "N/m"));
+    let calibrated = v["calibrated_parameters"].as_object().unwrap();
+    assert_eq!(params.len(), calibrated.len());
+    // JSON objects come sorted by name; the page keeps the model's order.
+    for row in &params {
+        let name = &row[0].0;
+        let value = &calibrated[name];
+        assert_eq!(row[1].0, "N/m", "{name}'s unit");
         assert!(same(row[2].1, value.as_f64()), "{name}");
     }
     assert!(r.dom.contains("<svg"), "the residual plot");
@@ -467,9 +474,64 @@ fn campaign_writes_a_report_listing_every_file_the_campaign_names() {
     let table = rows(&r.dom, "parameters");
     let params = v["parameters"].as_object().unwrap();
     assert_eq!(table.len(), params.len());
-    for (row, (name, value)) in table.iter().zip(params) {
-        assert_eq!((&row[0].0, row[1].0.as_str()), (name, "N/m"));
+    // JSON objects come sorted by name; the page keeps the model's order.
+    for row in &table {
+        let name = &row[0].0;
+        let value = &params[name];
+        assert_eq!(row[1].0, "N/m", "{name}'s unit");
         assert!(same(row[3].1, value.as_f64()), "{name}");
     }
     assert!(r.dom.contains("<span class=\"word\">"), "no verdict");
+}
+
+/// A ROSS run-up fit's page: each bearing coefficient in its unit (stiffnesses N/m, damping
+/// N·s/m), each run-up point, the verdict.
+#[test]
+fn a_runup_estimate_report_gives_each_coefficient_its_unit() {
+    let data = |name: &str| common::data_file("../eigenfit-rotordynamics/tests/data", name);
+    let (model, measured) = (data("runup_nominal.toml"), data("runup_truth.csv"));
+    let scratch = common::scratch();
+    let page = scratch.path().join("runup.html");
+    let out = eigenfit(&[
+        "estimate",
+        "--model",
+        &model,
+        "--measured",
+        &measured,
+        "--parameters",
+        "kxx,cyy",
+        "--quiet",
+        "--json",
+        "--report",
+        page.to_str().unwrap(),
+    ]);
+    assert!(matches!(out.status.code(), Some(0 | 3)), "{}", String::from_utf8_lossy(&out.stderr));
+    let v = json(&out);
+    let html = std::fs::read_to_string(&page).unwrap();
+    self_contained(&html);
+    let Some(browser) = chromium() else { return };
+    let r = render(&browser, &page);
+    assert!(r.requests.is_empty(), "{:?}", r.requests);
+    assert!(r.dom.contains(&format!("<span class=\"word\">{}</span>", v["verdict"].as_str().unwrap())));
+    let table = rows(&r.dom, "parameters");
+    let params = v["parameters"].as_object().unwrap();
+    assert_eq!(table.len(), params.len());
+    // JSON objects come sorted by name; the page keeps the model's order.
+    for row in &table {
+        let name = &row[0].0;
+        let value = &params[name];
+        let unit = if name.starts_with("kxx") { "N/m" } else { "N·s/m" };
+        assert_eq!(row[1].0, unit, "{name}'s unit");
+        assert!(same(row[3].1, value.as_f64()), "{name}");
+    }
+    let points = rows(&r.dom, "modes");
+    assert_eq!(points.len(), v["points"].as_array().unwrap().len());
+    for (row, p) in points.iter().zip(v["points"].as_array().unwrap()) {
+        assert!(
+            same(row[0].1, p["speed_rpm"].as_f64()) && same(row[2].1, p["measured_hz"].as_f64()),
+            "{row:?}"
+        );
+    }
+    lists_input(&r.dom, Path::new(&model));
+    lists_input(&r.dom, Path::new(&measured));
 }

@@ -122,7 +122,7 @@ pub fn fill(html: &mut Report, r: &CampbellReport, modes: usize) {
         class: "frequencies".into(),
     };
     for (k, rpm) in c.speeds_rpm.iter().enumerate() {
-        let mut row = vec![Cell::number(*rpm, 6)];
+        let mut row = vec![Cell::plain(*rpm, 1)];
         for (f, w) in c.frequencies_hz[k].iter().zip(&c.whirl[k]) {
             row.push(Cell { text: format!("{} ({})", number(*f, 6), w.name()), value: Some(*f) });
         }

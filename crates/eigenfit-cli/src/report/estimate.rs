@@ -343,7 +343,7 @@ pub fn fill_runup(html: &mut Report, r: &RunupEstimateReport) {
     s.text(format!(
         "Coefficients at the reference speed {} rpm (the lowest measured); each bearing table is scaled by \
          the estimated factor.",
-        number(r.reference_speed_rpm, 6)
+        crate::plot::style::trim(r.reference_speed_rpm, 1)
     ));
     s.table(parameter_table(
         "Nominal and estimated coefficients with 95 % intervals",
@@ -370,7 +370,7 @@ pub fn fill_runup(html: &mut Report, r: &RunupEstimateReport) {
     );
     for p in &r.points {
         t.row(vec![
-            Cell::number(p.speed_rpm, 6),
+            Cell::plain(p.speed_rpm, 1),
             Cell::integer(p.mode),
             Cell::number(p.measured_hz, 7),
             Cell::number(p.model_hz, 7),

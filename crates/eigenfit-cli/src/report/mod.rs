@@ -135,6 +135,12 @@ impl Cell {
         Self { text: number(v, digits), value: Some(v) }
     }
 
+    /// A number with at most `decimals` decimals and no trailing zeros (speeds in rpm: `1000`,
+    /// `999.5`), its exact value kept beside.
+    pub fn plain(v: f64, decimals: usize) -> Self {
+        Self { text: crate::plot::style::trim(v, decimals), value: Some(v) }
+    }
+
     /// A whole number (a mode, a count), shown as it is.
     pub fn integer(n: usize) -> Self {
         Self { text: n.to_string(), value: Some(n as f64) }
