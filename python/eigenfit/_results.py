@@ -341,7 +341,9 @@ class EstimateResult(Result):
         rows = []
         for name, value in d["parameters"].items():
             iv = intervals.get(name) or [None, None]
-            estimate = _cell(f"— (on a limit at {_number(value, 6)})") if name in at_limit else _cell(value, 6)
+            estimate = (
+                _cell(f"— (on a limit at {_number(value, 6)})") if name in at_limit else _cell(value, 6)
+            )
             rows.append(
                 [
                     _cell(name),
@@ -362,7 +364,11 @@ class EstimateResult(Result):
                 rows,
             ),
         ]
-        numbers = d.get("mode_numbers") or list(range(1, len(d["measured_hz"]) + 1))
+        # The measured mode numbers: the keys of ``pairing`` (measured → model mode), in order.
+        paired = sorted(int(k) for k in (d.get("pairing") or {}))
+        numbers = (
+            paired if len(paired) == len(d["measured_hz"]) else list(range(1, len(d["measured_hz"]) + 1))
+        )
         modes = [
             [_cell(n), _cell(m, 7), _cell(f, 7), _cell(f - m, 3)]
             for n, m, f in zip(numbers, d["measured_hz"], d["frequencies_hz"])
@@ -437,7 +443,14 @@ class DiscoverResult(Result):
             r = refitted.get(name) or {}
             iv = r.get("interval") or [None, None]
             params.append(
-                [_cell(name), _cell(_unit(units, name)), _cell(value, 6), _cell(r.get("value"), 6), _cell(iv[0], 4), _cell(iv[1], 4)]
+                [
+                    _cell(name),
+                    _cell(_unit(units, name)),
+                    _cell(value, 6),
+                    _cell(r.get("value"), 6),
+                    _cell(iv[0], 4),
+                    _cell(iv[1], 4),
+                ]
             )
         return "".join(
             [
@@ -489,7 +502,15 @@ class BenchResult(Result):
         return _table(
             "summary",
             "Success rate and model evaluations per problem and strategy",
-            ["problem", "strategy", "runs", "success [%]", "median evaluations", "median evaluations (successes)", "verdicts"],
+            [
+                "problem",
+                "strategy",
+                "runs",
+                "success [%]",
+                "median evaluations",
+                "median evaluations (successes)",
+                "verdicts",
+            ],
             rows,
         )
 
@@ -549,7 +570,13 @@ class CampbellResult(Result):
 
     def _html_body(self) -> str:
         rows = [
-            [_cell(k["rpm"], 6), _cell(k["rpm"] / 60.0, 6), _cell(k["whirl"]), _cell(k["log_dec"], 4), _cell(k["damping_ratio"], 3)]
+            [
+                _cell(k["rpm"], 6),
+                _cell(k["rpm"] / 60.0, 6),
+                _cell(k["whirl"]),
+                _cell(k["log_dec"], 4),
+                _cell(k["damping_ratio"], 3),
+            ]
             for k in self._data.get("critical_speeds") or []
         ]
         return _table(

@@ -100,18 +100,26 @@ def test_an_estimate_shows_the_reports_tables(cli, examples: Path, tmp_path: Pat
 
 
 def test_a_discovery_shows_the_named_effect_and_the_parameters(cli, examples: Path) -> None:
-    data, code = cli(["discover", "--preset", "paper-rotor", "--measured", str(examples / "measured_hidden_effect.csv")])
+    data, code = cli(
+        ["discover", "--preset", "paper-rotor", "--measured", str(examples / "measured_hidden_effect.csv")]
+    )
     shown = _parse(DiscoverResult(data, code)._repr_html_())
     assert shown.verdict == ("explained" if data["explained"] else "not explained")
     effect = data["missing_effect"]
     assert shown.tables["effects"][0][0][0] == f"{effect['kind']}@{effect['location']}"
-    assert [(r[0][0], r[2][1]) for r in shown.tables["parameters"]] == list(data["calibrated_parameters"].items())
+    assert [(r[0][0], r[2][1]) for r in shown.tables["parameters"]] == list(
+        data["calibrated_parameters"].items()
+    )
 
 
 def test_a_bench_shows_its_summary(cli) -> None:
-    data, code = cli(["bench", "--problems", "paper-table2", "--strategies", "newton,damped", "--starts", "2"])
+    data, code = cli(
+        ["bench", "--problems", "paper-table2", "--strategies", "newton,damped", "--starts", "2"]
+    )
     rows = _parse(BenchResult(data, code)._repr_html_()).tables["summary"]
-    assert [(r[1][0], r[3][1]) for r in rows] == [(s["strategy"], 100.0 * s["success_rate"]) for s in data["summary"]]
+    assert [(r[1][0], r[3][1]) for r in rows] == [
+        (s["strategy"], 100.0 * s["success_rate"]) for s in data["summary"]
+    ]
 
 
 def test_every_text_is_escaped() -> None:
