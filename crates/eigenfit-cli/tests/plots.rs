@@ -145,7 +145,7 @@ fn estimate_plots_its_convergence_history() {
             "k_K1",
             "k_K2",
             "newton (converged,",
-            "newton tolerance, 0.01 Hz (as in the paper)",
+            "newton tolerance, 0.01 Hz",
         ],
     );
 }

@@ -54,7 +54,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
         unit: "N/m".to_string(),
         runs: found.estimates.iter().map(Run::from_estimate).collect(),
         target: Some(TARGET.to_vec()),
-        tolerance: Some((0.01, "newton and p-step tolerance, 0.01 Hz (as in the paper)".to_string())),
+        tolerance: Some((0.01, "newton/p-step tolerance, 0.01 Hz".to_string())),
         sigma_hz: None,
     };
     plots.extend(plot::write(&figure, out, "convergence")?);

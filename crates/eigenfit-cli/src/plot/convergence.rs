@@ -5,12 +5,11 @@ use super::style::{self, log_bounds, log_tick, px, pxi, series_style, strategy_c
 use super::{err, DrawResult, Figure};
 use eigenfit_core::update::Estimate;
 use plotters::coord::combinators::WithKeyPoints;
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 /// A panel's coordinates: iterations across, a logarithmic axis with chosen ticks up.
-type Coords = Cartesian2d<RangedCoordf64, WithKeyPoints<LogCoord<f64>>>;
+type Coords = Cartesian2d<style::FixedTicks, WithKeyPoints<LogCoord<f64>>>;
 
 /// A panel of the figure on `area`: iterations 0…`x_end` across (whole numbers labelled), `y`
 /// on a log axis titled `y_title`, with `x_area` pixels for the x labels.
@@ -27,15 +26,31 @@ fn panel<'a, DB: DrawingBackend>(
         .margin_left(px(20))
         .x_label_area_size(px(x_area))
         .y_label_area_size(px(90))
-        .build_cartesian_2d(0.0..x_end, y.log_scale().with_key_points(labelled).with_light_points(grid))
+        .build_cartesian_2d(
+            style::FixedTicks { lo: 0.0, hi: x_end, ticks: iteration_ticks(x_end) },
+            y.log_scale().with_key_points(labelled).with_light_points(grid),
+        )
         .map_err(err)?;
-    let whole = |v: &f64| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() };
+    let whole = |v: &f64| format!("{v:.0}");
     style::grid(style::axes(&mut chart.configure_mesh(), "iteration", y_title), 0.4)
         .x_label_formatter(&whole)
         .y_label_formatter(&log_tick)
         .draw()
         .map_err(err)?;
     Ok(chart)
+}
+
+/// Whole iterations from 0 to `x_end`, every 1, 2, 5, 10, 20, … so that at most 11 are
+/// labelled: every tick drawn carries its number (plotters' own ticks fell between iterations,
+/// where there is no number to give).
+fn iteration_ticks(x_end: f64) -> Vec<f64> {
+    let last = x_end.floor().max(0.0);
+    let step = [1.0, 2.0, 5.0]
+        .iter()
+        .flat_map(|m| (0..12).map(move |e| m * 10f64.powi(e)))
+        .filter(|s| last / s <= 10.0)
+        .fold(f64::INFINITY, f64::min);
+    (0..).map(|k| k as f64 * step).take_while(|t| *t <= last).collect()
 }
 
 /// A thin dashed horizontal reference line at `y` (a target value, a tolerance).
@@ -106,7 +121,7 @@ pub fn strategy_tolerance(strategy: &str, setting: &str) -> Option<(f64, String)
     let given = setting.split(':').skip(1).find_map(|s| s.trim().strip_prefix("tolerance_hz="));
     let tol = given.and_then(|v| v.trim().parse::<f64>().ok()).unwrap_or(0.01);
     Some(if tol == 0.01 {
-        (tol, format!("{strategy} tolerance, 0.01 Hz (as in the paper)"))
+        (tol, format!("{strategy} tolerance, 0.01 Hz"))
     } else {
         (tol, format!("{strategy} tolerance, {tol} Hz"))
     })
@@ -243,6 +258,23 @@ mod tests {
     }
 
     #[test]
+    fn iterations_are_ticked_at_whole_numbers_only() {
+        assert_eq!(iteration_ticks(1.3), [0.0, 1.0]);
+        assert_eq!(iteration_ticks(7.3), (0..=7).map(f64::from).collect::<Vec<_>>());
+        assert_eq!(iteration_ticks(25.3), [0.0, 5.0, 10.0, 15.0, 20.0, 25.0]);
+        assert_eq!(iteration_ticks(1000.3).len(), 11);
+        // In the figure: as many tick marks as numeric labels.
+        let svg = crate::plot::to_svg(&figure("damped", 2, "damped")).unwrap();
+        let (across, up) = crate::plot::mode_shapes::tests::tick_marks(&svg);
+        let numeric = svg
+            .split("<text")
+            .filter_map(|t| t.split_once('>').map(|(_, r)| r.split("</text>").next().unwrap_or("").trim()))
+            .filter(|t| !t.is_empty() && t.chars().all(|c| c.is_ascii_digit() || "·⁰¹²³⁴⁵⁶⁷⁸⁹⁻".contains(c)))
+            .count();
+        assert_eq!(across + up, numeric, "tick marks without a number");
+    }
+
+    #[test]
     fn no_two_series_look_alike() {
         let own: HashSet<SeriesStyle> = (0..140).map(|j| series_style(j, None)).collect();
         assert_eq!(own.len(), 140, "colour, pattern and marker repeat within 140 series");
@@ -277,7 +309,7 @@ mod tests {
     #[test]
     fn the_tolerance_line_is_drawn_only_for_the_strategies_that_stop_on_it() {
         let newton = crate::plot::to_svg(&figure("newton", 2, "newton")).unwrap();
-        assert!(newton.contains("newton tolerance, 0.01 Hz (as in the paper)"));
+        assert!(newton.contains("newton tolerance, 0.01 Hz"));
         let set = crate::plot::to_svg(&figure("p-step", 2, "p-step:tolerance_hz=0.002")).unwrap();
         assert!(set.contains("p-step tolerance, 0.002 Hz"));
         for strategy in ["damped", "trf", "gn-line-search"] {

@@ -225,7 +225,7 @@ pub fn format_hz(f: f64) -> String {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// The markers follow the model, not the order of the bearings: in the paper rotor K2 is at
