@@ -103,6 +103,22 @@ fn render(browser: &Path, page: &Path) -> Rendered {
     Rendered { dom, requests }
 }
 
+/// The page as the browser paints it, 1200 px wide, tall enough for the whole report.
+fn screenshot(browser: &Path, page: &Path) -> image::RgbImage {
+    let scratch = common::scratch();
+    let png = scratch.path().join("page.png");
+    let out = Command::new(browser)
+        .args(["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--hide-scrollbars"])
+        .arg(format!("--user-data-dir={}", scratch.path().join("profile").display()))
+        .arg(format!("--screenshot={}", png.display()))
+        .arg("--window-size=1200,4000")
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .expect("chromium runs");
+    assert!(png.is_file(), "no screenshot: {}", String::from_utf8_lossy(&out.stderr));
+    image::open(&png).expect("a PNG").to_rgb8()
+}
+
 /// Checks the page's text for what makes it self-contained: nothing loaded from elsewhere.
 fn self_contained(html: &str) {
     for banned in ["<script", "<link", "<iframe", "<img", "@import", "url("] {
@@ -240,6 +256,12 @@ fn an_estimate_report_shows_the_verdict_every_parameter_with_its_unit_the_plots_
     assert!(dom.matches("<svg").count() >= 1, "no SVG in the page");
     assert!(dom.contains("<polyline") || dom.contains("<path"), "the SVG has no lines");
     assert!(dom.contains("convergence of the damped strategy"));
+    // What the page shows on screen: the verdict's box in its colour and the plot's curves.
+    let shot = screenshot(&browser, &page);
+    let count = |rgb: [u8; 3]| shot.pixels().filter(|p| p.0 == rgb).count();
+    let (box_colour, bad_colour) = ([0xea, 0xf7, 0xf2], [0xfc, 0xef, 0xe6]);
+    assert!(count(if good { box_colour } else { bad_colour }) > 10_000, "no verdict box on screen");
+    assert!(count([0, 114, 178]) > 200, "no curve of the convergence plot on screen");
     // Provenance: the measured file's SHA-256, the built-in model, the command line, the version.
     lists_input(dom, Path::new(&measured));
     assert!(dom.contains("preset paper-rotor"));
