@@ -380,6 +380,17 @@ fn discover_writes_a_report_naming_the_missing_effect() {
         assert_eq!(row[1].0, "N/m", "{name}'s unit");
         assert!(same(row[2].1, value.as_f64()), "{name}");
     }
+    // Each mode as the JSON numbers it (from 1), with both frequencies.
+    let modes = rows(&r.dom, "modes");
+    let json_modes = v["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), json_modes.len());
+    for (row, m) in modes.iter().zip(json_modes) {
+        assert_eq!(row[0].1, m["mode"].as_f64(), "{row:?}");
+        assert!(
+            same(row[1].1, m["measured_hz"].as_f64()) && same(row[5].1, m["after_hz"].as_f64()),
+            "{row:?}"
+        );
+    }
     assert!(r.dom.contains("<svg"), "the residual plot");
     lists_input(&r.dom, Path::new(&measured));
 }

@@ -5,15 +5,20 @@ use super::{number, Cell, Report, Table};
 use crate::plot::campbell::CampbellPlot;
 use eigenfit_workflow::rotordynamics::CampbellReport;
 
+/// A speed as an engineer writes it: `4000`, `876.5` (at most one decimal, no trailing zeros).
+fn rpm(v: f64) -> String {
+    crate::plot::style::trim(v, 1)
+}
+
 /// Fills `html` with a Campbell diagram of `modes` modes per speed.
 pub fn fill(html: &mut Report, r: &CampbellReport, modes: usize) {
     let c = &r.campbell;
     html.title = format!("{}: Campbell diagram", r.model);
     if let Some(margins) = &r.separation_margins {
         let failing: Vec<String> =
-            margins.iter().filter(|m| !m.passes).map(|m| format!("{} rpm", number(m.rpm, 5))).collect();
+            margins.iter().filter(|m| !m.passes).map(|m| format!("{} rpm", rpm(m.rpm))).collect();
         let [lo, hi] = r.operating_range_rpm.unwrap_or([f64::NAN, f64::NAN]);
-        let range = format!("{}–{} rpm", number(lo, 5), number(hi, 5));
+        let range = format!("{}–{} rpm", rpm(lo), rpm(hi));
         if failing.is_empty() {
             html.verdict(
                 true,
@@ -80,8 +85,8 @@ pub fn fill(html: &mut Report, r: &CampbellReport, modes: usize) {
             "margins",
             format!(
                 "Separation margins from the operating range {}–{} rpm (API 684 style)",
-                number(lo, 5),
-                number(hi, 5)
+                rpm(lo),
+                rpm(hi)
             ),
             &[
                 "critical speed [rpm]",

@@ -117,7 +117,7 @@ pub fn fill(html: &mut Report, r: &DiscoverReport, units: &[String], plot: Optio
     for m in &r.modes {
         let z = |f: f64| if m.std_hz > 0.0 { Some((f - m.measured_hz) / m.std_hz) } else { None };
         t.row(vec![
-            Cell::integer(m.mode + 1),
+            Cell::integer(m.mode),
             Cell::number(m.measured_hz, 7),
             Cell::number(m.std_hz, 3),
             Cell::number(m.before_hz, 7),
