@@ -333,3 +333,50 @@ fn plots_of_fewer_modes_than_asked_say_so() {
     assert!(shapes.contains("(the lowest 6 of the 8 modes asked: more would not be told apart)"));
     assert!(shapes.contains("mode 6:") && !shapes.contains("mode 7:"));
 }
+
+/// A benchmark's evaluations axis carries numbers even over less than a decade (3 starts of
+/// one problem: an ECDF between 15 and 60 evaluations had no label), and every tick has one.
+/// (One strategy that reaches the truth every time: the helper expects exit code 0.)
+#[test]
+fn bench_plots_label_every_tick_of_the_evaluations_axis() {
+    let (scratch, _) = plotted(&[
+        "bench",
+        "--problems",
+        "paper-table2",
+        "--strategies",
+        "damped",
+        "--starts",
+        "3",
+        "--quiet",
+    ]);
+    for stem in ["bench_ecdf", "bench_profile"] {
+        let svg = std::fs::read_to_string(scratch.path().join(format!("{stem}.svg"))).unwrap();
+        let texts: Vec<&str> = svg
+            .split("<text")
+            .filter_map(|t| {
+                t.split_once('>').map(|(_, rest)| rest.split("</text>").next().unwrap_or("").trim())
+            })
+            .collect();
+        // Numbers on the log axis read `10¹`, `2·10¹`; on the fraction axis `0.5`.
+        let numeric =
+            |t: &str| !t.is_empty() && t.chars().all(|c| c.is_ascii_digit() || ".·⁰¹²³⁴⁵⁶⁷⁸⁹⁻".contains(c));
+        let log_labels = texts.iter().filter(|t| numeric(t) && t.contains("10")).count();
+        assert!(log_labels >= 1, "{stem}: no number on the evaluations axis: {texts:?}");
+        let marks = svg
+            .split("<polyline")
+            .skip(1)
+            .map(|l| l.split("/>").next().unwrap_or(""))
+            .filter(|l| l.contains("stroke=\"#000000\""))
+            .filter_map(|l| l.split("points=\"").nth(1).and_then(|p| p.split('"').next()))
+            .filter(|p| {
+                let xy: Vec<i32> = p.split([' ', ',']).filter_map(|v| v.parse().ok()).collect();
+                matches!(xy[..], [x1, y1, x2, y2] if (y1 == y2 && (x2 - x1).abs() == 5) || (x1 == x2 && (y2 - y1).abs() == 5))
+            })
+            .count();
+        assert_eq!(
+            marks,
+            texts.iter().filter(|t| numeric(t)).count(),
+            "{stem}: tick marks without a number: {texts:?}"
+        );
+    }
+}

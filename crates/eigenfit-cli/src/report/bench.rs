@@ -1,17 +1,19 @@
 //! The `bench` report: each problem with its truth, each strategy's success rate and cost, the
 //! performance profile and the ECDF of evaluations.
 
-use super::{number, Cell, Report, Table};
+use super::{Cell, Report, Table};
+use crate::output::significant;
 use crate::plot::bench::{BenchFigure, Kind};
 use eigenfit_workflow::bench::BenchReport;
 
 /// Fills `html` with a benchmark.
 pub fn fill(html: &mut Report, r: &BenchReport) {
+    let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
     html.title = format!(
-        "Benchmark: {} problems × {} strategies × {} starts",
-        r.problems.len(),
-        r.strategies.len(),
-        r.starts
+        "Benchmark: {} × {} × {}",
+        plural(r.problems.len(), "problem"),
+        plural(r.strategies.len(), "strategy").replace("strategys", "strategies"),
+        plural(r.starts, "start")
     );
     let failed: Vec<String> = r
         .summary
@@ -57,8 +59,8 @@ pub fn fill(html: &mut Report, r: &BenchReport) {
             Cell::text(x.strategy.clone()),
             Cell::integer(x.runs),
             Cell::number(100.0 * x.success_rate, 3),
-            Cell::number(x.median_evaluations, 4),
-            Cell::maybe(x.median_evaluations_success, 4, "— (none)"),
+            Cell::plain(x.median_evaluations, 1),
+            x.median_evaluations_success.map_or(Cell::text("— (none)"), |m| Cell::plain(m, 1)),
             Cell::text(verdicts.join(", ")),
         ]);
     }
@@ -72,8 +74,8 @@ pub fn fill(html: &mut Report, r: &BenchReport) {
         &["problem", "truth", "measured [Hz]", "tolerance (relative) [–]"],
     );
     for p in &r.problems {
-        let truth: Vec<String> = p.truth.iter().map(|(n, v)| format!("{n} = {}", number(*v, 5))).collect();
-        let measured: Vec<String> = p.measured_hz.iter().map(|f| number(*f, 6)).collect();
+        let truth: Vec<String> = p.truth.iter().map(|(n, v)| format!("{n} = {}", significant(*v))).collect();
+        let measured: Vec<String> = p.measured_hz.iter().map(|f| significant(*f)).collect();
         t.row(vec![
             Cell::text(p.name.clone()),
             Cell::text(truth.join(", ")),
