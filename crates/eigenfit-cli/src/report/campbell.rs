@@ -44,6 +44,9 @@ pub fn fill(html: &mut Report, r: &CampbellReport, modes: usize) {
         }
     }
     let s = html.section("Critical speeds");
+    if r.separation_margins.is_none() {
+        s.text("No operating range was given (--operating FROM:TO): the separation margins are not judged.");
+    }
     if c.critical_speeds.is_empty() {
         s.text(if c.overdamped_crossings.is_empty() {
             "No critical speed in range: no followed mode crosses the 1× line."
