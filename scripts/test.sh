@@ -13,6 +13,14 @@ if ! dpkg -s libopenblas-dev >/dev/null 2>&1; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libopenblas-dev
 fi
 
+# Debian's Chromium: the HTML reports (`--report`) are rendered in a headless browser by
+# crates/eigenfit-cli/tests/report.rs, which fails without it (EIGENFIT_SKIP_BROWSER=1 skips).
+if ! command -v chromium >/dev/null 2>&1; then
+  echo "scripts/test.sh: installing chromium (the HTML reports are checked in a headless browser)" >&2
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium
+fi
+
 cargo test --workspace --all-features
 
 # The Python package (python/), as a user installs it: `pip install ./python` into a fresh virtual

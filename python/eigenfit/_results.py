@@ -5,7 +5,9 @@ pickling is the JSON text (small, version-tolerant, safe to ship between Dask wo
 from __future__ import annotations
 
 import copy
+import html
 import json
+import math
 from typing import Any, Dict, List, Optional
 
 import numpy as np
@@ -17,6 +19,67 @@ def _array(value: Any) -> Optional[np.ndarray]:
 
 def _arrays(mapping: Optional[Dict[str, Any]]) -> Dict[str, np.ndarray]:
     return {k: np.asarray(v, dtype=float) for k, v in (mapping or {}).items()}
+
+
+def _esc(value: Any) -> str:
+    """``value`` as HTML text (``& < > " '`` escaped)."""
+    return html.escape(str(value), quote=True)
+
+
+def _number(value: Optional[float], digits: int) -> str:
+    """``value`` to ``digits`` significant digits as the CLI's HTML report shows it: plain in
+    [1e-3, 1e5), else ``1.2346 × 10⁵``; ``—`` for none."""
+    if value is None or not math.isfinite(value):
+        return "—"
+    if value == 0:
+        return "0"
+    exponent = math.floor(math.log10(abs(value)))
+    if -3 <= exponent < 5:
+        return f"{value:.{max(digits - 1 - exponent, 0)}f}"
+    mantissa, exp = f"{value:.{digits - 1}e}".split("e")
+    sup = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+    return f"{mantissa} × 10{str(int(exp)).translate(sup)}"
+
+
+def _cell(value: Any, digits: int = 6) -> str:
+    """A table cell: a number with its exact value in ``data-value``, else text."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f"<td>{_esc('—' if value is None else value)}</td>"
+    if isinstance(value, int):
+        return f'<td class="num" data-value="{float(value)!r}">{value}</td>'
+    return f'<td class="num" data-value="{float(value)!r}">{_esc(_number(float(value), digits))}</td>'
+
+
+def _table(cls: str, caption: str, head: List[str], rows: List[List[str]]) -> str:
+    """An HTML table of class ``cls``; ``rows`` hold cells made by :func:`_cell`."""
+    out = [f'<table class="{_esc(cls)}"><caption>{_esc(caption)}</caption><thead><tr>']
+    out += [f"<th>{_esc(h)}</th>" for h in head]
+    out.append("</tr></thead><tbody>")
+    out += ["<tr>" + "".join(r) + "</tr>" for r in rows]
+    out.append("</tbody></table>")
+    return "".join(out)
+
+
+def _unit(units: Dict[str, Any], name: str) -> str:
+    """The unit the JSON states for ``name`` (``–`` for a dimensionless one), else a note."""
+    unit = units.get(name)
+    if unit is None:
+        return "as the model declares"
+    return "–" if unit in ("", "-") else str(unit)
+
+
+def _effect_label(effect: Dict[str, Any]) -> str:
+    """``kind@location`` as the CLI names an effect (``kind`` alone without a location)."""
+    location = effect.get("location")
+    return str(effect.get("kind")) + ("" if location is None else f"@{location}")
+
+
+def _verdict_html(word: str, good: bool) -> str:
+    colour = "#009e73" if good else "#d55e00"
+    return (
+        f'<p class="verdict {"good" if good else "bad"}" style="border-left:.4em solid {colour};'
+        f'padding-left:.6em"><b>Verdict:</b> <span class="word">{_esc(word)}</span></p>'
+    )
 
 
 class Result:
@@ -74,6 +137,21 @@ class Result:
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(model={self._data.get('model')!r})"
+
+    def _html_body(self) -> str:
+        """The tables of this kind of result (the scalar fields for the base class)."""
+        rows = [
+            [_cell(k), _cell(v)]
+            for k, v in self._data.items()
+            if v is None or isinstance(v, (str, int, float, bool))
+        ]
+        return _table("fields", "Fields", ["field", "value"], rows)
+
+    def _repr_html_(self) -> str:
+        """The result as HTML for notebooks: the same tables as the CLI's ``--report`` page
+        (its plots and provenance are in that page only). Every text is HTML-escaped."""
+        title = f"eigenfit {self.command or 'result'}: {self._data.get('model', '')}"
+        return f'<div class="eigenfit-result"><h3>{_esc(title)}</h3>{self._html_body()}</div>'
 
 
 class SimulateResult(Result):
@@ -253,6 +331,58 @@ class EstimateResult(Result):
             f"parameters={self.parameters!r})"
         )
 
+    def _html_body(self) -> str:
+        d = self._data
+        units = d.get("units") or {}
+        intervals = d.get("intervals") or {}
+        status = d.get("parameter_status") or {}
+        initial = d.get("initial") or {}
+        at_limit = set(d.get("at_limit") or [])
+        rows = []
+        for name, value in d["parameters"].items():
+            iv = intervals.get(name) or [None, None]
+            estimate = (
+                _cell(f"— (on a limit at {_number(value, 6)})") if name in at_limit else _cell(value, 6)
+            )
+            rows.append(
+                [
+                    _cell(name),
+                    _cell(_unit(units, name)),
+                    _cell(initial.get(name), 4),
+                    estimate,
+                    _cell(iv[0], 4),
+                    _cell(iv[1], 4),
+                    _cell(status.get(name, "")),
+                ]
+            )
+        parts = [
+            _verdict_html(str(d.get("verdict")), self.acceptable and self.unique),
+            _table(
+                "parameters",
+                "Estimated parameters with 95 % intervals",
+                ["parameter", "unit", "initial", "estimate", "95 % interval from", "to", "what the data say"],
+                rows,
+            ),
+        ]
+        # The measured mode numbers: the keys of ``pairing`` (measured → model mode), in order.
+        paired = sorted(int(k) for k in (d.get("pairing") or {}))
+        numbers = (
+            paired if len(paired) == len(d["measured_hz"]) else list(range(1, len(d["measured_hz"]) + 1))
+        )
+        modes = [
+            [_cell(n), _cell(m, 7), _cell(f, 7), _cell(f - m, 3)]
+            for n, m, f in zip(numbers, d["measured_hz"], d["frequencies_hz"])
+        ]
+        parts.append(
+            _table(
+                "modes",
+                "Measured and model frequencies at the estimate",
+                ["mode", "measured [Hz]", "model [Hz]", "model − measured [Hz]"],
+                modes,
+            )
+        )
+        return "".join(parts)
+
 
 class DiscoverResult(Result):
     """``eigenfit discover``: whether model and measurement disagree, and the effect that explains it."""
@@ -290,6 +420,56 @@ class DiscoverResult(Result):
         """p-value of the nominal model's misfit."""
         return self._data.get("p_value")
 
+    def _html_body(self) -> str:
+        d = self._data
+        units = d.get("units") or {}
+        effects = []
+        for e in d.get("missing_effects") or []:
+            iv = e.get("interval") or [None, None]
+            value = e.get("value")
+            effects.append(
+                [
+                    _cell(e.get("label") or _effect_label(e)),
+                    _cell(e.get("unit") if isinstance(value, (int, float)) else "–"),
+                    _cell(value, 5) if isinstance(value, (int, float)) else _cell("on"),
+                    _cell(iv[0], 4),
+                    _cell(iv[1], 4),
+                    _cell(e.get("delta_aicc"), 4),
+                ]
+            )
+        refitted = d.get("refitted_parameters") or {}
+        params = []
+        for name, value in d["calibrated_parameters"].items():
+            r = refitted.get(name) or {}
+            iv = r.get("interval") or [None, None]
+            params.append(
+                [
+                    _cell(name),
+                    _cell(_unit(units, name)),
+                    _cell(value, 6),
+                    _cell(r.get("value"), 6),
+                    _cell(iv[0], 4),
+                    _cell(iv[1], 4),
+                ]
+            )
+        return "".join(
+            [
+                _verdict_html("explained" if self.explained else "not explained", self.explained),
+                _table(
+                    "effects",
+                    "Missing effects, strongest first",
+                    ["effect", "unit", "value", "95 % interval from", "to", "ΔAICc [–]"],
+                    effects,
+                ),
+                _table(
+                    "parameters",
+                    "The model's parameters: calibrated alone, and refitted with the named effects",
+                    ["parameter", "unit", "calibrated", "refitted", "95 % interval from", "to"],
+                    params,
+                ),
+            ]
+        )
+
 
 class BenchResult(Result):
     """``eigenfit bench``: one record per run, a summary per problem and strategy."""
@@ -305,6 +485,34 @@ class BenchResult(Result):
     def summary(self) -> List[Dict[str, Any]]:
         """One entry per problem and strategy: success rate, median evaluations, verdicts."""
         return copy.deepcopy(self._data["summary"])
+
+    def _html_body(self) -> str:
+        rows = [
+            [
+                _cell(s["problem"]),
+                _cell(s["strategy"]),
+                _cell(s["runs"]),
+                _cell(100.0 * s["success_rate"], 3),
+                _cell(s["median_evaluations"], 4),
+                _cell(s.get("median_evaluations_success"), 4),
+                _cell(", ".join(f"{k} {v}" for k, v in (s.get("verdicts") or {}).items())),
+            ]
+            for s in self._data["summary"]
+        ]
+        return _table(
+            "summary",
+            "Success rate and model evaluations per problem and strategy",
+            [
+                "problem",
+                "strategy",
+                "runs",
+                "success [%]",
+                "median evaluations",
+                "median evaluations (successes)",
+                "verdicts",
+            ],
+            rows,
+        )
 
 
 class CompareResult(Result):
@@ -359,6 +567,24 @@ class CampbellResult(Result):
     def whirl(self) -> List[List[str]]:
         """Whirl of each mode at each speed: ``forward``, ``backward`` or ``mixed``."""
         return copy.deepcopy(self._data["whirl"])
+
+    def _html_body(self) -> str:
+        rows = [
+            [
+                _cell(k["rpm"], 6),
+                _cell(k["rpm"] / 60.0, 6),
+                _cell(k["whirl"]),
+                _cell(k["log_dec"], 4),
+                _cell(k["damping_ratio"], 3),
+            ]
+            for k in self._data.get("critical_speeds") or []
+        ]
+        return _table(
+            "critical-speeds",
+            "Critical speeds: where a followed mode crosses the 1× line",
+            ["speed [rpm]", "frequency [Hz]", "whirl", "log decrement [–]", "damping ratio ζ [–]"],
+            rows,
+        )
 
 
 #: Result class by name, for unpickling (the name, not the class, travels in the pickle).

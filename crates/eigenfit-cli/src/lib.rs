@@ -10,6 +10,7 @@ pub mod error;
 pub mod output;
 pub mod plot;
 pub mod progress;
+pub mod report;
 pub mod rotordynamics;
 pub mod source;
 pub mod testdata;
@@ -79,8 +80,11 @@ pub fn run_json(args: &[String]) -> Result<(serde_json::Value, u8), CliError> {
     }
     let cli =
         Cli::try_parse_from(&argv).map_err(|e| CliError::Input(e.to_string().trim_end().to_string()))?;
-    let (outcome, value) =
-        output::capture_json(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&cli))));
+    let (outcome, value) = output::capture_json(|| {
+        report::with_command_line(&argv, || {
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&cli)))
+        })
+    });
     let code = match outcome {
         Ok(result) => result?,
         Err(panic) => {

@@ -445,7 +445,7 @@ pub fn updated_model_toml(
 
 /// Today's date, UTC, as YYYY-MM-DD (Howard Hinnant's civil-from-days; no date crate needed
 /// for one header line).
-fn utc_date() -> String {
+pub fn utc_date() -> String {
     let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
     let z = (secs / 86_400) as i64 + 719_468;
     let era = z.div_euclid(146_097);

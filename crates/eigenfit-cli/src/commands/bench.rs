@@ -39,6 +39,9 @@ pub struct BenchArgs {
     /// `--quiet`, `--json`.
     #[command(flatten)]
     pub report: crate::output::ReportArgs,
+    /// `--report FILE.html`.
+    #[command(flatten)]
+    pub html: crate::report::HtmlArgs,
 }
 
 /// Runs `bench`: exit 0 when every problem and strategy reached the truth at least once, else 3
@@ -52,6 +55,20 @@ pub fn run(args: &BenchArgs) -> Result<u8, CliError> {
         budget: args.budget,
         max_iterations: args.max_iterations,
     };
+    args.html.check()?;
+    let html = args.html.html.as_ref().map(|_| {
+        let mut html = crate::report::Report::new("bench", "bench");
+        // Problem files (built-in problems are fixed by the version).
+        for p in &request.problems {
+            let path = std::path::Path::new(p);
+            if path.is_file() {
+                html.input("problem file", path);
+            } else {
+                html.builtin("problem", p);
+            }
+        }
+        html
+    });
     let report = bench::run(&request)?;
     if let Some(path) = &args.records {
         let mut lines = String::new();
@@ -74,6 +91,10 @@ pub fn run(args: &BenchArgs) -> Result<u8, CliError> {
             println!("wrote {}", path.display());
         }
     });
+    if let (Some(path), Some(mut html)) = (&args.html.html, html) {
+        crate::report::bench::fill(&mut html, &report);
+        html.write_after(path, args.report.json);
+    }
     Ok(code)
 }
 

@@ -32,6 +32,9 @@ pub struct CampaignArgs {
     /// `--quiet`, `--json`.
     #[command(flatten)]
     pub report: crate::output::ReportArgs,
+    /// `--report FILE.html`.
+    #[command(flatten)]
+    pub html: crate::report::HtmlArgs,
 }
 
 /// Runs `campaign`; returns the exit code (3 when not converged or a mode is unpaired).
@@ -44,6 +47,9 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         budget: args.budget,
         shape: args.shape.options(),
     };
+    args.html.check()?;
+    // The inputs are hashed as they are read: the campaign file and the files it names.
+    let html = args.html.html.as_ref().map(|_| html_inputs(&args.campaign));
     let report = campaign::run(&request, &mut Bars::new(args.report.quiet))?;
     crate::commands::simulate::print_notes(&report.file_notes);
     let done = report.outcome.converged && !report.budget.exhausted;
@@ -92,5 +98,51 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             );
         }
     });
+    if let (Some(path), Some(mut html)) = (&args.html.html, html) {
+        let names: Vec<String> = report.parameters.iter().map(|(n, _)| n.clone()).collect();
+        let declared = declared_units(&args.campaign);
+        let units: Vec<Option<String>> = crate::report::estimate::units(&report, &names, |n| {
+            declared.iter().find(|(m, _)| m == n).map_or(String::new(), |(_, u)| u.clone())
+        })
+        .into_iter()
+        .map(|u| Some(u).filter(|u| !u.is_empty()))
+        .collect();
+        crate::report::campaign::fill(&mut html, &report, &units);
+        html.write_after(path, args.report.json);
+    }
     Ok(code)
+}
+
+/// The report's page with the inputs recorded: the campaign file and each configuration's model
+/// and data files (a campaign file that cannot be read records itself only; the run says why).
+fn html_inputs(path: &std::path::Path) -> crate::report::Report {
+    let mut html = crate::report::Report::new("campaign", "campaign");
+    html.input("campaign file", path);
+    if let Ok(c) = eigenfit_rotor::campaign::Campaign::from_toml_file(path) {
+        for (k, conf) in c.configurations.iter().enumerate() {
+            let name = conf.name.clone().unwrap_or_else(|| format!("configuration {}", k + 1));
+            html.input(&format!("{name}: model"), &conf.model);
+            html.input(&format!("{name}: measured data"), &conf.measured);
+            if let Some(p) = &conf.shapes {
+                html.input(&format!("{name}: measured shapes"), p);
+            }
+            if let Some(p) = &conf.sensor_map {
+                html.input(&format!("{name}: sensor map"), p);
+            }
+        }
+    }
+    html
+}
+
+/// The parameters' units as the first configuration's model declares them (name, unit); empty
+/// when it cannot be read.
+fn declared_units(path: &std::path::Path) -> Vec<(String, String)> {
+    use eigenfit_core::model::StructuralModel;
+    let Ok(c) = eigenfit_rotor::campaign::Campaign::from_toml_file(path) else { return Vec::new() };
+    let Some(conf) = c.configurations.first() else { return Vec::new() };
+    let Ok(rotor) = eigenfit_rotor::Rotor::from_toml_file(&conf.model) else { return Vec::new() };
+    match eigenfit_rotor::updatable::UpdatableRotor::new(rotor) {
+        Ok(m) => m.parameters().iter().map(|p| (p.name.clone(), p.unit.clone())).collect(),
+        Err(_) => Vec::new(),
+    }
 }

@@ -31,10 +31,19 @@ pub struct CampbellArgs {
     /// `--json`.
     #[command(flatten)]
     pub report: crate::output::ReportArgs,
+    /// `--report FILE.html`.
+    #[command(flatten)]
+    pub html: crate::report::HtmlArgs,
 }
 
 /// Runs `campbell`.
 pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
+    args.html.check()?;
+    let html = args.html.html.as_ref().map(|_| {
+        let mut html = crate::report::Report::new("campbell", "campbell");
+        html.input("rotor (ROSS)", &args.model);
+        html
+    });
     let mut report = campbell_diagram_with(&args.model, &args.speeds, args.modes, args.operating.as_deref())?;
     crate::commands::simulate::print_notes(&report.notes);
     let plots = match &args.plot {
@@ -103,5 +112,9 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
         }
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
     });
+    if let (Some(path), Some(mut html)) = (&args.html.html, html) {
+        crate::report::campbell::fill(&mut html, &report, args.modes);
+        html.write_after(path, args.report.json);
+    }
     Ok(())
 }

@@ -46,7 +46,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
         &rotor,
         &eigenfit_core::eigen::DenseSolver,
         &TARGET,
-        simulate::MapOptions { range: (1e2, 1e9), plain: true, quiet: args.report.quiet },
+        simulate::MapOptions { range: (1e2, 1e9), plain: true, quiet: args.report.quiet, modes: 4 },
     )?;
     let figure = Convergence {
         title: format!("{LABEL}: Table 3 case 1, every strategy from 1e2 N/m"),
@@ -54,7 +54,7 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
         unit: "N/m".to_string(),
         runs: found.estimates.iter().map(Run::from_estimate).collect(),
         target: Some(TARGET.to_vec()),
-        tolerance_hz: Some(0.01),
+        tolerance: Some((0.01, "newton/p-step tolerance, 0.01 Hz".to_string())),
         sigma_hz: None,
     };
     plots.extend(plot::write(&figure, out, "convergence")?);

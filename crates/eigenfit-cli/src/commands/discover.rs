@@ -39,6 +39,9 @@ pub struct DiscoverArgs {
     /// `--quiet`, `--json`.
     #[command(flatten)]
     pub report: crate::output::ReportArgs,
+    /// `--report FILE.html`.
+    #[command(flatten)]
+    pub html: crate::report::HtmlArgs,
 }
 
 /// Runs `discover`; returns the exit code: 0 when the data are explained (by the noise, or after
@@ -51,6 +54,8 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
                 "--write-model and --plot are not available for ROSS rotors (the report names the effects)",
             ));
         }
+        args.html.check()?;
+        let html = args.html.html.as_ref().map(|_| html_inputs(args));
         let report =
             eigenfit_workflow::rotordynamics::discover(path, &args.measured, args.assumed_std, args.budget)?;
         // The rule of every discover, decided once in the workflow's report (`explained`): 0 when
@@ -58,6 +63,17 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
         let code = if report.discovery.explained { EXIT_OK } else { EXIT_NOT_CONVERGED };
         crate::error::set_exit_on_closed_pipe(code);
         crate::output::report(args.report.json, &report, crate::rotordynamics::print_discovery);
+        if let (Some(path), Some(mut html)) = (&args.html.html, html) {
+            let names: Vec<String> =
+                report.discovery.calibrated_parameters.iter().map(|(n, _)| n.clone()).collect();
+            let units = crate::report::estimate::units(
+                &report.discovery,
+                &names,
+                crate::report::estimate::ross_coefficient_unit,
+            );
+            crate::report::discover::fill(&mut html, &report.discovery, &units, None);
+            html.write_after(path, args.report.json);
+        }
         return Ok(code);
     }
     // Every output is checked writable before the search.
@@ -67,6 +83,8 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
     if let Some(dir) = &args.plot {
         crate::output::check_writable_dir(dir, "--plot")?;
     }
+    args.html.check()?;
+    let html = args.html.html.as_ref().map(|_| html_inputs(args));
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
     let mut notes = Vec::new();
@@ -107,7 +125,25 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
             println!("wrote {w}");
         }
     });
+    if let (Some(path), Some(mut html)) = (&args.html.html, html) {
+        let declared: Vec<String> = model.parameters().iter().map(|p| p.unit.clone()).collect();
+        let names: Vec<String> = report.calibrated_parameters.iter().map(|(n, _)| n.clone()).collect();
+        let units = crate::report::estimate::units(&report, &names, |n| {
+            names.iter().position(|m| m == n).and_then(|i| declared.get(i).cloned()).unwrap_or_default()
+        });
+        let figure = DiscoveryPlot::from_report(&label, &found.report);
+        crate::report::discover::fill(&mut html, &report, &units, Some(&figure));
+        html.write_after(path, args.report.json);
+    }
     Ok(code)
+}
+
+/// The report's page with the inputs recorded.
+fn html_inputs(args: &DiscoverArgs) -> crate::report::Report {
+    let mut html = crate::report::Report::new("discover", "discover");
+    html.model_source(&args.model);
+    html.input("measured data", &args.measured);
+    html
 }
 
 fn print_report(

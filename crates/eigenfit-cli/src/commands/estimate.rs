@@ -64,6 +64,9 @@ pub struct EstimateArgs {
     /// `--quiet`, `--json`.
     #[command(flatten)]
     pub report: crate::output::ReportArgs,
+    /// `--report FILE.html`.
+    #[command(flatten)]
+    pub html: crate::report::HtmlArgs,
     /// ROSS rotors: the bearing coefficients to estimate, comma-separated — kxx, kxy, kyx, kyy,
     /// cxx, cxy, cyx, cyy (that coefficient of every bearing) or `<coefficient>_<bearing>`
     /// (default kxx,kyy).
@@ -119,6 +122,9 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     if let Some(dir) = &args.plot {
         crate::output::check_writable_dir(dir, "--plot")?;
     }
+    args.html.check()?;
+    // The inputs are hashed as they are read, before the fit.
+    let html = args.html.html.as_ref().map(|_| html_inputs(args));
     let mut notes = Vec::new();
     let outcome = estimate::run(&request(args), &mut notes, &mut Bars::new(args.report.quiet));
     print_notes(&notes);
@@ -135,6 +141,10 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                     println!("wrote {}", path.display());
                 }
             }
+            if let (Some(path), Some(mut html)) = (&args.html.html, html) {
+                crate::report::estimate::fill_runup(&mut html, &report);
+                html.write_after(path, args.report.json);
+            }
             return Ok(code);
         }
         // No result to print: an error with exit code 3 (also through the Python package).
@@ -149,15 +159,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let plots = match &args.plot {
         Some(dir) => {
             let r = &est.report;
-            let figure = Convergence {
-                title: format!("{}: convergence of the {} strategy", r.model, r.strategy),
-                parameter_names: r.values.parameters.iter().map(|(n, _)| n.clone()).collect(),
-                unit: est.unit.clone(),
-                runs: vec![Run::from_estimate(&est.estimate)],
-                target: None,
-                tolerance_hz: Some(0.01),
-                sigma_hz: est.sigma_max,
-            };
+            let figure = convergence(&est, &args.strategy);
             // A plot that fails after the fit is lost, said so; the fit's exit code stands.
             let mut written = Vec::new();
             match plot::write(&figure, dir, "convergence") {
@@ -188,7 +190,55 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
             Err(e) => crate::output::report_lost("the updated model", &e),
         }
     }
+    if let (Some(path), Some(mut html)) = (&args.html.html, html) {
+        let names: Vec<String> = est.report.values.parameters.iter().map(|(n, _)| n.clone()).collect();
+        // The report's own `units` when it states them, else each parameter's declaration.
+        let declared = declared_units(&args.model);
+        let units = crate::report::estimate::units(&est.report, &names, |n| {
+            declared.iter().find(|(m, _)| m == n).map_or_else(|| est.unit.clone(), |(_, u)| u.clone())
+        });
+        crate::report::estimate::fill(&mut html, &est, &units, &convergence(&est, &args.strategy));
+        html.write_after(path, args.report.json);
+    }
     Ok(code)
+}
+
+/// The report's page with the inputs recorded (model, measured data, shapes, sensor map).
+fn html_inputs(args: &EstimateArgs) -> crate::report::Report {
+    let mut html = crate::report::Report::new("estimate", "estimate");
+    html.model_source(&args.model);
+    html.input("measured data", &args.measured);
+    if let Some(p) = &args.test_data.shapes {
+        html.input("measured shapes", p);
+    }
+    if let Some(p) = &args.test_data.sensor_map {
+        html.input("sensor map", p);
+    }
+    html
+}
+
+/// Each parameter's unit as the model declares it (name, unit); empty when the model cannot be
+/// loaded again.
+fn declared_units(model: &ModelArgs) -> Vec<(String, String)> {
+    use eigenfit_core::model::StructuralModel;
+    match model.load_any() {
+        Ok((m, _)) => m.parameters().iter().map(|p| (p.name.clone(), p.unit.clone())).collect(),
+        Err(_) => Vec::new(),
+    }
+}
+
+/// The convergence plot of an estimation run with `--strategy strategy`.
+fn convergence(est: &Estimation, strategy: &str) -> Convergence {
+    let r = &est.report;
+    Convergence {
+        title: format!("{}: convergence of the {} strategy", r.model, r.strategy),
+        parameter_names: r.values.parameters.iter().map(|(n, _)| n.clone()).collect(),
+        unit: est.unit.clone(),
+        runs: vec![Run::from_estimate(&est.estimate)],
+        target: None,
+        tolerance: plot::convergence::strategy_tolerance(r.strategy, strategy),
+        sigma_hz: est.sigma_max,
+    }
 }
 
 /// The text report: parameters, modes, fit quality, other solutions.

@@ -20,8 +20,9 @@ use std::path::{Path, PathBuf};
 
 /// Stiffnesses drawn on the critical speed map (log-spaced).
 const MAP_POINTS: usize = 61;
-/// Modes drawn on the critical speed map and the mode-shape plot.
-const PLOT_MODES: usize = 4;
+/// The most modes drawn on the critical speed map and the mode-shape plot (as many as there are
+/// mode colours); a plot of fewer than asked says so.
+pub const PLOT_MODES: usize = crate::plot::style::MODES.len();
 
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]
@@ -127,7 +128,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             Some(dir) => {
                 // Mode shapes at the model's (or the given) stiffnesses.
                 let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
-                let options = MapOptions { range, plain: args.effects.is_empty(), quiet: args.report.quiet };
+                let options = MapOptions {
+                    range,
+                    plain: args.effects.is_empty(),
+                    quiet: args.report.quiet,
+                    modes: args.modes,
+                };
                 write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
             }
             None => Vec::new(),
@@ -177,8 +183,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     print_notes(&report.notes);
     let plots = match &args.plot {
         Some(dir) => {
-            let options =
-                MapOptions { range: (1e2, 1e9), plain: args.effects.is_empty(), quiet: args.report.quiet };
+            let options = MapOptions {
+                range: (1e2, 1e9),
+                plain: args.effects.is_empty(),
+                quiet: args.report.quiet,
+                modes: args.modes,
+            };
             write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
         }
         None => Vec::new(),
@@ -257,6 +267,8 @@ pub struct MapOptions {
     pub plain: bool,
     /// No progress bar.
     pub quiet: bool,
+    /// Modes asked for (at most [`PLOT_MODES`] are drawn; the plots say so when fewer).
+    pub modes: usize,
 }
 
 /// Writes the critical speed map and the mode shapes at `p`; the paper's Table 1 is overlaid
@@ -267,16 +279,18 @@ pub fn write_plots(
     rotor: &Rotor,
     solver: &dyn EigenSolver,
     p: &[f64],
-    MapOptions { range, plain, quiet }: MapOptions,
+    MapOptions { range, plain, quiet, modes: asked }: MapOptions,
 ) -> Result<Vec<PathBuf>, CliError> {
-    let modes = PLOT_MODES.min(rotor.dofs());
+    let modes = asked.min(PLOT_MODES).min(rotor.dofs());
     let mut map =
         CriticalSpeedMap::sweep(label, rotor, solver, range, MAP_POINTS, modes, &mut Bars::new(quiet))?;
     if plain && is_paper_rotor(rotor) {
         map = map.with_paper_table_1();
     }
+    map.asked = asked;
     let mut written = plot::write(&map, dir, "critical-speed-map")?;
-    let shapes = ModeShapes::of_rotor(label, rotor, solver, p, modes)?;
+    let mut shapes = ModeShapes::of_rotor(label, rotor, solver, p, modes)?;
+    shapes.asked = asked;
     written.extend(plot::write(&shapes, dir, "mode-shapes")?);
     Ok(written)
 }

@@ -102,6 +102,7 @@ impl Figure for BenchFigure {
                 ((low / 2.0).max(0.5), top * 2.0)
             }
         };
+        let (labelled, grid) = style::log_ticks(&(lo..hi));
         let (title, x_desc) = match self.kind {
             Kind::Profile => {
                 ("performance profile (Dolan–Moré)", "τ: evaluations / best strategy's on the instance")
@@ -114,10 +115,14 @@ impl Figure for BenchFigure {
             .margin_top(px(5))
             .x_label_area_size(px(60))
             .y_label_area_size(px(80))
-            .build_cartesian_2d((lo..hi).log_scale(), 0.0..1.02)
+            // Ticks where they carry a number: plotters' own left a narrow range (an ECDF
+            // between 15 and 60 evaluations) without any label.
+            .build_cartesian_2d(
+                (lo..hi).log_scale().with_key_points(labelled).with_light_points(grid),
+                0.0..1.02,
+            )
             .map_err(err)?;
         style::grid(style::axes(&mut chart.configure_mesh(), x_desc, "fraction of instances solved"), 0.5)
-            .x_labels(6)
             .x_label_formatter(&log_tick)
             .draw()
             .map_err(err)?;

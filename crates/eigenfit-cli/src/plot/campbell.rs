@@ -45,6 +45,9 @@ impl Figure for CampbellPlot<'_> {
             style::axes(&mut chart.configure_mesh(), "rotor speed [rpm]", "damped natural frequency [Hz]"),
             0.5,
         )
+        // Whole rpm as `1000`, not plotters' `1000.0`; fractions keep what they need.
+        .x_label_formatter(&|v: &f64| style::trim(*v, 3))
+        .y_label_formatter(&|v: &f64| style::trim(*v, 3))
         .draw()
         .map_err(err)?;
         for curve in &c.curves {

@@ -1,16 +1,15 @@
 //! (c) Convergence history of estimates: parameters (log) and the largest frequency difference
 //! per iteration, one colour per strategy.
 
-use super::style::{self, log_bounds, log_tick, px, pxi, strategy_colour, Swatch, INK};
+use super::style::{self, log_bounds, log_tick, px, pxi, series_style, strategy_colour, Swatch, INK};
 use super::{err, DrawResult, Figure};
 use eigenfit_core::update::Estimate;
 use plotters::coord::combinators::WithKeyPoints;
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 /// A panel's coordinates: iterations across, a logarithmic axis with chosen ticks up.
-type Coords = Cartesian2d<RangedCoordf64, WithKeyPoints<LogCoord<f64>>>;
+type Coords = Cartesian2d<style::FixedTicks, WithKeyPoints<LogCoord<f64>>>;
 
 /// A panel of the figure on `area`: iterations 0…`x_end` across (whole numbers labelled), `y`
 /// on a log axis titled `y_title`, with `x_area` pixels for the x labels.
@@ -27,15 +26,31 @@ fn panel<'a, DB: DrawingBackend>(
         .margin_left(px(20))
         .x_label_area_size(px(x_area))
         .y_label_area_size(px(90))
-        .build_cartesian_2d(0.0..x_end, y.log_scale().with_key_points(labelled).with_light_points(grid))
+        .build_cartesian_2d(
+            style::FixedTicks { lo: 0.0, hi: x_end, ticks: iteration_ticks(x_end) },
+            y.log_scale().with_key_points(labelled).with_light_points(grid),
+        )
         .map_err(err)?;
-    let whole = |v: &f64| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() };
+    let whole = |v: &f64| format!("{v:.0}");
     style::grid(style::axes(&mut chart.configure_mesh(), "iteration", y_title), 0.4)
         .x_label_formatter(&whole)
         .y_label_formatter(&log_tick)
         .draw()
         .map_err(err)?;
     Ok(chart)
+}
+
+/// Whole iterations from 0 to `x_end`, every 1, 2, 5, 10, 20, … so that at most 11 are
+/// labelled: every tick drawn carries its number (plotters' own ticks fell between iterations,
+/// where there is no number to give).
+fn iteration_ticks(x_end: f64) -> Vec<f64> {
+    let last = x_end.floor().max(0.0);
+    let step = [1.0, 2.0, 5.0]
+        .iter()
+        .flat_map(|m| (0..12).map(move |e| m * 10f64.powi(e)))
+        .filter(|s| last / s <= 10.0)
+        .fold(f64::INFINITY, f64::min);
+    (0..).map(|k| k as f64 * step).take_while(|t| *t <= last).collect()
 }
 
 /// A thin dashed horizontal reference line at `y` (a target value, a tolerance).
@@ -87,11 +102,29 @@ pub struct Convergence {
     pub runs: Vec<Run>,
     /// True parameters, when known (drawn as dotted lines).
     pub target: Option<Vec<f64>>,
-    /// Frequency tolerance to mark on the residual panel (Hz), e.g. the paper's 0.01 Hz.
-    pub tolerance_hz: Option<f64>,
+    /// A convergence tolerance on the frequencies to mark on the residual panel (Hz) and what it
+    /// is: only a strategy that stops on it (Newton, p-step: [`strategy_tolerance`]).
+    pub tolerance: Option<(f64, String)>,
     /// The measurement's largest standard deviation (Hz), marked on the residual panel when
     /// given: a fit converged at the noise level ends near this line, not at the tolerance.
     pub sigma_hz: Option<f64>,
+}
+
+/// The frequency tolerance a run of `strategy` (its registered name) stops on, with a label for
+/// the plot: Newton and p-step stop when every |f − f_measured| is below `tolerance_hz` (the
+/// paper's 0.01 Hz unless `setting` — the `--strategy` text, `newton:tolerance_hz=…` — says
+/// otherwise); other strategies stop on other tests, so they get no such line.
+pub fn strategy_tolerance(strategy: &str, setting: &str) -> Option<(f64, String)> {
+    if !matches!(strategy, "newton" | "p-step") {
+        return None;
+    }
+    let given = setting.split(':').skip(1).find_map(|s| s.trim().strip_prefix("tolerance_hz="));
+    let tol = given.and_then(|v| v.trim().parse::<f64>().ok()).unwrap_or(0.01);
+    Some(if tol == 0.01 {
+        (tol, format!("{strategy} tolerance, 0.01 Hz"))
+    } else {
+        (tol, format!("{strategy} tolerance, {tol} Hz"))
+    })
 }
 
 /// Width of the legend column on the right (px).
@@ -126,30 +159,17 @@ impl Figure for Convergence {
             }
             entries.push((Swatch::Guide, "target".to_string()));
         }
+        // One run: a colour, a line pattern and a marker per parameter. Several runs: a colour
+        // per strategy, a pattern and a marker per parameter.
+        let one = self.runs.len() == 1;
         for run in &self.runs {
-            let c = strategy_colour(&run.strategy);
+            let colour = (!one).then(|| strategy_colour(&run.strategy));
             for (j, name) in self.parameter_names.iter().enumerate() {
                 let points: Vec<(f64, f64)> = run.history.iter().map(|h| (h.0 as f64, h.1[j])).collect();
-                if j == 0 {
-                    chart.draw_series(LineSeries::new(points.clone(), c.stroke_width(px(3)))).map_err(err)?;
-                    chart
-                        .draw_series(points.iter().map(|&p| Circle::new(p, px(4), c.filled())))
-                        .map_err(err)?;
-                    entries.push((Swatch::Line(c), format!("{} · {name}", run.strategy)));
-                } else {
-                    chart
-                        .draw_series(DashedLineSeries::new(
-                            points.clone(),
-                            px(8),
-                            px(5),
-                            c.stroke_width(px(3)),
-                        ))
-                        .map_err(err)?;
-                    chart
-                        .draw_series(points.iter().map(|&p| TriangleMarker::new(p, px(5), c.filled())))
-                        .map_err(err)?;
-                    entries.push((Swatch::Dashed(c), format!("{} · {name}", run.strategy)));
-                }
+                let st = series_style(j, colour);
+                style::draw_styled(&mut chart, &points, st, 3)?;
+                let label = if one { name.clone() } else { format!("{} · {name}", run.strategy) };
+                entries.push((Swatch::Series(st), label));
             }
         }
         style::legend_column(&legend, (0, pxi(30)), &entries)?;
@@ -160,15 +180,15 @@ impl Figure for Convergence {
             self.runs
                 .iter()
                 .flat_map(|r| r.history.iter().map(|h| h.2.max(FLOOR_HZ)))
-                .chain(self.tolerance_hz)
+                .chain(self.tolerance.as_ref().map(|t| t.0))
                 .chain(self.sigma_hz),
             3.0,
         );
         let mut chart = panel(&bottom, 50, x_end, d_range, "max |f − f_measured| [Hz]")?;
         let mut entries = Vec::new();
-        if let Some(tol) = self.tolerance_hz {
-            guide(&mut chart, tol, x_end)?;
-            entries.push((Swatch::Guide, format!("paper's tolerance, {tol} Hz")));
+        if let Some((tol, label)) = &self.tolerance {
+            guide(&mut chart, *tol, x_end)?;
+            entries.push((Swatch::Guide, label.clone()));
         }
         if let Some(sigma) = self.sigma_hz {
             chart
@@ -201,4 +221,100 @@ impl Figure for Convergence {
     }
 
     const SUPERSAMPLE: u32 = super::SUPERSAMPLE;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plot::style::{SeriesStyle, SERIES};
+    use std::collections::HashSet;
+
+    /// A run of `strategy` over `n` parameters, each its own history.
+    fn figure(strategy: &str, n: usize, setting: &str) -> Convergence {
+        let history = (0..4)
+            .map(|it| {
+                let p = (0..n).map(|j| 1e3 * (j + 1) as f64 * (1.0 + 1.0 / (it + 1) as f64)).collect();
+                (it, p, 10f64.powi(-(it as i32)))
+            })
+            .collect();
+        Convergence {
+            title: "test".to_string(),
+            parameter_names: (0..n).map(|j| format!("param_{j}")).collect(),
+            unit: "N/m".to_string(),
+            runs: vec![Run {
+                strategy: strategy.to_string(),
+                outcome: "converged, 3 it.".to_string(),
+                history,
+            }],
+            target: None,
+            tolerance: strategy_tolerance(strategy, setting),
+            sigma_hz: None,
+        }
+    }
+
+    /// `#rrggbb` of a colour, as plotters writes it into SVG.
+    fn hex(c: plotters::style::RGBColor) -> String {
+        format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)
+    }
+
+    #[test]
+    fn iterations_are_ticked_at_whole_numbers_only() {
+        assert_eq!(iteration_ticks(1.3), [0.0, 1.0]);
+        assert_eq!(iteration_ticks(7.3), (0..=7).map(f64::from).collect::<Vec<_>>());
+        assert_eq!(iteration_ticks(25.3), [0.0, 5.0, 10.0, 15.0, 20.0, 25.0]);
+        assert_eq!(iteration_ticks(1000.3).len(), 11);
+        // In the figure: as many tick marks as numeric labels.
+        let svg = crate::plot::to_svg(&figure("damped", 2, "damped")).unwrap();
+        let (across, up) = crate::plot::mode_shapes::tests::tick_marks(&svg);
+        let numeric = svg
+            .split("<text")
+            .filter_map(|t| t.split_once('>').map(|(_, r)| r.split("</text>").next().unwrap_or("").trim()))
+            .filter(|t| !t.is_empty() && t.chars().all(|c| c.is_ascii_digit() || "·⁰¹²³⁴⁵⁶⁷⁸⁹⁻".contains(c)))
+            .count();
+        assert_eq!(across + up, numeric, "tick marks without a number");
+    }
+
+    #[test]
+    fn no_two_series_look_alike() {
+        let own: HashSet<SeriesStyle> = (0..140).map(|j| series_style(j, None)).collect();
+        assert_eq!(own.len(), 140, "colour, pattern and marker repeat within 140 series");
+        let first: HashSet<_> = (0..7).map(|j| series_style(j, None).colour).collect();
+        assert_eq!(first.len(), 7, "the first seven series share a colour");
+        let fixed: HashSet<_> = (0..20).map(|j| series_style(j, Some(SERIES[0]))).collect();
+        assert_eq!(fixed.len(), 20, "with one colour, pattern and marker repeat within 20 series");
+    }
+
+    /// Four parameters of one run: four colours, each named in the legend, and the markers of
+    /// four kinds (circle, triangle, square, diamond).
+    #[test]
+    fn four_parameters_get_four_colours_and_four_markers() {
+        let svg = crate::plot::to_svg(&figure("damped", 4, "damped")).unwrap();
+        for j in 0..4 {
+            let st = series_style(j, None);
+            assert!(
+                svg.contains(&format!("stroke=\"{}\"", hex(st.colour))),
+                "param_{j}'s colour is not drawn"
+            );
+            assert!(svg.contains(&format!("param_{j}")), "param_{j} is not in the legend");
+        }
+        assert!(svg.contains("<circle"), "no circle markers");
+        assert!(svg.contains("<rect") && svg.contains("<polygon"), "no square, triangle or diamond markers");
+        // The triangles and the diamonds: at least one polygon per point of each (4 points + a
+        // legend swatch each).
+        assert!(svg.matches("<polygon").count() >= 2 * 5, "{} polygons", svg.matches("<polygon").count());
+    }
+
+    /// The paper's 0.01 Hz is Newton's and p-step's stopping test: drawn for them (with their own
+    /// setting when given), never for a strategy that does not stop on it.
+    #[test]
+    fn the_tolerance_line_is_drawn_only_for_the_strategies_that_stop_on_it() {
+        let newton = crate::plot::to_svg(&figure("newton", 2, "newton")).unwrap();
+        assert!(newton.contains("newton tolerance, 0.01 Hz"));
+        let set = crate::plot::to_svg(&figure("p-step", 2, "p-step:tolerance_hz=0.002")).unwrap();
+        assert!(set.contains("p-step tolerance, 0.002 Hz"));
+        for strategy in ["damped", "trf", "gn-line-search"] {
+            let svg = crate::plot::to_svg(&figure(strategy, 2, strategy)).unwrap();
+            assert!(!svg.contains("tolerance"), "{strategy}'s plot carries a tolerance line");
+        }
+    }
 }

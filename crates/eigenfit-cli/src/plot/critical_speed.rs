@@ -37,6 +37,8 @@ pub struct CriticalSpeedMap {
     pub reference: Vec<ReferencePoint>,
     /// Legend text of the markers.
     pub reference_label: String,
+    /// Modes asked for: when more than drawn, the legend says how many were drawn and why.
+    pub asked: usize,
 }
 
 impl CriticalSpeedMap {
@@ -60,6 +62,7 @@ impl CriticalSpeedMap {
             frequencies,
             reference: Vec::new(),
             reference_label: String::new(),
+            asked: modes,
         })
     }
 
@@ -138,6 +141,14 @@ impl Figure for CriticalSpeedMap {
                 .map_err(err)?
                 .label(self.reference_label.clone())
                 .legend(|(x, y)| Circle::new((x + pxi(12), y), px(6), INK.stroke_width(px(2))));
+        }
+        let drawn = self.mode_count();
+        if self.asked > drawn {
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(err)?
+                .label(format!("(the lowest {drawn} of the {} modes asked)", self.asked))
+                .legend(|(x, y)| EmptyElement::at((x, y)));
         }
         style::legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         Ok(())

@@ -19,6 +19,7 @@ pub mod discovery;
 pub mod mac_matrix;
 pub mod mode_shapes;
 pub mod style;
+pub mod text;
 
 use crate::error::{input, CliError};
 use crate::output::write_atomically;
@@ -58,7 +59,8 @@ pub fn to_rgb<F: Figure>(figure: &F) -> Result<Vec<u8>, String> {
     let (sw, sh) = (w * s, h * s);
     let mut big = vec![0u8; sw as usize * sh as usize * 3];
     style::scaled(s, || -> DrawResult {
-        let root = BitMapBackend::with_buffer(&mut big, (sw, sh)).into_drawing_area();
+        // Text set by `TrueText`: plotters' own bitmap text opens gaps inside words (text.rs).
+        let root = text::TrueText(BitMapBackend::with_buffer(&mut big, (sw, sh))).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
         figure.draw(&root)?;
         root.present().map_err(err)

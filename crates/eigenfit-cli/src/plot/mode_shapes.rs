@@ -40,6 +40,8 @@ pub struct ModeShapes {
     pub masses: Vec<Marker>,
     /// Bearings.
     pub bearings: Vec<Marker>,
+    /// Modes asked for: when more than drawn, the plot says which were drawn and why.
+    pub asked: usize,
 }
 
 /// Samples drawn per element (cubic Hermite interpolation between the nodes).
@@ -82,6 +84,7 @@ impl ModeShapes {
             shapes,
             masses,
             bearings,
+            asked: m.count(),
         })
     }
 }
@@ -120,24 +123,21 @@ impl Figure for ModeShapes {
         let (x0, x1) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
         let pad = (x1 - x0) * 0.04;
         let body = style::title(root, &self.title, 50)?;
+        // Ticks only where they carry a number: the axis reaches past ±1 to make room for the
+        // disk and bearing labels, which are not displacements.
+        let y_ticks = vec![-1.0, -0.5, 0.0, 0.5, 1.0];
         let mut chart = ChartBuilder::on(&body)
             .margin(px(20))
             .margin_top(px(5))
             .x_label_area_size(px(60))
             .y_label_area_size(px(80))
-            .build_cartesian_2d(x0 - pad..x1 + pad, -1.75..2.15)
+            .build_cartesian_2d(x0 - pad..x1 + pad, style::FixedTicks { lo: -1.75, hi: 2.15, ticks: y_ticks })
             .map_err(err)?;
         let mut mesh = chart.configure_mesh();
         let x = "position along the shaft x [m]";
         style::grid(style::axes(&mut mesh, x, "displacement (normalised to the largest) [–]"), 0.4)
-            .y_labels(17)
-            .y_label_formatter(&|v: &f64| {
-                if v.abs() > 1.01 || (v * 2.0 - (v * 2.0).round()).abs() > 1e-9 {
-                    String::new()
-                } else {
-                    style::trim(*v, 1)
-                }
-            })
+            .x_label_formatter(&|v: &f64| style::trim(*v, 3))
+            .y_label_formatter(&|v: &f64| style::trim(*v, 1))
             .draw()
             .map_err(err)?;
         drop(mesh);
@@ -189,6 +189,23 @@ impl Figure for ModeShapes {
                     PathElement::new(vec![(x, y), (x + pxi(24), y)], c.stroke_width(px(3)))
                 });
         }
+        if self.asked > self.shapes.len() {
+            // Said where the modes are named, so no reader takes the plot for all that was asked.
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(err)?
+                .label(format!(
+                    "(the lowest {} of the {} modes asked: {})",
+                    self.shapes.len(),
+                    self.asked,
+                    if self.shapes.len() < super::style::MODES.len() {
+                        "the model has no more"
+                    } else {
+                        "more would not be told apart"
+                    }
+                ))
+                .legend(|(x, y)| EmptyElement::at((x, y)));
+        }
         style::legend(&mut chart, SeriesLabelPosition::UpperMiddle)?;
         Ok(())
     }
@@ -208,7 +225,7 @@ pub fn format_hz(f: f64) -> String {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// The markers follow the model, not the order of the bearings: in the paper rotor K2 is at
@@ -224,5 +241,82 @@ mod tests {
         let heavy = plot.masses.iter().find(|m| m.label == "disk 1.35 kg").unwrap();
         assert!(heavy.x < 0.25, "the heavy disk is near K2: {heavy:?}");
         assert!(plot.bearings.iter().any(|b| b.label == "K2 = 1e3 N/m"), "{:?}", plot.bearings);
+    }
+
+    /// Tick labels of the SVG: the texts that are numbers.
+    fn numbers(svg: &str) -> Vec<String> {
+        svg.split("<text")
+            .filter_map(|t| {
+                t.split_once('>').map(|(_, rest)| rest.split("</text>").next().unwrap_or("").trim())
+            })
+            .filter(|t| !t.is_empty() && t.parse::<f64>().is_ok())
+            .map(str::to_string)
+            .collect()
+    }
+
+    /// The tick marks of the SVG: black two-point strokes 5 px long, (horizontal ones: the
+    /// y axis's, vertical ones: the x axis's).
+    pub(crate) fn tick_marks(svg: &str) -> (usize, usize) {
+        let (mut horizontal, mut vertical) = (0, 0);
+        for line in svg.split("<polyline").skip(1) {
+            let line = line.split("/>").next().unwrap_or("");
+            if !line.contains("stroke=\"#000000\"") {
+                continue;
+            }
+            let Some(points) = line.split("points=\"").nth(1).and_then(|p| p.split('"').next()) else {
+                continue;
+            };
+            let xy: Vec<i32> = points.split([' ', ',']).filter_map(|v| v.parse().ok()).collect();
+            if let [x1, y1, x2, y2] = xy[..] {
+                if y1 == y2 && (x2 - x1).abs() == 5 {
+                    horizontal += 1;
+                } else if x1 == x2 && (y2 - y1).abs() == 5 {
+                    vertical += 1;
+                }
+            }
+        }
+        (horizontal, vertical)
+    }
+
+    /// Every displacement tick carries its number: ticks only at −1 … 1 in halves (the axis
+    /// reaches past ±1 only to make room for the labels of disks and bearings).
+    #[test]
+    fn every_displacement_tick_is_labelled() {
+        let rotor = eigenfit_rotor::presets::paper_rotor();
+        let plot =
+            ModeShapes::of_rotor("paper-rotor", &rotor, &eigenfit_core::eigen::DenseSolver, &[1e5, 1e5], 4)
+                .unwrap();
+        let svg = crate::plot::to_svg(&plot).unwrap();
+        let labels = numbers(&svg);
+        for y in ["-1", "-0.5", "0", "0.5", "1"] {
+            assert!(labels.iter().any(|l| l == y), "no `{y}` tick: {labels:?}");
+        }
+        for beyond in ["1.5", "2", "-1.5"] {
+            assert!(!labels.iter().any(|l| l == beyond), "a `{beyond}` tick: {labels:?}");
+        }
+        // Every tick mark (a 5 px black stroke off an axis) carries a number: as many marks as
+        // numeric labels, five of them on the displacement axis.
+        let (across, up) = tick_marks(&svg);
+        assert_eq!(across, 5, "tick marks on the displacement axis");
+        assert_eq!(across + up, labels.len(), "tick marks without a number: {labels:?}");
+        assert!(!svg.contains("(the lowest"), "all 4 modes asked are drawn: no note");
+    }
+
+    /// Fewer modes drawn than asked: the legend says how many of how many, and why.
+    #[test]
+    fn fewer_modes_than_asked_are_said_so() {
+        let rotor = eigenfit_rotor::presets::paper_rotor();
+        let mut plot =
+            ModeShapes::of_rotor("paper-rotor", &rotor, &eigenfit_core::eigen::DenseSolver, &[1e5, 1e5], 6)
+                .unwrap();
+        plot.asked = 10;
+        let svg = crate::plot::to_svg(&plot).unwrap();
+        assert!(
+            svg.contains("(the lowest 6 of the 10 modes asked: more would not be told apart)"),
+            "no note"
+        );
+        for k in 1..=6 {
+            assert!(svg.contains(&format!("mode {k}:")), "mode {k} is not in the legend");
+        }
     }
 }

@@ -11,7 +11,7 @@ use std::ops::Range;
 use std::sync::Once;
 
 /// DejaVu Sans, bundled: plots look the same on every machine.
-static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+pub(crate) static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// The font family every plot uses (registered to the bundled font).
 pub const FAMILY: &str = "sans-serif";
@@ -93,6 +93,144 @@ pub const MODES: [RGBColor; 6] = [
 /// Colour of mode `k` (0-based).
 pub fn mode_colour(k: usize) -> RGBColor {
     MODES[k % MODES.len()]
+}
+
+/// Colours of the parameters of one run, in order (Okabe–Ito without the yellow, which is too
+/// pale on white): seven colours that colour-blind readers tell apart.
+pub const SERIES: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(30, 30, 30),
+];
+
+/// How a line is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Dash {
+    /// Unbroken.
+    Solid,
+    /// 8 px dashes.
+    Dashed,
+    /// 2 px dots.
+    Dotted,
+    /// 16 px dashes.
+    Long,
+}
+
+/// The dash patterns, in order.
+pub const DASHES: [Dash; 4] = [Dash::Solid, Dash::Dashed, Dash::Dotted, Dash::Long];
+
+impl Dash {
+    /// Dash length and gap (px), `None` for a solid line.
+    pub fn pattern(self) -> Option<(u32, u32)> {
+        match self {
+            Dash::Solid => None,
+            Dash::Dashed => Some((8, 5)),
+            Dash::Dotted => Some((2, 5)),
+            Dash::Long => Some((16, 6)),
+        }
+    }
+}
+
+/// A point marker.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Mark {
+    /// A filled circle.
+    Circle,
+    /// A filled triangle.
+    Triangle,
+    /// A filled square.
+    Square,
+    /// A filled diamond.
+    Diamond,
+    /// An × cross.
+    Cross,
+}
+
+/// The markers, in order.
+pub const MARKS: [Mark; 5] = [Mark::Circle, Mark::Triangle, Mark::Square, Mark::Diamond, Mark::Cross];
+
+/// A series' colour, line pattern and marker.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SeriesStyle {
+    /// Colour.
+    pub colour: RGBColor,
+    /// Line pattern.
+    pub dash: Dash,
+    /// Marker.
+    pub mark: Mark,
+}
+
+/// The style of the `j`-th series (0-based): colour, pattern and marker each cycle through
+/// lists of coprime lengths (7, 4, 5), so that no two of the first 140 series look alike and
+/// the first seven differ in all three. With `colour` given (one colour per strategy), pattern
+/// and marker alone tell the first 20 series apart.
+pub fn series_style(j: usize, colour: Option<RGBColor>) -> SeriesStyle {
+    SeriesStyle {
+        colour: colour.unwrap_or(SERIES[j % SERIES.len()]),
+        dash: DASHES[j % DASHES.len()],
+        mark: MARKS[j % MARKS.len()],
+    }
+}
+
+/// Draws the marker `mark` centred at the pixel `(x, y)` of `area`, `r` px across half.
+pub fn draw_mark<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    (x, y): (i32, i32),
+    mark: Mark,
+    colour: RGBColor,
+    r: i32,
+) -> Result<(), String> {
+    let e = super::err;
+    let r = pxi(r);
+    match mark {
+        Mark::Circle => area.draw(&Circle::new((x, y), r as u32, colour.filled())).map_err(e),
+        Mark::Triangle => area.draw(&TriangleMarker::new((x, y), r + pxi(1), colour.filled())).map_err(e),
+        Mark::Square => {
+            let h = r * 4 / 5;
+            area.draw(&Rectangle::new([(x - h, y - h), (x + h, y + h)], colour.filled())).map_err(e)
+        }
+        Mark::Diamond => area
+            .draw(&Polygon::new(
+                vec![(x, y - r - 1), (x + r + 1, y), (x, y + r + 1), (x - r - 1, y)],
+                colour.filled(),
+            ))
+            .map_err(e),
+        Mark::Cross => area.draw(&Cross::new((x, y), r, colour.stroke_width(px(2)))).map_err(e),
+    }
+}
+
+/// Draws `points` as a line in `style`'s colour and pattern, `width` px wide, with its marker on
+/// every point.
+pub fn draw_styled<'a, DB: DrawingBackend, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    points: &[(f64, f64)],
+    style: SeriesStyle,
+    width: u32,
+) -> Result<(), String>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let line = style.colour.stroke_width(px(width));
+    match style.dash.pattern() {
+        None => chart.draw_series(LineSeries::new(points.iter().copied(), line)).map(|_| ()),
+        Some((dash, gap)) => chart
+            .draw_series(DashedLineSeries::new(points.iter().copied(), px(dash), px(gap), line))
+            .map(|_| ()),
+    }
+    .map_err(super::err)?;
+    let area = chart.plotting_area().strip_coord_spec();
+    for &p in points {
+        let (x, y) = chart.backend_coord(&p);
+        // Backend coordinates are the root's; the stripped area draws in its own.
+        let (ox, oy) = area.get_base_pixel();
+        draw_mark(&area, (x - ox, y - oy), style.mark, style.colour, 5)?;
+    }
+    Ok(())
 }
 
 /// Colour of a strategy, the same in every plot.
@@ -244,6 +382,37 @@ impl Ranged for SymLog {
     }
 }
 
+/// A linear axis over `lo..hi` with ticks only at `ticks`: every tick drawn is one the chart
+/// labels (plotters' own choice spreads ticks over the whole range, also where the axis holds
+/// no values to read).
+#[derive(Debug, Clone)]
+pub struct FixedTicks {
+    /// Lower end.
+    pub lo: f64,
+    /// Upper end.
+    pub hi: f64,
+    /// The ticks, inside the range.
+    pub ticks: Vec<f64>,
+}
+
+impl Ranged for FixedTicks {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        let r = (value - self.lo) / (self.hi - self.lo);
+        limit.0 + (r * f64::from(limit.1 - limit.0)).round() as i32
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, _hint: Hint) -> Vec<f64> {
+        self.ticks.iter().copied().filter(|t| (self.lo..=self.hi).contains(t)).collect()
+    }
+
+    fn range(&self) -> Range<f64> {
+        self.lo..self.hi
+    }
+}
+
 /// Tick label of the symmetric-log residual axis: `0`, `±2σ`, `+1000σ`.
 pub fn sigma_tick(v: &f64) -> String {
     if *v == 0.0 {
@@ -262,6 +431,8 @@ pub enum Swatch {
     Line(RGBColor),
     /// A dashed line.
     Dashed(RGBColor),
+    /// A series' line pattern with its marker.
+    Series(SeriesStyle),
     /// A thin dashed guide line.
     Guide,
     /// The target marker (a cross).
@@ -297,6 +468,25 @@ fn swatch<DB: DrawingBackend>(
                     .map_err(e)?;
             }
             Ok(p(34))
+        }
+        Swatch::Series(st) => {
+            let line = st.colour.stroke_width(px(3));
+            let segments: Vec<(i32, i32)> = match st.dash.pattern() {
+                None => vec![(0, 34)],
+                Some((dash, gap)) => {
+                    let (dash, gap) = (dash as i32, gap as i32);
+                    (0..)
+                        .map(|k| k * (dash + gap))
+                        .take_while(|a| *a < 34)
+                        .map(|a| (a, (a + dash).min(34)))
+                        .collect()
+                }
+            };
+            for (a, b) in segments {
+                area.draw(&PathElement::new(vec![(x + p(a), mid), (x + p(b), mid)], line)).map_err(e)?;
+            }
+            draw_mark(area, (x + p(17), mid), st.mark, st.colour, 5)?;
+            Ok(p(44))
         }
         Swatch::Guide => {
             for (a, b) in [(0, 4), (9, 13), (18, 22)] {
