@@ -95,7 +95,7 @@ const CASES: &[Case] = &[
     measured("measured/negative_std.csv", "measured/negative_std.csv:2: std_hz -0.05 must be a positive finite number"),
     measured("measured/semicolons.csv", "measured/semicolons.csv:1: unknown column `mode;frequency_hz`; the header must be `mode,frequency_hz[,std_hz]`"),
     measured("measured/text_frequency.csv", "measured/text_frequency.csv:3: frequency_hz `abc` is not a number"),
-    measured("measured/too_few_modes.csv", "measured/too_few_modes.csv: 1 measured modes for 2 parameters: at least 2 are needed"),
+    measured("measured/too_few_modes.csv", "measured/too_few_modes.csv: 1 measured frequency for 2 parameters: at least 2 are needed"),
     measured("measured/zero_frequency.csv", "measured/zero_frequency.csv:2: frequency_hz 0 must be a positive finite number"),
     measured("measured/zero_std.csv", "measured/zero_std.csv:3: std_hz 0 must be a positive finite number"),
 ];

@@ -304,11 +304,19 @@ pub fn run(
     let np = model.parameters().len();
     let measured_name = request.measured.display();
     // With shapes every mode gives a row per sensor too: fewer modes than parameters may do.
-    let rows = measurement.len() * (1 + data.sensors.as_ref().map_or(0, |s| s.sensors.len()));
+    let sensors = data.sensors.as_ref().map_or(0, |s| s.sensors.len());
+    let rows = measurement.len() * (1 + sensors);
     if rows < np {
+        let counted = match sensors {
+            0 if measurement.len() == 1 => "1 measured frequency".to_string(),
+            0 => format!("{} measured frequencies", measurement.len()),
+            s => format!(
+                "{} measured modes × (1 frequency + {s} shape components) = {rows} data",
+                measurement.len()
+            ),
+        };
         return Err(input(format!(
-            "{measured_name}: {} measured modes for {np} parameters: at least {np} are needed",
-            measurement.len()
+            "{measured_name}: {counted} for {np} parameters: at least {np} are needed"
         )));
     }
     if measurement.modes_needed() > any.dofs() {
