@@ -15,8 +15,11 @@ or, for Markdown the command prints itself (tables):
     <!-- end regen -->
 
 Commands run with bash from the repository root, with target/release (the `eigenfit` binary)
-first on PATH. Usage:
-    cargo build --release -p eigenfit-cli && cargo build --release --examples && scripts/regenerate-docs.py docs/*.md
+first on PATH, or the folder EIGENFIT_BIN_DIR names (a debug build prints the same numbers).
+`--cli-only` regenerates the `regen:` blocks only (the CLI's output, which the test
+crates/eigenfit-cli/tests/docs_output.rs checks), not the `regen-md` ones (release-built examples,
+peer scripts). Usage:
+    cargo build --release -p eigenfit-cli && cargo build --release --examples && scripts/regenerate-docs.py README.md docs/*.md
 """
 import os
 import re
@@ -24,7 +27,8 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-ENV = dict(os.environ, PATH=os.path.join(ROOT, "target", "release") + os.pathsep + os.environ["PATH"])
+BIN = os.environ.get("EIGENFIT_BIN_DIR", os.path.join(ROOT, "target", "release"))
+ENV = dict(os.environ, PATH=os.path.abspath(BIN) + os.pathsep + os.environ["PATH"])
 
 CODE = re.compile(r"(<!-- regen: (.+?) -->\n```[^\n]*\n)(.*?)(```)", re.S)
 MD = re.compile(r"(<!-- regen-md: (.+?) -->\n)(.*?)(<!-- end regen -->)", re.S)
@@ -37,10 +41,12 @@ def run(cmd: str) -> str:
     return out.stdout if out.stdout.endswith("\n") else out.stdout + "\n"
 
 
-for path in sys.argv[1:]:
+cli_only = "--cli-only" in sys.argv[1:]
+for path in (a for a in sys.argv[1:] if a != "--cli-only"):
     text = open(path, encoding="utf-8").read()
     new = CODE.sub(lambda m: m.group(1) + run(m.group(2)) + m.group(4), text)
-    new = MD.sub(lambda m: m.group(1) + run(m.group(2)) + m.group(4), new)
+    if not cli_only:
+        new = MD.sub(lambda m: m.group(1) + run(m.group(2)) + m.group(4), new)
     if new != text:
         open(path, "w", encoding="utf-8").write(new)
         print(f"updated {path}")

@@ -217,7 +217,8 @@ pub struct Summary {
     /// Converged runs within [`WITHIN_1E6`] of the target.
     #[serde(rename = "converged_within_1e-6")]
     pub converged_within_1e6: usize,
-    /// Converged runs whose data also fit another, equally good solution.
+    /// Converged runs for which another solution fits the data at least as well (the
+    /// equally-good test of `analysis::alternatives`; a better one passes it too).
     pub ambiguous: usize,
     /// Median iterations of the converged runs.
     pub median_iterations: Option<usize>,

@@ -153,7 +153,7 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
                 s.ambiguous
             );
         }
-        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged runs whose data also fit another, equally good solution)");
+        println!("(it. med/max: median and largest iterations of the converged runs; max rel err: largest |estimate/target − 1| [–]; ambiguous: converged runs for which another solution fits the data at least as well, by the χ² test of the verdicts)");
         if cut > 0 {
             println!(
                 "{cut} run(s) ran out of their evaluation budget ({} model evaluations each): their results are incomplete; raise it with --budget",
