@@ -370,7 +370,10 @@ fn with_shapes(name: &str) -> Value {
         let i = floats(&v["intervals"][n]);
         assert!(i[0] <= *x && *x <= i[1], "{name}: {n} = {x} outside its interval {i:?}");
     }
-    // Every alternative: its χ² recomputed, its Δχ², and the claim the stated test makes.
+    // Every alternative: its χ² recomputed, its Δχ², and the claim the stated test makes. Both
+    // sources give no std; with shapes eigenfit states `std` (the default weights stand in for
+    // σ, as in the fit-quality test) although docs/user-guide.md, "Verdicts", says σ comes from
+    // the residuals without std_hz, and the intervals here do: each basis is checked as stated.
     let sigma2 = match v["alternatives_sigma"].as_str() {
         Some("std") => 1.0,
         Some("residuals") => reported / dof as f64,
