@@ -36,9 +36,11 @@ pub struct ShapeArgs {
     /// Distance in metres within which a measured node matches a model node.
     #[arg(long, default_value_t = 1e-3, value_name = "M")]
     pub node_tolerance: f64,
-    /// Standard deviation of the entries of a unit-length measured shape (shape residual weight).
-    #[arg(long, default_value_t = eigenfit_core::analysis::DEFAULT_SHAPE_STD, value_name = "S")]
-    pub shape_std: f64,
+    /// Standard deviation of the entries of a unit-length measured shape, as measured. Without
+    /// it shapes are weighted by 0.05 (and frequencies without std by 0.5 %): weights, not a
+    /// measured σ, so the fit's χ² is not judged and σ comes from the residual scatter.
+    #[arg(long, value_name = "S")]
+    pub shape_std: Option<f64>,
     /// Lowest MAC at which a measured mode counts as paired; below it the mode is named
     /// unpaired and the run is not acceptable (exit code 3).
     #[arg(long, default_value_t = 0.6, value_name = "MAC")]

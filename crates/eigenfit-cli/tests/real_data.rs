@@ -355,8 +355,12 @@ fn with_shapes(name: &str) -> Value {
     assert_eq!(v["dof"], dof, "{name}");
     let estimate = data.values(&v["parameters"]);
     let (chi2, pairing) = data.shape_chi2(&estimate);
-    let reported = v["chi2"].as_f64().unwrap();
-    assert!(close(chi2, reported, 1e-6, 1e-9), "{name}: χ² {reported} reported, {chi2} recomputed");
+    // Σr² of the weighted residual (default weights: neither source gives a std); χ² only with std.
+    let reported = v["misfit"].as_f64().unwrap();
+    assert!(close(chi2, reported, 1e-6, 1e-9), "{name}: Σr² {reported} reported, {chi2} recomputed");
+    if let Some(c) = v["chi2"].as_f64() {
+        assert!(close(c, reported, 1e-12, 0.0), "{name}: χ² {c} is not the misfit {reported}");
+    }
     let paired: Vec<usize> =
         (1..=m).map(|k| v["pairing"][k.to_string()].as_u64().unwrap() as usize - 1).collect();
     assert_eq!(paired, pairing, "{name}: MAC pairing");
@@ -370,10 +374,11 @@ fn with_shapes(name: &str) -> Value {
         let i = floats(&v["intervals"][n]);
         assert!(i[0] <= *x && *x <= i[1], "{name}: {n} = {x} outside its interval {i:?}");
     }
-    // Every alternative: its χ² recomputed, its Δχ², and the claim the stated test makes. Both
-    // sources give no std; with shapes eigenfit states `std` (the default weights stand in for
-    // σ, as in the fit-quality test) although docs/user-guide.md, "Verdicts", says σ comes from
-    // the residuals without std_hz, and the intervals here do: each basis is checked as stated.
+    // Every alternative: its misfit recomputed, its Δχ², and the claim the stated test makes.
+    // Neither source gives a std, so the default weights are not σ: docs/user-guide.md,
+    // "Verdicts", says σ then comes from the residuals, and the fit quality is not judged.
+    assert_eq!(v["alternatives_sigma"], "residuals", "{name}: default weights taken for measured σ");
+    assert_eq!(v["fit_quality"], "not-judged", "{name}: χ² judged on weights nobody measured");
     let sigma2 = match v["alternatives_sigma"].as_str() {
         Some("std") => 1.0,
         Some("residuals") => reported / dof as f64,
@@ -381,8 +386,10 @@ fn with_shapes(name: &str) -> Value {
     };
     for a in v["alternative_solutions"].as_array().unwrap() {
         let (alt, _) = data.shape_chi2(&data.values(&a["parameters"]));
-        let listed = a["chi2"].as_f64().unwrap();
-        assert!(close(alt, listed, 1e-6, 1e-9), "{name}: alternative χ² {listed}, recomputed {alt}: {a}");
+        let listed = a["misfit"].as_f64().unwrap();
+        assert!(close(alt, listed, 1e-6, 1e-9), "{name}: alternative Σr² {listed}, recomputed {alt}: {a}");
+        let scaled = a["chi2"].as_f64().unwrap();
+        assert!(close(scaled * sigma2, alt, 1e-6, 1e-9), "{name}: χ² {scaled} is not Σr²/σ² {alt}/{sigma2}");
         assert!(alt >= chi2 * (1.0 - 1e-9), "{name}: an alternative fits better than the estimate: {a}");
         let delta = a["delta_chi2"].as_f64().unwrap();
         assert!(
@@ -463,7 +470,10 @@ fn four_storey_frequencies_every_exact_solution_is_listed() {
 #[test]
 fn four_storey_with_shapes_claims_hold() {
     let v = with_shapes("four_storey_gatech");
-    eprintln!("four_storey_gatech with shapes: verdict {} χ² {} ({} dof)", v["verdict"], v["chi2"], v["dof"]);
+    eprintln!(
+        "four_storey_gatech with shapes: verdict {} Σr² {} ({} dof)",
+        v["verdict"], v["misfit"], v["dof"]
+    );
 }
 
 /// The 18-storey frame's three frequencies with three stiffness zones: no exact solution
@@ -490,7 +500,7 @@ fn eighteen_storey_frequencies_claims_hold() {
 fn eighteen_storey_with_shapes_claims_hold() {
     let v = with_shapes("eighteen_storey_edefense");
     eprintln!(
-        "eighteen_storey_edefense with shapes: verdict {} χ² {} ({} dof)",
-        v["verdict"], v["chi2"], v["dof"]
+        "eighteen_storey_edefense with shapes: verdict {} Σr² {} ({} dof)",
+        v["verdict"], v["misfit"], v["dof"]
     );
 }

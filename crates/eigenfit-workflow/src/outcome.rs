@@ -39,6 +39,9 @@ pub struct FitQualityReport<D> {
     pub fit_quality: &'static str,
     /// χ² = Σ (residual/σ)² (with std only).
     pub chi2: Option<f64>,
+    /// Σr² of the weighted residual whatever σ is: χ² with std; without, what the alternatives'
+    /// `misfit` compares with (σ̂² = misfit / dof when `alternatives_sigma` is `residuals`).
+    pub misfit: f64,
     /// Degrees of freedom: measured values − free parameters.
     pub dof: usize,
     /// P(χ²_dof > χ²): the probability that noise alone gives a misfit this large (with std only).
@@ -55,6 +58,7 @@ impl<D> FitQualityReport<D> {
         Self {
             fit_quality: quality.verdict.label(),
             chi2: quality.chi2,
+            misfit: quality.misfit,
             dof: quality.dof,
             p_value: quality.p_value,
             relative_rms_residual: quality.relative_rms,

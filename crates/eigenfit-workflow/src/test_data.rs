@@ -24,19 +24,17 @@ use std::path::{Path, PathBuf};
 pub struct ShapeOptions {
     /// Distance in metres within which a measured node matches a model node.
     pub node_tolerance: f64,
-    /// Standard deviation of the entries of a unit-length measured shape.
-    pub shape_std: f64,
+    /// Standard deviation of the entries of a unit-length measured shape, when the data give it;
+    /// `None`: [`DEFAULT_SHAPE_STD`](eigenfit_core::analysis::DEFAULT_SHAPE_STD) is assumed (a
+    /// weight, not a measured σ: the fit is then not judged by χ²).
+    pub shape_std: Option<f64>,
     /// Lowest MAC at which a measured mode counts as paired.
     pub mac_threshold: f64,
 }
 
 impl Default for ShapeOptions {
     fn default() -> Self {
-        Self {
-            node_tolerance: 1e-3,
-            shape_std: eigenfit_core::analysis::DEFAULT_SHAPE_STD,
-            mac_threshold: 0.6,
-        }
+        Self { node_tolerance: 1e-3, shape_std: None, mac_threshold: 0.6 }
     }
 }
 
@@ -111,7 +109,7 @@ pub fn read(
     if !(node_tolerance.is_finite() && node_tolerance >= 0.0) {
         return Err(input(format!("--node-tolerance {node_tolerance}: must be a finite distance ≥ 0 m")));
     }
-    if !(shape_std.is_finite() && shape_std > 0.0) {
+    if let Some(shape_std) = shape_std.filter(|s| !(s.is_finite() && *s > 0.0)) {
         return Err(input(format!("--shape-std {shape_std}: must be a positive finite number")));
     }
     if !(0.0..=1.0).contains(&mac_threshold) {
@@ -208,14 +206,18 @@ pub enum Fit<'a> {
 }
 
 impl<'a> Fit<'a> {
-    /// The fit for `problem` and the data's sensors, shape entries weighted by `shape_std`.
-    pub fn new(problem: RotorProblem<'a>, data: &TestData, shape_std: f64) -> Self {
+    /// The fit for `problem` and the data's sensors, shape entries weighted by `shape_std` (the
+    /// measured one, or the default assumed).
+    pub fn new(problem: RotorProblem<'a>, data: &TestData, shape_std: Option<f64>) -> Self {
         match &data.sensors {
             None => Fit::Frequencies(problem),
-            Some(set) => Fit::Shapes(ShapeFit::new(
-                problem.with_pairing(Pairing::Mac { sensor_dofs: set.dofs() }),
-                shape_std,
-            )),
+            Some(set) => {
+                let fit = ShapeFit::new(
+                    problem.with_pairing(Pairing::Mac { sensor_dofs: set.dofs() }),
+                    shape_std.unwrap_or(eigenfit_core::analysis::DEFAULT_SHAPE_STD),
+                );
+                Fit::Shapes(if shape_std.is_some() { fit.with_measured_shape_std() } else { fit })
+            }
         }
     }
 

@@ -32,6 +32,8 @@ pub struct ShapeFit<M, S> {
     /// Divides every row: 1 for fitting; the residual scatter σ̂ for intervals from data
     /// without standard deviations.
     pub scale: f64,
+    /// Whether `shape_std` is the measurement's own (given by the user), not the assumed default.
+    pub measured_shape_std: bool,
 }
 
 impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
@@ -39,7 +41,21 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     /// [`DEFAULT_FREQUENCY_STD_REL`] relative (for the relative residual).
     pub fn new(problem: Problem<M, S>, shape_std: f64) -> Self {
         let frequency_weight = if problem.measured.has_std() { 1.0 } else { 1.0 / DEFAULT_FREQUENCY_STD_REL };
-        Self { problem, shape_std, frequency_weight, scale: 1.0 }
+        Self { problem, shape_std, frequency_weight, scale: 1.0, measured_shape_std: false }
+    }
+
+    /// Says that `shape_std` is the measurement's own standard deviation: with std on every
+    /// frequency too, the rows are then in noise units and χ² is a test of the fit
+    /// ([`Linearisation::has_std`]); with an assumed weight anywhere it only sets how rows count
+    /// against each other, and σ comes from the residual scatter.
+    pub fn with_measured_shape_std(mut self) -> Self {
+        self.measured_shape_std = true;
+        self
+    }
+
+    /// Whether every row is weighted by a standard deviation the data carry.
+    pub fn has_std(&self) -> bool {
+        self.measured_shape_std && self.problem.measured.has_std()
     }
 
     /// The model shapes at the sensors, one per computed mode, and the paired model modes,
@@ -73,7 +89,7 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         at: &Linearisation,
         budget: &crate::update::Budget,
     ) -> Option<(crate::analysis::Uncertainty, f64)> {
-        let has_std = self.problem.measured.has_std();
+        let has_std = self.has_std();
         crate::analysis::statistics::scatter_uncertainty(self, |fit| &mut fit.scale, at, has_std, budget)
     }
 
@@ -141,8 +157,9 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
         }
         lin.residual = residual;
         lin.jacobian = jacobian;
-        // Every row is now weighted by a standard deviation: given, or the documented defaults.
-        lin.has_std = true;
+        // Every row is weighted by a standard deviation, given or the documented defaults; χ² is a
+        // test only when every weight is the data's own (default weights are not measured σ).
+        lin.has_std = self.has_std();
         Ok(lin)
     }
 }

@@ -51,6 +51,9 @@ pub struct FitQuality {
     pub verdict: FitVerdict,
     /// χ² = Σ (residual/σ)² (with std only).
     pub chi2: Option<f64>,
+    /// Σr² of the weighted residual whatever σ is (χ² with std; without, the misfit the
+    /// alternatives' `misfit` compares with, and σ̂² = misfit / dof).
+    pub misfit: f64,
     /// Degrees of freedom: measured modes − free parameters.
     pub dof: usize,
     /// P(χ²_dof > χ²): the probability that noise alone gives a misfit this large (with std and
@@ -79,6 +82,7 @@ pub fn judge(lin: &Linearisation, free: usize) -> FitQuality {
         return FitQuality {
             verdict: FitVerdict::NotJudged,
             chi2: None,
+            misfit: lin.residual.norm_squared(),
             dof,
             p_value: None,
             relative_rms,
@@ -103,7 +107,15 @@ pub fn judge(lin: &Linearisation, free: usize) -> FitQuality {
         disagreeing.extend(order.first());
     }
     let verdict = if poor { FitVerdict::Poor } else { FitVerdict::Acceptable };
-    FitQuality { verdict, chi2: Some(chi2), dof, p_value, relative_rms, disagreeing }
+    FitQuality {
+        verdict,
+        chi2: Some(chi2),
+        misfit: lin.residual.norm_squared(),
+        dof,
+        p_value,
+        relative_rms,
+        disagreeing,
+    }
 }
 
 /// Per parameter: which limit (−1 lower, +1 upper) the value sits on or runs to (within 10⁻⁶ of
