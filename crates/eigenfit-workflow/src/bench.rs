@@ -258,13 +258,7 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
     let params = model.parameters();
     let mut truth = vec![f64::NAN; params.len()];
     for (key, value) in &file.truth {
-        let i = params.index_of(key).map_err(|_| {
-            at(format!(
-                "truth: `{}` is not a parameter of the model; its parameters: {}",
-                shown(key),
-                params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
-            ))
-        })?;
+        let i = params.index_of(key).map_err(|e| at(format!("truth: {e}")))?;
         truth[i] = number(value).ok_or_else(|| at(format!("truth: `{key}` must be a finite number")))?;
     }
     if let Some(missing) = params.iter().zip(&truth).find(|(_, t)| t.is_nan()) {
@@ -297,8 +291,7 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
     };
     let mut start_range: Vec<(f64, f64)> = params.iter().map(|p| p.search_range()).collect();
     for (key, value) in file.starts.iter().flatten() {
-        let i =
-            params.index_of(key).map_err(|_| at(format!("starts: `{}` is not a parameter", shown(key))))?;
+        let i = params.index_of(key).map_err(|e| at(format!("starts: {e}")))?;
         let pair =
             value.as_array().filter(|a| a.len() == 2).and_then(|a| Some((number(&a[0])?, number(&a[1])?)));
         let (lo, hi) = pair.ok_or_else(|| at(format!("starts: `{key}` must be [low, high]")))?;

@@ -5,7 +5,7 @@ use crate::error::{failure, input, WorkflowError};
 use crate::model::AnyModel;
 use crate::named::Named;
 use crate::progress::Progress;
-use eigenfit_core::analysis::verdict::check_reachable;
+use eigenfit_core::analysis::verdict::{check_reachable, check_softest};
 use eigenfit_core::discovery::{
     discover, BaseMisfit, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect,
 };
@@ -148,6 +148,8 @@ pub fn run(
     }
     // Estimate's sanity check, so a typing slip ends here as it does there (exit 2, mode named).
     let mode_numbers: Vec<usize> = data.modes().iter().map(|m| m.mode + 1).collect();
+    check_softest(model, solver, &data, &mode_numbers)
+        .map_err(|e| input(format!("{}: {e}", measured.display())))?;
     let problem = Problem::new(model, solver, data.clone());
     let check = Budget::new(budget);
     check_reachable(&problem, &mode_numbers, &check).map_err(|e| {

@@ -43,7 +43,7 @@ impl std::fmt::Debug for Method {
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum StrategyError {
     /// No strategy is registered under this name.
-    #[error("unknown strategy `{name}`; available: {available}")]
+    #[error("{}", crate::names::unknown("strategy", name, &available.split(", ").collect::<Vec<_>>()))]
     Unknown {
         /// The name asked for.
         name: String,
