@@ -332,18 +332,20 @@ impl Covariances {
         let rows = |f: &dyn Fn(usize, usize) -> f64| -> Vec<Vec<f64>> {
             (0..n).map(|i| (0..n).map(|j| f(i, j)).collect()).collect()
         };
+        // Symmetric to the last bit: (i, j) and (j, i) from the same sum.
+        let sym = |i: usize, j: usize| 0.5 * (c[(i, j)] + c[(j, i)]);
         let correlation = rows(&|i, j| {
             if i == j {
                 1.0
             } else {
-                (c[(i, j)] / (c[(i, i)].sqrt() * c[(j, j)].sqrt())).clamp(-1.0, 1.0)
+                (sym(i, j) / (c[(i, i)].sqrt() * c[(j, j)].sqrt())).clamp(-1.0, 1.0)
             }
         });
         Self {
             covariance: Some(CovarianceReport {
                 coordinates: "physical",
                 parameters: names.to_vec(),
-                matrix: rows(&|i, j| 0.5 * (c[(i, j)] + c[(j, i)])),
+                matrix: rows(&sym),
             }),
             correlation: Some(CorrelationReport { parameters: names.to_vec(), matrix: correlation }),
         }
