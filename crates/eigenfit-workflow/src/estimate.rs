@@ -336,12 +336,20 @@ pub fn run(
     let mode_numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
     let sigma_max = measurement.modes().iter().filter_map(|m| m.std_hz).reduce(f64::max);
     let measurement_for_sampling = measurement.clone();
-    // Frequencies below what the softest supports allow (entered in kHz, say) are refused by
-    // name before anything is fitted; with shapes a measured mode may pair with another model
-    // mode, so the mode-by-mode bound is checked on frequency data only.
+    // Frequencies no stiffness can give, all explained by one unit slip (entered in kHz, say),
+    // are refused naming the unit before anything is fitted; without such a slip they may be a
+    // model error, said in a note. With shapes a measured mode may pair with another model mode,
+    // so the mode-by-mode bounds are checked on frequency data only.
     if data.sensors.is_none() {
-        check_softest(&model, solver.as_ref(), &measurement, &mode_numbers)
-            .map_err(|e| input(format!("{measured_name}: {e}")))?;
+        match check_softest(&model, solver.as_ref(), &measurement, &mode_numbers) {
+            Some(e) if e.slip.is_some() => return Err(input(format!("{measured_name}: {e}"))),
+            Some(e) => notes.push(format!(
+                "{measured_name}: no stiffness within the limits can produce {}: the fit cannot reach these \
+                 modes; a missing effect (`eigenfit discover`) or modes numbered differently from the model's?",
+                e.modes_said()
+            )),
+            None => {}
+        }
     }
     let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
     let mut fit = Fit::new(problem, &data, options.shape.shape_std);

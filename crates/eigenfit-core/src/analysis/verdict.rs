@@ -277,34 +277,38 @@ fn stiffening(model: &dyn StructuralModel, a: &[f64], b: &[f64], i: usize) -> bo
     sub.symmetric_eigenvalues().iter().all(|&l| l >= -1e-12 * scale)
 }
 
-/// Measured modes below the lowest frequency the model can have: when raising any parameter can
-/// only raise every eigenvalue (each is a stiffness: ∂M = 0, ∂K semi-definite and constant), the
-/// model's modes with every parameter at its lower limit bound each mode from below over the
-/// whole box — however soft the supports, mode k cannot go below it (mode 3 of a two-bearing
-/// rotor stays above the free–free rotor's first bending mode). The check [`check_reachable`]
-/// makes from the box's corners loses these bounds when the softest corner cannot be evaluated
-/// (its rigid-body modes lost to round-off); this one needs eigenvalues only. `None` when the
-/// model is not of that kind or cannot be solved there: nothing is claimed. `mode_numbers`: the
+/// Measured modes outside the frequencies the model can have at all: when raising any parameter
+/// can only raise every eigenvalue (each is a stiffness: ∂M = 0, ∂K semi-definite and constant),
+/// the model's modes with every parameter at its lower limit bound each mode from below over
+/// the whole box, and with every parameter at its upper limit from above (Courant–Fischer) —
+/// however soft the supports, mode k cannot go below its bound (mode 3 of a two-bearing rotor
+/// stays above the free–free rotor's first bending mode). The check [`check_reachable`] makes
+/// from the box's corners loses the lower bounds when the softest corner cannot be evaluated
+/// (its rigid-body modes lost to round-off); this one needs eigenvalues only. `None` when every
+/// mode is within (10 % margin), or the model is not of that kind or cannot be solved there:
+/// nothing is claimed. The modes outside come with the unit slip that explains them all, if one
+/// does (frequencies entered in kHz are all 1000× too low): data to refuse; without one they
+/// may be a model error (an effect the model lacks), for the caller to say. `mode_numbers`: the
 /// measured modes' numbers (from 1) in the measurement's order.
 pub fn check_softest(
     model: &dyn StructuralModel,
     solver: &dyn EigenSolver,
     measurement: &Measurement,
     mode_numbers: &[usize],
-) -> Result<(), UnreachableData> {
+) -> Option<UnreachableData> {
     let params = model.parameters();
     if params.is_empty() || !params.iter().all(|p| p.lower.is_finite()) {
-        return Ok(());
+        return None;
     }
     let lower: Vec<f64> = params.iter().map(|p| p.lower).collect();
     let upper: Vec<f64> =
         params.iter().map(|p| if p.upper.is_finite() { p.upper } else { p.search_range().1 }).collect();
     if !(0..params.len()).all(|i| stiffening(model, &lower, &upper, i)) {
-        return Ok(());
+        return None;
     }
     let count = measurement.modes().iter().map(|m| m.mode + 1).max().unwrap_or(0);
-    let Ok(system) = model.assemble(&lower) else { return Ok(()) };
-    let Ok(eigenvalues) = solver.lowest_eigenvalues(&system, count) else { return Ok(()) };
+    let system = model.assemble(&lower).ok()?;
+    let eigenvalues = solver.lowest_eigenvalues(&system, count).ok()?;
     let measured: Vec<f64> = measurement.modes().iter().map(|m| m.frequency_hz).collect();
     let lo: Vec<f64> =
         measurement.modes().iter().map(|m| crate::units::eigenvalue_to_hz(eigenvalues[m.mode])).collect();
@@ -316,12 +320,12 @@ pub fn check_softest(
         }
         _ => vec![f64::INFINITY; lo.len()],
     };
-    let below = outside(&measured, &lo, &hi, UNREACHABLE_MARGIN);
-    if below.is_empty() {
-        return Ok(());
+    let beyond = outside(&measured, &lo, &hi, UNREACHABLE_MARGIN);
+    if beyond.is_empty() {
+        return None;
     }
-    Err(UnreachableData {
-        modes: below
+    Some(UnreachableData {
+        modes: beyond
             .into_iter()
             .map(|u| (mode_numbers.get(u.index).copied().unwrap_or(u.index + 1), u))
             .collect(),
@@ -342,6 +346,14 @@ pub struct UnreachableData {
     /// The unit the frequencies were most likely entered in (its name, and the factor that turns
     /// its numbers into Hz), when converting all of them from it puts every mode within reach.
     pub slip: Option<(&'static str, f64)>,
+}
+
+impl UnreachableData {
+    /// The modes and the ranges the model reaches, in words (`mode 6 at 1106.1289 Hz (the model
+    /// reaches 1874.6098–3458.8551 Hz)`), without the verdict on the cause.
+    pub fn modes_said(&self) -> String {
+        listed(&self.modes)
+    }
 }
 
 /// What the message says about the cause: the unit slip when one explains every mode.
