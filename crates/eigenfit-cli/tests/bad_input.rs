@@ -85,7 +85,7 @@ const CASES: &[Case] = &[
     measured("measured/missing_frequency_column.csv", "measured/missing_frequency_column.csv:1: missing column `frequency_hz`; the header must be `mode,frequency_hz[,std_hz]`"),
     measured("measured/missing_mode_column.csv", "measured/missing_mode_column.csv:1: missing column `mode`; the header must be `mode,frequency_hz[,std_hz]`"),
     measured("measured/missing_std.csv", "measured/missing_std.csv:3: std_hz is empty"),
-    measured("measured/misspelled_column.csv", "measured/misspelled_column.csv:2: unknown column `frequncy_hz`; the header must be `mode,frequency_hz[,std_hz]`"),
+    measured("measured/misspelled_column.csv", "measured/misspelled_column.csv:2: unknown column `frequncy_hz` (did you mean `frequency_hz`?); the header must be `mode,frequency_hz[,std_hz]`"),
     measured("measured/mode_beyond_model.csv", "measured/mode_beyond_model.csv: mode 99 measured but the model has only 22 modes"),
     measured("measured/mode_fraction.csv", "measured/mode_fraction.csv:3: mode `2.5` must be a whole number ≥ 1 (modes count from 1)"),
     measured("measured/mode_zero.csv", "measured/mode_zero.csv:2: mode `0` must be a whole number ≥ 1 (modes count from 1)"),

@@ -350,6 +350,15 @@ fn every_unknown_name_lists_the_valid_ones_and_the_nearest() {
             "--strategy: no strategy named `dampd`; did you mean `damped`? The strategies are: newton, p-step, damped",
         ),
         (
+            vec!["estimate", "--preset", "paper-rotor", "--measured", &measured, "--strategy", "damped:max_trails=3"],
+            "strategy `damped` has no setting `max_trails` (did you mean `max_trials`?); its settings: residual_tolerance",
+        ),
+        (
+            vec!["bench", "--problems", "paper-tabel3"],
+            "`paper-tabel3` is neither a built-in problem (paper-table2, paper-table3, paper-table4, paper-table5, \
+             shear-frame) nor a problem file (did you mean `paper-table3`?)",
+        ),
+        (
             vec!["estimate", "--preset", "paper-rotor", "--measured", &measured, "--residual", "hertz"],
             "--residual: no residual named `hertz`; the residuals are: relative, hz, eigenvalue",
         ),

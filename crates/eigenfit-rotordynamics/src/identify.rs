@@ -90,7 +90,11 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, RunupError> {
     {
         return Err(line_error(
             1,
-            format!("unknown column `{bad}` (speed_rpm, mode, frequency_hz, std_hz, whirl)"),
+            format!(
+                "unknown column `{bad}`{} (speed_rpm, mode, frequency_hz, std_hz, whirl)",
+                eigenfit_core::names::nearest(bad, &["speed_rpm", "mode", "frequency_hz", "std_hz", "whirl"])
+                    .map_or(String::new(), |n| format!("; did you mean `{n}`?"))
+            ),
         ));
     }
     let (cstd, cw) = (col("std_hz"), col("whirl"));

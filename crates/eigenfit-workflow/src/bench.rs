@@ -236,7 +236,8 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
     let at = |msg: String| input(format!("{}: {msg}", path.display()));
     crate::model::check_model_file(path)?;
     let text = std::fs::read_to_string(path).map_err(|e| at(format!("cannot read: {e}")))?;
-    let file: ProblemFile = toml::from_str(&text).map_err(|e| at(e.to_string().trim_end().to_string()))?;
+    let file: ProblemFile = toml::from_str(&text)
+        .map_err(|e| at(eigenfit_core::names::with_serde_hint(e.to_string().trim_end())))?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let source = ModelSource {
         model: Some(dir.join(&file.model)),
@@ -316,8 +317,10 @@ pub fn problem(name: &str) -> Result<BenchProblem, WorkflowError> {
     if path.extension().is_some_and(|e| e == "toml") || path.exists() {
         return load_problem_file(path);
     }
+    let hint = eigenfit_core::names::nearest(name, &BUILTIN_PROBLEMS)
+        .map_or(String::new(), |n| format!(" (did you mean `{n}`?)"));
     Err(input(format!(
-        "--problems: `{}` is neither a built-in problem ({}) nor a problem file",
+        "--problems: `{}` is neither a built-in problem ({}) nor a problem file{hint}",
         shown(name),
         BUILTIN_PROBLEMS.join(", ")
     )))
