@@ -21,9 +21,9 @@ def test_a_misspelled_keyword_is_a_type_error_naming_it_and_the_one_meant():
     with pytest.raises(TypeError, match=r"bench\(\) got an unexpected keyword argument 'strategy'; "
                                         r"did you mean 'strategies'\?"):
         eigenfit.bench(["paper-table3"], strategy="damped")
-    # A keyword nothing resembles is named with the list of keywords.
-    with pytest.raises(TypeError, match=r"argument 'colour' Its keywords are: .*modes"):
-        eigenfit.simulate("paper-rotor", colour="red")
+    # A keyword nothing resembles is named with the list of keywords, before anything runs.
+    with pytest.raises(TypeError, match=r"argument 'no_such_option' Its keywords are: .*modes"):
+        eigenfit.simulate("paper-rotor", no_such_option=1)
 
 
 def test_simulate_shapes_are_an_array_of_dofs_by_modes_equal_to_the_cli(cli):
