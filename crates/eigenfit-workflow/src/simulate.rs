@@ -322,6 +322,9 @@ pub fn matrices_mode_shapes(
     shapes_report(model, solver, p, count, labels, &|shape| model.expand_shape(p, shape).map_err(failure))
 }
 
+/// A shape on the solved DOFs to the shape on every DOF of the model as read.
+type ExpandShape<'a> = dyn Fn(&[f64]) -> Result<Vec<f64>, WorkflowError> + 'a;
+
 /// The shapes of `model`'s lowest `count` modes at `p`, each passed through `expand`, with the
 /// DOFs `labels` (numbered `dof1`, `dof2`, … when they do not label every value).
 fn shapes_report(
@@ -330,7 +333,7 @@ fn shapes_report(
     p: &[f64],
     count: usize,
     labels: Vec<String>,
-    expand: &dyn Fn(&[f64]) -> Result<Vec<f64>, WorkflowError>,
+    expand: &ExpandShape<'_>,
 ) -> Result<ModeShapesReport, WorkflowError> {
     let modes = modes_at(model, solver, p, count)?;
     let shapes = (0..modes.count())
