@@ -43,7 +43,7 @@ pub fn nearest<'a, S: AsRef<str>>(given: &str, valid: &'a [S]) -> Option<&'a str
     }
 }
 
-/// The valid names as a list to read: all of them, or the first [`MAX_LISTED`] and how many
+/// The valid names as a list to read: all of them, or the first 40 and how many
 /// more; `(none)` when there are none.
 pub fn listed<S: AsRef<str>>(valid: &[S]) -> String {
     if valid.is_empty() {

@@ -313,12 +313,15 @@ pub fn check_softest(
     let lo: Vec<f64> =
         measurement.modes().iter().map(|m| crate::units::eigenvalue_to_hz(eigenvalues[m.mode])).collect();
     // Raising every parameter to its upper limit bounds each mode from above, by the same
-    // argument (∞ where that model cannot be solved).
-    let hi: Vec<f64> = match model.assemble(&upper).map(|s| solver.lowest_eigenvalues(&s, count)) {
-        Ok(Ok(top)) => {
+    // argument (∞ when a parameter has no upper limit, or that model cannot be solved).
+    let bounded = params.iter().all(|p| p.upper.is_finite());
+    let top =
+        bounded.then(|| model.assemble(&upper).ok().and_then(|s| solver.lowest_eigenvalues(&s, count).ok()));
+    let hi: Vec<f64> = match top.flatten() {
+        Some(top) => {
             measurement.modes().iter().map(|m| crate::units::eigenvalue_to_hz(top[m.mode])).collect()
         }
-        _ => vec![f64::INFINITY; lo.len()],
+        None => vec![f64::INFINITY; lo.len()],
     };
     let beyond = outside(&measured, &lo, &hi, UNREACHABLE_MARGIN);
     if beyond.is_empty() {
