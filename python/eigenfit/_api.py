@@ -6,7 +6,7 @@ import os
 from typing import Any, Mapping, Optional, Sequence, Type, TypeVar, Union
 
 from . import _native
-from ._args import TempFiles, is_ross_rotor, measured_args, model_args, option_args
+from ._args import TempFiles, check_keywords, is_ross_rotor, measured_args, model_args, option_args
 from ._results import (
     BenchResult,
     CampbellResult,
@@ -63,6 +63,8 @@ def _call(
     measured: Optional[Measured],
     options: Mapping[str, Any],
 ) -> R:
+    # A misspelled keyword is a TypeError naming it, before any file is written or work done.
+    check_keywords(command, command, options)
     with TempFiles() as tmp:
         args = [command] + model_args(model, tmp)
         if measured is not None:
@@ -102,10 +104,15 @@ def simulate(
         effects: what-if effects, ``"KIND[@LOCATION]=VALUE"`` each.
         sweep: ``(from, to, count)``: every bearing at the same log-spaced stiffness.
         solver: eigen-solver backend (``auto``, ``banded``, ``dense``, ``lapack``).
-        **options: any other ``eigenfit simulate`` option, ``elements=200`` → ``--elements 200``.
+        **options: any other ``eigenfit simulate`` option, ``elements=200`` → ``--elements 200``;
+            ``shapes=True`` adds the mass-normalised mode shapes (``result.mode_shapes``, an
+            array of DOFs × modes, rows named by ``result.dof_labels``).
 
     Returns:
         SimulateResult; ``to_dict()`` is the CLI's JSON.
+
+    Raises:
+        TypeError: a keyword that is no option of ``eigenfit simulate`` (named, with the nearest).
     """
     return _call(
         "simulate",
@@ -247,6 +254,7 @@ def bench(
         BenchResult (exit code 3 when some problem and strategy never reached the truth).
     """
     args = ["bench", "--problems", ",".join(os.fspath(p) for p in problems)]
+    check_keywords("bench", "bench", options)
     args += option_args(
         {"strategies": strategies, "starts": starts, "seed": seed, "budget": budget, **options}
     )

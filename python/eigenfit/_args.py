@@ -10,6 +10,7 @@ call.
 
 from __future__ import annotations
 
+import difflib
 import os
 import tempfile
 from collections.abc import Iterable, Mapping
@@ -69,6 +70,34 @@ def _list(value: Any) -> str:
         else:
             items.append(":".join(_number(v) for v in np.asarray(item).ravel()))
     return ",".join(items)
+
+
+def check_keywords(function: str, command: str, keywords: Iterable[str], accepted: Iterable[str] = ()) -> None:
+    """Raises ``TypeError`` naming the first keyword that is no option of ``eigenfit COMMAND``.
+
+    A keyword ``max_iterations`` is the option ``--max-iterations``; ``set``/``sets`` and
+    ``effect``/``effects`` are ``--set`` and ``--effect``. The message names the function, the
+    keyword, the nearest valid one (a typo such as ``stifness``) and all of them, as Python's own
+    "unexpected keyword argument" would, instead of the command line's usage text.
+    ``accepted``: the function's own keywords (valid whatever the command's options are).
+    """
+    from . import _native
+
+    names = _native.options(command)
+    if names is None:
+        return
+    valid = {n.replace("-", "_") for n in names if n not in ("json", "help", "version")}
+    valid |= {k for k, flag in _REPEATED_OPTIONS.items() if flag[2:] in names}
+    valid |= set(accepted)
+    for key in keywords:
+        if key in valid:
+            continue
+        close = difflib.get_close_matches(key, sorted(valid), n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
+        raise TypeError(
+            f"{function}() got an unexpected keyword argument '{key}'{hint} "
+            f"Its keywords are: {', '.join(sorted(valid))}"
+        )
 
 
 def option_args(options: Mapping[str, Any]) -> list[str]:

@@ -180,6 +180,25 @@ class SimulateResult(Result):
         return _arrays(self._data.get("sensitivities_hz"))
 
     @property
+    def units(self) -> Dict[str, str]:
+        """Each parameter's unit as declared (``""`` when none was); empty for a sweep."""
+        return dict(self._data.get("units") or {})
+
+    @property
+    def mode_shapes(self) -> Optional[np.ndarray]:
+        """Mass-normalised mode shapes (ΦᵀMΦ = I), shape (DOFs, modes): column k is mode k + 1,
+        rows in the order of :attr:`dof_labels`; None unless asked for with ``shapes=True``."""
+        shapes = self._data.get("mode_shapes")
+        return None if shapes is None else np.asarray(shapes["shapes"], dtype=float).T
+
+    @property
+    def dof_labels(self) -> Optional[List[str]]:
+        """The DOF of each row of :attr:`mode_shapes` (a planar rotor's ``v3``, ``theta3``; a
+        matrices model's ``node:direction`` or ``dof1``…); None without shapes."""
+        shapes = self._data.get("mode_shapes")
+        return None if shapes is None else list(shapes["dofs"])
+
+    @property
     def sweep_stiffness(self) -> Optional[np.ndarray]:
         """The swept stiffness values (N/m), or None without a sweep."""
         sweep = self._data.get("sweep")
@@ -309,6 +328,26 @@ class EstimateResult(Result):
         """Whether the data determine each parameter (an entry's bound, if any, is in
         ``result["identifiable"]``); empty when no uncertainty was computed."""
         return {k: v is True for k, v in (self._data.get("identifiable") or {}).items()}
+
+    @property
+    def units(self) -> Dict[str, str]:
+        """Each parameter's unit as declared (``""`` when none was)."""
+        return dict(self._data.get("units") or {})
+
+    @property
+    def covariance(self) -> Optional[np.ndarray]:
+        """The parameters' covariance in physical units (entry (i, j) in unitᵢ·unitⱼ), rows and
+        columns in the order of :attr:`parameters`; None when not computed (no std, no
+        convergence) or not computable (rank-deficient)."""
+        c = self._data.get("covariance")
+        return None if c is None else np.asarray(c["matrix"], dtype=float)
+
+    @property
+    def correlation(self) -> Optional[np.ndarray]:
+        """The parameters' correlation (ones on the diagonal), ordered as :attr:`covariance`;
+        None when the covariance is."""
+        c = self._data.get("correlation")
+        return None if c is None else np.asarray(c["matrix"], dtype=float)
 
     @property
     def singular_values(self) -> Optional[np.ndarray]:

@@ -19,6 +19,13 @@ fn run_json(py: Python<'_>, args: Vec<String>) -> (u8, String) {
     })
 }
 
+/// The long options (`max-iterations`, without the dashes) of the command `command`, or `None`
+/// for no such command: the keywords a Python function accepts (`max_iterations`).
+#[pyfunction]
+fn options(command: &str) -> Option<Vec<String>> {
+    eigenfit_cli::option_names(command)
+}
+
 /// The version of the Rust crates this extension was built from.
 #[pyfunction]
 fn version() -> &'static str {
@@ -29,5 +36,6 @@ fn version() -> &'static str {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_json, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add_function(wrap_pyfunction!(options, m)?)?;
     Ok(())
 }

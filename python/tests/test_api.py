@@ -143,15 +143,14 @@ def test_to_dict_is_a_copy():
 @pytest.mark.parametrize(
     "call, fragment",
     [
-        (lambda: eigenfit.simulate("no-such-rotor"), "unknown preset `no-such-rotor`"),
+        (lambda: eigenfit.simulate("no-such-rotor"), "no preset named `no-such-rotor`"),
         (lambda: eigenfit.simulate("paper-rotor", modes=0), "--modes 0"),
-        (lambda: eigenfit.simulate("paper-rotor", no_such_option=1), "--no-such-option"),
         (lambda: eigenfit.simulate("missing/rotor.toml"), "missing/rotor.toml"),
         (lambda: eigenfit.estimate("paper-rotor", "missing.csv"), "missing.csv"),
         (lambda: eigenfit.estimate("paper-rotor", {"frequency_hz": [30.0]}), "at least 2"),
         (
             lambda: eigenfit.estimate("paper-rotor", {"frequency_hz": [30.0, 90.0]}, strategy="guess"),
-            "unknown strategy",
+            "no strategy named `guess`",
         ),
     ],
 )

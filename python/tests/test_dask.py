@@ -64,7 +64,7 @@ def test_cluster_failed_job_is_returned_or_raised(client):
     results = eigenfit.batch.estimate_many(jobs, client=client, errors="return")
     assert isinstance(results[0], eigenfit.EstimateResult)
     assert isinstance(results[1], eigenfit.EigenfitError) and results[1].exit_code == 2
-    with pytest.raises(eigenfit.EigenfitError, match="unknown preset"):
+    with pytest.raises(eigenfit.EigenfitError, match="no preset named"):
         eigenfit.batch.estimate_many(jobs, client=client)
 
 

@@ -66,6 +66,17 @@ pub fn run(cli: &Cli) -> Result<u8, CliError> {
     }
 }
 
+/// The long options `command` takes (`max-iterations`, without the dashes), as `--help` lists
+/// them; `None` when there is no such command. Front ends check their keyword arguments against
+/// them before running (the Python package raises a `TypeError` naming a misspelled keyword and
+/// the nearest option, rather than passing clap's usage text on).
+pub fn option_names(command: &str) -> Option<Vec<String>> {
+    use clap::CommandFactory;
+    let cli = Cli::command();
+    let sub = cli.get_subcommands().find(|c| c.get_name() == command)?;
+    Some(sub.get_arguments().filter_map(|a| a.get_long().map(str::to_string)).collect())
+}
+
 /// Runs `eigenfit ARGS… --json` in this process and returns its JSON result with the exit code
 /// (0, or 3 for an estimation that did not converge), exactly what the binary would print.
 /// `args` start at the subcommand (`["simulate", "--preset", "paper-rotor"]`); `--json` is added

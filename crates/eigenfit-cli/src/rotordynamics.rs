@@ -45,11 +45,19 @@ pub fn print_estimate(r: &RunupEstimateReport) {
     if !r.outcome.converged {
         println!("stopped: {}", r.outcome.termination.detail);
     }
-    println!("{:<28}{:>16}{:>16}{:>32}", "parameter", "initial", "estimate", "95% interval / status");
-    for (((name, initial), (_, value)), (_, status)) in
-        r.values.initial.iter().zip(r.values.parameters.iter()).zip(r.values.parameter_status.iter())
-    {
-        println!("{name:<28}{initial:>16.4e}{value:>16.6e}{status:>32}");
+    println!(
+        "{:<28}{:>8}{:>16}{:>16}{:>32}",
+        "parameter", "unit", "initial", "estimate", "95% interval / status"
+    );
+    let rows = r
+        .values
+        .initial
+        .iter()
+        .zip(r.values.parameters.iter())
+        .zip(r.values.parameter_status.iter())
+        .zip(r.units.iter());
+    for ((((name, initial), (_, value)), (_, status)), (_, unit)) in rows {
+        println!("{name:<28}{unit:>8}{initial:>16.4e}{value:>16.6e}{status:>32}");
     }
     println!(
         "{:>10}{:>6}{:>16}{:>16}{:>12}{:>10}",

@@ -158,7 +158,7 @@ fn tmcmc_needs_std_and_samples_only_for_samplers() {
         "gauss",
     ]);
     assert_eq!(code, 2);
-    assert!(err.contains("unknown strategy `gauss`") && err.contains("trf"), "{err}");
+    assert!(err.contains("no strategy named `gauss`") && err.contains("trf"), "{err}");
 }
 
 #[test]

@@ -63,7 +63,7 @@ fn discover_through_the_library_matches_the_binary() {
 #[test]
 fn bad_input_is_an_error_value_with_exit_code_2() {
     let cases: [(&[&str], &str); 3] = [
-        (&["simulate", "--preset", "no-such-rotor"], "unknown preset `no-such-rotor`"),
+        (&["simulate", "--preset", "no-such-rotor"], "no preset named `no-such-rotor`; the presets are: "),
         (&["simulate", "--preset", "paper-rotor", "--no-such-option"], "--no-such-option"),
         (&["estimate", "--preset", "paper-rotor", "--measured", "/no/such.csv"], "/no/such.csv"),
     ];

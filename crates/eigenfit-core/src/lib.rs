@@ -30,6 +30,8 @@
 pub mod units;
 // Finite-difference references for plugins' derivative tests (uses nothing of core).
 pub mod testing;
+// "No such name" messages with the valid names and the nearest (uses nothing of core).
+pub mod names;
 
 pub mod matrix;
 

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 const CORE_LAYERS: &[&str] = &[
     "units",
     "testing",
+    "names",
     "matrix",
     "model",
     "eigen",

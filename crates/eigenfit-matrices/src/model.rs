@@ -132,8 +132,10 @@ impl MatricesModel {
         .map_err(|detail| MatricesError::Unreadable { detail })?;
         let text = String::from_utf8(bytes)
             .map_err(|_| MatricesError::invalid(path, "not UTF-8 text: a model file is TOML"))?;
-        let file: ModelFile = toml::from_str(&text)
-            .map_err(|e| MatricesError::Toml { path: path.to_path_buf(), detail: e.to_string() })?;
+        let file: ModelFile = toml::from_str(&text).map_err(|e| MatricesError::Toml {
+            path: path.to_path_buf(),
+            detail: eigenfit_core::names::with_serde_hint(&e.to_string()),
+        })?;
         if file.kind != "matrices" {
             return Err(MatricesError::invalid(
                 path,

@@ -381,7 +381,7 @@ fn material_index(spec: &RotorSpec, location: String, name: &str) -> Result<usiz
         defined: if spec.materials.is_empty() {
             "none".into()
         } else {
-            spec.materials.iter().map(|m| format!("`{}`", m.name)).collect::<Vec<_>>().join(", ")
+            spec.materials.iter().map(|m| m.name.as_str()).collect::<Vec<_>>().join(", ")
         },
     })
 }

@@ -91,7 +91,7 @@ impl Campaign {
         let mut c: Campaign = toml::from_str(&text).map_err(|e| CampaignError::Syntax {
             path: path.into(),
             line: e.span().map(|s| text[..s.start].matches('\n').count() + 1),
-            message: e.message().into(),
+            message: eigenfit_core::names::with_serde_hint(e.message()),
         })?;
         if c.configurations.is_empty() {
             return Err(CampaignError::NoConfiguration { path: path.into() });

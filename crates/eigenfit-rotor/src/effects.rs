@@ -117,7 +117,7 @@ pub enum EffectParseError {
         location: String,
     },
     /// The kind is not one of [`KINDS`].
-    #[error("`{text}`: unknown effect `{kind}`; known: {}", KINDS.join(", "))]
+    #[error("`{text}`: {}", eigenfit_core::names::unknown("effect", kind, &KINDS))]
     UnknownKind {
         /// The whole effect text.
         text: String,
@@ -157,7 +157,7 @@ pub(crate) fn unit_contribution(
     let (mut dk, mut dm) = (SparseSymmetric::zeros(n), SparseSymmetric::zeros(n));
     let bad = |why: String| RotorError::Effect { entry, kind: spec.kind.clone(), why };
     if !KINDS.contains(&spec.kind.as_str()) {
-        return Err(bad(format!("unknown kind; known: {}", KINDS.join(", "))));
+        return Err(bad(eigenfit_core::names::unknown("kind", &spec.kind, &KINDS)));
     }
     let location_given = match (spec.kind.as_str(), spec.position_m, spec.elements) {
         ("point-mass", Some(x), _) => Some(node_near(parts, x, &bad)?),

@@ -155,7 +155,7 @@ pub enum RotorError {
         element: usize,
     },
     /// A material name that no `[[material]]` defines.
-    #[error("{location}: unknown material `{name}` (defined: {defined})")]
+    #[error("{location}: {}", eigenfit_core::names::unknown("material", name, &listed_names(defined)))]
     UnknownMaterial {
         /// Where it was referenced.
         location: String,
@@ -270,4 +270,9 @@ impl std::fmt::Display for Num {
 /// (`-0.1`, not `-0.09999999999999998`).
 fn round12(v: f64) -> f64 {
     format!("{v:.11e}").parse().unwrap_or(v)
+}
+
+/// The names of a comma-separated list (`none` or empty: no names).
+fn listed_names(list: &str) -> Vec<&str> {
+    list.split(", ").map(str::trim).filter(|n| !n.is_empty() && *n != "none").collect()
 }

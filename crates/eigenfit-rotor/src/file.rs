@@ -299,7 +299,8 @@ fn parse(text: &str, path: Option<&Path>) -> Result<RotorBuilder, RotorError> {
         Ok(spec) => Ok(RotorBuilder::from_spec(spec)),
         Err(e) => {
             let path = path.map(Path::to_path_buf);
-            let message = e.message().trim_end().to_string();
+            // Serde lists the valid keys; the one most likely meant is named too.
+            let message = eigenfit_core::names::with_serde_hint(e.message().trim_end());
             Err(match e.span() {
                 Some(span) => {
                     let (line, column) = line_column(text, span.start);

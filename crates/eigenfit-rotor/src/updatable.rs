@@ -433,7 +433,7 @@ fn resolve(rotor: &Rotor, s: &ParameterSpec) -> Result<Resolved, String> {
                 (Kind::ModulusScale, sections, 1.0, format!("e_scale_{what}"), "-", (0.01, 100.0))
             }
         }
-        other => return Err(format!("unknown kind `{other}`; available: {}", KINDS.join(", "))),
+        other => return Err(eigenfit_core::names::unknown("kind", other, &KINDS)),
     };
     Ok((Extra { kind, members, nominal, elements: scaled, stiffness: k, mass: m }, name, unit, bounds))
 }

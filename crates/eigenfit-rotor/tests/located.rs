@@ -77,7 +77,7 @@ fn the_offending_key_of_each_kind_of_entry() {
             "kind = \"support-mass\"",
             "kind = \"magic\"",
             37,
-            "effect 0 `magic`: unknown kind; known: disk-rotary-inertia, bearing-rotational-stiffness, \
+            "effect 0 `magic`: no kind named `magic`; the kinds are: disk-rotary-inertia, bearing-rotational-stiffness, \
              support-mass, point-mass, shaft-stiffness-loss, modulus-error, shear-deformation, \
              shaft-rotary-inertia, timoshenko-shaft, section-change",
         ),

@@ -102,8 +102,9 @@ fn bad_declarations_are_named() {
         bad("[[parameter]]\nkind = \"bearing-rotational-stiffness\"\nindex = 1\n"),
         "parameter 0 (bearing-rotational-stiffness): nominal value 0 must be positive (the parameter is updated on a log scale): set it in the model"
     );
-    assert!(bad("[[parameter]]\nkind = \"spring\"\nindex = 0\n")
-        .contains("unknown kind `spring`; available: bearing-rotational-stiffness"));
+    assert!(bad("[[parameter]]\nkind = \"spring\"\nindex = 0\n").contains(
+        "no kind named `spring`; the kinds are: bearing-rotational-stiffness, disk-mass, disk-inertia"
+    ));
     assert!(bad("[[parameter]]\nkind = \"section-modulus-scale\"\n[[parameter]]\nkind = \"section-diameter-scale\"\nindex = 0\n")
         .starts_with("parameter 1 (section-diameter-scale): acts on the same quantity or elements as parameter 0"));
 }

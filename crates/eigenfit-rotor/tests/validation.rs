@@ -167,11 +167,11 @@ fn duplicate_bearing_names() {
 fn materials() {
     assert_eq!(
         message(base().shaft_material("bronze")),
-        "shaft: unknown material `bronze` (defined: `steel`)"
+        "shaft: no material named `bronze`; the materials are: steel"
     );
     assert_eq!(
         message(base().section(Section::new(0, 0).material("alu"))),
-        "shaft section 0: unknown material `alu` (defined: `steel`)"
+        "shaft section 0: no material named `alu`; the materials are: steel"
     );
     assert_eq!(
         message(base().material(Material::steel())),

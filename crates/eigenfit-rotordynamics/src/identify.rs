@@ -90,7 +90,11 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, RunupError> {
     {
         return Err(line_error(
             1,
-            format!("unknown column `{bad}` (speed_rpm, mode, frequency_hz, std_hz, whirl)"),
+            format!(
+                "unknown column `{bad}`{} (speed_rpm, mode, frequency_hz, std_hz, whirl)",
+                eigenfit_core::names::nearest(bad, &["speed_rpm", "mode", "frequency_hz", "std_hz", "whirl"])
+                    .map_or(String::new(), |n| format!("; did you mean `{n}`?"))
+            ),
         ));
     }
     let (cstd, cw) = (col("std_hz"), col("whirl"));
@@ -180,7 +184,23 @@ pub struct Parameter {
     pub coefficient: usize,
 }
 
+/// The unit of a bearing coefficient by its index in [`COEFFICIENT_NAMES`]: N/m for a
+/// stiffness, N·s/m for a damping coefficient.
+pub fn coefficient_unit(coefficient: usize) -> &'static str {
+    if coefficient < 4 {
+        "N/m"
+    } else {
+        "N·s/m"
+    }
+}
+
 impl Parameter {
+    /// The unit of the coefficient it scales (reported values are the coefficient's, not the
+    /// factor's): N/m or N·s/m, [`coefficient_unit`].
+    pub fn unit(&self) -> &'static str {
+        coefficient_unit(self.coefficient)
+    }
+
     fn curve<'a>(&self, rotor: &'a Rotor) -> &'a Coefficient {
         let b = &rotor.bearings[self.bearing];
         if self.coefficient < 4 {
@@ -249,8 +269,21 @@ pub fn bearing_parameters(rotor: &Rotor, selection: &[&str]) -> Result<Vec<Param
         }
         if !hit {
             let tags: Vec<&str> = rotor.bearings.iter().map(|b| b.tag.as_str()).collect();
+            // Every name the item may be: a coefficient, or one bearing's coefficient.
+            let valid: Vec<String> = COEFFICIENT_NAMES
+                .iter()
+                .map(|c| c.to_string())
+                .chain(
+                    rotor
+                        .bearings
+                        .iter()
+                        .flat_map(|b| COEFFICIENT_NAMES.iter().map(move |c| format!("{c}_{}", b.tag))),
+                )
+                .collect();
+            let hint = eigenfit_core::names::nearest(item, &valid)
+                .map_or(String::new(), |n| format!("; did you mean `{n}`?"));
             return Err(RotorDynError::Data(format!(
-                "parameter `{item}`: not one of {} (every bearing) or <coefficient>_<bearing> with a bearing of {}",
+                "parameter `{item}`: not one of {} (every bearing) or <coefficient>_<bearing> with a bearing of {}{hint}",
                 COEFFICIENT_NAMES.join(", "),
                 tags.join(", ")
             )));

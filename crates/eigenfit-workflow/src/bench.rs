@@ -236,7 +236,8 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
     let at = |msg: String| input(format!("{}: {msg}", path.display()));
     crate::model::check_model_file(path)?;
     let text = std::fs::read_to_string(path).map_err(|e| at(format!("cannot read: {e}")))?;
-    let file: ProblemFile = toml::from_str(&text).map_err(|e| at(e.to_string().trim_end().to_string()))?;
+    let file: ProblemFile = toml::from_str(&text)
+        .map_err(|e| at(eigenfit_core::names::with_serde_hint(e.to_string().trim_end())))?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let source = ModelSource {
         model: Some(dir.join(&file.model)),
@@ -258,13 +259,7 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
     let params = model.parameters();
     let mut truth = vec![f64::NAN; params.len()];
     for (key, value) in &file.truth {
-        let i = params.index_of(key).map_err(|_| {
-            at(format!(
-                "truth: `{}` is not a parameter of the model; its parameters: {}",
-                shown(key),
-                params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
-            ))
-        })?;
+        let i = params.index_of(key).map_err(|e| at(format!("truth: {e}")))?;
         truth[i] = number(value).ok_or_else(|| at(format!("truth: `{key}` must be a finite number")))?;
     }
     if let Some(missing) = params.iter().zip(&truth).find(|(_, t)| t.is_nan()) {
@@ -297,8 +292,7 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
     };
     let mut start_range: Vec<(f64, f64)> = params.iter().map(|p| p.search_range()).collect();
     for (key, value) in file.starts.iter().flatten() {
-        let i =
-            params.index_of(key).map_err(|_| at(format!("starts: `{}` is not a parameter", shown(key))))?;
+        let i = params.index_of(key).map_err(|e| at(format!("starts: {e}")))?;
         let pair =
             value.as_array().filter(|a| a.len() == 2).and_then(|a| Some((number(&a[0])?, number(&a[1])?)));
         let (lo, hi) = pair.ok_or_else(|| at(format!("starts: `{key}` must be [low, high]")))?;
@@ -323,8 +317,10 @@ pub fn problem(name: &str) -> Result<BenchProblem, WorkflowError> {
     if path.extension().is_some_and(|e| e == "toml") || path.exists() {
         return load_problem_file(path);
     }
+    let hint = eigenfit_core::names::nearest(name, &BUILTIN_PROBLEMS)
+        .map_or(String::new(), |n| format!(" (did you mean `{n}`?)"));
     Err(input(format!(
-        "--problems: `{}` is neither a built-in problem ({}) nor a problem file",
+        "--problems: `{}` is neither a built-in problem ({}) nor a problem file{hint}",
         shown(name),
         BUILTIN_PROBLEMS.join(", ")
     )))

@@ -108,7 +108,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
     let solver: Box<dyn EigenSolver> = match request.solver.as_str() {
         "banded" | "auto" => Box::new(BandedSolver::default()),
         "dense" => Box::new(DenseSolver),
-        other => return Err(input(format!("unknown solver `{other}`; available: banded, dense"))),
+        other => return Err(input(eigenfit_core::names::unknown("solver", other, &["banded", "dense"]))),
     };
     let (strategy_name, method) =
         registry::build(&request.strategy).map_err(|e| input(format!("--strategy: {e}")))?;

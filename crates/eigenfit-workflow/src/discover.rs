@@ -5,7 +5,7 @@ use crate::error::{failure, input, WorkflowError};
 use crate::model::AnyModel;
 use crate::named::Named;
 use crate::progress::Progress;
-use eigenfit_core::analysis::verdict::check_reachable;
+use eigenfit_core::analysis::verdict::{check_reachable, check_softest};
 use eigenfit_core::discovery::{
     discover, BaseMisfit, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect,
 };
@@ -148,6 +148,11 @@ pub fn run(
     }
     // Estimate's sanity check, so a typing slip ends here as it does there (exit 2, mode named).
     let mode_numbers: Vec<usize> = data.modes().iter().map(|m| m.mode + 1).collect();
+    // Frequencies all explained by one unit slip (kHz for Hz) are refused naming it; others
+    // outside the model's reach are what discovery is for.
+    if let Some(e) = check_softest(model, solver, &data, &mode_numbers).filter(|e| e.slip.is_some()) {
+        return Err(input(format!("{}: {e}", measured.display())));
+    }
     let problem = Problem::new(model, solver, data.clone());
     let check = Budget::new(budget);
     check_reachable(&problem, &mode_numbers, &check).map_err(|e| {

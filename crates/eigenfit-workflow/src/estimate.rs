@@ -4,7 +4,7 @@
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
 use crate::outcome::{
-    cycles, phase_counts, FitQualityReport, Outcome, PairedFrequencies, ParameterValues, Verdict,
+    cycles, phase_counts, Covariances, FitQualityReport, Outcome, PairedFrequencies, ParameterValues, Verdict,
 };
 pub use crate::outcome::{AlternativeSolution, ParameterIdentifiability};
 use crate::overrides::{fixed, parameter_vector};
@@ -18,7 +18,7 @@ use eigenfit_core::analysis::alternatives::{
     better_minimum, like_exchanges, local_minima, mirror_solutions, other_solutions, scaled_distance,
     search_starts, Equivalence, Mirrors, OtherSolution, SAME_MINIMUM,
 };
-use eigenfit_core::analysis::verdict::{at_limits, check_reachable, judge, FitQuality};
+use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Uncertainty};
 use eigenfit_core::measurement::mac::MacReport;
 use eigenfit_core::measurement::measured_csv::{shown, shown_number};
@@ -150,6 +150,12 @@ pub struct EstimateReport {
     /// Intervals and what the data determine (a converged run with std or scatter).
     #[serde(flatten)]
     pub uncertainty: IntervalsReport,
+    /// Each parameter's unit as declared (empty when none was), by name.
+    pub units: Named<String>,
+    /// The parameters' covariance (physical coordinates) and correlation, `null` when not
+    /// computed or not computable.
+    #[serde(flatten)]
+    pub covariances: Covariances,
     /// Other minima found and mirror points, each with its χ², Δχ² and the test's outcome.
     pub alternative_solutions: Vec<AlternativeSolution>,
     /// How σ was taken for the alternatives' test: `std` (given), `residuals` (estimated from the
@@ -198,7 +204,8 @@ pub struct Estimation {
     pub mode_numbers: Vec<usize>,
     /// Per parameter: whether it sits on a limit.
     pub on_limit: Vec<bool>,
-    /// The unit of the first parameter (for plots).
+    /// The free parameters' units, each once, joined by `, ` (for a plot's axis drawing them
+    /// all; empty when none declares one).
     pub unit: String,
     /// The largest measured standard deviation (Hz).
     pub sigma_max: Option<f64>,
@@ -289,8 +296,8 @@ pub fn run(
         "eigenvalue" => ResidualKind::Eigenvalue,
         other => {
             return Err(input(format!(
-                "unknown residual `{}`; available: relative, hz, eigenvalue",
-                shown(other)
+                "--residual: {}",
+                eigenfit_core::names::unknown("residual", &shown(other), &["relative", "hz", "eigenvalue"])
             )))
         }
     };
@@ -337,6 +344,21 @@ pub fn run(
     let mode_numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
     let sigma_max = measurement.modes().iter().filter_map(|m| m.std_hz).reduce(f64::max);
     let measurement_for_sampling = measurement.clone();
+    // Frequencies no stiffness can give, all explained by one unit slip (entered in kHz, say),
+    // are refused naming the unit before anything is fitted; without such a slip they may be a
+    // model error, said in a note. With shapes a measured mode may pair with another model mode,
+    // so the mode-by-mode bounds are checked on frequency data only.
+    if data.sensors.is_none() {
+        match check_softest(&model, solver.as_ref(), &measurement, &mode_numbers) {
+            Some(e) if e.slip.is_some() => return Err(input(format!("{measured_name}: {e}"))),
+            Some(e) => notes.push(format!(
+                "{measured_name}: no stiffness within the limits can produce {}: the fit cannot reach these \
+                 modes; a missing effect (`eigenfit discover`) or modes numbered differently from the model's?",
+                e.modes_said()
+            )),
+            None => {}
+        }
+    }
     let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
     let mut fit = Fit::new(problem, &data, options.shape.shape_std);
     let budget = Budget::new(request.budget);
@@ -543,6 +565,8 @@ pub fn run(
             })
             .collect(),
         uncertainty: IntervalsReport::new(&names, unc.as_ref()),
+        units: crate::simulate::units_of(&model),
+        covariances: Covariances::of(&names, unc.as_ref().map(|u| &u.covariance)),
         plots: None,
         test_data: ShapeReport::new(&fit, &data, &estimate, mac.as_ref(), scatter),
         fixed: (!held.is_empty()).then_some(Named(held)),
@@ -555,7 +579,7 @@ pub fn run(
     );
     let updated_model =
         request.write_model.then(|| updated_model_toml(&request.measured, &model, &estimate, unc.as_ref()));
-    let unit = any.parameters().iter().next().map_or(String::new(), |p| p.unit.clone());
+    let unit = axis_unit(model.parameters());
     drop(fit);
     Ok(EstimateOutcome::Done(Box::new(Estimation {
         report,
@@ -616,4 +640,16 @@ fn free_permutations(
         })
         .filter(|perm| !matches!(cycles(perm).as_slice(), [pair] if pair.len() == 2))
         .collect()
+}
+
+/// The units of `params`, each once in order, joined by `, `: one axis's unit for parameters
+/// drawn together (`N/m`; `N/m, kg` when they differ; empty when none declares one).
+pub fn axis_unit(params: &ParameterSet) -> String {
+    let mut units: Vec<&str> = Vec::new();
+    for u in params.iter().map(|p| p.unit()).filter(|u| !u.is_empty()) {
+        if !units.contains(&u) {
+            units.push(u);
+        }
+    }
+    units.join(", ")
 }

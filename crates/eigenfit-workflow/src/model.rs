@@ -160,9 +160,13 @@ pub fn other_kind(path: &Path, what: &str) -> Option<WorkflowError> {
         };
         let Some(value) = rest.trim_start().strip_prefix('=') else { continue };
         let value = value.split('#').next().unwrap_or_default().trim();
+        let unquoted = value.trim_matches(|c| c == '"' || c == '\'');
+        let hint = eigenfit_core::names::nearest(unquoted, &["matrices"])
+            .map_or(".".to_string(), |n| format!("; did you mean `kind = \"{n}\"`?"));
         return Some(input(format!(
-            "{}: line {}: kind = {} is not a kind of model eigenfit knows: `kind = \"matrices\"` for K(p) \
-             from Matrix Market files (docs/matrices.md), or no `kind` for a planar rotor",
+            "{}: line {}: kind = {} is not a kind of model eigenfit knows{hint} The kinds are `kind = \"matrices\"` \
+             for K(p) from Matrix Market, DMIG or Abaqus files (docs/matrices.md), no `kind` for a planar rotor \
+             (docs/rotor-model.md), and a two-plane rotor saved by ROSS (`Rotor.save`, docs/rotordynamics.md)",
             path.display(),
             i + 1,
             value.chars().take(40).collect::<String>()

@@ -6,6 +6,7 @@ use crate::named::Named;
 use eigenfit_core::analysis::alternatives::OtherSolution;
 use eigenfit_core::analysis::verdict::FitVerdict;
 use eigenfit_core::analysis::Identifiability;
+use eigenfit_core::nalgebra::DMatrix;
 use serde::Serialize;
 
 /// `converged`, `termination`, `iterations`, `evaluations`, flattened into every estimating
@@ -283,4 +284,74 @@ pub(crate) fn phase_counts(totals: &[(&str, usize)]) -> Named<usize> {
             })
             .collect(),
     )
+}
+
+/// A parameter covariance in a report: `coordinates` says in which (always `physical`: each
+/// parameter in its own unit, as `units` gives it, so entry (i, j) is in unitᵢ·unitⱼ), and
+/// `matrix[i][j]` is between `parameters[i]` and `parameters[j]`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CovarianceReport {
+    /// `physical`: the parameters in their own units (not the update's scaled coordinates).
+    pub coordinates: &'static str,
+    /// Row and column order.
+    pub parameters: Vec<String>,
+    /// The symmetric matrix, row by row.
+    pub matrix: Vec<Vec<f64>>,
+}
+
+/// A parameter correlation in a report: cov(i, j)/√(cov(i, i)·cov(j, j)), the same in any
+/// coordinates that scale each parameter on its own (physical, log or factors on a nominal).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CorrelationReport {
+    /// Row and column order.
+    pub parameters: Vec<String>,
+    /// The symmetric matrix, row by row, ones on the diagonal.
+    pub matrix: Vec<Vec<f64>>,
+}
+
+/// `covariance`, `correlation`: the linearised covariance the intervals come from, and the
+/// correlation, flattened into every estimating report; each `null` when it is not computed (no
+/// std and no residual scatter, a run that did not converge) or not computable (a
+/// rank-deficient Jacobian: some combination of parameters the data do not determine).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Covariances {
+    /// The covariance in physical coordinates.
+    pub covariance: Option<CovarianceReport>,
+    /// The correlation.
+    pub correlation: Option<CorrelationReport>,
+}
+
+impl Covariances {
+    /// The report of `covariance` (physical) for parameters `names`: both `null` without one,
+    /// or when an entry is not finite or a variance not positive (rank-deficient).
+    pub fn of(names: &[String], covariance: Option<&DMatrix<f64>>) -> Self {
+        let n = names.len();
+        let usable = covariance.filter(|c| {
+            c.nrows() == n
+                && c.ncols() == n
+                && c.iter().all(|v| v.is_finite())
+                && (0..n).all(|i| c[(i, i)] > 0.0)
+        });
+        let Some(c) = usable else { return Self { covariance: None, correlation: None } };
+        let rows = |f: &dyn Fn(usize, usize) -> f64| -> Vec<Vec<f64>> {
+            (0..n).map(|i| (0..n).map(|j| f(i, j)).collect()).collect()
+        };
+        // Symmetric to the last bit: (i, j) and (j, i) from the same sum.
+        let sym = |i: usize, j: usize| 0.5 * (c[(i, j)] + c[(j, i)]);
+        let correlation = rows(&|i, j| {
+            if i == j {
+                1.0
+            } else {
+                (sym(i, j) / (c[(i, i)].sqrt() * c[(j, j)].sqrt())).clamp(-1.0, 1.0)
+            }
+        });
+        Self {
+            covariance: Some(CovarianceReport {
+                coordinates: "physical",
+                parameters: names.to_vec(),
+                matrix: rows(&sym),
+            }),
+            correlation: Some(CorrelationReport { parameters: names.to_vec(), matrix: correlation }),
+        }
+    }
 }

@@ -36,10 +36,10 @@ pub fn parameter_vector(
         let values = parse_list(flag, text)?;
         if values.len() != p.len() {
             return Err(input(format!(
-                "{flag}: {} values given but the model has {} bearing stiffnesses ({})",
+                "{flag}: {} values given but the model has {} parameters ({})",
                 values.len(),
                 p.len(),
-                params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>().join(", ")
+                eigenfit_core::names::listed(&params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>())
             )));
         }
         p = values;

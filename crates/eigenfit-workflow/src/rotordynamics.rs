@@ -4,8 +4,8 @@
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
 use crate::outcome::{
-    phase_counts, AlternativeSolution, BudgetReport, FitQualityReport, Outcome, ParameterIdentifiability,
-    ParameterValues, Verdict,
+    phase_counts, AlternativeSolution, BudgetReport, Covariances, FitQualityReport, Outcome,
+    ParameterIdentifiability, ParameterValues, Verdict,
 };
 use eigenfit_core::analysis::alternatives::{like_exchanges, mirror_solutions, Equivalence};
 use eigenfit_core::analysis::verdict::judge;
@@ -41,6 +41,32 @@ fn to_workflow(e: RotorDynError) -> WorkflowError {
 /// otherwise).
 pub fn ross_text_for(text: &str, path: &Path) -> Result<String, WorkflowError> {
     ross_file::in_format_for(text, path).map_err(|e| input(format!("{}: {e}", path.display())))
+}
+
+/// Refuses, naming what it is, a model file of another kind where `command` needs a ROSS rotor:
+/// a planar rotor or a matrices model is said to be one (rather than failing on its first
+/// table as "not a ROSS element"). Unreadable files are left to the reader, whose errors name
+/// them.
+pub fn require_ross(path: &Path, command: &str) -> Result<(), WorkflowError> {
+    crate::model::check_model_file(path)?;
+    let Ok(text) = std::fs::read_to_string(path) else { return Ok(()) };
+    if ross_file::looks_like_ross(&text) {
+        return Ok(());
+    }
+    let what = if eigenfit_matrices::is_matrices_file(&text) {
+        "a `kind = \"matrices\"` model (K(p), M(p) from matrix files), which has no rotor speed".to_string()
+    } else if eigenfit_rotor::RotorSpec::from_toml_str(&text).is_ok() {
+        "a planar rotor model (docs/rotor-model.md), which has no speed-dependent terms: its natural \
+         frequencies against support stiffness are `eigenfit simulate --sweep FROM:TO:COUNT`"
+            .to_string()
+    } else {
+        "a file without the `ShaftElement_…` tables of a ROSS rotor".to_string()
+    };
+    Err(input(format!(
+        "{}: {command} needs a two-plane rotor saved by ROSS (`Rotor.save`, docs/rotordynamics.md); \
+         this is {what}",
+        path.display()
+    )))
 }
 
 /// Loads a ROSS rotor, errors naming the file.
@@ -133,8 +159,8 @@ pub fn apply_sets(rotor: &mut Rotor, sets: &[String]) -> Result<Vec<String>, Wor
             Some(_) => {}
             None => {
                 return Err(input(format!(
-                    "--set: `{name}` is not a bearing coefficient of this rotor; the names are {}",
-                    settable_names(rotor).join(", ")
+                    "--set: {}",
+                    eigenfit_core::names::unknown("bearing coefficient", name, &settable_names(rotor))
                 )))
             }
         }
@@ -250,6 +276,13 @@ pub struct RunupEstimateReport {
     pub values: ParameterValues,
     /// Estimated scale factors on the nominal curves.
     pub scales: Named<f64>,
+    /// Each coefficient's unit (N/m for a stiffness, N·s/m for a damping), by name.
+    pub units: Named<String>,
+    /// The coefficients' covariance (physical coordinates: the coefficients at
+    /// `reference_speed_rpm` in their units, from the factors' as the intervals are) and
+    /// correlation, `null` when not computed (no std, no convergence) or not computable.
+    #[serde(flatten)]
+    pub covariances: Covariances,
     /// Σ r² (weighted by std, or of relative residuals without).
     pub cost: f64,
     /// 95 % intervals of the coefficients (profile likelihood where the linearisation is too
@@ -354,10 +387,10 @@ fn initial_factors(
                 input(format!("--initial `{item}`: expected NAME=VALUE like the other items"))
             })?;
             let i = params.iter().position(|p| p.name == name.trim()).ok_or_else(|| {
+                let estimated: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
                 input(format!(
-                    "--initial: `{}` is not an estimated parameter; they are {}",
-                    name.trim(),
-                    names()
+                    "--initial: {} (the parameters estimated; choose others with --parameters)",
+                    eigenfit_core::names::unknown("estimated parameter", name.trim(), &estimated)
                 ))
             })?;
             values.push((i, crate::overrides::parse_list("--initial", value)?[0]));
@@ -545,6 +578,19 @@ pub fn estimate_with(
             status,
         ),
         scales: Named::new(&names, estimate.parameters.iter().copied()),
+        units: Named::new(&names, params.iter().map(|p| p.unit().to_string())),
+        // Coefficient = nominal × factor: cov(kᵢ, kⱼ) = nominalᵢ·nominalⱼ·cov(factorᵢ, factorⱼ).
+        covariances: Covariances::of(
+            &names,
+            uncertainty
+                .as_ref()
+                .map(|u| {
+                    eigenfit_core::nalgebra::DMatrix::from_fn(np, np, |i, j| {
+                        u.covariance[(i, j)] * nominal[i] * nominal[j]
+                    })
+                })
+                .as_ref(),
+        ),
         cost: lin.chi2(),
         intervals: intervals.map(|iv| Named::new(&names, iv)),
         identifiable: uncertainty
@@ -741,6 +787,7 @@ pub struct CampbellReport {
 /// `campbell`: damped frequencies, whirl and log decrement of a ROSS rotor against speed.
 pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<CampbellReport, WorkflowError> {
     let speeds = parse_speeds(speeds)?;
+    require_ross(path, "campbell")?;
     let rotor = load(path)?;
     if modes == 0 {
         return Err(input("--modes 0: at least one mode"));

@@ -272,9 +272,81 @@ pub struct PointReport {
     pub sensitivities_unavailable: Option<String>,
     /// Plot files written (the CLI's `--plot`).
     pub plots: Option<Vec<String>>,
+    /// Each parameter's unit as declared (empty when none was), by name.
+    pub units: Named<String>,
+    /// The mode shapes, when asked for (`--shapes`).
+    pub mode_shapes: Option<ModeShapesReport>,
     /// Notes for the log (round-off that may reach the trailing digits).
     #[serde(skip)]
     pub notes: Vec<String>,
+}
+
+/// Mode shapes in a report: the DOFs by label and, per mode, one value per DOF.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeShapesReport {
+    /// Always `mass`: the shapes Φ satisfy ΦᵀMΦ = I with M the model's mass matrix at the
+    /// parameters reported (SI units: a displacement in m·kg^-½, a rotation in rad·kg^-½).
+    pub normalisation: &'static str,
+    /// Each DOF's label, in the order of every shape's values: a planar rotor's `v<node>`
+    /// (lateral displacement) and `theta<node>` (rotation), nodes counted from 0; a matrices
+    /// model's `<node>:<direction>` from its DOF map, or `dof<i>` (from 1) without one.
+    pub dofs: Vec<String>,
+    /// One shape per mode, lowest first; `shapes[k][i]` is mode k + 1 at `dofs[i]`.
+    pub shapes: Vec<Vec<f64>>,
+}
+
+/// The lowest `count` mode shapes of a planar rotor at `p`, mass-normalised.
+pub fn rotor_mode_shapes(
+    rotor: &Rotor,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    count: usize,
+) -> Result<ModeShapesReport, WorkflowError> {
+    let labels = (0..rotor.nodes().len()).flat_map(|i| [format!("v{i}"), format!("theta{i}")]).collect();
+    shapes_report(rotor, solver, p, count, labels, &|shape| Ok(shape.to_vec()))
+}
+
+/// The lowest `count` mode shapes of a matrices model at `p`, mass-normalised, each on every
+/// DOF of the matrices as read: the massless DOFs, condensed out for the solve, are filled back
+/// in (exactly the full eigenvector, still mass-normalised, as a massless DOF carries no mass).
+pub fn matrices_mode_shapes(
+    model: &eigenfit_matrices::MatricesModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    count: usize,
+) -> Result<ModeShapesReport, WorkflowError> {
+    let labels = model
+        .dof_map()
+        .map(|map| map.iter().map(|d| format!("{}:{}", d.node, d.direction)).collect())
+        .unwrap_or_default();
+    shapes_report(model, solver, p, count, labels, &|shape| model.expand_shape(p, shape).map_err(failure))
+}
+
+/// A shape on the solved DOFs to the shape on every DOF of the model as read.
+type ExpandShape<'a> = dyn Fn(&[f64]) -> Result<Vec<f64>, WorkflowError> + 'a;
+
+/// The shapes of `model`'s lowest `count` modes at `p`, each passed through `expand`, with the
+/// DOFs `labels` (numbered `dof1`, `dof2`, … when they do not label every value).
+fn shapes_report(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    count: usize,
+    labels: Vec<String>,
+    expand: &ExpandShape<'_>,
+) -> Result<ModeShapesReport, WorkflowError> {
+    let modes = modes_at(model, solver, p, count)?;
+    let shapes = (0..modes.count())
+        .map(|j| expand(&modes.shapes.column(j).iter().copied().collect::<Vec<f64>>()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let n = shapes.first().map_or(0, Vec::len);
+    let dofs = if labels.len() == n { labels } else { (1..=n).map(|i| format!("dof{i}")).collect() };
+    Ok(ModeShapesReport { normalisation: "mass", dofs, shapes })
+}
+
+/// Each parameter's unit as declared (empty when none was), by name: the reports' `units`.
+pub fn units_of(model: &dyn StructuralModel) -> Named<String> {
+    Named(model.parameters().iter().map(|q| (q.name.clone(), q.unit().to_string())).collect())
 }
 
 /// Frequencies and their sensitivities at `p` from one solve; a model whose modes have none
@@ -327,6 +399,8 @@ pub fn at_point(
         sensitivities_hz,
         sensitivities_unavailable,
         plots: None,
+        units: units_of(model),
+        mode_shapes: None,
         notes,
     })
 }

@@ -104,9 +104,8 @@ impl ModelSource {
                 presets::uniform_rotor(elements).map_err(|e| input(format!("--elements {elements}: {e}")))?;
             return Ok((rotor, name.to_string()));
         }
-        let rotor = presets::by_name(name).ok_or_else(|| {
-            input(format!("unknown preset `{name}`; available: {}", presets::NAMES.join(", ")))
-        })?;
+        let rotor = presets::by_name(name)
+            .ok_or_else(|| input(eigenfit_core::names::unknown("preset", name, &presets::NAMES)))?;
         Ok((rotor, name.to_string()))
     }
 
@@ -126,7 +125,12 @@ impl ModelSource {
                 "this eigenfit was built without the `lapack` feature; rebuild with --features lapack",
             )),
             other => Err(input(format!(
-                "unknown solver `{other}`; available: auto, dense, banded, sparse, lapack"
+                "--solver: {}",
+                eigenfit_core::names::unknown(
+                    "solver",
+                    other,
+                    &["auto", "dense", "banded", "sparse", "lapack"]
+                )
             ))),
         }
     }

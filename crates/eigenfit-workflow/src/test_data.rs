@@ -437,7 +437,7 @@ pub fn updated_model_toml(
         let interval = unc.map_or("no interval".to_string(), |u| {
             format!("95% interval [{:.6e}, {:.6e}]", u.intervals[i][0], u.intervals[i][1])
         });
-        head += &format!("# {} = {:.6e} {} ({interval})\n", p.name, estimate.parameters[i], p.unit);
+        head += &format!("# {} = {:.6e} {} ({interval})\n", p.name, estimate.parameters[i], p.unit());
     }
     for (name, v) in model.held() {
         head += &format!("# {name} = {v:.6e} (held by --fix)\n");

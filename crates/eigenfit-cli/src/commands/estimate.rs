@@ -249,14 +249,17 @@ fn print_report(est: &Estimation) {
         "{}: {} strategy, {} after {} iterations ({} model evaluations)",
         r.model, r.strategy, r.outcome.termination, r.outcome.iterations, r.budget.used
     );
-    println!("{:<20}{:>16}{:>16}   95% interval [N/m]", "parameter", "initial [N/m]", "estimate [N/m]");
+    // Each parameter in its declared unit (a column: one model may mix N/m, kg and factors).
+    println!("{:<20}{:>8}{:>16}{:>16}   95% interval", "parameter", "unit", "initial", "estimate");
     for (i, n) in names.iter().enumerate() {
         // A value on a limit is where the search stopped, not an estimate.
         let value =
             if est.on_limit[i] { "—".to_string() } else { format!("{:.6e}", r.values.parameters.0[i].1) };
         println!(
-            "{n:<20}{:>16.4e}{value:>16}   {}",
-            r.values.initial.0[i].1, r.values.parameter_status.0[i].1
+            "{n:<20}{:>8}{:>16.4e}{value:>16}   {}",
+            shown_unit(&r.units.0[i].1),
+            r.values.initial.0[i].1,
+            r.values.parameter_status.0[i].1
         );
     }
     if let Some(post) = &r.posterior {
@@ -268,9 +271,10 @@ fn print_report(est: &Estimation) {
             post.evaluations,
             post.log_evidence
         );
-        println!("{:<20}{:>16}{:>16}   95% credible", "parameter", "mean", "std");
-        for (((n, m), (_, s)), (_, c)) in post.mean.iter().zip(post.std.iter()).zip(post.credible_95.iter()) {
-            println!("{n:<20}{m:>16.4e}{s:>16.4e}   [{:.4e}, {:.4e}]", c[0], c[1]);
+        println!("{:<20}{:>8}{:>16}{:>16}   95% credible", "parameter", "unit", "mean", "std");
+        let rows = post.mean.iter().zip(post.std.iter()).zip(post.credible_95.iter()).zip(r.units.iter());
+        for ((((n, m), (_, s)), (_, c)), (_, unit)) in rows {
+            println!("{n:<20}{:>8}{m:>16.4e}{s:>16.4e}   [{:.4e}, {:.4e}]", shown_unit(unit), c[0], c[1]);
         }
     }
     println!("{:>6}{:>16}{:>16}{:>14}", "mode", "measured [Hz]", "model [Hz]", "diff [Hz]");
@@ -319,4 +323,13 @@ fn print_report(est: &Estimation) {
 
 fn join(v: &[usize]) -> String {
     v.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")
+}
+
+/// A unit in a table's unit column: as declared, `-` when none was declared.
+pub(crate) fn shown_unit(unit: &str) -> &str {
+    if unit.is_empty() {
+        "-"
+    } else {
+        unit
+    }
 }

@@ -12,8 +12,8 @@ use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{EffectSpec, Rotor};
 use eigenfit_workflow::overrides::parameter_vector;
 use eigenfit_workflow::simulate::{
-    at_point, check_modes, is_paper_rotor, sweep, sweep_points, PointReport, SweepCheck, SweepPoint,
-    SweepReport,
+    at_point, check_modes, is_paper_rotor, matrices_mode_shapes, rotor_mode_shapes, sweep, sweep_points,
+    PointReport, SweepCheck, SweepPoint, SweepReport,
 };
 use eigenfit_workflow::AnyModel;
 use std::path::{Path, PathBuf};
@@ -58,6 +58,10 @@ pub struct SimulateArgs {
     /// docs/test-data.md).
     #[arg(long, value_name = "FILE.unv", conflicts_with = "sweep")]
     pub uff: Option<PathBuf>,
+    /// Also report the mode shapes (mass-normalised, ΦᵀMΦ = I, on every DOF by label): `mode_shapes`
+    /// in --json, a table otherwise. Planar rotors and matrices models.
+    #[arg(long, conflicts_with = "sweep")]
+    pub shapes: bool,
     /// `--quiet`, `--json`.
     #[command(flatten)]
     pub report: crate::output::ReportArgs,
@@ -77,6 +81,12 @@ fn refuse_for_ross(args: &SimulateArgs) -> Result<(), CliError> {
         (args.plot.is_some(), "--plot", "draw the Campbell diagram with `eigenfit campbell --plot DIR`"),
         (args.uff.is_some(), "--uff", "the universal-file export is written for planar rotors"),
         (args.model.solver != "auto", "--solver", "a ROSS rotor has its own damped gyroscopic solver"),
+        (
+            args.shapes,
+            "--shapes",
+            "a gyroscopic rotor's modes are complex (forward and backward whirl orbits), not the real \
+             mass-normalised shapes --shapes reports",
+        ),
     ];
     match refused.iter().find(|(given, _, _)| *given) {
         Some((_, flag, instead)) => {
@@ -180,6 +190,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         crate::output::write_atomically(path, text.as_bytes())?;
     }
     let mut report = at_point(&label, &rotor, solver.as_ref(), &p, args.modes, SweepCheck::RefuseRoundoff)?;
+    if args.shapes {
+        report.mode_shapes = Some(rotor_mode_shapes(&rotor, solver.as_ref(), &p, args.modes)?);
+    }
     print_notes(&report.notes);
     let plots = match &args.plot {
         Some(dir) => {
@@ -196,7 +209,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
     crate::output::report(args.report.json, &report, |report| {
         println!("{label} ({} DOF, {} solver)", rotor.dofs(), solver.name());
-        print_point(report, &vec!["N/m".to_string(); p.len()]);
+        print_point(report);
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
         args.uff.iter().for_each(|w| println!("wrote {}", w.display()));
     });
@@ -229,10 +242,12 @@ fn simulate_matrices(
     let p = parameter_vector(model, "--set", None, &args.sets)?;
     let mut report = at_point(label, model, solver, &p, args.modes, SweepCheck::None)?;
     report.dofs = Some(model.dofs());
+    if args.shapes {
+        report.mode_shapes = Some(matrices_mode_shapes(model, solver, &p, args.modes)?);
+    }
     crate::output::report(args.report.json, &report, |report| {
         println!("{label} ({} DOF, {} stored entries, {} solver)", model.dofs(), model.nnz(), solver.name());
-        let units: Vec<String> = model.parameters().iter().map(|q| q.unit.clone()).collect();
-        print_point(report, &units);
+        print_point(report);
         if let Some(why) = &report.sensitivities_unavailable {
             println!("(no sensitivities: {why})");
         }
@@ -240,14 +255,25 @@ fn simulate_matrices(
     Ok(())
 }
 
-/// The parameters (with `units`) and the frequencies of a point.
-fn print_point(report: &PointReport, units: &[String]) {
-    for ((n, v), unit) in report.parameters.iter().zip(units) {
-        println!("  {n} = {v:.6e} {unit}");
+/// The parameters (each in its unit), the frequencies of a point and, when asked, the shapes.
+fn print_point(report: &PointReport) {
+    for ((n, v), (_, unit)) in report.parameters.iter().zip(report.units.iter()) {
+        println!("  {n} = {v:.6e}{}", if unit.is_empty() { String::new() } else { format!(" {unit}") });
     }
     println!("{:>6}{:>18}", "mode", "frequency [Hz]");
     for (i, v) in report.frequencies_hz.iter().enumerate() {
         println!("{:>6}{v:>18.6}", i + 1);
+    }
+    if let Some(s) = &report.mode_shapes {
+        println!("mode shapes (mass-normalised, ΦᵀMΦ = I):");
+        print!("{:>12}", "dof");
+        (1..=s.shapes.len()).for_each(|m| print!("{:>14}", format!("mode {m}")));
+        println!();
+        for (i, dof) in s.dofs.iter().enumerate() {
+            print!("{dof:>12}");
+            s.shapes.iter().for_each(|shape| print!("{:>14.6e}", shape[i]));
+            println!();
+        }
     }
 }
 

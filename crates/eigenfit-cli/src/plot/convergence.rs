@@ -96,7 +96,8 @@ pub struct Convergence {
     pub title: String,
     /// Parameter names (with the unit given in the axis title).
     pub parameter_names: Vec<String>,
-    /// Unit of the parameters, e.g. `N/m`.
+    /// Unit of the parameters, e.g. `N/m` (`N/m, kg` when they differ; empty: none declared, no
+    /// brackets drawn).
     pub unit: String,
     /// The runs, drawn in order.
     pub runs: Vec<Run>,
@@ -151,7 +152,13 @@ impl Figure for Convergence {
                 .chain(self.target.iter().flatten().copied()),
             2.0,
         );
-        let mut chart = panel(&top, 45, x_end, p_range, &format!("parameter [{}]", self.unit))?;
+        let mut chart = panel(
+            &top,
+            45,
+            x_end,
+            p_range,
+            &format!("parameter{}", eigenfit_core::model::bracketed(&self.unit)),
+        )?;
         let mut entries = Vec::new();
         if let Some(t) = &self.target {
             for &v in t {

@@ -2,8 +2,10 @@
 //! the data cannot say, and the relative RMS residual is all that is reported.
 
 use crate::analysis::chi2_upper_tail;
+use crate::eigen::EigenSolver;
 use crate::measurement::measured_csv::shown_number;
-use crate::model::ParameterSet;
+use crate::measurement::Measurement;
+use crate::model::{ParameterSet, StructuralModel};
 use crate::problem::{Linearisation, Objective};
 use crate::update::Budget;
 use thiserror::Error;
@@ -158,6 +160,22 @@ pub struct Unreachable {
 /// is tried, beyond only the all-lower and all-upper ones; corners the model cannot be evaluated
 /// at (e.g. a rigid-body mode at a vanishing support) are skipped. Charged to `budget`.
 pub fn unreachable_modes(problem: &dyn Objective, margin: f64, budget: &Budget) -> Vec<Unreachable> {
+    let Some((lo, hi, measured)) = reachable_ranges(problem, budget) else { return Vec::new() };
+    outside(&measured, &lo, &hi, margin)
+}
+
+/// The measured modes more than `margin` (relative) outside `[lo, hi]` (each mode's range, Hz).
+fn outside(measured: &[f64], lo: &[f64], hi: &[f64], margin: f64) -> Vec<Unreachable> {
+    (0..measured.len())
+        .filter(|&k| measured[k] > hi[k] * (1.0 + margin) || measured[k] < lo[k] * (1.0 - margin))
+        .map(|k| Unreachable { index: k, measured_hz: measured[k], reachable_hz: [lo[k], hi[k]] })
+        .collect()
+}
+
+/// Per measured mode, the lowest and highest model frequency at the corners of the parameter
+/// box (the lowest 0 when a corner could not be evaluated), and the measured frequencies; `None`
+/// when no corner could be evaluated. See [`unreachable_modes`].
+fn reachable_ranges(problem: &dyn Objective, budget: &Budget) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
     let params = problem.parameters().as_slice();
     let np = params.len();
     let corner = |mask: usize| -> Vec<f64> {
@@ -197,16 +215,137 @@ pub fn unreachable_modes(problem: &dyn Objective, margin: f64, budget: &Budget) 
             hi[k] = hi[k].max(f);
         }
     }
-    let Some((mut lo, hi, measured)) = range else { return Vec::new() };
+    let (mut lo, hi, measured) = range?;
     if !all_corners {
         // A corner that could not be evaluated is a soft one (a support going to zero): the
-        // upper frequencies are still known, the lower ones are not.
+        // upper frequencies are still known, the lower ones are not (see [`check_softest`]).
         lo.iter_mut().for_each(|l| *l = 0.0);
     }
-    (0..measured.len())
-        .filter(|&k| measured[k] > hi[k] * (1.0 + margin) || measured[k] < lo[k] * (1.0 - margin))
-        .map(|k| Unreachable { index: k, measured_hz: measured[k], reachable_hz: [lo[k], hi[k]] })
-        .collect()
+    Some((lo, hi, measured))
+}
+
+/// Units a frequency is mistyped in, each with the factor that turns its number into Hz: a
+/// file's frequencies entered in one of these are that factor off, every one of them alike.
+const UNIT_SLIPS: [(&str, f64); 4] = [
+    ("kHz", 1e3),
+    ("MHz", 1e6),
+    ("rpm (revolutions per minute)", 1.0 / 60.0),
+    ("rad/s", 1.0 / (2.0 * std::f64::consts::PI)),
+];
+
+/// The unit the measured frequencies were most likely entered in, when converting every one of
+/// them from it to Hz puts each measured mode within `margin` of its reachable range
+/// `[lo, hi]` (and none is now): the unit's name and its factor. A slip is a property of the
+/// whole file, so one factor must bring every mode within reach.
+fn unit_slip(measured: &[f64], lo: &[f64], hi: &[f64], margin: f64) -> Option<(&'static str, f64)> {
+    UNIT_SLIPS.iter().copied().find(|&(_, factor)| {
+        let scaled: Vec<f64> = measured.iter().map(|f| f * factor).collect();
+        outside(&scaled, lo, hi, margin).is_empty()
+    })
+}
+
+/// Whether raising parameter `i` can only raise every eigenvalue, wherever in the box: ∂M/∂pᵢ
+/// is zero and ∂K/∂pᵢ is positive semi-definite and the same at `a` and `b` (so K is linear in
+/// pᵢ). Then by Courant–Fischer λₖ(p) is non-decreasing in pᵢ (a bearing or support stiffness,
+/// a spring). Unknown (`false`) when ∂K/∂pᵢ couples more than 64 DOFs.
+fn stiffening(model: &dyn StructuralModel, a: &[f64], b: &[f64], i: usize) -> bool {
+    let (Ok(da), Ok(db)) = (model.derivative(a, i), model.derivative(b, i)) else { return false };
+    if da.mass.entries().iter().chain(db.mass.entries()).any(|e| e.2 != 0.0) {
+        return false;
+    }
+    // The entries summed by position (duplicates add up), never densified: a derivative of a
+    // large model is a handful of entries.
+    let summed = |d: &crate::matrix::SparseSymmetric| {
+        let mut map = std::collections::BTreeMap::new();
+        for &(r, c, v) in d.entries() {
+            *map.entry((r, c)).or_insert(0.0) += v;
+        }
+        map
+    };
+    let (ka, kb) = (summed(&da.stiffness), summed(&db.stiffness));
+    let scale = ka.values().chain(kb.values()).fold(0.0f64, |m, v| m.max(v.abs()));
+    let differ = |x: &std::collections::BTreeMap<(usize, usize), f64>,
+                  y: &std::collections::BTreeMap<(usize, usize), f64>| {
+        x.iter().any(|(k, v)| (v - y.get(k).copied().unwrap_or(0.0)).abs() > 1e-12 * scale)
+    };
+    if differ(&ka, &kb) || differ(&kb, &ka) {
+        return false;
+    }
+    // The DOFs ∂K touches; semi-definite there is semi-definite everywhere.
+    let mut touched: Vec<usize> = ka.keys().flat_map(|&(r, c)| [r, c]).collect();
+    touched.sort_unstable();
+    touched.dedup();
+    if touched.len() > 64 {
+        return false;
+    }
+    let at = |dof: usize| touched.binary_search(&dof).unwrap_or(0);
+    let mut sub = nalgebra::DMatrix::<f64>::zeros(touched.len(), touched.len());
+    for (&(r, c), &v) in &ka {
+        sub[(at(r), at(c))] += v;
+        if r != c {
+            sub[(at(c), at(r))] += v;
+        }
+    }
+    sub.symmetric_eigenvalues().iter().all(|&l| l >= -1e-12 * scale)
+}
+
+/// Measured modes outside the frequencies the model can have at all: when raising any parameter
+/// can only raise every eigenvalue (each is a stiffness: ∂M = 0, ∂K semi-definite and constant),
+/// the model's modes with every parameter at its lower limit bound each mode from below over
+/// the whole box, and with every parameter at its upper limit from above (Courant–Fischer) —
+/// however soft the supports, mode k cannot go below its bound (mode 3 of a two-bearing rotor
+/// stays above the free–free rotor's first bending mode). The check [`check_reachable`] makes
+/// from the box's corners loses the lower bounds when the softest corner cannot be evaluated
+/// (its rigid-body modes lost to round-off); this one needs eigenvalues only. `None` when every
+/// mode is within (10 % margin), or the model is not of that kind or cannot be solved there:
+/// nothing is claimed. The modes outside come with the unit slip that explains them all, if one
+/// does (frequencies entered in kHz are all 1000× too low): data to refuse; without one they
+/// may be a model error (an effect the model lacks), for the caller to say. `mode_numbers`: the
+/// measured modes' numbers (from 1) in the measurement's order.
+pub fn check_softest(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    measurement: &Measurement,
+    mode_numbers: &[usize],
+) -> Option<UnreachableData> {
+    let params = model.parameters();
+    if params.is_empty() || !params.iter().all(|p| p.lower.is_finite()) {
+        return None;
+    }
+    let lower: Vec<f64> = params.iter().map(|p| p.lower).collect();
+    let upper: Vec<f64> =
+        params.iter().map(|p| if p.upper.is_finite() { p.upper } else { p.search_range().1 }).collect();
+    if !(0..params.len()).all(|i| stiffening(model, &lower, &upper, i)) {
+        return None;
+    }
+    let count = measurement.modes().iter().map(|m| m.mode + 1).max().unwrap_or(0);
+    let system = model.assemble(&lower).ok()?;
+    let eigenvalues = solver.lowest_eigenvalues(&system, count).ok()?;
+    let measured: Vec<f64> = measurement.modes().iter().map(|m| m.frequency_hz).collect();
+    let lo: Vec<f64> =
+        measurement.modes().iter().map(|m| crate::units::eigenvalue_to_hz(eigenvalues[m.mode])).collect();
+    // Raising every parameter to its upper limit bounds each mode from above, by the same
+    // argument (∞ when a parameter has no upper limit, or that model cannot be solved).
+    let bounded = params.iter().all(|p| p.upper.is_finite());
+    let top =
+        bounded.then(|| model.assemble(&upper).ok().and_then(|s| solver.lowest_eigenvalues(&s, count).ok()));
+    let hi: Vec<f64> = match top.flatten() {
+        Some(top) => {
+            measurement.modes().iter().map(|m| crate::units::eigenvalue_to_hz(top[m.mode])).collect()
+        }
+        None => vec![f64::INFINITY; lo.len()],
+    };
+    let beyond = outside(&measured, &lo, &hi, UNREACHABLE_MARGIN);
+    if beyond.is_empty() {
+        return None;
+    }
+    Some(UnreachableData {
+        modes: beyond
+            .into_iter()
+            .map(|u| (mode_numbers.get(u.index).copied().unwrap_or(u.index + 1), u))
+            .collect(),
+        slip: unit_slip(&measured, &lo, &hi, UNREACHABLE_MARGIN),
+    })
 }
 
 /// A measured mode this far (relative) outside every frequency the model reaches is refused.
@@ -215,22 +354,54 @@ pub const UNREACHABLE_MARGIN: f64 = 0.1;
 /// Measured data no parameter value within the limits can produce: the reason a fit or a
 /// discovery is refused before it starts.
 #[derive(Debug, Clone, PartialEq, Error)]
-#[error("no stiffness within the limits can produce {}: a typing slip or a wrong unit?", listed(.modes))]
+#[error("no stiffness within the limits can produce {}: {}", listed(.modes), slip_said(*.slip))]
 pub struct UnreachableData {
     /// The measured mode number (from 1) and why it cannot be reached, per refused mode.
     pub modes: Vec<(usize, Unreachable)>,
+    /// The unit the frequencies were most likely entered in (its name, and the factor that turns
+    /// its numbers into Hz), when converting all of them from it puts every mode within reach.
+    pub slip: Option<(&'static str, f64)>,
+}
+
+impl UnreachableData {
+    /// The modes and the ranges the model reaches, in words (`mode 6 at 1106.1289 Hz (the model
+    /// reaches 1874.6098–3458.8551 Hz)`), without the verdict on the cause.
+    pub fn modes_said(&self) -> String {
+        listed(&self.modes)
+    }
+}
+
+/// What the message says about the cause: the unit slip when one explains every mode.
+fn slip_said(slip: Option<(&str, f64)>) -> String {
+    match slip {
+        Some((unit, factor)) => format!(
+            "the frequencies look entered in {unit}, not Hz: converted (×{}) every measured mode lies within \
+             what the model reaches; give them in Hz",
+            shown_number(factor)
+        ),
+        None => "a typing slip or a wrong unit?".to_string(),
+    }
 }
 
 fn listed(modes: &[(usize, Unreachable)]) -> String {
     let parts: Vec<String> = modes
         .iter()
         .map(|(mode, u)| {
-            format!(
-                "mode {mode} at {} Hz (the model reaches {:.4}–{:.4} Hz)",
-                shown_number(u.measured_hz),
-                u.reachable_hz[0],
-                u.reachable_hz[1]
-            )
+            if u.reachable_hz[1].is_infinite() {
+                format!(
+                    "mode {mode} at {} Hz (with every parameter at its lower limit the model's mode {mode} is at \
+                     {:.4} Hz, and lower values cannot bring it down: the lowest it can be)",
+                    shown_number(u.measured_hz),
+                    u.reachable_hz[0]
+                )
+            } else {
+                format!(
+                    "mode {mode} at {} Hz (the model reaches {:.4}–{:.4} Hz)",
+                    shown_number(u.measured_hz),
+                    u.reachable_hz[0],
+                    u.reachable_hz[1]
+                )
+            }
         })
         .collect();
     parts.join("; ")
@@ -245,13 +416,14 @@ pub fn check_reachable(
     mode_numbers: &[usize],
     budget: &Budget,
 ) -> Result<(), UnreachableData> {
-    let unreachable = unreachable_modes(problem, UNREACHABLE_MARGIN, budget);
+    let Some((lo, hi, measured)) = reachable_ranges(problem, budget) else { return Ok(()) };
+    let unreachable = outside(&measured, &lo, &hi, UNREACHABLE_MARGIN);
     if unreachable.is_empty() {
         return Ok(());
     }
     let modes =
         unreachable.into_iter().map(|u| (mode_numbers.get(u.index).copied().unwrap_or(u.index + 1), u));
-    Err(UnreachableData { modes: modes.collect() })
+    Err(UnreachableData { modes: modes.collect(), slip: unit_slip(&measured, &lo, &hi, UNREACHABLE_MARGIN) })
 }
 
 #[cfg(test)]

@@ -205,13 +205,18 @@ pub fn parse_with_notes(text: &str) -> Result<(Measurement, Vec<String>), CsvErr
                 continue;
             }
             other => {
+                // A misspelled name gets the one meant; a header joined by another separator
+                // (`mode;frequency_hz`) is no misspelling, and gets none.
+                let hint = crate::names::nearest(other, &["mode", "frequency_hz", "std_hz"])
+                    .filter(|_| !other.contains([';', '\t', ' ']))
+                    .map_or(String::new(), |n| format!(" (did you mean `{n}`?)"));
                 return Err(at(
                     hline,
                     format!(
-                        "unknown column `{}`; the header must be `mode,frequency_hz[,std_hz]`",
+                        "unknown column `{}`{hint}; the header must be `mode,frequency_hz[,std_hz]`",
                         shown(other)
                     ),
-                ))
+                ));
             }
         };
         if col[slot].replace(i).is_some() {

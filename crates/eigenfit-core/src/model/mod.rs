@@ -13,5 +13,5 @@ pub(crate) mod structural_model;
 pub use augmented::Augmented;
 pub use candidate::{Candidate, Companion, GradedPart, ValueLaw};
 pub use fixed::Fixed;
-pub use parameters::{Parameter, ParameterError, ParameterSet, Scale};
+pub use parameters::{bracketed, Parameter, ParameterError, ParameterSet, Scale};
 pub use structural_model::{finite_difference_derivative, ModelError, StructuralModel};

@@ -46,6 +46,19 @@ impl Parameter {
         }
     }
 
+    /// The parameter's unit as declared (`N/m`, `kg`, `-` for a declared dimensionless one),
+    /// trimmed; empty when none was declared. The one source of every table's, plot's and
+    /// report's unit for this parameter.
+    pub fn unit(&self) -> &str {
+        self.unit.trim()
+    }
+
+    /// The unit in brackets after a space (` [N/m]`), for a label or a column heading; empty
+    /// when none was declared, so a label never reads `parameter []`.
+    pub fn bracketed_unit(&self) -> String {
+        bracketed(self.unit())
+    }
+
     /// Sets the range a global search (restart seeds) covers.
     pub fn with_search_range(mut self, lower: f64, upper: f64) -> Self {
         self.search = Some((lower, upper));
@@ -143,9 +156,23 @@ pub enum ParameterError {
     /// A parameter vector has the wrong length.
     #[error("expected {expected} parameter values, got {got}")]
     Count { expected: usize, got: usize },
-    /// No parameter has this name.
-    #[error("no parameter named `{0}`")]
-    UnknownName(String),
+    /// No parameter has this name: the message lists the parameters and the nearest name.
+    #[error("{}", crate::names::unknown("parameter", name, known))]
+    UnknownName {
+        /// The name asked for.
+        name: String,
+        /// The parameters' names, in order.
+        known: Vec<String>,
+    },
+}
+
+/// `unit` in brackets after a space (` [N/m]`), or nothing for no unit.
+pub fn bracketed(unit: &str) -> String {
+    if unit.trim().is_empty() {
+        String::new()
+    } else {
+        format!(" [{}]", unit.trim())
+    }
 }
 
 /// A bound or value as a person reads it: exponent form where plain digits would run to hundreds
@@ -217,10 +244,10 @@ impl ParameterSet {
 
     /// Index of the parameter called `name`.
     pub fn index_of(&self, name: &str) -> Result<usize, ParameterError> {
-        self.params
-            .iter()
-            .position(|p| p.name == name)
-            .ok_or_else(|| ParameterError::UnknownName(name.to_string()))
+        self.params.iter().position(|p| p.name == name).ok_or_else(|| ParameterError::UnknownName {
+            name: name.to_string(),
+            known: self.params.iter().map(|p| p.name.clone()).collect(),
+        })
     }
 
     /// The nominal values in order.

@@ -39,11 +39,17 @@ impl std::fmt::Debug for Method {
     }
 }
 
+/// ` (did you mean `x`?)` for the setting of `known` (comma-separated) nearest `setting`.
+fn meant(setting: &str, known: &str) -> String {
+    let known: Vec<&str> = known.split(", ").collect();
+    crate::names::nearest(setting, &known).map_or(String::new(), |n| format!(" (did you mean `{n}`?)"))
+}
+
 /// Why a strategy name could not be built.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum StrategyError {
     /// No strategy is registered under this name.
-    #[error("unknown strategy `{name}`; available: {available}")]
+    #[error("{}", crate::names::unknown("strategy", name, &available.split(", ").collect::<Vec<_>>()))]
     Unknown {
         /// The name asked for.
         name: String,
@@ -51,7 +57,10 @@ pub enum StrategyError {
         available: String,
     },
     /// The name carries a setting the strategy does not have.
-    #[error("strategy `{strategy}` has no setting `{setting}`; its settings: {known}")]
+    #[error(
+        "strategy `{strategy}` has no setting `{setting}`{}; its settings: {known}",
+        meant(setting, known)
+    )]
     UnknownSetting {
         /// The strategy.
         strategy: String,
