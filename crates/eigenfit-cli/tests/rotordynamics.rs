@@ -711,3 +711,38 @@ fn campbell_operating_range_gives_a_separation_margin_per_critical_speed() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--operating"));
 }
+
+/// A ROSS 2 file written by `estimate --write-model` is read by ROSS 2.3 as eigenfit reads it:
+/// ROSS 2.3's damped lateral frequencies of the written rotor at the run-up speeds
+/// (`scripts/ross2_write_model.py`, which also checks that ROSS 2.3's `Rotor.load` takes the file)
+/// against eigenfit's of the same file, to the 1e-6 of eigenfit's ROSS 2 agreement.
+#[test]
+fn ross2_reads_the_written_model_as_eigenfit_does() {
+    let reference: Value =
+        serde_json::from_str(&std::fs::read_to_string(data("runup_written_ross2.json")).unwrap()).unwrap();
+    assert!(reference["ross_version"].as_str().unwrap().starts_with("2.3"), "{}", reference["ross_version"]);
+    let speeds = reference["speeds_rpm"].as_array().unwrap();
+    for (speed, ross) in speeds.iter().zip(reference["lateral_hz"].as_array().unwrap()) {
+        let speed = speed.as_f64().unwrap().to_string();
+        let s = json(&run(&[
+            "simulate",
+            "--model",
+            &data("runup_written.toml"),
+            "--speed",
+            &speed,
+            "--modes",
+            "4",
+            "--json",
+        ]));
+        let ours = s["frequencies_hz"].as_array().unwrap();
+        for (k, (a, b)) in ours.iter().zip(ross.as_array().unwrap()).enumerate() {
+            let (a, b) = (a.as_f64().unwrap(), b.as_f64().unwrap());
+            assert!(
+                (a / b - 1.0).abs() < 1e-6,
+                "{speed} rpm, mode {}: eigenfit {a} Hz, ROSS 2.3 {b} Hz",
+                k + 1
+            );
+        }
+        assert_eq!(ours.len(), 4, "{speed} rpm: {s}");
+    }
+}
