@@ -133,6 +133,7 @@ impl Objective for RunupObjective<'_> {
             }),
             jacobian: DMatrix::from_fn(m, np, |i, j| df[(i, j)] / sigma[i]),
             has_std,
+            rows_weighted: has_std,
             round_off: Vec::new(),
         })
     }

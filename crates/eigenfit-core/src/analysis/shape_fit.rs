@@ -160,6 +160,7 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
         // Every row is weighted by a standard deviation, given or the documented defaults; χ² is a
         // test only when every weight is the data's own (default weights are not measured σ).
         lin.has_std = self.has_std();
+        lin.rows_weighted = true;
         Ok(lin)
     }
 }

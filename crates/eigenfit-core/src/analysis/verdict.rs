@@ -444,6 +444,7 @@ mod tests {
             residual: DVector::from_column_slice(residual),
             jacobian: DMatrix::zeros(n, 1),
             has_std,
+            rows_weighted: has_std,
             round_off: Vec::new(),
         }
     }

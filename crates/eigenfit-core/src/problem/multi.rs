@@ -61,6 +61,7 @@ pub fn stack(p: &[f64], parts: &[Linearisation]) -> Linearisation {
         residual: vec(&|l| &l.residual),
         jacobian: mat(&|l| &l.jacobian),
         has_std: parts.iter().all(|l| l.has_std),
+        rows_weighted: parts.iter().all(|l| l.rows_weighted),
         round_off: parts.iter().flat_map(|l| l.round_off.iter().copied()).collect(),
     }
 }

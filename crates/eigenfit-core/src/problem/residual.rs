@@ -78,8 +78,13 @@ pub struct Linearisation {
     pub residual: DVector<f64>,
     /// Weighted d(model)/dp in physical units, so that J Δp ≈ residual.
     pub jacobian: DMatrix<f64>,
-    /// True when the residual is weighted by measured standard deviations (cost = ½χ²).
+    /// True when the residual is weighted by measured standard deviations (cost = ½χ²): what
+    /// the verdicts and intervals may treat as noise units.
     pub has_std: bool,
+    /// True when every row is divided by a standard deviation, measured or assumed (a shape fit's
+    /// documented defaults): a scale an optimiser may use to decide whether a fit is good enough
+    /// to stop restarting, never a statistical claim.
+    pub rows_weighted: bool,
     /// Relative accuracy of each model frequency as the matrices define it (half the
     /// eigenvalue's, [`crate::sensitivity::eigenvalue_round_off`]); empty when not known.
     pub round_off: Vec<f64>,
@@ -230,6 +235,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             residual: DVector::zeros(m),
             jacobian: DMatrix::zeros(m, np),
             has_std: self.measured.has_std(),
+            rows_weighted: self.measured.has_std(),
             round_off: vec![0.0; m],
         };
         for (row, (meas, &k)) in self.measured.modes().iter().zip(&paired).enumerate() {

@@ -205,14 +205,16 @@ impl LevenbergMarquardt {
         !self.fixed.get(i).copied().unwrap_or(false)
     }
 
-    /// Good enough to stop without restarting: an exact fit, or with standard deviations a
-    /// χ² per degree of freedom that noise can explain (≤ 4).
+    /// Good enough to stop without restarting: an exact fit, or with rows weighted by standard
+    /// deviations (measured, or a shape fit's assumed defaults) a weighted misfit per degree of
+    /// freedom that noise of that size can explain (≤ 4). A stopping rule, not a verdict: the
+    /// verdict tests χ² only with measured σ.
     fn acceptable(&self, lin: &Linearisation, free: usize) -> bool {
         if self.converged(lin) {
             return true;
         }
         let dof = lin.residual.len().saturating_sub(free);
-        lin.has_std && dof > 0 && 2.0 * lin.cost() / dof as f64 <= 4.0
+        lin.rows_weighted && dof > 0 && 2.0 * lin.cost() / dof as f64 <= 4.0
     }
 
     fn remember(&mut self, lin: &Linearisation) {
