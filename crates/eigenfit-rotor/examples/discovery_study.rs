@@ -63,7 +63,10 @@ fn main() {
                             format!("{}={:?} (ΔAICc {:.1}) ~{:?}", n.label, n.value, n.delta_aicc, alts)
                         })
                         .collect();
-                    eprintln!("{} {noise} {}: {outcome:?} {labels:?}", case.name, draw.draw);
+                    eprintln!(
+                        "{} {noise} {}: {outcome:?} {labels:?} {spent} solves {:?}",
+                        case.name, draw.draw, found.report.spending
+                    );
                 }
             }
             let n: usize = counts.iter().sum();

@@ -168,6 +168,16 @@ pub fn run(draw: &Draw) -> Vec<NamedEffect> {
 /// Runs rotor discovery on the paper rotor against `frequency_hz` (std `std_hz`), every
 /// eigen-solve going through `solver`.
 pub fn run_counted(frequency_hz: &[f64], std_hz: &[f64], solver: &CountingSolver) -> RotorDiscovery {
+    run_with(frequency_hz, std_hz, solver, &DiscoveryOptions::default())
+}
+
+/// [`run_counted`] with `options`.
+pub fn run_with(
+    frequency_hz: &[f64],
+    std_hz: &[f64],
+    solver: &CountingSolver,
+    options: &DiscoveryOptions,
+) -> RotorDiscovery {
     let rotor = presets::paper_rotor();
     let modes: Vec<MeasuredMode> = frequency_hz
         .iter()
@@ -176,7 +186,7 @@ pub fn run_counted(frequency_hz: &[f64], std_hz: &[f64], solver: &CountingSolver
         .map(|(m, (&f, &s))| MeasuredMode::new(m, f).with_std(s))
         .collect();
     let measured = Measurement::new(modes).expect("fixture frequencies are valid");
-    discover_rotor(&rotor, solver, &measured, &rotor.nominal_stiffnesses(), &DiscoveryOptions::default())
+    discover_rotor(&rotor, solver, &measured, &rotor.nominal_stiffnesses(), options)
         .expect("discovery runs on valid data")
 }
 
