@@ -72,6 +72,10 @@ pub struct DiscoveryOptions {
     /// (default false): for a start known to be close, such as one mesh's calibration carried
     /// to a refined mesh, where restarts would only spend solves on a misfit no start removes.
     pub local_calibration: bool,
+    /// Most first choices carried through the next step when the leader's alternatives pass the
+    /// ambiguity test and a further effect is needed (default [`BEAM_WIDTH`]; 1: the leader
+    /// only, the selection of before).
+    pub beam_width: usize,
 }
 
 /// Evaluations a discovery run may spend by default: about 1 s of one core on 8 modes of the
@@ -93,6 +97,7 @@ impl Default for DiscoveryOptions {
             ambiguity_aicc: 2.0,
             max_evaluations: DEFAULT_EVALUATIONS,
             local_calibration: false,
+            beam_width: BEAM_WIDTH,
         }
     }
 }
@@ -659,7 +664,7 @@ pub fn discover_effects<E: EffectSearch>(
     };
     let trunk = Path { chosen: Vec::new(), current: Fit::base(&base_lin, n), named: Vec::new() };
     let mut log = RoundLog::default();
-    let path = context.extend(trunk, 0, true, &mut log);
+    let path = context.extend(trunk, 0, true, budget.limit(), &mut log);
     report.screening = log.screening;
     report.fits = log.fits;
     report.runner_up = log.runner_up;
@@ -786,15 +791,19 @@ fn same_place(a: &Candidate, b: &Candidate) -> bool {
     a.kind == b.kind && a.location == b.location && a.position_m == b.position_m && a.elements == b.elements
 }
 
-/// Most first choices carried through the next step when the leader is ambiguous: the leader and
-/// its best alternatives that the data cannot tell from it (a small beam).
+/// Most first choices carried through the next step when the leader is ambiguous, by default
+/// ([`DiscoveryOptions::beam_width`]): the leader and its best alternatives that the data cannot
+/// tell from it (a small beam).
 pub const BEAM_WIDTH: usize = 3;
 
-/// Share of the budget left at a round's start that the round's leader refits may spend (the
-/// screen's leader itself is always refitted, whatever is left). The rest is kept for confirming
-/// the leader (its look-alikes' refits) and the rounds after, so a round of many candidates can
-/// no longer spend the budget before the leader is confirmed.
+/// Share of a round's allowance that the local refits of the screen's leaders may spend; the rest
+/// is kept for confirming the leading fits (look-alikes, restarts), so a round of many candidates
+/// can no longer spend the budget before its leader is confirmed.
 const REFIT_SHARE: f64 = 0.5;
+
+/// Fits of a round refitted with restarts (from a grid of seeds) before the choice: the best few
+/// local fits, so the leader and its nearest rivals rest on full fits.
+const CONFIRMED: usize = 3;
 
 /// One line of forward selection: the effects chosen so far and the joint fit with them.
 #[derive(Clone)]
@@ -885,13 +894,27 @@ impl<E: EffectSearch> Selection<'_, E> {
 
     /// Forward selection from `path`, rounds `first..`; `may_branch`: an ambiguous leader may be
     /// carried beside its alternatives (once per search: the branches do not branch again).
-    fn extend(&self, mut path: Path, first: usize, may_branch: bool, log: &mut RoundLog) -> Path {
+    /// The rounds spend the budget up to `until` evaluations used: each round half of what is
+    /// left, the last round possible all of it.
+    fn extend(
+        &self,
+        mut path: Path,
+        first: usize,
+        may_branch: bool,
+        until: usize,
+        log: &mut RoundLog,
+    ) -> Path {
         let candidates = self.candidates;
         for round in first..self.options.max_effects {
             if self.budget.exhausted() || (round > 0 && self.explained(&path.current)) {
                 break;
             }
-            let fits = self.round(&path, round == 0, log);
+            let used = self.budget.used();
+            let round_end = match self.options.max_effects - round {
+                1 => until,
+                _ => used + until.saturating_sub(used) / 2,
+            };
+            let fits = self.round(&path, round == 0, round_end, log);
             let mut plausible = fits.iter().filter(|(_, f)| f.plausible);
             let Some((best_i, best)) = plausible.next().cloned() else { break };
             let Some(gain) = self.earns(&path.current, &best) else { break };
@@ -900,8 +923,8 @@ impl<E: EffectSearch> Selection<'_, E> {
             }
             let ambiguous_with = self.ambiguity(&fits, best_i, &best);
             let continues = round + 1 < self.options.max_effects && !self.explained(&best);
-            if may_branch && continues && !ambiguous_with.is_empty() {
-                return self.carry(path, round, &fits, (best_i, &best), log);
+            if may_branch && continues && !ambiguous_with.is_empty() && self.options.beam_width > 1 {
+                return self.carry(path, round, &fits, (best_i, &best), until, log);
             }
             path.named.push(NamedEffect::new(&candidates[best_i], gain, ambiguous_with));
             path.chosen.push(best_i);
@@ -922,13 +945,14 @@ impl<E: EffectSearch> Selection<'_, E> {
         round: usize,
         fits: &[(usize, Fit)],
         (best_i, best): (usize, &Fit),
+        until: usize,
         log: &mut RoundLog,
     ) -> Path {
         let c = self.candidates;
         let leader_alternatives = self.ambiguity(fits, best_i, best);
         let mut starts: Vec<(usize, Fit)> = vec![(best_i, best.clone())];
         for (i, f) in fits {
-            if starts.len() >= BEAM_WIDTH {
+            if starts.len() >= self.options.beam_width {
                 break;
             }
             let listed = leader_alternatives.iter().any(|a| a.place == Place::of(&c[*i]));
@@ -938,18 +962,21 @@ impl<E: EffectSearch> Selection<'_, E> {
         }
         let mut ends: Vec<Path> = Vec::with_capacity(starts.len());
         for (b, (i, f)) in starts.iter().enumerate() {
+            // Each carried first choice gets an equal share of what is left.
+            let used = self.budget.used();
+            let until = used + until.saturating_sub(used) / (starts.len() - b);
             let mut p = path.clone();
             let gain = self.earns(&p.current, f).unwrap_or(p.current.score() - f.score());
             p.named.push(NamedEffect::new(&c[*i], gain, Vec::new()));
             p.chosen.push(*i);
             p.current = f.clone();
             if b == 0 {
-                ends.push(self.extend(p, round + 1, false, log));
+                ends.push(self.extend(p, round + 1, false, until, log));
             } else {
                 // The alternatives' steps are what carrying the doubt costs.
                 let mut scratch = RoundLog::default();
                 let spent = self.budget.used();
-                ends.push(self.extend(p, round + 1, false, &mut scratch));
+                ends.push(self.extend(p, round + 1, false, until, &mut scratch));
                 log.spending.carried += self.budget.used() - spent;
                 log.spending.refits_skipped += scratch.spending.refits_skipped;
             }
@@ -991,7 +1018,7 @@ impl<E: EffectSearch> Selection<'_, E> {
     /// One round: screen every open candidate against the current fit, refit the leaders (the
     /// best few, the best of each kind, the switches) within the round's share of the budget,
     /// then confirm the leading fit by refitting its look-alikes. Returns the fits, best first.
-    fn round(&self, path: &Path, record: bool, log: &mut RoundLog) -> Vec<(usize, Fit)> {
+    fn round(&self, path: &Path, record: bool, round_end: usize, log: &mut RoundLog) -> Vec<(usize, Fit)> {
         let (candidates, n, options, budget) = (self.candidates, self.n, self.options, self.budget);
         let chosen_refs: Vec<&Candidate> = path.chosen.iter().map(|&i| &candidates[i]).collect();
         let open = |i: usize| !path.chosen.iter().any(|&c| same_place(&candidates[c], &candidates[i]));
@@ -1060,10 +1087,10 @@ impl<E: EffectSearch> Selection<'_, E> {
         let mut to_refit: Vec<usize> = picks.iter().take(1).copied().collect();
         to_refit.extend(unscreened);
         to_refit.extend(picks.iter().skip(1));
-        let refit_one = |i: usize, cap: Option<usize>| {
+        let refit_one = |i: usize, cap: usize, restarts: bool| {
             let mut set = chosen_refs.clone();
             set.push(&candidates[i]);
-            match refit(self.search, n, &set, &path.current.parameters, budget, cap) {
+            match refit(self.search, n, &set, &path.current.parameters, budget, (cap, restarts)) {
                 RefitOutcome::Fit(mut fit) => {
                     fit.place_charge = path.current.place_charge + self.charges[i];
                     RefitOutcome::Fit(fit)
@@ -1071,48 +1098,75 @@ impl<E: EffectSearch> Selection<'_, E> {
                 other => other,
             }
         };
+        // Refits: a local fit from the current one for each of the screen's leaders (a wrong
+        // candidate's fit does not reach the noise, and restarting it from a grid of seeds was
+        // most of the work); with restarts for the effects the screen cannot judge. Within the
+        // leaders' share of the round's allowance.
         let spent = budget.used();
-        let share = (budget.remaining() as f64 * REFIT_SHARE) as usize;
-        let mut fits: Vec<(usize, Fit)> = Vec::new();
-        for (rank, &i) in to_refit.iter().enumerate() {
-            // The screen's leader is refitted whatever is left; the others within the share.
-            let cap = (rank > 0).then(|| share.saturating_sub(budget.used() - spent));
-            if cap == Some(0) {
-                log.spending.refits_skipped += 1;
-                continue;
-            }
-            match refit_one(i, cap) {
-                RefitOutcome::Fit(fit) => fits.push((i, *fit)),
-                RefitOutcome::CutShort => log.spending.refits_skipped += 1,
+        let refits_end = spent + ((round_end.saturating_sub(spent)) as f64 * REFIT_SHARE) as usize;
+        let mut fits: Vec<(usize, Fit, bool)> = Vec::new();
+        let mut skipped = 0;
+        for &i in &to_refit {
+            let restarts = candidates[i].needs_refit();
+            match refit_one(i, refits_end.saturating_sub(budget.used()), restarts) {
+                RefitOutcome::Fit(fit) => fits.push((i, *fit, restarts)),
+                RefitOutcome::CutShort => skipped += 1,
                 RefitOutcome::Failed => {}
             }
         }
         log.spending.refits += budget.used() - spent;
         fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
-        // Confirmation: the linear screen misranks close variants of a large effect (a step and
-        // the tapers around it crowd each other out of the refits, whether their places overlap
-        // or not): the candidates whose predictions are most alike the leader's are refitted
-        // too, so the choice and its ambiguities rest on fits. At most `refits` of them: bounded
-        // work, drawn on what the leaders' share left.
+        // Confirmation, within the round's allowance: the linear screen misranks close variants
+        // of a large effect (a step and the tapers around it crowd each other out of the refits,
+        // whether their places overlap or not), so the candidates whose predictions are most
+        // alike the leader's are refitted too (at most `refits`), and the best `CONFIRMED` fits
+        // are refitted with restarts, so the choice and its ambiguities rest on full fits.
         let spent = budget.used();
-        if let Some((_, lead)) = fits.iter().find(|(_, f)| f.plausible) {
+        if let Some((_, lead, _)) = fits.iter().find(|(_, f, _)| f.plausible) {
             let change =
                 projector.apply(&noise_units(&lead.frequencies_hz, &path.current.frequencies_hz, &self.stds));
             let mut alike: Vec<(usize, f64)> = screened
                 .iter()
-                .filter(|(i, _)| !fits.iter().any(|(j, _)| j == i))
+                .filter(|(i, _)| !fits.iter().any(|(j, _, _)| j == i))
                 .map(|(i, s)| (*i, likeness(&s.direction, &change)))
                 .collect();
             alike.sort_by(|a, b| b.1.total_cmp(&a.1));
             let near: Vec<usize> =
                 alike.iter().take_while(|(_, l)| *l >= ALIKE).take(options.refits).map(|&(i, _)| i).collect();
             for i in near {
-                if let RefitOutcome::Fit(fit) = refit_one(i, None) {
-                    fits.push((i, *fit));
+                match refit_one(i, round_end.saturating_sub(budget.used()), false) {
+                    RefitOutcome::Fit(fit) => fits.push((i, *fit, false)),
+                    RefitOutcome::CutShort => skipped += 1,
+                    RefitOutcome::Failed => {}
                 }
             }
             fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
         }
+        let mut confirmed = 0;
+        for slot in 0..fits.len() {
+            if confirmed == CONFIRMED {
+                break;
+            }
+            if fits[slot].2 {
+                confirmed += 1;
+                continue;
+            }
+            let i = fits[slot].0;
+            match refit_one(i, round_end.saturating_sub(budget.used()), true) {
+                RefitOutcome::Fit(fit) => {
+                    if fit.score() <= fits[slot].1.score() {
+                        fits[slot].1 = *fit;
+                    }
+                    fits[slot].2 = true;
+                    confirmed += 1;
+                }
+                RefitOutcome::CutShort => skipped += 1,
+                RefitOutcome::Failed => {}
+            }
+        }
+        let mut fits: Vec<(usize, Fit)> = fits.into_iter().map(|(i, f, _)| (i, f)).collect();
+        fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
+        log.spending.refits_skipped += skipped;
         log.spending.confirmation += budget.used() - spent;
         if record {
             log.fits = fits.iter().map(|(_, f)| f.clone()).collect();
@@ -1242,15 +1296,17 @@ fn screen<E: EffectSearch>(
 /// Refits the current parameters with the candidate set `set` (the chosen ones, then the new
 /// one, last); intervals are the covariance ones (cheap: no profile per candidate). The base
 /// parameters start where [`EffectSearch::refit_base_start`] says (by default the current ones).
-/// With `cap`, the refit may spend at most that many evaluations of `budget` (it is cut short,
-/// [`RefitOutcome::CutShort`], rather than spend what is kept for later).
+/// The refit may spend at most `cap` evaluations of `budget` (it is cut short,
+/// [`RefitOutcome::CutShort`], rather than spend what is kept for later); `restarts`: with the
+/// damped strategy's restarts from a grid of seeds when the local fit does not reach the noise,
+/// else one local fit.
 fn refit<E: EffectSearch>(
     search: &E,
     n: usize,
     set: &[&Candidate],
     current: &[f64],
     budget: &Budget,
-    cap: Option<usize>,
+    (cap, restarts): (usize, bool),
 ) -> RefitOutcome {
     let Some(&candidate) = set.last() else { return RefitOutcome::Failed };
     let chosen_values: usize = set[..set.len() - 1].iter().map(|c| c.parameter_count()).sum();
@@ -1261,18 +1317,20 @@ fn refit<E: EffectSearch>(
     }
     start.extend_from_slice(&current[base_len..]);
     start.extend(candidate.parameters().map(|p| p.nominal));
-    let capped = cap.map(Budget::new);
+    if cap == 0 {
+        return RefitOutcome::CutShort;
+    }
+    let capped = Budget::new(cap);
     let fit = search.with_effects(set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
         let driver = Driver { max_iterations: 60 };
         let mut strategy = LevenbergMarquardt::default();
-        let est = match &capped {
-            // Every evaluation charged to the run's budget and to the cap.
-            Some(cap) => driver.run_within(&budget.wrap(problem), &mut strategy, &start, cap),
-            None => driver.run_within(problem, &mut strategy, &start, budget),
+        if !restarts {
+            strategy = strategy.with_max_restarts(0);
         }
-        .ok()?;
+        // Every evaluation charged to the run's budget and to the cap.
+        let est = driver.run_within(&budget.wrap(problem), &mut strategy, &start, &capped).ok()?;
         // A fit cut short by the budget is not a fit.
         if matches!(est.termination, Termination::BudgetExhausted { .. }) {
             return None;
@@ -1319,7 +1377,7 @@ fn refit<E: EffectSearch>(
     });
     match fit {
         Some(fit) => RefitOutcome::Fit(Box::new(fit)),
-        None if capped.is_some_and(|c| c.exhausted()) => RefitOutcome::CutShort,
+        None if capped.exhausted() => RefitOutcome::CutShort,
         None => RefitOutcome::Failed,
     }
 }
