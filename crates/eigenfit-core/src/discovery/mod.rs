@@ -801,6 +801,11 @@ pub const BEAM_WIDTH: usize = 3;
 /// can no longer spend the budget before its leader is confirmed.
 const REFIT_SHARE: f64 = 0.5;
 
+/// Share of what is left of the budget that a round may spend when more rounds may follow: the
+/// rest is kept so a further effect can still be screened, refitted and confirmed (a second
+/// round costs more than the first: one more parameter in every fit).
+const ROUND_SHARE: f64 = 0.75;
+
 /// Fits of a round refitted with restarts (from a grid of seeds) before the choice: the best few
 /// local fits, so the leader and its nearest rivals rest on full fits.
 const CONFIRMED: usize = 3;
@@ -894,8 +899,8 @@ impl<E: EffectSearch> Selection<'_, E> {
 
     /// Forward selection from `path`, rounds `first..`; `may_branch`: an ambiguous leader may be
     /// carried beside its alternatives (once per search: the branches do not branch again).
-    /// The rounds spend the budget up to `until` evaluations used: each round half of what is
-    /// left, the last round possible all of it.
+    /// The rounds spend the budget up to `until` evaluations used: each round [`ROUND_SHARE`] of
+    /// what is left, the last round possible all of it.
     fn extend(
         &self,
         mut path: Path,
@@ -912,7 +917,7 @@ impl<E: EffectSearch> Selection<'_, E> {
             let used = self.budget.used();
             let round_end = match self.options.max_effects - round {
                 1 => until,
-                _ => used + until.saturating_sub(used) / 2,
+                _ => used + (until.saturating_sub(used) as f64 * ROUND_SHARE) as usize,
             };
             let fits = self.round(&path, round == 0, round_end, log);
             let mut plausible = fits.iter().filter(|(_, f)| f.plausible);
@@ -1090,7 +1095,10 @@ impl<E: EffectSearch> Selection<'_, E> {
         let refit_one = |i: usize, cap: usize, restarts: bool| {
             let mut set = chosen_refs.clone();
             set.push(&candidates[i]);
-            match refit(self.search, n, &set, &path.current.parameters, budget, (cap, restarts)) {
+            // A screened candidate's value starts where the screen's Gauss–Newton step put it
+            // (a step cap far below a large value can otherwise keep the fit short of it).
+            let from = screened.iter().find(|(j, _)| *j == i).map(|(_, s)| s.value);
+            match refit(self.search, n, &set, &path.current.parameters, budget, (cap, restarts), from) {
                 RefitOutcome::Fit(mut fit) => {
                     fit.place_charge = path.current.place_charge + self.charges[i];
                     RefitOutcome::Fit(fit)
@@ -1264,6 +1272,9 @@ struct Screened {
     /// How its value moves the predictions (in noise units), off what the current parameters
     /// can do.
     direction: DVector<f64>,
+    /// The value one (bound-limited) Gauss–Newton step from the nominal predicts: where its
+    /// refit starts.
+    value: f64,
 }
 
 /// Screens one candidate ([`Screened`]).
@@ -1284,13 +1295,13 @@ fn screen<E: EffectSearch>(
     let r = projector.apply(&lin.residual);
     let jj = j.norm_squared();
     if jj == 0.0 {
-        return Some(Screened { reduction: 0.0, direction: j });
+        return Some(Screened { reduction: 0.0, direction: j, value: par.nominal });
     }
     let step = j.dot(&r) / jj;
     let admissible = (par.nominal + step).clamp(par.lower, par.upper) - par.nominal;
     // χ² reduction of the (bound-limited) linear step: 2·a·(j·r) − a²·‖j‖².
     let reduction = (2.0 * admissible * j.dot(&r) - admissible * admissible * jj).max(0.0);
-    Some(Screened { reduction, direction: j })
+    Some(Screened { reduction, direction: j, value: par.nominal + admissible })
 }
 
 /// Refits the current parameters with the candidate set `set` (the chosen ones, then the new
@@ -1299,7 +1310,7 @@ fn screen<E: EffectSearch>(
 /// The refit may spend at most `cap` evaluations of `budget` (it is cut short,
 /// [`RefitOutcome::CutShort`], rather than spend what is kept for later); `restarts`: with the
 /// damped strategy's restarts from a grid of seeds when the local fit does not reach the noise,
-/// else one local fit.
+/// else one local fit. The new candidate's value starts at `from` when given (else its nominal).
 fn refit<E: EffectSearch>(
     search: &E,
     n: usize,
@@ -1307,6 +1318,7 @@ fn refit<E: EffectSearch>(
     current: &[f64],
     budget: &Budget,
     (cap, restarts): (usize, bool),
+    from: Option<f64>,
 ) -> RefitOutcome {
     let Some(&candidate) = set.last() else { return RefitOutcome::Failed };
     let chosen_values: usize = set[..set.len() - 1].iter().map(|c| c.parameter_count()).sum();
@@ -1317,6 +1329,9 @@ fn refit<E: EffectSearch>(
     }
     start.extend_from_slice(&current[base_len..]);
     start.extend(candidate.parameters().map(|p| p.nominal));
+    if let (Some(v), Some(first)) = (from, candidate.parameter.as_ref().map(|_| base_len + chosen_values)) {
+        start[first] = v;
+    }
     if cap == 0 {
         return RefitOutcome::CutShort;
     }
