@@ -6,7 +6,8 @@
 //! (`STUDY_CASES=pedestal,clean` for some cases only, `STUDY_VERBOSE=1` for every answer,
 //! `STUDY_BUDGET=N` for another evaluation budget than the default,
 //! `STUDY_SET=heldout` for the draws of `generate.py --heldout`, `STUDY_SET=fresh` for those of
-//! `generate.py --fresh`, `STUDY_SET=fresh2` for those of `generate.py --fresh2`, instead of the
+//! `generate.py --fresh`, `STUDY_SET=fresh2` for those of `generate.py --fresh2`,
+//! `STUDY_SET=fresh3` for those of `generate.py --fresh3`, instead of the
 //! design draws)
 
 #[path = "../tests/common/study.rs"]
@@ -22,6 +23,7 @@ fn main() {
         "heldout" => (study::load_heldout(), "held-out (heldout.toml, seed 99173)"),
         "fresh" => (study::load_fresh(), "fresh held-out (fresh.toml, seed 60411)"),
         "fresh2" => (study::load_fresh2(), "second fresh held-out (fresh2.toml, seed 53913)"),
+        "fresh3" => (study::load_fresh3(), "third fresh held-out (fresh3.toml, seed 67138)"),
         _ => (study::load(), "design (independent.toml, seed 20261123)"),
     };
     println!("draws: {name}\n");
