@@ -476,6 +476,7 @@ fn a_user_candidate_that_fits_exactly_with_one_degree_of_freedom_left_is_named()
     let value = v["missing_effect"]["value"].as_f64().unwrap();
     assert!((value / 0.5 - 1.0).abs() < 1e-6, "fitted mass {value}");
     assert_eq!(v["explained"], true, "{v}");
+    let mut before_off = 0.0f64;
     for m in v["modes"].as_array().unwrap() {
         let (measured, before, after) = (
             m["measured_hz"].as_f64().unwrap(),
@@ -483,8 +484,10 @@ fn a_user_candidate_that_fits_exactly_with_one_degree_of_freedom_left_is_named()
             m["after_hz"].as_f64().unwrap(),
         );
         assert!((after / measured - 1.0).abs() < 1e-8, "after {after} vs measured {measured}: {m}");
-        assert!((before / measured - 1.0).abs() > 1e-4, "the calibration alone fits mode {m}");
+        before_off = before_off.max((before / measured - 1.0).abs());
     }
+    // The "after" column is the augmented model's, not a copy of the calibration's.
+    assert!(before_off > 1e-4, "the calibration alone fits every mode: {v}");
     assert_eq!(v["untestable_candidates"].as_array().unwrap().len(), 0, "{v}");
 }
 

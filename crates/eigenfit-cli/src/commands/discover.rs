@@ -201,6 +201,12 @@ fn print_report(
             }
         }
     }
+    if r.spending.refits_skipped > 0 && !r.budget_exhausted {
+        println!(
+            "{} refit(s) of screened candidates left out to keep the budget for confirming the leader; raise it with --budget to try them",
+            r.spending.refits_skipped
+        );
+    }
     if !r.untestable.is_empty() && !(found.effects.is_empty() && r.fits.is_empty()) {
         print_untestable(r);
     }

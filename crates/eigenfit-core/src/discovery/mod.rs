@@ -676,7 +676,9 @@ pub fn discover_effects<E: EffectSearch>(
     report.spending.carried = log.spending.carried;
     let Path { chosen, current, mut named } = path;
     report.evaluations = budget.used();
-    report.budget_exhausted = budget.exhausted();
+    // Refits cut short by the budget plan are not refused evaluations, but a search that used
+    // every evaluation it had did stop at its budget: said so, as a refusal would be.
+    report.budget_exhausted = budget.exhausted() || budget.remaining() == 0;
     // (c) name the effects only if, with them, the misfit is one the noise can explain.
     let k = current.parameters.len();
     let consistent = n > k && chi2_upper_tail(current.chi2, n - k) >= options.min_after_p_value;
