@@ -5,8 +5,12 @@
 //! 2. **Detect**: χ² of the calibrated residual against the noise, overall (p-value) and per mode.
 //! 3. **Screen** every candidate by the χ² reduction a linear fit of its value would give, with
 //!    the residual's sensitivity projected off the already-fitted parameters.
-//! 4. **Refit** the most promising with the nominal parameters; **select** by AICc among the
-//!    physically plausible fits, and report the runner-up.
+//! 4. **Refit** the most promising with the nominal parameters (a local fit from the screen's
+//!    Gauss–Newton value; the best few confirmed with restarts), each round within its share of
+//!    the budget ([`Spending`] says how it was spent); **select** by AICc among the physically
+//!    plausible fits, and report the runner-up. An ambiguous leader is carried beside its
+//!    alternatives through the next step ([`BEAM_WIDTH`]); candidates that would leave no degree
+//!    of freedom are reported as [`Untestable`].
 //!
 //! Nothing here is rotor-specific: a plugin offers [`Candidate`]s, the engine does the rest.
 
