@@ -237,7 +237,7 @@ fn print_report(
 /// The candidates that could not be tested, and why.
 fn print_untestable(r: &DiscoveryReport) {
     let Some(first) = r.untestable.first() else { return };
-    let labels: Vec<&str> = r.untestable.iter().map(|u| u.label.as_str()).collect();
+    let labels: Vec<&str> = r.untestable.iter().map(|u| u.place.label.as_str()).collect();
     println!(
         "cannot test {} candidate effect(s) ({}): with one of them the fit would have {} parameters for {} measured modes, \
          no degree of freedom left, so it would fit exactly whatever the truth; measure more modes (or hold a parameter fixed)",

@@ -1157,21 +1157,20 @@ impl<E: EffectSearch> Selection<'_, E> {
             fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
         }
         let mut confirmed = 0;
-        for slot in 0..fits.len() {
+        for (i, fit, full) in &mut fits {
             if confirmed == CONFIRMED {
                 break;
             }
-            if fits[slot].2 {
+            if *full {
                 confirmed += 1;
                 continue;
             }
-            let i = fits[slot].0;
-            match refit_one(i, round_end.saturating_sub(budget.used()), true) {
-                RefitOutcome::Fit(fit) => {
-                    if fit.score() <= fits[slot].1.score() {
-                        fits[slot].1 = *fit;
+            match refit_one(*i, round_end.saturating_sub(budget.used()), true) {
+                RefitOutcome::Fit(restarted) => {
+                    if restarted.score() <= fit.score() {
+                        *fit = *restarted;
                     }
-                    fits[slot].2 = true;
+                    *full = true;
                     confirmed += 1;
                 }
                 RefitOutcome::CutShort => skipped += 1,
