@@ -207,7 +207,9 @@ fn print_report(
             r.spending.refits_skipped
         );
     }
-    if !r.untestable.is_empty() && !(found.effects.is_empty() && r.fits.is_empty()) {
+    // Said above already when nothing could be tested at all.
+    let said = found.effects.is_empty() && r.fits.is_empty();
+    if !r.untestable.is_empty() && !said {
         print_untestable(r);
     }
     if r.budget_exhausted {

@@ -1101,9 +1101,11 @@ impl<E: EffectSearch> Selection<'_, E> {
         let refit_one = |i: usize, cap: usize, restarts: bool| {
             let mut set = chosen_refs.clone();
             set.push(&candidates[i]);
-            // A screened candidate's value starts where the screen's Gauss–Newton step put it
-            // (a step cap far below a large value can otherwise keep the fit short of it).
-            let from = screened.iter().find(|(j, _)| *j == i).map(|(_, s)| s.value);
+            // A screened candidate's local fit starts where the screen's Gauss–Newton step put
+            // its value (a step cap far below a large value can otherwise keep the fit short of
+            // it); the confirmation with restarts from its nominal value, the start the local
+            // path may have missed — the better of the two is kept.
+            let from = screened.iter().find(|(j, _)| *j == i).map(|(_, s)| s.value).filter(|_| !restarts);
             match refit(self.search, n, &set, &path.current.parameters, budget, (cap, restarts), from) {
                 RefitOutcome::Fit(mut fit) => {
                     fit.place_charge = path.current.place_charge + self.charges[i];
