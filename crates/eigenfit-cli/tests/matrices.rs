@@ -384,3 +384,158 @@ fn measured_shapes_on_a_large_model_are_refused_before_any_solve() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("measured shapes") && err.contains("2100 DOFs") && err.contains("2000"), "{err}");
 }
+
+/// A four-mass chain (4 DOFs, masses 1): springs to ground at mass 1 (`a`), between masses 1–2
+/// (`b`) and 2–3 (`c`), and a fixed spring between 3–4 in K₀; a `[[candidate]]` mass at mass 1
+/// (the springs cannot absorb it: checked with scipy, the best fit of 2 or 3 of them leaves
+/// χ² > 5000 at 0.1 %).
+/// `parameters` are the chain's fitted springs (the others stay in K₀ at 1e4 N/m); `candidate` is
+/// the candidate table's extra lines.
+fn chain(dir: &std::path::Path, parameters: &[&str], candidate: &str) -> std::path::PathBuf {
+    let mtx = |entries: &[(usize, usize, f64)]| {
+        let body: String = entries.iter().map(|(i, j, v)| format!("{i} {j} {v}\n")).collect();
+        format!("%%MatrixMarket matrix coordinate real symmetric\n4 4 {}\n{body}", entries.len())
+    };
+    let spring = |i: usize, j: usize| vec![(i, i, 1e4), (j, j, 1e4), (j, i, -1e4)];
+    let springs = [("a", vec![(1, 1, 1e4)]), ("b", spring(1, 2)), ("c", spring(2, 3))];
+    let mut k0 = spring(3, 4);
+    let mut tables = String::new();
+    for (name, entries) in &springs {
+        if parameters.contains(name) {
+            std::fs::write(dir.join(format!("K_{name}.mtx")), mtx(entries)).unwrap();
+            tables += &format!(
+                "[[parameter]]\nname = \"{name}\"\nnominal = 1.0\nlower = 0.1\nupper = 10\nscale = \"log\"\nstiffness = \"K_{name}.mtx\"\n"
+            );
+        } else {
+            k0.extend(entries);
+        }
+    }
+    // Summed entries: the same (i, j) listed twice adds up.
+    let mut summed: Vec<(usize, usize, f64)> = Vec::new();
+    for (i, j, v) in k0 {
+        match summed.iter_mut().find(|(a, b, _)| (*a, *b) == (i, j)) {
+            Some(e) => e.2 += v,
+            None => summed.push((i, j, v)),
+        }
+    }
+    std::fs::write(dir.join("K0.mtx"), mtx(&summed)).unwrap();
+    std::fs::write(dir.join("M0.mtx"), mtx(&[(1, 1, 1.0), (2, 2, 1.0), (3, 3, 1.0), (4, 4, 1.0)])).unwrap();
+    std::fs::write(dir.join("Mc.mtx"), mtx(&[(1, 1, 1.0)])).unwrap();
+    let head = "kind = \"matrices\"\nstiffness = \"K0.mtx\"\nmass = \"M0.mtx\"\n";
+    let path = dir.join(format!("chain{}.toml", parameters.len()));
+    std::fs::write(
+        &path,
+        format!("{head}{tables}[[candidate]]\nname = \"tip-mass\"\nmass = \"Mc.mtx\"\n{candidate}"),
+    )
+    .unwrap();
+    path
+}
+
+/// The chain's four frequencies with `mass` kg added at mass 1 (its springs at their nominal
+/// values), as a measured CSV (std 0.1 % assumed by discover).
+fn chain_measured(dir: &std::path::Path, mass: f64) -> std::path::PathBuf {
+    let model = chain(dir, &[], "upper = 100\n");
+    let truth = dir.join("truth.toml");
+    let text = std::fs::read_to_string(&model).unwrap().replace("[[candidate]]", "[[parameter]]").replace(
+        "name = \"tip-mass\"",
+        &format!("name = \"tip-mass\"\nnominal = {mass}\nlower = 0\nscale = \"linear\""),
+    );
+    std::fs::write(&truth, text).unwrap();
+    let (code, v, err) =
+        eigenfit(&["simulate", "--model", truth.to_str().unwrap(), "--modes", "4", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let csv: String =
+        floats(&v["frequencies_hz"]).iter().enumerate().map(|(k, f)| format!("{},{f}\n", k + 1)).collect();
+    let measured = dir.join("measured.csv");
+    std::fs::write(&measured, format!("mode,frequency_hz\n{csv}")).unwrap();
+    measured
+}
+
+fn discover_json(model: &std::path::Path, measured: &std::path::Path) -> (i32, Value, String) {
+    eigenfit(&[
+        "discover",
+        "--model",
+        model.to_str().unwrap(),
+        "--measured",
+        measured.to_str().unwrap(),
+        "--json",
+    ])
+}
+
+#[test]
+fn a_user_candidate_that_fits_exactly_with_one_degree_of_freedom_left_is_named() {
+    // 4 modes, 2 fitted springs + the candidate: the AICc's correction is unbounded (n − k − 1 =
+    // 0), one degree of freedom is left to test the fit. The candidate at its true value fits to
+    // round-off; it must be named, and the "after" column must be the augmented model's.
+    let scratch = common::scratch();
+    let dir = scratch.path();
+    let measured = chain_measured(dir, 0.5);
+    let model = chain(dir, &["a", "b"], "upper = 100\n");
+    let (code, v, err) = discover_json(&model, &measured);
+    assert_eq!(code, 0, "{err}\n{v}");
+    assert_eq!(v["disagreement_significant"], true, "{v}");
+    assert_eq!(v["missing_effect"]["kind"], "tip-mass", "{v}");
+    let value = v["missing_effect"]["value"].as_f64().unwrap();
+    assert!((value / 0.5 - 1.0).abs() < 1e-6, "fitted mass {value}");
+    assert_eq!(v["explained"], true, "{v}");
+    let mut before_off = 0.0f64;
+    for m in v["modes"].as_array().unwrap() {
+        let (measured, before, after) = (
+            m["measured_hz"].as_f64().unwrap(),
+            m["before_hz"].as_f64().unwrap(),
+            m["after_hz"].as_f64().unwrap(),
+        );
+        assert!((after / measured - 1.0).abs() < 1e-8, "after {after} vs measured {measured}: {m}");
+        before_off = before_off.max((before / measured - 1.0).abs());
+    }
+    // The "after" column is the augmented model's, not a copy of the calibration's.
+    assert!(before_off > 1e-4, "the calibration alone fits every mode: {v}");
+    assert_eq!(v["untestable_candidates"].as_array().unwrap().len(), 0, "{v}");
+}
+
+#[test]
+fn a_candidate_that_would_leave_no_degree_of_freedom_is_said_untestable() {
+    // 4 modes, 3 fitted springs: with the candidate the fit has 4 parameters for 4 modes.
+    let scratch = common::scratch();
+    let dir = scratch.path();
+    let measured = chain_measured(dir, 2.0);
+    let model = chain(dir, &["a", "b", "c"], "upper = 100\n");
+    let (code, v, err) = discover_json(&model, &measured);
+    assert_eq!(v["disagreement_significant"], true, "{v}");
+    assert_eq!(code, 3, "a significant disagreement left unexplained: {err}\n{v}");
+    assert!(v["missing_effects"].as_array().unwrap().is_empty(), "{v}");
+    let untestable = v["untestable_candidates"].as_array().unwrap();
+    assert_eq!(untestable.len(), 1, "{v}");
+    assert_eq!(untestable[0]["kind"], "tip-mass");
+    assert_eq!((untestable[0]["parameters"].as_u64(), untestable[0]["modes"].as_u64()), (Some(4), Some(4)));
+    assert!(v["candidates_refitted"].as_array().unwrap().is_empty(), "no exact refit reported: {v}");
+    let out = Command::new(env!("CARGO_BIN_EXE_eigenfit"))
+        .args(["discover", "--model", model.to_str().unwrap(), "--measured", measured.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("cannot test 1 candidate effect(s) (tip-mass)"), "{text}");
+    assert!(text.contains("4 parameters for 4 measured modes"), "{text}");
+    assert!(!text.contains("best partial explanation"), "{text}");
+}
+
+#[test]
+fn a_candidate_named_like_a_parameter_or_with_a_range_outside_its_bounds_is_bad_input() {
+    let scratch = common::scratch();
+    let dir = scratch.path();
+    let measured = chain_measured(dir, 0.5);
+    let model = chain(dir, &["a", "b"], "upper = 100\n");
+    let clash = dir.join("clash.toml");
+    std::fs::write(
+        &clash,
+        std::fs::read_to_string(&model).unwrap().replace("name = \"tip-mass\"", "name = \"b\""),
+    )
+    .unwrap();
+    let (code, _, err) = discover_json(&clash, &measured);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[[candidate]] 1 (`b`): named like a [[parameter]]"), "{err}");
+    let outside = chain(dir, &["a", "b"], "upper = 100\nplausible = [0, 200]\n");
+    let (code, _, err) = discover_json(&outside, &measured);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("plausible = [0, 200] lies outside the candidate's bounds [0, 100]"), "{err}");
+}

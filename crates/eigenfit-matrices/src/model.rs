@@ -229,6 +229,20 @@ impl MatricesModel {
         let mut candidate_matrices = Vec::with_capacity(file.candidate.len());
         for (i, t) in file.candidate.iter().enumerate() {
             let table = format!("[[candidate]] {} (`{}`)", i + 1, t.name);
+            // The candidate's value is fitted beside the parameters, under its name: a clash
+            // would make the fit's parameters ambiguous.
+            if params.iter().any(|p| p.name == t.name) {
+                return Err(MatricesError::invalid(
+                    path,
+                    format!("{table}: named like a [[parameter]]: a candidate's name must differ from every parameter's"),
+                ));
+            }
+            if file.candidate[..i].iter().any(|other| other.name == t.name) {
+                return Err(MatricesError::invalid(
+                    path,
+                    format!("{table}: another [[candidate]] has the same name"),
+                ));
+            }
             if t.scale.is_some() {
                 return Err(MatricesError::invalid(
                     path,
@@ -252,6 +266,14 @@ impl MatricesModel {
                 parameter(&t.name, nominal, Some(lower), Some(upper), Some(Scale::Linear), t.unit.as_deref())
                     .map_err(|e| MatricesError::invalid(path, format!("{table}: {e}")))?;
             let plausible = match t.plausible {
+                Some([a, b]) if a <= b && (a < lower || b > upper) => {
+                    return Err(MatricesError::invalid(
+                        path,
+                        format!(
+                            "{table}: plausible = [{a}, {b}] lies outside the candidate's bounds [{lower}, {upper}] (`lower`, `upper`): a value outside them is never fitted"
+                        ),
+                    ))
+                }
                 Some([a, b]) if a <= b => (a, b),
                 Some([a, b]) => {
                     return Err(MatricesError::invalid(

@@ -4,8 +4,10 @@
 //!
 //! cargo run --release -p eigenfit-rotor --example discovery_study
 //! (`STUDY_CASES=pedestal,clean` for some cases only, `STUDY_VERBOSE=1` for every answer,
+//! `STUDY_BUDGET=N` for another evaluation budget than the default,
 //! `STUDY_SET=heldout` for the draws of `generate.py --heldout`, `STUDY_SET=fresh` for those of
-//! `generate.py --fresh`, `STUDY_SET=fresh2` for those of `generate.py --fresh2`, instead of the
+//! `generate.py --fresh`, `STUDY_SET=fresh2` for those of `generate.py --fresh2`,
+//! `STUDY_SET=fresh3` for those of `generate.py --fresh3`, instead of the
 //! design draws)
 
 #[path = "../tests/common/study.rs"]
@@ -21,6 +23,7 @@ fn main() {
         "heldout" => (study::load_heldout(), "held-out (heldout.toml, seed 99173)"),
         "fresh" => (study::load_fresh(), "fresh held-out (fresh.toml, seed 60411)"),
         "fresh2" => (study::load_fresh2(), "second fresh held-out (fresh2.toml, seed 53913)"),
+        "fresh3" => (study::load_fresh3(), "third fresh held-out (fresh3.toml, seed 67138)"),
         _ => (study::load(), "design (independent.toml, seed 20261123)"),
     };
     println!("draws: {name}\n");
@@ -29,6 +32,11 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|---|---|");
     let mut slowest = 0.0f64;
+    // STUDY_BUDGET=N gives each run N evaluations instead of the default.
+    let mut options = eigenfit_core::discovery::DiscoveryOptions::default();
+    if let Some(n) = std::env::var("STUDY_BUDGET").ok().and_then(|n| n.parse().ok()) {
+        options.max_evaluations = n;
+    }
     // STUDY_CASES=pedestal,clean runs only those cases.
     let only = std::env::var("STUDY_CASES").ok();
     let wanted = |name: &str| only.as_deref().is_none_or(|o| o.split(',').any(|c| c == name));
@@ -43,7 +51,7 @@ fn main() {
             for draw in fixtures.draw.iter().filter(|d| d.case == case.name && d.noise == noise) {
                 let t = Instant::now();
                 let solver = study::CountingSolver::default();
-                let found = study::run_counted(&draw.frequency_hz, &draw.std_hz, &solver);
+                let found = study::run_with(&draw.frequency_hz, &draw.std_hz, &solver, &options);
                 slowest = slowest.max(t.elapsed().as_secs_f64());
                 let spent = solver.solves.load(Ordering::Relaxed);
                 (solves, most) = (solves + spent, most.max(spent));
@@ -63,7 +71,10 @@ fn main() {
                             format!("{}={:?} (ΔAICc {:.1}) ~{:?}", n.label, n.value, n.delta_aicc, alts)
                         })
                         .collect();
-                    eprintln!("{} {noise} {}: {outcome:?} {labels:?}", case.name, draw.draw);
+                    eprintln!(
+                        "{} {noise} {}: {outcome:?} {labels:?} {spent} solves {:?}",
+                        case.name, draw.draw, found.report.spending
+                    );
                 }
             }
             let n: usize = counts.iter().sum();

@@ -132,6 +132,8 @@ impl<S: EigenSolver> Request<'_, S> {
         }
         if let Ok(mut fine_base) = fine_base {
             coarse_result.report.evaluations += fine_base.evaluations;
+            coarse_result.report.spending.refined_mesh += fine_base.evaluations;
+            fine_base.spending = coarse_result.report.spending;
             fine_base.evaluations = coarse_result.report.evaluations;
             let gain = final_aicc(&coarse_result.report) - fine_base.before.aicc;
             let apart = separation2(&coarse_result.report, &fine_base);
@@ -182,6 +184,7 @@ impl<S: EigenSolver> Request<'_, S> {
             }
         };
         coarse_result.report.evaluations += fine.evaluations;
+        coarse_result.report.spending.refined_mesh += fine.evaluations;
         coarse_result.report.budget_exhausted |= fine.budget_exhausted;
         fine.evaluations = coarse_result.report.evaluations;
         fine.budget_exhausted = coarse_result.report.budget_exhausted;
@@ -205,6 +208,8 @@ impl<S: EigenSolver> Request<'_, S> {
         fine.rms_after_hz = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
         fine.rms_before_hz = c.rms_before_hz;
         fine.before = c.before;
+        fine.spending = c.spending;
+        fine.untestable = c.untestable.clone();
         let mut named = fine.effects.clone();
         named.push(mesh_effect(gain, Vec::new()));
         named.sort_by(|a, b| b.delta_aicc.total_cmp(&a.delta_aicc));
@@ -243,6 +248,7 @@ fn mesh_explains(
     fine.before = c.before;
     fine.fits = c.fits;
     fine.screening = c.screening;
+    fine.untestable = c.untestable;
     let effect = mesh_effect(gain, ambiguous_with);
     RotorDiscovery { report: fine, effects: vec![effect], mesh_factor: REFINEMENT }
 }

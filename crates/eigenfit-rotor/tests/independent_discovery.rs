@@ -227,3 +227,39 @@ fn discovery_work_is_bounded_whatever_the_data() {
         assert_eq!(solves, found.report.evaluations, "{name}: every solve is charged to the budget");
     }
 }
+
+/// Issue #31: the search spent its budget refitting many candidates before it confirmed a leader
+/// (a point mass between two nodes, two effects at once: ≥ 2856 and ≥ 6420 solves on these
+/// draws before). The screen's leaders are now refitted locally, each round within its share,
+/// so both are named — with nothing left unconfirmed — within budgets the old search could not
+/// finish in; every solve is counted at the solver and accounted to a phase.
+#[test]
+fn a_mass_between_nodes_and_two_effects_are_confirmed_within_small_budgets() {
+    use std::sync::atomic::Ordering;
+    let fixtures = study::load();
+    for (case, budget) in [("mass-between-nodes", 2000), ("two-effects", 5500)] {
+        let draw = fixtures.draw.iter().find(|d| d.case == case && d.noise == 0.001 && d.draw == 0).unwrap();
+        let case_def = fixtures.case.iter().find(|c| c.name == case).unwrap();
+        let solver = study::CountingSolver::default();
+        let options =
+            eigenfit_core::discovery::DiscoveryOptions { max_evaluations: budget, ..Default::default() };
+        let found = study::run_with(&draw.frequency_hz, &draw.std_hz, &solver, &options);
+        let r = &found.report;
+        assert!(!r.budget_exhausted, "{case}: budget of {budget} ran out: {:?}", r.spending);
+        let (outcome, _) = study::score(&case_def.expect, &found.effects);
+        assert_eq!(outcome, Outcome::Named, "{case}: {:?}", found.effects);
+        let solves = solver.solves.load(Ordering::Relaxed);
+        assert_eq!(solves, r.evaluations, "{case}: every solve is charged");
+        assert!(solves <= budget, "{case}: {solves} solves");
+        let s = r.spending;
+        let phases = s.data_check
+            + s.calibration
+            + s.screening
+            + s.refits
+            + s.confirmation
+            + s.carried
+            + s.refined_mesh;
+        assert_eq!(phases, r.evaluations, "{case}: every solve belongs to a phase: {s:?}");
+        assert!(s.screening > 0 && s.refits > 0, "{case}: {s:?}");
+    }
+}

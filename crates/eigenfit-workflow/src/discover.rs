@@ -7,7 +7,8 @@ use crate::named::Named;
 use crate::progress::Progress;
 use eigenfit_core::analysis::verdict::{check_reachable, check_softest};
 use eigenfit_core::discovery::{
-    discover, BaseMisfit, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect,
+    discover, BaseMisfit, DiscoveryError, DiscoveryOptions, DiscoveryReport, Fit, NamedEffect, Spending,
+    Untestable,
 };
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
@@ -69,6 +70,13 @@ pub struct DiscoverReport {
     pub budget_limit: usize,
     /// True when the search stopped at its budget of eigen-solves.
     pub budget_exhausted: bool,
+    /// How `evaluations` were spent, by phase (the data check, calibration, screening, the
+    /// leaders' refits, confirmation, carried alternatives, the refined mesh) and how many leader
+    /// refits the budget's share for them left out.
+    pub budget_spent: Spending,
+    /// Candidates that could not be tested: with one of them the fit would leave no degree of
+    /// freedom (as many parameters as measured modes), so it would fit exactly whatever the truth.
+    pub untestable_candidates: Vec<Untestable>,
     /// True when the data are explained: by the noise from the start, or by the named effects
     /// (the search names effects only when, with them, the noise explains what is left). False
     /// when a significant disagreement stays unexplained or the budget ran out: exit code 3.
@@ -184,6 +192,7 @@ pub fn run(
         e => input(format!("{}: {e}", measured.display())),
     })?;
     found.report.evaluations += check.used();
+    found.report.spending.data_check += check.used();
     let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
     let report = report_of(label, &found.report, &found.effects, found.mesh_factor, &names, budget);
     Ok(Discovery { found, report })
@@ -225,6 +234,8 @@ pub(crate) fn report_of(
         evaluations: r.evaluations,
         budget_limit: budget,
         budget_exhausted: r.budget_exhausted,
+        budget_spent: r.spending,
+        untestable_candidates: r.untestable.clone(),
         explained: !r.budget_exhausted && (!r.before.significant || !effects.is_empty()),
     }
 }

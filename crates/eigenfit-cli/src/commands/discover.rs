@@ -180,6 +180,7 @@ fn print_report(
                 );
             }
         }
+        (true, true) if r.fits.is_empty() && !r.untestable.is_empty() => print_untestable(r),
         (true, true) => {
             println!(
                 "no candidate effect, alone or with others, explains the disagreement down to the noise."
@@ -236,6 +237,17 @@ fn print_report(
             }
         }
     }
+    if r.spending.refits_skipped > 0 && !r.budget_exhausted {
+        println!(
+            "{} refit(s) of screened candidates left out to keep the budget for confirming the leader; raise it with --budget to try them",
+            r.spending.refits_skipped
+        );
+    }
+    // Said above already when nothing could be tested at all.
+    let said = found.effects.is_empty() && r.fits.is_empty();
+    if !r.untestable.is_empty() && !said {
+        print_untestable(r);
+    }
     if r.budget_exhausted {
         println!(
             "the evaluation budget ({} model evaluations) ran out: the search stopped with what it had, effects it had not reached were not tried; raise it with --budget",
@@ -258,4 +270,18 @@ fn print_report(
             m.normalised_after()
         );
     }
+}
+
+/// The candidates that could not be tested, and why.
+fn print_untestable(r: &DiscoveryReport) {
+    let Some(first) = r.untestable.first() else { return };
+    let labels: Vec<&str> = r.untestable.iter().map(|u| u.place.label.as_str()).collect();
+    println!(
+        "cannot test {} candidate effect(s) ({}): with one of them the fit would have {} parameters for {} measured modes, \
+         no degree of freedom left, so it would fit exactly whatever the truth; measure more modes (or hold a parameter fixed)",
+        labels.len(),
+        labels.join(", "),
+        first.parameters,
+        first.modes
+    );
 }

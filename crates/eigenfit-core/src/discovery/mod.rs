@@ -5,15 +5,19 @@
 //! 2. **Detect**: χ² of the calibrated residual against the noise, overall (p-value) and per mode.
 //! 3. **Screen** every candidate by the χ² reduction a linear fit of its value would give, with
 //!    the residual's sensitivity projected off the already-fitted parameters.
-//! 4. **Refit** the most promising with the nominal parameters; **select** by AICc among the
-//!    physically plausible fits, and report the runner-up.
+//! 4. **Refit** the most promising with the nominal parameters (a local fit from the screen's
+//!    Gauss–Newton value; the best few confirmed with restarts), each round within its share of
+//!    the budget ([`Spending`] says how it was spent); **select** by AICc among the physically
+//!    plausible fits, and report the runner-up. An ambiguous leader is carried beside its
+//!    alternatives through the next step ([`BEAM_WIDTH`]); candidates that would leave no degree
+//!    of freedom are reported as [`Untestable`].
 //!
 //! Nothing here is rotor-specific: a plugin offers [`Candidate`]s, the engine does the rest.
 
 mod interval;
 
 use crate::analysis::chi2::{normal_quantile_upper, Z_95};
-use crate::analysis::chi2_upper_tail;
+use crate::analysis::{chi2_quantile_upper, chi2_upper_tail};
 use crate::eigen::EigenSolver;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::{Augmented, Candidate, StructuralModel};
@@ -72,6 +76,10 @@ pub struct DiscoveryOptions {
     /// (default false): for a start known to be close, such as one mesh's calibration carried
     /// to a refined mesh, where restarts would only spend solves on a misfit no start removes.
     pub local_calibration: bool,
+    /// Most first choices carried through the next step when the leader's alternatives pass the
+    /// ambiguity test and a further effect is needed (default [`BEAM_WIDTH`]; 1: the leader
+    /// only, the selection of before).
+    pub beam_width: usize,
 }
 
 /// Evaluations a discovery run may spend by default: about 1 s of one core on 8 modes of the
@@ -93,6 +101,7 @@ impl Default for DiscoveryOptions {
             ambiguity_aicc: 2.0,
             max_evaluations: DEFAULT_EVALUATIONS,
             local_calibration: false,
+            beam_width: BEAM_WIDTH,
         }
     }
 }
@@ -214,6 +223,11 @@ pub struct Fit {
     pub place_charge: f64,
     /// Is the value physically plausible (and, for a value, its interval clear of zero)?
     pub plausible: bool,
+    /// True when the fit leaves too few degrees of freedom for the AICc (n − k − 1 ≤ 0, its
+    /// correction unbounded): `aicc` then holds the AIC χ² + 2k, and the effect is named only if
+    /// it also passes a likelihood-ratio test (see [`criterion`]).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub aicc_undefined: bool,
     /// Model frequencies of the measured modes, Hz.
     #[serde(skip)]
     pub frequencies_hz: Vec<f64>,
@@ -225,8 +239,10 @@ impl Fit {
         self.aicc + self.place_charge
     }
 
-    /// The calibrated base model as a "fit" with no effect.
-    fn base(lin: &Linearisation, aicc: f64) -> Self {
+    /// The calibrated base model as a "fit" with no effect, `n` measured values.
+    fn base(lin: &Linearisation, n: usize) -> Self {
+        let chi2 = 2.0 * lin.cost();
+        let (aicc, aicc_undefined) = criterion(chi2, n, lin.parameters.len());
         Self {
             place: Place::default(),
             value: None,
@@ -234,10 +250,11 @@ impl Fit {
             interval: None,
             parameters: lin.parameters.clone(),
             intervals: vec![None; lin.parameters.len()],
-            chi2: 2.0 * lin.cost(),
+            chi2,
             aicc,
             place_charge: 0.0,
             plausible: true,
+            aicc_undefined,
             frequencies_hz: lin.frequencies_hz.clone(),
         }
     }
@@ -373,6 +390,50 @@ pub struct DiscoveryReport {
     pub evaluations: usize,
     /// True when [`DiscoveryOptions::max_evaluations`] ran out before the search ended.
     pub budget_exhausted: bool,
+    /// How the evaluations were spent, by phase.
+    pub spending: Spending,
+    /// Candidates that could not be tested in the first round: with them the fit would have as
+    /// many parameters as measured values (no degree of freedom left), so any of them fits
+    /// exactly and its χ² says nothing.
+    pub untestable: Vec<Untestable>,
+}
+
+/// Evaluations (eigen-solves) a discovery run spent, by phase; `discover --json` reports it as
+/// `budget_spent`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Spending {
+    /// The caller's check of the data before the search (`discover`'s check that every measured
+    /// mode is within the model's reach); 0 in the library's own runs.
+    pub data_check: usize,
+    /// Calibrating the nominal parameters.
+    pub calibration: usize,
+    /// The linear screen: one linearisation per candidate and round (the candidate's sensitivity
+    /// column beside the current fit's Jacobian; no refit).
+    pub screening: usize,
+    /// Refits of the screen's leaders (the best few, the best of each kind, the switches).
+    pub refits: usize,
+    /// Confirming each round's leading fit: refits of the candidates predicting alike.
+    pub confirmation: usize,
+    /// Carrying an ambiguous leader's alternatives through the next steps ([`BEAM_WIDTH`]).
+    pub carried: usize,
+    /// Leader refits not run or cut short because the round's share of the budget was spent
+    /// (the rest is kept for confirmation and the rounds after).
+    pub refits_skipped: usize,
+    /// A plugin's further searches on another form of the model (the rotor's refined mesh: its
+    /// calibration and, when run, its whole search).
+    pub refined_mesh: usize,
+}
+
+/// A candidate that could not be tested: with it the fit would leave no degree of freedom.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Untestable {
+    /// What and where.
+    #[serde(flatten)]
+    pub place: Place,
+    /// Parameters the fit with it would have.
+    pub parameters: usize,
+    /// Measured values.
+    pub modes: usize,
 }
 
 /// Corrected Akaike information criterion with known σ: χ² + 2k + 2k(k+1)/(n − k − 1).
@@ -380,6 +441,17 @@ pub fn aicc(chi2: f64, n: usize, k: usize) -> f64 {
     let (n, k) = (n as f64, k as f64);
     let correction = if n - k - 1.0 > 0.0 { 2.0 * k * (k + 1.0) / (n - k - 1.0) } else { f64::INFINITY };
     chi2 + 2.0 * k + correction
+}
+
+/// The score of a fit of `k` parameters to `n` values with χ² `chi2`: its [`aicc`] when defined
+/// (n − k − 1 > 0), else the AIC χ² + 2k and `true` (the AICc's small-sample correction is
+/// unbounded there; comparisons then also need a likelihood-ratio test).
+pub fn criterion(chi2: f64, n: usize, k: usize) -> (f64, bool) {
+    if n > k + 1 {
+        (aicc(chi2, n, k), false)
+    } else {
+        (chi2 + 2.0 * k as f64, true)
+    }
 }
 
 /// Runs the workflow on `model` against `measured`, starting the calibration from `initial`.
@@ -570,6 +642,8 @@ pub fn discover_effects<E: EffectSearch>(
         rms_after_hz: rms_diff(&base_lin),
         evaluations: 0,
         budget_exhausted: false,
+        spending: Spending { calibration: budget.used(), ..Spending::default() },
+        untestable: Vec::new(),
     };
     if !before.significant {
         report.evaluations = budget.used();
@@ -579,119 +653,36 @@ pub fn discover_effects<E: EffectSearch>(
     // (b) forward selection: each round screens the candidates not yet chosen against the model
     // with the chosen ones, refits the most promising jointly with everything already fitted, and
     // adds the best plausible one if it earns its parameter (AICc); it stops when the noise
-    // explains what is left.
-    let mut chosen: Vec<usize> = Vec::new();
-    let mut current = Fit::base(&base_lin, before.aicc);
-    let charges = place_charges(candidates);
-    let mut named: Vec<NamedEffect> = Vec::new();
-    for round in 0..options.max_effects {
-        if budget.exhausted() {
-            break;
-        }
-        if round > 0 && chi2_upper_tail(current.chi2, n - current.parameters.len()) >= options.significance {
-            break;
-        }
-        let chosen_refs: Vec<&Candidate> = chosen.iter().map(|&i| &candidates[i]).collect();
-        let open = |i: usize| !chosen.iter().any(|&c| same_place(&candidates[c], &candidates[i]));
-        let (screened, projector) = search
-            .with_effects(&chosen_refs, |problem| {
-                let lin = budget.wrap(problem).linearise(&current.parameters).ok()?;
-                let projector = Projector::new(problem, &lin);
-                let screened: Vec<(usize, Screened)> = candidates
-                    .iter()
-                    .enumerate()
-                    .filter(|&(i, c)| !c.needs_refit() && open(i))
-                    .filter_map(|(i, c)| {
-                        screen(search, &chosen_refs, c, (&lin, &projector), &budget).map(|s| (i, s))
-                    })
-                    .collect();
-                Some((screened, projector))
-            })
-            .unwrap_or_else(|| (Vec::new(), Projector::none()));
-        let mut scored: Vec<(usize, f64)> = screened.iter().map(|(i, s)| (*i, s.reduction)).collect();
-        scored.sort_by(|a, b| b.1.total_cmp(&a.1));
-        if round == 0 {
-            report.screening = scored.iter().map(|&(i, s)| (candidates[i].label(), s)).collect();
-        }
-        // The best few overall, and the best of every kind: a linear screen misjudges large
-        // effects, and one kind's many locations must not crowd out the other kinds.
-        let mut per_kind: Vec<(&str, usize)> = Vec::new();
-        let mut picks: Vec<usize> = Vec::new();
-        for (rank, &(i, _)) in scored.iter().enumerate() {
-            let kind = candidates[i].kind.as_str();
-            let seen = per_kind.iter().position(|(k, _)| *k == kind);
-            let taken = seen.map_or(0, |s| per_kind[s].1);
-            if rank < options.refits || taken < options.refits_per_kind {
-                picks.push(i);
-                match seen {
-                    Some(s) => per_kind[s].1 += 1,
-                    None => per_kind.push((kind, 1)),
-                }
-            }
-        }
-        let to_refit: Vec<usize> = picks
-            .into_iter()
-            .chain(candidates.iter().enumerate().filter(|&(i, c)| c.needs_refit() && open(i)).map(|(i, _)| i))
-            .collect();
-        let refit_one = |i: usize| {
-            let mut set = chosen_refs.clone();
-            set.push(&candidates[i]);
-            let mut fit = refit(search, n, &set, &current.parameters, &budget)?;
-            fit.place_charge = current.place_charge + charges[i];
-            Some((i, fit))
-        };
-        let mut fits: Vec<(usize, Fit)> = to_refit.into_iter().filter_map(refit_one).collect();
-        fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
-        // The linear screen misranks close variants of a large effect (a step and the tapers
-        // around it crowd each other out of the refits, whether their places overlap or not):
-        // the candidates whose predictions are most alike the leader's are refitted too, so the
-        // choice and its ambiguities rest on fits. At most `refits` of them: bounded work.
-        if let Some((_, lead)) = fits.iter().find(|(_, f)| f.plausible) {
-            let change = projector.apply(&noise_units(&lead.frequencies_hz, &current.frequencies_hz, &stds));
-            let mut alike: Vec<(usize, f64)> = screened
-                .iter()
-                .filter(|(i, _)| !fits.iter().any(|(j, _)| j == i))
-                .map(|(i, s)| (*i, likeness(&s.direction, &change)))
-                .collect();
-            alike.sort_by(|a, b| b.1.total_cmp(&a.1));
-            let near: Vec<usize> =
-                alike.iter().take_while(|(_, l)| *l >= ALIKE).take(options.refits).map(|&(i, _)| i).collect();
-            fits.extend(near.into_iter().filter_map(refit_one));
-            fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
-        }
-        if round == 0 {
-            report.fits = fits.iter().map(|(_, f)| f.clone()).collect();
-        }
-        let mut plausible = fits.iter().filter(|(_, f)| f.plausible);
-        let Some((best_i, best)) = plausible.next().cloned() else { break };
-        if current.score() - best.score() < options.min_aicc_gain {
-            break;
-        }
-        if round == 0 {
-            report.runner_up = plausible.next().map(|(_, f)| f.clone());
-        }
-        // The chosen fit is the best of every plausible one compared: each is tested against it
-        // at 95 % / (their number), so the named effect and its alternatives together hold the
-        // truth in ≥ 95 % of draws however many were compared (Bonferroni).
-        let others: Vec<&(usize, Fit)> = fits
-            .iter()
-            .filter(|(i, f)| f.plausible && !same_place(&candidates[*i], &candidates[best_i]))
-            .collect();
-        let z = normal_quantile_upper(0.025 / others.len().max(1) as f64);
-        let ambiguous_with = others
-            .into_iter()
-            .filter(|(_, f)| {
-                let apart = separation2(&f.frequencies_hz, &best.frequencies_hz, &stds);
-                within_margin(f.score() - best.score(), apart, options.ambiguity_aicc, z)
-            })
-            .map(|(i, f)| Alternative::new(&candidates[*i], f, best.score()))
-            .collect();
-        named.push(NamedEffect::new(&candidates[best_i], current.score() - best.score(), ambiguous_with));
-        chosen.push(best_i);
-        current = best;
-    }
+    // explains what is left. When the leader's alternatives pass the ambiguity test and a further
+    // effect is needed, each of them (at most `BEAM_WIDTH` in all) is carried through the
+    // following rounds and the final models are compared.
+    let context = Selection {
+        search,
+        candidates,
+        charges: place_charges(candidates),
+        stds,
+        n,
+        options,
+        budget: &budget,
+        compared: candidates.len().max(1),
+    };
+    let trunk = Path { chosen: Vec::new(), current: Fit::base(&base_lin, n), named: Vec::new() };
+    let mut log = RoundLog::default();
+    let path = context.extend(trunk, 0, true, budget.limit(), &mut log);
+    report.screening = log.screening;
+    report.fits = log.fits;
+    report.runner_up = log.runner_up;
+    report.untestable = log.untestable;
+    report.spending.screening = log.spending.screening;
+    report.spending.refits = log.spending.refits;
+    report.spending.confirmation = log.spending.confirmation;
+    report.spending.refits_skipped = log.spending.refits_skipped;
+    report.spending.carried = log.spending.carried;
+    let Path { chosen, current, mut named } = path;
     report.evaluations = budget.used();
-    report.budget_exhausted = budget.exhausted();
+    // Refits cut short by the budget plan are not refused evaluations, but a search that used
+    // every evaluation it had did stop at its budget: said so, as a refusal would be.
+    report.budget_exhausted = budget.exhausted() || budget.remaining() == 0;
     // (c) name the effects only if, with them, the misfit is one the noise can explain.
     let k = current.parameters.len();
     let consistent = n > k && chi2_upper_tail(current.chi2, n - k) >= options.min_after_p_value;
@@ -806,6 +797,399 @@ fn same_place(a: &Candidate, b: &Candidate) -> bool {
     a.kind == b.kind && a.location == b.location && a.position_m == b.position_m && a.elements == b.elements
 }
 
+/// Most first choices carried through the next step when the leader is ambiguous, by default
+/// ([`DiscoveryOptions::beam_width`]): the leader and its best alternatives that the data cannot
+/// tell from it (a small beam).
+pub const BEAM_WIDTH: usize = 3;
+
+/// Share of a round's allowance that the local refits of the screen's leaders may spend; the rest
+/// is kept for confirming the leading fits (look-alikes, restarts), so a round of many candidates
+/// can no longer spend the budget before its leader is confirmed.
+const REFIT_SHARE: f64 = 0.5;
+
+/// Share of what is left of the budget that a round may spend when more rounds may follow: the
+/// rest is kept so a further effect can still be screened, refitted and confirmed (a second
+/// round costs more than the first: one more parameter in every fit).
+const ROUND_SHARE: f64 = 0.75;
+
+/// Fits of a round refitted with restarts (from a grid of seeds) before the choice: the best few
+/// local fits, so the leader and its nearest rivals rest on full fits.
+const CONFIRMED: usize = 3;
+
+/// One line of forward selection: the effects chosen so far and the joint fit with them.
+#[derive(Clone)]
+struct Path {
+    chosen: Vec<usize>,
+    current: Fit,
+    named: Vec<NamedEffect>,
+}
+
+/// What the rounds record for the report (the first round's screen, fits and runner-up) and how
+/// the budget was spent.
+#[derive(Default)]
+struct RoundLog {
+    screening: Vec<(String, f64)>,
+    fits: Vec<Fit>,
+    runner_up: Option<Fit>,
+    untestable: Vec<Untestable>,
+    spending: Spending,
+}
+
+/// Everything a round of forward selection needs.
+struct Selection<'a, E> {
+    search: &'a E,
+    candidates: &'a [Candidate],
+    charges: Vec<f64>,
+    stds: Vec<f64>,
+    n: usize,
+    options: &'a DiscoveryOptions,
+    budget: &'a Budget,
+    /// Candidates on offer: the look-elsewhere count of the likelihood-ratio test.
+    compared: usize,
+}
+
+/// How one refit ended.
+enum RefitOutcome {
+    /// Converged (or stopped) with a fit.
+    Fit(Box<Fit>),
+    /// Could not be built or run.
+    Failed,
+    /// Cut short by the share of the budget it was given: not a fit.
+    CutShort,
+}
+
+impl<E: EffectSearch> Selection<'_, E> {
+    /// Is `fit` a misfit the noise explains at the detection level (no further effect sought)?
+    fn explained(&self, fit: &Fit) -> bool {
+        let k = fit.parameters.len();
+        self.n > k && chi2_upper_tail(fit.chi2, self.n - k) >= self.options.significance
+    }
+
+    /// Does `best` earn its place over `current`: AICc (with the place charges) better by
+    /// [`DiscoveryOptions::min_aicc_gain`]? Where a fit leaves too few degrees of freedom for the
+    /// AICc (n − k − 1 ≤ 0: [`Fit::aicc_undefined`]) both are scored by the AIC χ² + 2k instead,
+    /// and the added values must also pass the likelihood-ratio test at the significance level
+    /// shared among the candidates on offer (Bonferroni: the best of many fits noise better).
+    /// Returns the gain when it does.
+    fn earns(&self, current: &Fit, best: &Fit) -> Option<f64> {
+        if !(current.aicc_undefined || best.aicc_undefined) {
+            let gain = current.score() - best.score();
+            return (gain >= self.options.min_aicc_gain).then_some(gain);
+        }
+        let aic = |f: &Fit| f.chi2 + 2.0 * f.parameters.len() as f64 + f.place_charge;
+        let gain = aic(current) - aic(best);
+        let added = best.parameters.len().saturating_sub(current.parameters.len());
+        let tested = added == 0
+            || current.chi2 - best.chi2
+                > chi2_quantile_upper(self.options.significance / self.compared as f64, added);
+        (gain >= self.options.min_aicc_gain && tested).then_some(gain)
+    }
+
+    /// The alternatives to `best` (candidate `best_i`) among a round's `fits` that the data cannot
+    /// reject: each tested against it at 2.5 %/m, m the plausible fits compared (Bonferroni), so
+    /// the named effect and its alternatives together hold the truth in ≥ 95 % of draws.
+    fn ambiguity(&self, fits: &[(usize, Fit)], best_i: usize, best: &Fit) -> Vec<Alternative> {
+        let c = self.candidates;
+        let others: Vec<&(usize, Fit)> =
+            fits.iter().filter(|(i, f)| f.plausible && !same_place(&c[*i], &c[best_i])).collect();
+        let z = normal_quantile_upper(0.025 / others.len().max(1) as f64);
+        others
+            .into_iter()
+            .filter(|(_, f)| {
+                let apart = separation2(&f.frequencies_hz, &best.frequencies_hz, &self.stds);
+                within_margin(f.score() - best.score(), apart, self.options.ambiguity_aicc, z)
+            })
+            .map(|(i, f)| Alternative::new(&c[*i], f, best.score()))
+            .collect()
+    }
+
+    /// Forward selection from `path`, rounds `first..`; `may_branch`: an ambiguous leader may be
+    /// carried beside its alternatives (once per search: the branches do not branch again).
+    /// The rounds spend the budget up to `until` evaluations used: each round [`ROUND_SHARE`] of
+    /// what is left, the last round possible all of it.
+    fn extend(
+        &self,
+        mut path: Path,
+        first: usize,
+        may_branch: bool,
+        until: usize,
+        log: &mut RoundLog,
+    ) -> Path {
+        let candidates = self.candidates;
+        for round in first..self.options.max_effects {
+            if self.budget.exhausted() || (round > 0 && self.explained(&path.current)) {
+                break;
+            }
+            let used = self.budget.used();
+            let round_end = match self.options.max_effects - round {
+                1 => until,
+                _ => used + (until.saturating_sub(used) as f64 * ROUND_SHARE) as usize,
+            };
+            let fits = self.round(&path, round == 0, round_end, log);
+            let mut plausible = fits.iter().filter(|(_, f)| f.plausible);
+            let Some((best_i, best)) = plausible.next().cloned() else { break };
+            let Some(gain) = self.earns(&path.current, &best) else { break };
+            if round == 0 {
+                log.runner_up = plausible.next().map(|(_, f)| f.clone());
+            }
+            let ambiguous_with = self.ambiguity(&fits, best_i, &best);
+            let continues = round + 1 < self.options.max_effects && !self.explained(&best);
+            if may_branch && continues && !ambiguous_with.is_empty() && self.options.beam_width > 1 {
+                return self.carry(path, round, &fits, (best_i, &best), until, log);
+            }
+            path.named.push(NamedEffect::new(&candidates[best_i], gain, ambiguous_with));
+            path.chosen.push(best_i);
+            path.current = best;
+        }
+        path
+    }
+
+    /// The leader `best` of round `round` is ambiguous and a further effect is needed: the leader
+    /// and its best alternatives (at most [`BEAM_WIDTH`], each earning its place on its own) are
+    /// each carried through the rounds after, and the final model with the best AICc (place
+    /// charges included) wins. A second effect that only compensates a wrong first choice then
+    /// loses to the right first choice, which needs none. The other carried first choices are
+    /// listed as ambiguous with the winner's when the data cannot tell the final models apart.
+    fn carry(
+        &self,
+        path: Path,
+        round: usize,
+        fits: &[(usize, Fit)],
+        (best_i, best): (usize, &Fit),
+        until: usize,
+        log: &mut RoundLog,
+    ) -> Path {
+        let c = self.candidates;
+        let leader_alternatives = self.ambiguity(fits, best_i, best);
+        let mut starts: Vec<(usize, Fit)> = vec![(best_i, best.clone())];
+        for (i, f) in fits {
+            if starts.len() >= self.options.beam_width {
+                break;
+            }
+            let listed = leader_alternatives.iter().any(|a| a.place == Place::of(&c[*i]));
+            if f.plausible && *i != best_i && listed && self.earns(&path.current, f).is_some() {
+                starts.push((*i, f.clone()));
+            }
+        }
+        let mut ends: Vec<Path> = Vec::with_capacity(starts.len());
+        for (b, (i, f)) in starts.iter().enumerate() {
+            // Each carried first choice gets an equal share of what is left.
+            let used = self.budget.used();
+            let until = used + until.saturating_sub(used) / (starts.len() - b);
+            let mut p = path.clone();
+            let gain = self.earns(&p.current, f).unwrap_or(p.current.score() - f.score());
+            p.named.push(NamedEffect::new(&c[*i], gain, Vec::new()));
+            p.chosen.push(*i);
+            p.current = f.clone();
+            if b == 0 {
+                ends.push(self.extend(p, round + 1, false, until, log));
+            } else {
+                // The alternatives' steps are what carrying the doubt costs.
+                let mut scratch = RoundLog::default();
+                let spent = self.budget.used();
+                ends.push(self.extend(p, round + 1, false, until, &mut scratch));
+                log.spending.carried += self.budget.used() - spent;
+                log.spending.refits_skipped += scratch.spending.refits_skipped;
+            }
+        }
+        let w = (0..ends.len())
+            .min_by(|&a, &b| ends[a].current.score().total_cmp(&ends[b].current.score()))
+            .unwrap_or(0);
+        // The winner's first choice: its alternatives among the round's fits, except the other
+        // carried first choices, which are judged by their final models instead.
+        let (wi, wf) = (&starts[w].0, &starts[w].1);
+        let carried = |i: usize| starts.iter().any(|(s, _)| same_place(&c[*s], &c[i]));
+        let mut ambiguous_with: Vec<Alternative> = self
+            .ambiguity(fits, *wi, wf)
+            .into_iter()
+            .filter(|a| !fits.iter().any(|(i, _)| carried(*i) && Place::of(&c[*i]) == a.place))
+            .collect();
+        let winner = &ends[w].current;
+        let z = normal_quantile_upper(0.025 / (ends.len() - 1).max(1) as f64);
+        for (b, end) in ends.iter().enumerate().filter(|&(b, _)| b != w) {
+            let delta = end.current.score() - winner.score();
+            let apart = separation2(&end.current.frequencies_hz, &winner.frequencies_hz, &self.stds);
+            if within_margin(delta, apart, self.options.ambiguity_aicc, z) {
+                let (si, sf) = &starts[b];
+                ambiguous_with.push(Alternative {
+                    place: Place::of(&c[*si]),
+                    value: sf.value,
+                    unit: c[*si].unit().to_string(),
+                    delta_aicc: delta,
+                });
+            }
+        }
+        let mut end = ends.swap_remove(w);
+        if let Some(first) = end.named.get_mut(round) {
+            first.ambiguous_with = ambiguous_with;
+        }
+        end
+    }
+
+    /// One round: screen every open candidate against the current fit, refit the leaders (the
+    /// best few, the best of each kind, the switches) within the round's share of the budget,
+    /// then confirm the leading fit by refitting its look-alikes. Returns the fits, best first.
+    fn round(&self, path: &Path, record: bool, round_end: usize, log: &mut RoundLog) -> Vec<(usize, Fit)> {
+        let (candidates, n, options, budget) = (self.candidates, self.n, self.options, self.budget);
+        let chosen_refs: Vec<&Candidate> = path.chosen.iter().map(|&i| &candidates[i]).collect();
+        let open = |i: usize| !path.chosen.iter().any(|&c| same_place(&candidates[c], &candidates[i]));
+        // A candidate whose fit would leave no degree of freedom cannot be tested: every such fit
+        // is exact, so its χ² says nothing. Said, not refitted.
+        let k_now = path.current.parameters.len();
+        let testable = |c: &Candidate| k_now + c.parameter_count() < n;
+        if record {
+            log.untestable = candidates
+                .iter()
+                .enumerate()
+                .filter(|&(i, c)| open(i) && !testable(c))
+                .map(|(_, c)| Untestable {
+                    place: Place::of(c),
+                    parameters: k_now + c.parameter_count(),
+                    modes: n,
+                })
+                .collect();
+        }
+        let spent = budget.used();
+        let (screened, projector) = self
+            .search
+            .with_effects(&chosen_refs, |problem| {
+                let lin = budget.wrap(problem).linearise(&path.current.parameters).ok()?;
+                let projector = Projector::new(problem, &lin);
+                let screened: Vec<(usize, Screened)> = candidates
+                    .iter()
+                    .enumerate()
+                    .filter(|&(i, c)| !c.needs_refit() && open(i) && testable(c))
+                    .filter_map(|(i, c)| {
+                        screen(self.search, &chosen_refs, c, (&lin, &projector), budget).map(|s| (i, s))
+                    })
+                    .collect();
+                Some((screened, projector))
+            })
+            .unwrap_or_else(|| (Vec::new(), Projector::none()));
+        log.spending.screening += budget.used() - spent;
+        let mut scored: Vec<(usize, f64)> = screened.iter().map(|(i, s)| (*i, s.reduction)).collect();
+        scored.sort_by(|a, b| b.1.total_cmp(&a.1));
+        if record {
+            log.screening = scored.iter().map(|&(i, s)| (candidates[i].label(), s)).collect();
+        }
+        // The best few overall, and the best of every kind: a linear screen misjudges large
+        // effects, and one kind's many locations must not crowd out the other kinds. In the
+        // screen's order, so the leaders are refitted first.
+        let mut per_kind: Vec<(&str, usize)> = Vec::new();
+        let mut picks: Vec<usize> = Vec::new();
+        for (rank, &(i, _)) in scored.iter().enumerate() {
+            let kind = candidates[i].kind.as_str();
+            let seen = per_kind.iter().position(|(k, _)| *k == kind);
+            let taken = seen.map_or(0, |s| per_kind[s].1);
+            if rank < options.refits || taken < options.refits_per_kind {
+                picks.push(i);
+                match seen {
+                    Some(s) => per_kind[s].1 += 1,
+                    None => per_kind.push((kind, 1)),
+                }
+            }
+        }
+        // Effects the screen cannot judge (switches, added DOFs) after the screen's leader.
+        let unscreened = candidates
+            .iter()
+            .enumerate()
+            .filter(|&(i, c)| c.needs_refit() && open(i) && testable(c))
+            .map(|(i, _)| i);
+        let mut to_refit: Vec<usize> = picks.iter().take(1).copied().collect();
+        to_refit.extend(unscreened);
+        to_refit.extend(picks.iter().skip(1));
+        let refit_one = |i: usize, cap: usize, restarts: bool| {
+            let mut set = chosen_refs.clone();
+            set.push(&candidates[i]);
+            // A screened candidate's local fit starts where the screen's Gauss–Newton step put
+            // its value (a step cap far below a large value can otherwise keep the fit short of
+            // it); the confirmation with restarts from its nominal value, the start the local
+            // path may have missed — the better of the two is kept.
+            let from = screened.iter().find(|(j, _)| *j == i).map(|(_, s)| s.value).filter(|_| !restarts);
+            match refit(self.search, n, &set, &path.current.parameters, budget, (cap, restarts), from) {
+                RefitOutcome::Fit(mut fit) => {
+                    fit.place_charge = path.current.place_charge + self.charges[i];
+                    RefitOutcome::Fit(fit)
+                }
+                other => other,
+            }
+        };
+        // Refits: a local fit from the current one for each of the screen's leaders (a wrong
+        // candidate's fit does not reach the noise, and restarting it from a grid of seeds was
+        // most of the work); with restarts for the effects the screen cannot judge. Within the
+        // leaders' share of the round's allowance.
+        let spent = budget.used();
+        let refits_end = spent + ((round_end.saturating_sub(spent)) as f64 * REFIT_SHARE) as usize;
+        let mut fits: Vec<(usize, Fit, bool)> = Vec::new();
+        let mut skipped = 0;
+        for &i in &to_refit {
+            let restarts = candidates[i].needs_refit();
+            match refit_one(i, refits_end.saturating_sub(budget.used()), restarts) {
+                RefitOutcome::Fit(fit) => fits.push((i, *fit, restarts)),
+                RefitOutcome::CutShort => skipped += 1,
+                RefitOutcome::Failed => {}
+            }
+        }
+        log.spending.refits += budget.used() - spent;
+        fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
+        // Confirmation, within the round's allowance: the linear screen misranks close variants
+        // of a large effect (a step and the tapers around it crowd each other out of the refits,
+        // whether their places overlap or not), so the candidates whose predictions are most
+        // alike the leader's are refitted too (at most `refits`), and the best `CONFIRMED` fits
+        // are refitted with restarts, so the choice and its ambiguities rest on full fits.
+        let spent = budget.used();
+        if let Some((_, lead, _)) = fits.iter().find(|(_, f, _)| f.plausible) {
+            let change =
+                projector.apply(&noise_units(&lead.frequencies_hz, &path.current.frequencies_hz, &self.stds));
+            let mut alike: Vec<(usize, f64)> = screened
+                .iter()
+                .filter(|(i, _)| !fits.iter().any(|(j, _, _)| j == i))
+                .map(|(i, s)| (*i, likeness(&s.direction, &change)))
+                .collect();
+            alike.sort_by(|a, b| b.1.total_cmp(&a.1));
+            let near: Vec<usize> =
+                alike.iter().take_while(|(_, l)| *l >= ALIKE).take(options.refits).map(|&(i, _)| i).collect();
+            for i in near {
+                match refit_one(i, round_end.saturating_sub(budget.used()), false) {
+                    RefitOutcome::Fit(fit) => fits.push((i, *fit, false)),
+                    RefitOutcome::CutShort => skipped += 1,
+                    RefitOutcome::Failed => {}
+                }
+            }
+            fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
+        }
+        let mut confirmed = 0;
+        for (i, fit, full) in &mut fits {
+            if confirmed == CONFIRMED {
+                break;
+            }
+            if *full {
+                confirmed += 1;
+                continue;
+            }
+            match refit_one(*i, round_end.saturating_sub(budget.used()), true) {
+                RefitOutcome::Fit(restarted) => {
+                    if restarted.score() <= fit.score() {
+                        *fit = *restarted;
+                    }
+                    *full = true;
+                    confirmed += 1;
+                }
+                RefitOutcome::CutShort => skipped += 1,
+                RefitOutcome::Failed => {}
+            }
+        }
+        let mut fits: Vec<(usize, Fit)> = fits.into_iter().map(|(i, f, _)| (i, f)).collect();
+        fits.sort_by(|a, b| a.1.score().total_cmp(&b.1.score()));
+        log.spending.refits_skipped += skipped;
+        log.spending.confirmation += budget.used() - spent;
+        if record {
+            log.fits = fits.iter().map(|(_, f)| f.clone()).collect();
+        }
+        fits
+    }
+}
+
 /// Gives every mode a standard deviation (the assumed relative one where none was measured).
 fn with_std(measured: &Measurement, relative: f64) -> Result<Measurement, DiscoveryError> {
     let modes: Vec<MeasuredMode> = measured
@@ -895,6 +1279,9 @@ struct Screened {
     /// How its value moves the predictions (in noise units), off what the current parameters
     /// can do.
     direction: DVector<f64>,
+    /// The value one (bound-limited) Gauss–Newton step from the nominal predicts: where its
+    /// refit starts.
+    value: f64,
 }
 
 /// Screens one candidate ([`Screened`]).
@@ -915,46 +1302,64 @@ fn screen<E: EffectSearch>(
     let r = projector.apply(&lin.residual);
     let jj = j.norm_squared();
     if jj == 0.0 {
-        return Some(Screened { reduction: 0.0, direction: j });
+        return Some(Screened { reduction: 0.0, direction: j, value: par.nominal });
     }
     let step = j.dot(&r) / jj;
     let admissible = (par.nominal + step).clamp(par.lower, par.upper) - par.nominal;
     // χ² reduction of the (bound-limited) linear step: 2·a·(j·r) − a²·‖j‖².
     let reduction = (2.0 * admissible * j.dot(&r) - admissible * admissible * jj).max(0.0);
-    Some(Screened { reduction, direction: j })
+    Some(Screened { reduction, direction: j, value: par.nominal + admissible })
 }
 
 /// Refits the current parameters with the candidate set `set` (the chosen ones, then the new
 /// one, last); intervals are the covariance ones (cheap: no profile per candidate). The base
 /// parameters start where [`EffectSearch::refit_base_start`] says (by default the current ones).
+/// The refit may spend at most `cap` evaluations of `budget` (it is cut short,
+/// [`RefitOutcome::CutShort`], rather than spend what is kept for later); `restarts`: with the
+/// damped strategy's restarts from a grid of seeds when the local fit does not reach the noise,
+/// else one local fit. The new candidate's value starts at `from` when given (else its nominal).
 fn refit<E: EffectSearch>(
     search: &E,
     n: usize,
     set: &[&Candidate],
     current: &[f64],
     budget: &Budget,
-) -> Option<Fit> {
-    let candidate = *set.last()?;
+    (cap, restarts): (usize, bool),
+    from: Option<f64>,
+) -> RefitOutcome {
+    let Some(&candidate) = set.last() else { return RefitOutcome::Failed };
     let chosen_values: usize = set[..set.len() - 1].iter().map(|c| c.parameter_count()).sum();
-    let base_len = current.len().checked_sub(chosen_values)?;
+    let Some(base_len) = current.len().checked_sub(chosen_values) else { return RefitOutcome::Failed };
     let mut start = search.refit_base_start(&current[..base_len]);
     if start.len() != base_len {
-        return None;
+        return RefitOutcome::Failed;
     }
     start.extend_from_slice(&current[base_len..]);
     start.extend(candidate.parameters().map(|p| p.nominal));
-    search.with_effects(set, |problem| {
+    if let (Some(v), Some(first)) = (from, candidate.parameter.as_ref().map(|_| base_len + chosen_values)) {
+        start[first] = v;
+    }
+    if cap == 0 {
+        return RefitOutcome::CutShort;
+    }
+    let capped = Budget::new(cap);
+    let fit = search.with_effects(set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
-        let est = Driver { max_iterations: 60 }
-            .run_within(problem, &mut LevenbergMarquardt::default(), &start, budget)
-            .ok()?;
+        let driver = Driver { max_iterations: 60 };
+        let mut strategy = LevenbergMarquardt::default();
+        if !restarts {
+            strategy = strategy.with_max_restarts(0);
+        }
+        // Every evaluation charged to the run's budget and to the cap.
+        let est = driver.run_within(&budget.wrap(problem), &mut strategy, &start, &capped).ok()?;
         // A fit cut short by the budget is not a fit.
         if matches!(est.termination, Termination::BudgetExhausted { .. }) {
             return None;
         }
         let k = problem.parameters().len();
         let chi2 = 2.0 * est.last.cost();
+        let (aicc, aicc_undefined) = criterion(chi2, n, k);
         let intervals = interval::covariance_intervals(problem, &est.last);
         // Every fitted effect value (not only the new one) must stay plausible.
         let nb = k - set.iter().map(|c| c.parameter_count()).sum::<usize>();
@@ -983,14 +1388,20 @@ fn refit<E: EffectSearch>(
             unit: candidate.unit().to_string(),
             interval,
             chi2,
-            aicc: aicc(chi2, n, k),
+            aicc,
             place_charge: 0.0,
             plausible,
+            aicc_undefined,
             frequencies_hz: est.last.frequencies_hz.clone(),
             parameters: est.parameters,
             intervals,
         })
-    })
+    });
+    match fit {
+        Some(fit) => RefitOutcome::Fit(Box::new(fit)),
+        None if capped.exhausted() => RefitOutcome::CutShort,
+        None => RefitOutcome::Failed,
+    }
 }
 
 #[cfg(test)]

@@ -33,6 +33,11 @@ pub const FRESH: &str =
 pub const FRESH2: &str =
     include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/discovery/fresh2.toml"));
 
+/// Third fresh held-out draws (`generate.py --fresh3`, a fifth seed), scored once after issue
+/// #31's changes.
+pub const FRESH3: &str =
+    include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/discovery/fresh3.toml"));
+
 #[derive(Debug, Deserialize)]
 pub struct Fixtures {
     pub case: Vec<Case>,
@@ -99,6 +104,11 @@ pub fn load_fresh() -> Fixtures {
 /// The second fresh held-out draws.
 pub fn load_fresh2() -> Fixtures {
     parse(FRESH2)
+}
+
+/// The third fresh held-out draws.
+pub fn load_fresh3() -> Fixtures {
+    parse(FRESH3)
 }
 
 fn parse(text: &str) -> Fixtures {
@@ -168,6 +178,16 @@ pub fn run(draw: &Draw) -> Vec<NamedEffect> {
 /// Runs rotor discovery on the paper rotor against `frequency_hz` (std `std_hz`), every
 /// eigen-solve going through `solver`.
 pub fn run_counted(frequency_hz: &[f64], std_hz: &[f64], solver: &CountingSolver) -> RotorDiscovery {
+    run_with(frequency_hz, std_hz, solver, &DiscoveryOptions::default())
+}
+
+/// [`run_counted`] with `options`.
+pub fn run_with(
+    frequency_hz: &[f64],
+    std_hz: &[f64],
+    solver: &CountingSolver,
+    options: &DiscoveryOptions,
+) -> RotorDiscovery {
     let rotor = presets::paper_rotor();
     let modes: Vec<MeasuredMode> = frequency_hz
         .iter()
@@ -176,7 +196,7 @@ pub fn run_counted(frequency_hz: &[f64], std_hz: &[f64], solver: &CountingSolver
         .map(|(m, (&f, &s))| MeasuredMode::new(m, f).with_std(s))
         .collect();
     let measured = Measurement::new(modes).expect("fixture frequencies are valid");
-    discover_rotor(&rotor, solver, &measured, &rotor.nominal_stiffnesses(), &DiscoveryOptions::default())
+    discover_rotor(&rotor, solver, &measured, &rotor.nominal_stiffnesses(), options)
         .expect("discovery runs on valid data")
 }
 
