@@ -492,6 +492,13 @@ fn eighteen_storey_frequencies_claims_hold() {
     for (x, r) in estimate.iter().zip(data.values(&best["parameters"])) {
         assert!(close(*x, r, 1e-4, 0.0), "{name}: estimate {estimate:?}, scipy's best {best}");
     }
+    // No std and no degree of freedom: no test can reject the other minima, and the text must
+    // not say the data reject them — only that they fit worse.
+    assert_eq!(v["alternatives_sigma"], "exact", "{name}");
+    let text = eigenfit(&["estimate", "--model", &data.model(), "--measured", &data.file("measured.csv")]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(!text.contains("reject"), "{name}: a rejection claimed without a test:\n{text}");
+    assert!(text.contains("fits worse (no test: no std and no degree of freedom)"), "{text}");
     eprintln!("{name} frequencies only: verdict {}", v["verdict"]);
 }
 

@@ -126,7 +126,12 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
     let mut damped = LevenbergMarquardt::default();
     let est = Driver::default().run(&fit, &mut damped as &mut dyn UpdateStrategy, &start).unwrap();
     assert!(est.termination.is_converged(), "{}", est.termination);
-    let u = uncertainty(&fit, &est.last).unwrap();
+    // No measured shape std: the default weights are not σ, so the intervals come from the
+    // residual scatter (`ShapeFit::uncertainty`), not from the weights.
+    assert!(!est.last.has_std);
+    assert!(uncertainty(&fit, &est.last).is_none());
+    let mut fit = fit;
+    let (u, _sigma_hat) = fit.uncertainty(&est.last).unwrap();
     for (i, name) in ["drive_end", "free_end"].iter().enumerate() {
         let [lo, hi] = u.intervals[i];
         assert!(lo <= TRUTH[i] && TRUTH[i] <= hi, "{name}: truth {} outside [{lo}, {hi}]", TRUTH[i]);

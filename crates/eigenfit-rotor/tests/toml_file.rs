@@ -40,11 +40,11 @@ fn unknown_key_is_named_with_position() {
     assert_eq!(
         error_after("diameter = 0.014", "diamter = 0.014"),
         "line 10, column 1: unknown field `diamter`, expected one of `nodes`, `length`, `elements`, \
-         `diameter`, `inner_diameter`, `material`, `section`"
+         `diameter`, `inner_diameter`, `material`, `section`; did you mean `diameter`?"
     );
     assert_eq!(
         error_after("[[disk]]", "[[disc]]"),
-        format!("line 12, column 3: unknown field `disc`, {TABLES}")
+        format!("line 12, column 3: unknown field `disc`, {TABLES}; did you mean `disk`?")
     );
 }
 

@@ -208,7 +208,11 @@ fn alternatives(s: &mut Section, list: &[AlternativeSolution], units: &[String],
             Cell::text(values.join(", ")),
             Cell::maybe(a.delta_chi2, 4, "—"),
             Cell::number(a.misfit, 4),
-            Cell::text(if a.equally_good { "equally good" } else { "worse: the data reject it" }),
+            Cell::text(match (a.equally_good, a.delta_chi2) {
+                (true, _) => "equally good",
+                (false, Some(_)) => "worse: the data reject it",
+                (false, None) => "fits worse (no test: no std, no degree of freedom)",
+            }),
         ]);
     }
     s.table(t);
