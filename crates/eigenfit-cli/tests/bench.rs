@@ -4,23 +4,12 @@
 
 mod common;
 
+use common::{eigenfit_json as eigenfit, floats as numbers};
+
 use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 use eigenfit_core::model::StructuralModel;
 use eigenfit_rotor::{presets, UpdatableRotor};
 use serde_json::Value;
-use std::process::Command;
-
-fn eigenfit(args: &[&str]) -> (i32, Value, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs");
-    let stdout = String::from_utf8(out.stdout).expect("utf-8");
-    let stderr = String::from_utf8(out.stderr).expect("utf-8");
-    let json = serde_json::from_str(&stdout).unwrap_or(Value::Null);
-    (out.status.code().unwrap_or(-1), json, stderr)
-}
-
-fn numbers(v: &Value) -> Vec<f64> {
-    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
-}
 
 /// The paper rotor's lowest three frequencies at `k`, each with std `rel`·f, as CSV text.
 fn paper_csv(k: [f64; 2], rel: f64) -> (String, Vec<f64>, Vec<f64>) {

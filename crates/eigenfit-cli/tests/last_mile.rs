@@ -4,13 +4,10 @@
 
 mod common;
 
+use common::{eigenfit as run, floats};
+
 use eigenfit_core::model::StructuralModel;
 use serde_json::Value;
-use std::process::{Command, Output};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs")
-}
 
 fn json(args: &[&str]) -> Value {
     let out = run(args);
@@ -39,10 +36,6 @@ fn refused(args: &[&str]) -> String {
     let err = String::from_utf8_lossy(&out.stderr).to_string();
     assert_eq!(out.status.code(), Some(2), "eigenfit {args:?}: {err}");
     err
-}
-
-fn floats(v: &Value) -> Vec<f64> {
-    v.as_array().unwrap_or_else(|| panic!("not an array: {v}")).iter().map(|x| x.as_f64().unwrap()).collect()
 }
 
 fn matrix(v: &Value) -> Vec<Vec<f64>> {

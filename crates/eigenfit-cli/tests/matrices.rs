@@ -3,23 +3,13 @@
 
 mod common;
 
+use common::{eigenfit_json as eigenfit, floats};
+
 use serde_json::Value;
 use std::process::Command;
 
 fn plate(name: &str) -> String {
     common::data_file("../eigenfit-matrices/tests/data/plate", name)
-}
-
-fn eigenfit(args: &[&str]) -> (i32, Value, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs");
-    let stdout = String::from_utf8(out.stdout).expect("utf-8");
-    let stderr = String::from_utf8(out.stderr).expect("utf-8");
-    let json = serde_json::from_str(&stdout).unwrap_or(Value::Null);
-    (out.status.code().unwrap_or(-1), json, stderr)
-}
-
-fn floats(v: &Value) -> Vec<f64> {
-    v.as_array().unwrap_or_else(|| panic!("not an array: {v}")).iter().map(|x| x.as_f64().unwrap()).collect()
 }
 
 fn json_file(name: &str) -> Value {

@@ -4,13 +4,11 @@
 
 mod common;
 
+use common::eigenfit;
+
 use serde_json::Value;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn eigenfit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs")
-}
+use std::process::Output;
 
 fn json(out: &Output) -> Value {
     let stdout = String::from_utf8(out.stdout.clone()).expect("utf-8");

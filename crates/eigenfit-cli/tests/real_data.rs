@@ -12,10 +12,12 @@
 
 mod common;
 
+use common::{eigenfit, floats};
+
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 /// χ²₀.₉₅(n) for n = 1 … 4 free parameters, from the tables.
 const CHI2_95: [f64; 4] =
@@ -25,10 +27,6 @@ const FREQUENCY_STD_REL: f64 = 0.005;
 const SHAPE_STD: f64 = 0.05;
 /// The significance level of every verdict (docs/user-guide.md, "Verdicts").
 const ALPHA: f64 = 0.05;
-
-fn eigenfit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("the eigenfit binary runs")
-}
 
 fn json(out: &Output) -> Value {
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
@@ -42,10 +40,6 @@ fn json(out: &Output) -> Value {
 
 fn folder(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/real_data").join(name)
-}
-
-fn floats(v: &Value) -> Vec<f64> {
-    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
 }
 
 /// Reads a Matrix Market `coordinate real symmetric` file into a dense matrix.

@@ -6,14 +6,12 @@
 
 mod common;
 
+use common::eigenfit;
+
 use serde_json::Value;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn eigenfit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs")
-}
 
 fn json(out: &Output) -> Value {
     let stdout = String::from_utf8(out.stdout.clone()).expect("utf-8");

@@ -3,12 +3,10 @@
 
 mod common;
 
-use serde_json::Value;
-use std::process::{Command, Output};
+use common::eigenfit as run;
 
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("runs")
-}
+use serde_json::Value;
+use std::process::Output;
 
 fn data(name: &str) -> String {
     common::data_file("../eigenfit-rotordynamics/tests/data", name)

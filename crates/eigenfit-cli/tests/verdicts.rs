@@ -5,13 +5,11 @@
 
 mod common;
 
+use common::eigenfit;
+
 use serde_json::Value;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn eigenfit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eigenfit")).args(args).output().expect("the eigenfit binary runs")
-}
+use std::process::Output;
 
 fn json(out: &Output) -> Value {
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
