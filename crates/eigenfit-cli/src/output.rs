@@ -293,12 +293,7 @@ pub fn print_alternatives(alternatives: &[eigenfit_workflow::estimate::Alternati
             Some(d) => format!("Δχ² {}", significant(d)),
             None => format!("Σr² {}", significant(a.misfit)),
         };
-        // Without a Δχ² there was no test to reject it (no std, no degree of freedom): it only fits worse.
-        let what = match (a.equally_good, a.delta_chi2) {
-            (true, _) => "equally good",
-            (false, Some(_)) => "worse (the data reject it)",
-            (false, None) => "fits worse (no test: no std and no degree of freedom)",
-        };
+        let what = a.judgement();
         let cycles: Vec<String> = a
             .exchanged
             .iter()

@@ -192,6 +192,16 @@ pub struct AlternativeSolution {
 }
 
 impl AlternativeSolution {
+    /// What the test said about it, in words: equally good, rejected by the data, or — without a
+    /// Δχ², when no test was possible (no std and no degree of freedom) — only fitting worse.
+    pub fn judgement(&self) -> &'static str {
+        match (self.equally_good, self.delta_chi2) {
+            (true, _) => "equally good",
+            (false, Some(_)) => "worse (the data reject it)",
+            (false, None) => "fits worse (no test: no std and no degree of freedom)",
+        }
+    }
+
     /// The report of `others` for parameters `names` (values in the parameters' own units).
     pub fn list(names: &[String], others: &[OtherSolution]) -> Vec<Self> {
         others

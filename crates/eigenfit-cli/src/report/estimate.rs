@@ -208,11 +208,7 @@ fn alternatives(s: &mut Section, list: &[AlternativeSolution], units: &[String],
             Cell::text(values.join(", ")),
             Cell::maybe(a.delta_chi2, 4, "—"),
             Cell::number(a.misfit, 4),
-            Cell::text(match (a.equally_good, a.delta_chi2) {
-                (true, _) => "equally good",
-                (false, Some(_)) => "worse: the data reject it",
-                (false, None) => "fits worse (no test: no std, no degree of freedom)",
-            }),
+            Cell::text(a.judgement()),
         ]);
     }
     s.table(t);
