@@ -473,3 +473,40 @@ fn frequencies_in_khz_or_rpm_are_refused_naming_the_unit() {
     let v = json(&["estimate", "--preset", "paper-rotor", "--measured", &hz, "--json"]);
     assert_eq!(v["converged"], true);
 }
+
+#[test]
+fn compare_fits_the_parameters_estimate_fits_each_in_its_unit_and_range() {
+    // A bearing pair tied to one stiffness and a disk mass: N/m and kg, as estimate fits them.
+    let scratch = common::scratch();
+    let base = std::fs::read_to_string(common::data_file("../../examples", "rotor.toml")).unwrap();
+    let rotor = common::write_in(
+        &scratch,
+        "rotor.toml",
+        &format!("{base}\n[[parameter]]\nkind = \"bearing-stiffness\"\nindex = [0, 1]\n\n[[parameter]]\nkind = \"disk-mass\"\nindex = 0\n"),
+    );
+    let rotor = rotor.to_str().unwrap();
+    let with = |more: &[&str]| -> Vec<String> {
+        ["compare", "--model", rotor, "--targets", "2e5:3", "--grid", "2", "--strategies", "damped"]
+            .iter()
+            .chain(more)
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let a = with(&["--range", "1e4:1e6,1:10", "--json"]);
+    let v = json(&as_refs(&a));
+    assert_eq!(v["units"], serde_json::json!({"k_drive_end_free_end": "N/m", "m_disk_0": "kg"}));
+    // One range per parameter: the stiffness axis over 1e4…1e6 N/m, the mass axis over 1…10 kg.
+    let initials: Vec<Vec<f64>> =
+        v["runs"].as_array().unwrap().iter().map(|r| floats(&r["initial"])).collect();
+    assert_eq!(initials, vec![vec![1e4, 1.0], vec![1e4, 10.0], vec![1e6, 1.0], vec![1e6, 10.0]]);
+    let a = with(&["--range", "1e4:1e6,1:10"]);
+    let out = text(&as_refs(&a));
+    assert!(out.lines().nth(1).is_some_and(|l| l.starts_with("target [N/m, kg] ")), "{out}");
+    let a = with(&["--range", "1e4:1e6,1:10,3:4"]);
+    let err = refused(&as_refs(&a));
+    assert!(err.contains("3 ranges for 2 parameters"), "{err}");
+}
+
+fn as_refs(a: &[String]) -> Vec<&str> {
+    a.iter().map(String::as_str).collect()
+}

@@ -289,6 +289,23 @@ fn a_campaign_with_a_test_mass_tells_the_sides_apart_from_frequencies() {
     assert!(k.iter().zip(truth).all(|(a, b)| (a / b - 1.0).abs() < 0.02), "{k:?}");
     assert_eq!(v["configurations"].as_array().unwrap().len(), 2);
     assert_eq!(v["configurations"][1]["name"], "test mass at node 3");
+    // Units as the rotor declares them; the covariance behind the intervals, as estimate gives it.
+    assert_eq!(v["units"], serde_json::json!({"k_drive_end": "N/m", "k_free_end": "N/m"}));
+    assert_eq!(v["covariance"]["coordinates"], "physical");
+    let c = &v["covariance"]["matrix"];
+    let r = &v["correlation"]["matrix"];
+    for (i, name) in ["k_drive_end", "k_free_end"].iter().enumerate() {
+        let iv = &v["intervals"][name];
+        let (lo, hi) = (iv[0].as_f64().unwrap(), iv[1].as_f64().unwrap());
+        let sd = c[i][i].as_f64().unwrap().sqrt();
+        // A 95 % interval spans about ±2 standard deviations of the same covariance.
+        assert!(lo < k[i] && k[i] < hi && (hi - lo) / sd > 3.0 && (hi - lo) / sd < 5.0, "{iv} vs sd {sd}");
+        assert_eq!(r[i][i].as_f64(), Some(1.0));
+        let j = 1 - i;
+        assert_eq!(c[i][j], c[j][i]);
+        let rho = c[i][j].as_f64().unwrap() / (c[i][i].as_f64().unwrap() * c[j][j].as_f64().unwrap()).sqrt();
+        assert!((r[i][j].as_f64().unwrap() - rho).abs() < 1e-12, "{r}");
+    }
     // A configuration that names a missing file is an error naming it.
     std::fs::write(
         dir.join("bad.toml"),

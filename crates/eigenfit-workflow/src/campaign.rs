@@ -4,7 +4,7 @@
 use crate::error::{failure, input, WorkflowError};
 use crate::model::Updatable;
 use crate::named::Named;
-use crate::outcome::{BudgetReport, Outcome, PairedFrequencies};
+use crate::outcome::{BudgetReport, Covariances, Outcome, PairedFrequencies};
 use crate::overrides::fixed;
 use crate::progress::Progress;
 use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDataOptions};
@@ -89,6 +89,12 @@ pub struct CampaignReport {
     /// What the intervals were scaled by.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub interval_basis: Option<String>,
+    /// Each parameter's unit as declared (empty when none was), by name.
+    pub units: Named<String>,
+    /// The parameters' covariance (physical coordinates) and correlation, `null` when not
+    /// computed or not computable.
+    #[serde(flatten)]
+    pub covariances: Covariances,
     /// Each configuration.
     pub configurations: Vec<ConfigurationReport>,
     /// Every configuration has std and no shapes.
@@ -223,6 +229,8 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         dof: estimate.last.degrees_of_freedom(),
         intervals: unc.as_ref().map(|u| Named::new(&pnames, u.intervals.iter().copied())),
         interval_basis: scatter.map(|s| interval_basis(s, has_std)),
+        units: Named(joint.parameters().iter().map(|q| (q.name.clone(), q.unit().to_string())).collect()),
+        covariances: Covariances::of(&pnames, unc.as_ref().map(|u| &u.covariance)),
         configurations,
         has_std,
         scatter,

@@ -9,7 +9,7 @@
 use crate::error::{input, WorkflowError};
 use crate::overrides::{parse_list, points};
 use eigenfit_core::analysis::compare::{
-    checked_strategies, log_space, run_grid, tensor_grid, CompareRun, CompareSettings, ReferenceSettings,
+    axes_grid, checked_strategies, log_space, run_grid, CompareRun, CompareSettings, ReferenceSettings,
 };
 use eigenfit_core::analysis::Identifiability;
 use eigenfit_core::eigen::EigenSolver;
@@ -32,11 +32,12 @@ pub const MAX_RUNS: usize = 1_000_000;
 /// What to compare, as the command line gives it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompareRequest {
-    /// Target stiffness sets `K1:K2,…` (N/m).
+    /// Target parameter sets `K1:K2,…` (in the parameters' units).
     pub targets: String,
     /// Log grid of initial guesses with this many points per parameter.
     pub grid: Option<usize>,
-    /// Range of the grid, `FROM:TO` (N/m).
+    /// Range of the grid, `FROM:TO` for every parameter or one `FROM:TO` per parameter,
+    /// comma-separated (each in its parameter's unit).
     pub range: String,
     /// Explicit initial guesses `K1:K2,…`, instead of a grid.
     pub initials: Option<String>,
@@ -78,6 +79,29 @@ impl ComparePlan {
     }
 }
 
+/// The log-spaced axis of each of `np` parameters, `n` points over its range: `text` is one
+/// `FROM:TO` for all or one per parameter (`1e4:1e6,1:10`), so parameters in different units
+/// (a stiffness and a mass) each get a range of their own.
+fn grid_axes(text: &str, np: usize, n: usize) -> Result<Vec<Vec<f64>>, WorkflowError> {
+    let ranges: Vec<&str> = text.split(',').map(str::trim).collect();
+    if ranges.len() != 1 && ranges.len() != np {
+        return Err(input(format!(
+            "--range `{text}`: {} ranges for {np} parameters; give one FROM:TO for all or one per parameter",
+            ranges.len()
+        )));
+    }
+    (0..np)
+        .map(|i| {
+            let range = ranges[i.min(ranges.len() - 1)];
+            let r = parse_list("--range", &range.replace(':', ","))?;
+            if r.len() != 2 || !(r[0] > 0.0 && r[1] > r[0]) {
+                return Err(input(format!("--range `{range}`: expected FROM:TO with 0 < FROM < TO")));
+            }
+            Ok(log_space(r[0], r[1], n))
+        })
+        .collect()
+}
+
 /// Checks `request` against a model with `np` parameters; nothing is allocated beyond
 /// [`MAX_RUNS`].
 pub fn plan(request: &CompareRequest, np: usize) -> Result<ComparePlan, WorkflowError> {
@@ -85,13 +109,6 @@ pub fn plan(request: &CompareRequest, np: usize) -> Result<ComparePlan, Workflow
     let initials = match (&request.initials, request.grid) {
         (Some(text), _) => points("--initials", text, np)?,
         (None, Some(n)) if n >= 2 => {
-            let r = parse_list("--range", &request.range.replace(':', ","))?;
-            if r.len() != 2 || !(r[0] > 0.0 && r[1] > r[0]) {
-                return Err(input(format!(
-                    "--range `{}`: expected FROM:TO with 0 < FROM < TO",
-                    request.range
-                )));
-            }
             // Counted before the grid is built: 10000^2 points would exhaust memory first.
             u32::try_from(np)
                 .ok()
@@ -102,7 +119,7 @@ pub fn plan(request: &CompareRequest, np: usize) -> Result<ComparePlan, Workflow
                         "--grid {n}: {n}^{np} initial guesses, more than the {MAX_RUNS} runs compare accepts; use a smaller --grid"
                     ))
                 })?;
-            tensor_grid(&log_space(r[0], r[1], n), np)
+            axes_grid(&grid_axes(&request.range, np, n)?)
         }
         _ => return Err(input("give --grid N (N ≥ 2) or --initials K1:K2,…")),
     };
@@ -296,6 +313,9 @@ pub struct CompareReport {
     pub model: String,
     /// The eigen-solver's name.
     pub solver: String,
+    /// Each parameter's unit as declared (empty when none was), by name: the unit of targets,
+    /// initial guesses and estimates.
+    pub units: crate::Named<String>,
     /// Reference modes, the decimals their frequencies were rounded to, their standard
     /// deviation (Hz).
     #[serde(flatten)]
@@ -328,6 +348,7 @@ pub fn run(
     Ok(CompareReport {
         model: label.to_string(),
         solver: solver.name().to_string(),
+        units: crate::simulate::units_of(model),
         reference: plan.settings.reference.clone(),
         runs: runs.iter().map(|r| RunReport::new(r, plan.timing)).collect(),
         summary: summarise(&runs, &plan.targets, &plan.strategies),

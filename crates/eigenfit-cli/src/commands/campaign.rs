@@ -65,8 +65,10 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             report.outcome.iterations
         );
         println!("{:<24}{:>16}{:>16}{:>34}", "parameter", "initial", "estimate", "95% interval");
-        for (i, ((n, initial), (_, value))) in report.initial.iter().zip(report.parameters.iter()).enumerate()
+        for (i, ((name, initial), (_, value))) in
+            report.initial.iter().zip(report.parameters.iter()).enumerate()
         {
+            let n = format!("{name}{}", eigenfit_core::model::bracketed(&report.units.0[i].1));
             let iv = report.intervals.as_ref().map_or("-".to_string(), |u| {
                 let iv = u.0[i].1;
                 format!("[{:.4e}, {:.4e}]", iv[0], iv[1])
@@ -99,14 +101,8 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
         }
     });
     if let (Some(path), Some(mut html)) = (&args.html.html, html) {
-        let names: Vec<String> = report.parameters.iter().map(|(n, _)| n.clone()).collect();
-        let declared = declared_units(&args.campaign);
-        let units: Vec<Option<String>> = crate::report::estimate::units(&report, &names, |n| {
-            declared.iter().find(|(m, _)| m == n).map_or(String::new(), |(_, u)| u.clone())
-        })
-        .into_iter()
-        .map(|u| Some(u).filter(|u| !u.is_empty()))
-        .collect();
+        let units: Vec<Option<String>> =
+            report.units.iter().map(|(_, u)| Some(u.clone()).filter(|u| !u.is_empty())).collect();
         crate::report::campaign::fill(&mut html, &report, &units);
         html.write_after(path, args.report.json);
     }
@@ -132,17 +128,4 @@ fn html_inputs(path: &std::path::Path) -> crate::report::Report {
         }
     }
     html
-}
-
-/// The parameters' units as the first configuration's model declares them (name, unit); empty
-/// when it cannot be read.
-fn declared_units(path: &std::path::Path) -> Vec<(String, String)> {
-    use eigenfit_core::model::StructuralModel;
-    let Ok(c) = eigenfit_rotor::campaign::Campaign::from_toml_file(path) else { return Vec::new() };
-    let Some(conf) = c.configurations.first() else { return Vec::new() };
-    let Ok(rotor) = eigenfit_rotor::Rotor::from_toml_file(&conf.model) else { return Vec::new() };
-    match eigenfit_rotor::updatable::UpdatableRotor::new(rotor) {
-        Ok(m) => m.parameters().iter().map(|p| (p.name.clone(), p.unit.clone())).collect(),
-        Err(_) => Vec::new(),
-    }
 }

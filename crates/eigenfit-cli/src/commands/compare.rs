@@ -7,8 +7,9 @@ use crate::source::ModelArgs;
 use crate::{plot, progress};
 use clap::Args;
 use eigenfit_core::analysis::compare::CompareRun;
-use eigenfit_core::model::StructuralModel;
+use eigenfit_core::model::{bracketed, ParameterSet, StructuralModel};
 use eigenfit_workflow::compare::{self, CompareRequest, WITHIN_1E6};
+use eigenfit_workflow::estimate::axis_unit;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `compare`.
@@ -16,15 +17,16 @@ use std::path::{Path, PathBuf};
 pub struct CompareArgs {
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Target stiffness sets, `K1:K2` separated by commas (N/m); reference data are the model's
-    /// frequencies there.
+    /// Target parameter sets, `K1:K2` separated by commas (in the parameters' units: N/m for
+    /// support stiffnesses); reference data are the model's frequencies there.
     #[arg(long, value_name = "K1:K2,…")]
     pub targets: String,
     /// Log grid of initial guesses with this many points per parameter.
     #[arg(long, value_name = "N", conflicts_with = "initials")]
     pub grid: Option<usize>,
-    /// Range of the grid, FROM:TO in N/m.
-    #[arg(long, default_value = "1e1:1e9", value_name = "FROM:TO")]
+    /// Range of the grid in the parameters' units: one FROM:TO for every parameter, or one per
+    /// parameter, comma-separated (`1e4:1e6,0.1:10` for a stiffness and a mass).
+    #[arg(long, default_value = "1e1:1e9", value_name = "FROM:TO[,…]")]
     pub range: String,
     /// Explicit initial guesses `K1:K2` separated by commas, instead of a grid.
     #[arg(long, value_name = "K1:K2,…")]
@@ -91,7 +93,9 @@ fn request(args: &CompareArgs) -> CompareRequest {
 /// Runs `compare`; returns the exit code (3 when a run ran out of its evaluation budget: the
 /// comparison is incomplete).
 pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
-    let (model, label) = args.model.load_any()?;
+    let (loaded, label) = args.model.load_any()?;
+    // The parameters estimate fits: a rotor's `[[parameter]]` tables resolved.
+    let model = loaded.updatable(&label)?;
     let solver = args.model.solver()?;
     let np = model.parameters().len();
     let plan = compare::plan(&request(args), np)?;
@@ -108,15 +112,17 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
     });
     pb.finish_and_clear();
     let mut report = report?;
-    let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
     let plots = match &args.plot {
-        Some(dir) => write_maps(dir, &label, &names, &report.raw, &plan.targets, &plan.strategies)?,
+        Some(dir) => {
+            write_maps(dir, &label, model.parameters(), &report.raw, &plan.targets, &plan.strategies)?
+        }
         None => Vec::new(),
     };
     report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
     let cut: usize = report.summary.iter().map(|s| s.budget_exhausted).sum();
     let code = if cut > 0 { EXIT_NOT_CONVERGED } else { EXIT_OK };
     crate::error::set_exit_on_closed_pipe(code);
+    let target_heading = format!("target{}", bracketed(&axis_unit(model.parameters())));
     crate::output::report(args.report.json, &report, |report| {
         println!(
             "{label}: {} runs ({} targets × {} initial guesses × {} strategies), {} reference modes",
@@ -127,9 +133,16 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
             report.reference.modes
         );
         let width = report.summary.iter().map(|s| s.strategy.chars().count() + 1).fold(9, usize::max);
+        let tw = report
+            .summary
+            .iter()
+            .map(|s| s.target.iter().map(|v| format!("{v:.0e}").len() + 1).sum::<usize>())
+            .chain([target_heading.chars().count() + 1, 16])
+            .max()
+            .unwrap_or(16);
         println!(
-            "{:<16}{:<width$}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",
-            "target [N/m]",
+            "{:<tw$}{:<width$}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",
+            target_heading,
             "strategy",
             "converged",
             "err ≤ 1e-6",
@@ -142,7 +155,7 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
             let target: Vec<String> = s.target.iter().map(|v| format!("{v:.0e}")).collect();
             let fmt = |v: Option<usize>| v.map_or("-".to_string(), |v| v.to_string());
             println!(
-                "{:<16}{:<width$}{:>11}{:>12}{:>9}{:>9}{:>15.2e}{:>11}",
+                "{:<tw$}{:<width$}{:>11}{:>12}{:>9}{:>9}{:>15.2e}{:>11}",
                 target.join(":"),
                 s.strategy,
                 format!("{}/{}", s.converged, s.runs),
@@ -178,21 +191,24 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
 pub fn write_maps(
     dir: &Path,
     label: &str,
-    names: &[String],
+    params: &ParameterSet,
     runs: &[CompareRun],
     targets: &[Vec<f64>],
     strategies: &[String],
 ) -> Result<Vec<PathBuf>, CliError> {
-    if names.len() != 2 {
+    if params.len() != 2 {
         eprintln!("eigenfit: --plot: compare maps need a model with two parameters; none written");
         return Ok(Vec::new());
     }
-    let names = [names[0].clone(), names[1].clone()];
+    let (x, y) =
+        (params.iter().next().expect("two parameters"), params.iter().nth(1).expect("two parameters"));
+    let names = [x.name.clone(), y.name.clone()];
+    let units = [x.unit().to_string(), y.unit().to_string()];
     let mut written = Vec::new();
     for (kind, stem) in
         [(MapKind::Convergence, "compare-convergence"), (MapKind::Iterations, "compare-iterations")]
     {
-        match CompareMaps::from_runs(label, names.clone(), runs, targets, strategies, kind) {
+        match CompareMaps::from_runs(label, names.clone(), units.clone(), runs, targets, strategies, kind) {
             Some(maps) => written.extend(plot::write(&maps, dir, stem)?),
             None => {
                 eprintln!(

@@ -58,7 +58,14 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
         sigma_hz: None,
     };
     plots.extend(plot::write(&figure, out, "convergence")?);
-    plots.extend(compare::write_maps(out, LABEL, &names, &found.grid, &found.targets, &found.strategies)?);
+    plots.extend(compare::write_maps(
+        out,
+        LABEL,
+        rotor.parameters(),
+        &found.grid,
+        &found.targets,
+        &found.strategies,
+    )?);
     plots.extend(plot::write(&DiscoveryPlot::from_report(LABEL, &found.discovery), out, "discovery")?);
     found.report.out = out.display().to_string();
     found.report.plots = plot::names(&plots);

@@ -5,6 +5,7 @@
 use super::style::{self, log_tick, short_sci, strategy_colour, Swatch, INK, LIGHT};
 use super::{err, DrawResult, Figure};
 use eigenfit_core::analysis::compare::CompareRun;
+use eigenfit_core::model::bracketed;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -63,6 +64,8 @@ pub struct CompareMaps {
     pub title: String,
     /// Parameter names (x, y).
     pub names: [String; 2],
+    /// Their units as declared (x, y; empty when none was).
+    pub units: [String; 2],
     /// Panels, row by row (targets), strategies across.
     pub panels: Vec<Panel>,
     /// Panels per row (strategies).
@@ -77,6 +80,7 @@ impl CompareMaps {
     pub fn from_runs(
         title: &str,
         names: [String; 2],
+        units: [String; 2],
         runs: &[CompareRun],
         targets: &[Vec<f64>],
         strategies: &[String],
@@ -104,7 +108,7 @@ impl CompareMaps {
                 panels.push(Panel { strategy: s.clone(), target: [t[0], t[1]], cells });
             }
         }
-        Some(Self { title: title.to_string(), names, panels, columns: strategies.len().max(1), kind })
+        Some(Self { title: title.to_string(), names, units, panels, columns: strategies.len().max(1), kind })
     }
 
     fn rows(&self) -> usize {
@@ -252,12 +256,14 @@ impl CompareMaps {
             return Ok(());
         }
         let (ex, ey) = (edges(&xs), edges(&ys));
-        let caption = format!(
-            "{} · target {}, {} N/m",
-            panel.strategy,
-            short_sci(panel.target[0]),
-            short_sci(panel.target[1])
-        );
+        let [x, y] = panel.target.map(short_sci);
+        // One unit after both values when they share it (`1e5, 1e5 N/m`), else each its own.
+        let with_unit = |v: &str, u: &str| format!("{v} {u}").trim_end().to_string();
+        let target = match &self.units {
+            [a, b] if a == b => with_unit(&format!("{x}, {y}"), a),
+            [a, b] => format!("{}, {}", with_unit(&x, a), with_unit(&y, b)),
+        };
+        let caption = format!("{} · target {target}", panel.strategy);
         let mut chart = ChartBuilder::on(area)
             .caption(caption, style::text(style::CAPTION, strategy_colour(&panel.strategy)))
             .margin(12)
@@ -268,8 +274,8 @@ impl CompareMaps {
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc(format!("initial {} [N/m]", self.names[0]))
-            .y_desc(format!("initial {} [N/m]", self.names[1]))
+            .x_desc(format!("initial {}{}", self.names[0], bracketed(&self.units[0])))
+            .y_desc(format!("initial {}{}", self.names[1], bracketed(&self.units[1])))
             .axis_desc_style(style::font(style::TICK + 1))
             .label_style(style::font(style::TICK - 1))
             .x_labels(6)

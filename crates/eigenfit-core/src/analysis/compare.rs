@@ -356,7 +356,13 @@ pub fn log_space(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 
 /// The full tensor grid of `axis` over `dims` parameters.
 pub fn tensor_grid(axis: &[f64], dims: usize) -> Vec<Vec<f64>> {
-    crate::update::grid::tensor_product(&vec![axis.to_vec(); dims], usize::MAX)
+    axes_grid(&vec![axis.to_vec(); dims])
+}
+
+/// Every combination of one value per axis (axis `i` gives parameter `i`; its own range and
+/// count), the last parameter varying fastest as in [`tensor_grid`].
+pub fn axes_grid(axes: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    crate::update::grid::tensor_product(axes, usize::MAX)
 }
 
 fn relative_error(estimate: &[f64], target: &[f64]) -> f64 {
