@@ -105,7 +105,7 @@ pub fn print_discovery(r: &RunupDiscoverReport) {
     let d = &r.discovery;
     println!("{}: calibrated the bearings (at {} rpm):", d.model, r.reference_speed_rpm);
     for (n, v) in d.calibrated_parameters.iter() {
-        println!("  {n} = {v:.6e} N/m");
+        println!("  {n} = {v:.6e} {}", crate::report::estimate::ross_coefficient_unit(n));
     }
     crate::output::print_misfit(&d.before);
     if !d.before.significant {

@@ -112,12 +112,15 @@ fn passes(lin: &eigenfit_core::problem::Linearisation, free: usize) -> bool {
     match judge(lin, free).verdict {
         FitVerdict::Acceptable => true,
         FitVerdict::Poor => false,
-        FitVerdict::NotJudged => lin.max_rel_diff() <= EXACT_RELATIVE,
+        FitVerdict::NotJudged => lin.is_exact_fit(EXACT_RELATIVE, free),
     }
 }
 
-/// Relative misfit below which a run-up fit without std is exact (the modal solver's agreement
-/// with itself): no other start can do better.
+/// The tolerance of the one exact-fit rule ([`Linearisation::is_exact_fit`]) for a run-up fit
+/// without std: the modal solver's agreement with itself, below which no other start can do
+/// better.
+///
+/// [`Linearisation::is_exact_fit`]: eigenfit_core::problem::Linearisation::is_exact_fit
 const EXACT_RELATIVE: f64 = 1e-9;
 
 /// `first` continued by `then` (started where `first` ended): one history, the counts summed,
