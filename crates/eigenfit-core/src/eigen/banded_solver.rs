@@ -134,7 +134,7 @@ impl EigenSolver for BandedSolver {
 
     /// The next eigenvalue's bound is the Sturm check's shift: no eigenvalue beyond the modes
     /// returned lies below it, at no extra cost. Eigenvalues only are iterated less far
-    /// ([`request_tolerance`]).
+    /// (`request_tolerance`).
     fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
         match self.banded(system, request.count, request_tolerance(request, self.tolerance))? {
             Some((modes, next)) => Ok(SolvedModes::answering(request, modes, next)),

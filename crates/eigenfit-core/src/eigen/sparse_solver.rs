@@ -262,7 +262,7 @@ impl EigenSolver for SparseSolver {
     }
 
     /// The next eigenvalue's bound is the Sturm count's shift. Eigenvalues only are iterated
-    /// less far ([`request_tolerance`]).
+    /// less far (`request_tolerance`).
     fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
         let tolerance = request_tolerance(request, self.tolerance);
         let (modes, next) = self.solve_with_tolerance(system, request.count, tolerance)?;

@@ -3,7 +3,7 @@
 //! Read: 15 and 2411 (node coordinates), 55 (data at nodes: real normal modes, analysis type 2;
 //! complex modes, types 3 and 7, are turned real with a warning, see [`UffMode::complex`]), 164
 //! (units: coordinates are converted to metres). Other datasets are skipped and listed in
-//! [`UffFile::skipped`]; binary ones (58b) are refused. Written: 164, 15 and 55 by [`write`].
+//! [`UffFile::skipped`]; binary ones (58b) are refused. Written: 164, 15 and 55 by [`write()`].
 //!
 //! No maintained Rust crate reads dataset 55, so this is a small reader of our own. Records are
 //! read as whitespace-separated tokens (Fortran `D` exponents accepted), which every writer we

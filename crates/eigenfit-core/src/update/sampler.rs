@@ -15,7 +15,7 @@ pub trait LogLikelihood {
 }
 
 /// Independent Gaussian errors on residuals given in noise units (r = (measured − model)/σ, as
-/// a [`Problem`](crate::problem::Problem) with [`ResidualKind::FrequencyHz`] and measured std
+/// a [`Problem`](crate::problem::Problem) with [`ResidualKind::FrequencyHz`](crate::problem::ResidualKind::FrequencyHz) and measured std
 /// makes them), normalised: ln L = −½‖r‖² + `log_normaliser`, the objective's cost giving ½‖r‖².
 #[derive(Debug, Clone, PartialEq)]
 pub struct Gaussian {
