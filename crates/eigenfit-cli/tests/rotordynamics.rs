@@ -642,25 +642,48 @@ fn estimate_initial_on_a_ross_rotor_sets_the_start() {
 /// on a rotor whose bearings are tables over whirl frequency.
 #[test]
 fn estimate_on_a_ross_rotor_refuses_what_it_cannot_do() {
-    let scratch = common::scratch();
     let model = data("ross3/pchip_speed_start.toml");
     let measured = data("ross3/pchip_speed_runup.csv");
-    for extra in [
-        &["--plot", scratch.path().to_str().unwrap()][..],
-        &["--strategy", "newton"],
-        &["--fix", "kxx_DE=1e6"],
-        &["--residual", "hz"],
-    ] {
+    for extra in [&["--strategy", "newton"][..], &["--fix", "kxx_DE=1e6"], &["--residual", "hz"]] {
         let mut a = vec!["estimate", "--model", &model, "--measured", &measured];
         a.extend_from_slice(extra);
         let out = run(&a);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", String::from_utf8_lossy(&out.stderr));
         assert!(String::from_utf8_lossy(&out.stderr).contains(extra[0]), "{extra:?}");
     }
-    assert_eq!(std::fs::read_dir(scratch.path()).unwrap().count(), 0, "--plot wrote files");
     let out = run(&["estimate", "--model", &data("ross3/frequency_table.toml"), "--measured", &measured]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("whirl frequency"));
+}
+
+/// `estimate --plot DIR` on a ROSS run-up draws the run-up fit: every measured point and the
+/// model's at the estimate, named in the JSON's `plots`.
+#[test]
+fn estimate_on_a_ross_rotor_plots_the_runup_fit() {
+    let scratch = common::scratch();
+    let dir = scratch.path().join("plots");
+    let v = json(&run(&[
+        "estimate",
+        "--model",
+        &data("ross3/pchip_speed_start.toml"),
+        "--measured",
+        &data("ross3/pchip_speed_runup.csv"),
+        "--plot",
+        dir.to_str().unwrap(),
+        "--json",
+    ]));
+    let plots: Vec<&str> = v["plots"].as_array().unwrap().iter().map(|p| p.as_str().unwrap()).collect();
+    assert_eq!(plots.len(), 2, "{plots:?}");
+    let svg = std::fs::read_to_string(dir.join("runup-fit.svg")).unwrap();
+    let modes: std::collections::BTreeSet<u64> =
+        v["points"].as_array().unwrap().iter().map(|p| p["mode"].as_u64().unwrap()).collect();
+    for m in &modes {
+        assert!(svg.contains(&format!("\nmode {m}\n")), "mode {m} missing");
+    }
+    // One measured mark (a circle) per run-up point.
+    let points = v["points"].as_array().unwrap().len();
+    assert_eq!(svg.matches("<circle").count(), points);
+    assert!(std::fs::metadata(dir.join("runup-fit.png")).unwrap().len() > 10_000);
 }
 
 /// `campbell --operating FROM:TO`: one separation margin per critical speed, placed below, inside or

@@ -301,6 +301,9 @@ pub struct RunupEstimateReport {
     pub alternatives_sigma: &'static str,
     /// The run-up points at the estimate.
     pub points: Vec<RunupPointReport>,
+    /// Plot files written (`--plot`: the run-up fit).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plots: Option<Vec<String>>,
     /// Bearing tables extrapolated at measured speeds.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
@@ -625,6 +628,7 @@ pub fn estimate_with(
                 measured_whirl: p.whirl.map(|w| w.name()),
             })
             .collect(),
+        plots: None,
     })
 }
 

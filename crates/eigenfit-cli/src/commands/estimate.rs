@@ -58,7 +58,9 @@ pub struct EstimateArgs {
     /// (`refits` in --json; default 6).
     #[arg(long, value_name = "N")]
     pub alternative_starts: Option<usize>,
-    /// Write the convergence history (convergence.svg/.png) into this folder.
+    /// Write the plots into this folder: the convergence history (convergence.svg/.png) and,
+    /// with shapes, the MAC matrix (mac.svg/.png); for a run-up on a ROSS rotor the run-up fit
+    /// (runup-fit.svg/.png: measured and model frequencies against speed).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
     /// `--quiet`, `--json`.
@@ -107,14 +109,6 @@ fn default_budget(strategy: &str, samples: Option<usize>) -> usize {
 /// Runs `estimate`; returns the exit code (3 when the run did not converge, the fit is poor, a
 /// parameter sits on a limit or the budget ran out).
 pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
-    if args.plot.is_some()
-        && eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()).is_some()
-    {
-        return Err(crate::error::input(
-            "--plot is not available for a run-up fit on a two-plane (ROSS) rotor: draw the rotor's \
-             Campbell diagram with `eigenfit campbell --plot DIR`",
-        ));
-    }
     // Every output is checked writable before the fit: a fit never runs for nothing.
     if let Some(path) = &args.test_data.write_model {
         crate::output::check_writable(path, "--write-model")?;
@@ -129,11 +123,27 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let outcome = estimate::run(&request(args), &mut notes, &mut Bars::new(args.report.quiet));
     print_notes(&notes);
     let mut est = match outcome? {
-        EstimateOutcome::Runup(report) => {
+        EstimateOutcome::Runup(mut report) => {
             print_notes(&report.notes);
             let code = if report.verdict.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
+            let plots = match &args.plot {
+                // A plot that fails after the fit is lost, said so; the fit's exit code stands.
+                Some(dir) => {
+                    let figure =
+                        plot::runup::RunupFit { title: report.model.clone(), points: &report.points };
+                    plot::write(&figure, dir, "runup-fit").unwrap_or_else(|e| {
+                        crate::output::report_lost("the run-up fit plot", &e);
+                        Vec::new()
+                    })
+                }
+                None => Vec::new(),
+            };
+            report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
             crate::error::set_exit_on_closed_pipe(code);
-            crate::output::report(args.report.json, &*report, crate::rotordynamics::print_estimate);
+            crate::output::report(args.report.json, &*report, |r| {
+                crate::rotordynamics::print_estimate(r);
+                plots.iter().for_each(|w| println!("wrote {}", w.display()));
+            });
             if let (Some(path), Some(text)) = (&args.test_data.write_model, &report.updated_model) {
                 let text = eigenfit_workflow::rotordynamics::ross_text_for(text, path)?;
                 crate::output::write_atomically(path, text.as_bytes())?;

@@ -400,7 +400,9 @@ pub fn fill_runup(html: &mut Report, r: &RunupEstimateReport) {
     s.list(r.notes.clone());
     let s = html.section("Other solutions");
     alternatives(s, &r.alternative_solutions, &units, r.alternatives_sigma);
-    html.section("Plots").text(
-        "A run-up fit draws no convergence plot; `eigenfit campbell --report` draws the rotor's Campbell diagram.",
+    html.section("Plots").figure(
+        "Run-up fit: each mode's measured frequencies (marks) and the model's at the estimate (line) against \
+         rotor speed, with the synchronous 1× line. `eigenfit campbell --report` draws the rotor's Campbell diagram.",
+        &crate::plot::runup::RunupFit { title: r.model.clone(), points: &r.points },
     );
 }
