@@ -319,7 +319,7 @@ fn weighted_uncertainty(
     let covariance = DMatrix::from_fn(np, np, |i, j| scaled_cov[(i, j)] * jac[i] * jac[j]);
     let s_hat: Vec<f64> = params.iter().zip(&at.parameters).map(|(p, &v)| p.to_scaled(v)).collect();
     let (lo, hi) = scaled_bounds(params);
-    let near = |a: f64, b: f64| (a - b).abs() <= 1e-9 * (1.0 + b.abs());
+    let near = |a: f64, b: f64| b.is_finite() && (a - b).abs() <= 1e-9 * (1.0 + b.abs());
     // A parameter on one of its limits: that limit is one end of its interval, the profile the
     // other; no linearised interval may reach past the limit.
     let on_limit: Vec<bool> = (0..np).map(|i| near(s_hat[i], lo[i]) || near(s_hat[i], hi[i])).collect();
