@@ -505,3 +505,101 @@ fn eighteen_storey_with_shapes_claims_hold() {
         v["verdict"], v["misfit"], v["dof"]
     );
 }
+
+/// Issue 29, item 4: the 18-storey frame with one parameter per storey — 3 modes with shapes at
+/// 6 floors are 21 data for 18 parameters. It is not refused by a count of modes: it runs, and
+/// says what it counted and what the rank of the weighted Jacobian of all the data is.
+#[test]
+fn eighteen_storeys_eighteen_parameters_are_counted_by_data_not_modes() {
+    let dir = common::scratch();
+    let model = common::per_storey_model(dir.path()).display().to_string();
+    let data = folder("eighteen_storey_edefense");
+    let file = |n: &str| data.join(n).display().to_string();
+    let args = ["estimate", "--model", &model, "--measured", &file("measured.csv")];
+    // Frequencies alone: 3 data for 18 parameters, refused naming what was counted.
+    let (code, _, stderr) = common::eigenfit_json(&args);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("3 measured frequencies for 18 parameters: at least 18 are needed"), "{stderr}");
+    // With the shapes: run, whatever the verdict.
+    let shapes = file("shapes.csv");
+    let with_shapes = [&args[..], &["--shapes", &shapes, "--alternative-starts", "0", "--json"]].concat();
+    let (code, v, stderr) = common::eigenfit_json(&with_shapes);
+    assert!(code == 0 || code == 3, "exit {code}: {stderr}");
+    let d = &v["data_rank"];
+    assert_eq!(d["counted"], "3 measured modes × (1 frequency + 6 shape components) = 21 data", "{d}");
+    assert_eq!((d["rows"].as_u64(), d["parameters"].as_u64()), (Some(21), Some(18)), "{d}");
+    let rank = d["rank"].as_u64().unwrap() as usize;
+    let null = d["null_directions"].as_array().unwrap();
+    assert!(rank <= 18 && rank + null.len() == 18, "{d}");
+    // The singular values the report gives (of the same Jacobian, rescaled by σ̂) say the same rank.
+    let sv = floats(&v["singular_values"]);
+    assert_eq!(sv.iter().filter(|&&s| s > 1e-10 * sv[0]).count(), rank, "{sv:?} against {d}");
+    // Unit shapes at 6 sensors carry 5 numbers each: the 18 parameters see at most 3 + 15 data,
+    // so some combinations are barely determined, and the report names them.
+    let weak = v["poorly_determined_directions"].as_array().unwrap();
+    assert!(!weak.is_empty(), "{v}");
+    assert!(weak.iter().all(|w| w.as_str().unwrap().contains("storey_")), "{weak:?}");
+    eprintln!("rank {rank} of 18; poorly determined: {weak:?}; evaluations {}", v["evaluations_by_phase"]);
+}
+
+/// A rank-deficient Jacobian is said as the directions the data cannot tell apart: the three-
+/// zone frame with a fourth parameter on the same stiffness matrix as the first zone, so that
+/// only their sum of effects is seen (in log parameters: p₁·δ₁ + p₄·δ₄ = 0 changes nothing).
+#[test]
+fn a_rank_deficient_jacobian_names_the_directions_the_data_cannot_tell_apart() {
+    let dir = common::scratch();
+    let src = folder("eighteen_storey_edefense");
+    for f in
+        ["K0.mtx", "M0.mtx", "dofs.csv", "K_storeys_1_6.mtx", "K_storeys_7_12.mtx", "K_storeys_13_18.mtx"]
+    {
+        std::fs::copy(src.join(f), dir.path().join(f)).unwrap();
+    }
+    let mut toml = std::fs::read_to_string(src.join("model.toml")).unwrap();
+    toml.push_str(
+        "\n[[parameter]]\nname = \"twin_of_1_6\"\nnominal = 1.0\nlower = 0.1\nupper = 10.0\nscale = \"log\"\n\
+         unit = \"\"\nstiffness = \"K_storeys_1_6.mtx\"\n",
+    );
+    let model = common::write_in(&dir, "model.toml", &toml).display().to_string();
+    let measured = src.join("measured.csv").display().to_string();
+    let shapes = src.join("shapes.csv").display().to_string();
+    let args = [
+        "estimate",
+        "--model",
+        &model,
+        "--measured",
+        &measured,
+        "--shapes",
+        &shapes,
+        "--alternative-starts",
+        "0",
+    ];
+    let (code, v, stderr) = common::eigenfit_json(&[&args[..], &["--json"]].concat());
+    assert!(code == 0 || code == 3, "exit {code}: {stderr}");
+    let d = &v["data_rank"];
+    assert_eq!(
+        (d["rows"].as_u64(), d["parameters"].as_u64(), d["rank"].as_u64()),
+        (Some(21), Some(4), Some(3)),
+        "{d}"
+    );
+    let null = d["null_directions"].as_array().unwrap();
+    assert_eq!(null.len(), 1, "{d}");
+    // The direction (p₄, −p₁)/‖·‖ in log parameters, from the estimate's own values.
+    let p1 = v["parameters"]["storeys_1_6"].as_f64().unwrap();
+    let p4 = v["parameters"]["twin_of_1_6"].as_f64().unwrap();
+    let norm = p1.hypot(p4);
+    let (a, b) = (p4 / norm, p1 / norm);
+    let said = null[0].as_str().unwrap();
+    let expected = if a >= b {
+        format!("{a:.2}·storeys_1_6 − {b:.2}·twin_of_1_6")
+    } else {
+        format!("{b:.2}·twin_of_1_6 − {a:.2}·storeys_1_6")
+    };
+    assert_eq!(said, expected, "{d}");
+    assert!(
+        stderr.contains("determine 3 of the 4 parameter directions") && stderr.contains(said),
+        "{stderr}"
+    );
+    let text = common::eigenfit(&args);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("they cannot tell apart changes along: ") && text.contains(said), "{text}");
+}

@@ -19,7 +19,7 @@ use eigenfit_core::analysis::alternatives::{
     search_starts, Equivalence, Mirrors, OtherSolution, SAME_MINIMUM,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
-use eigenfit_core::analysis::{Identifiability, Uncertainty};
+use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};
 use eigenfit_core::measurement::mac::MacReport;
 use eigenfit_core::measurement::measured_csv::{shown, shown_number};
 use eigenfit_core::model::{ParameterSet, StructuralModel};
@@ -104,6 +104,9 @@ pub struct IntervalsReport {
     pub condition_number: Option<f64>,
     /// Standard deviations.
     pub standard_deviations: Option<Named<f64>>,
+    /// Combinations of parameters the data barely tell apart (a linearised 95 % interval wider
+    /// than a factor of 10 each way along them), in words ([`Uncertainty::poorly_determined`]).
+    pub poorly_determined_directions: Option<Vec<String>>,
 }
 
 impl IntervalsReport {
@@ -116,6 +119,7 @@ impl IntervalsReport {
             condition_number: u.map(|u| u.condition_number),
             standard_deviations: u
                 .map(|u| Named::new(names, (0..names.len()).map(|i| u.covariance[(i, i)].sqrt()))),
+            poorly_determined_directions: u.map(|u| Rank::said(&u.poorly_determined, names)),
         }
     }
 }
@@ -142,6 +146,9 @@ pub struct EstimateReport {
     /// Evaluations spent in each phase reached: reachability, fit, intervals,
     /// mirror_solutions, other_solutions (on a large model each is an eigen-solve of seconds).
     pub evaluations_by_phase: Named<usize>,
+    /// The data counted and what they determine: the rank of their weighted Jacobian at the
+    /// estimate and the parameter directions they cannot tell apart.
+    pub data_rank: DataRankReport,
     /// Initial and estimated values, and what the data say about each parameter, in words.
     #[serde(flatten)]
     pub values: ParameterValues,
@@ -180,6 +187,47 @@ pub struct EstimateReport {
     /// Held parameters.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fixed: Option<Named<f64>>,
+}
+
+/// The data an estimate counted and what they determine (the `data_rank` object).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DataRankReport {
+    /// What was counted, in words: `3 measured frequencies + 3 × 6 shape components = 21 data`.
+    pub counted: String,
+    /// Data rows: frequencies and shape components.
+    pub rows: usize,
+    /// Free parameters.
+    pub parameters: usize,
+    /// The numerical rank of the weighted Jacobian of all the data at the estimate.
+    pub rank: usize,
+    /// The parameter directions the data do not see (null directions of that Jacobian, in
+    /// scaled parameters), in words; empty at full rank.
+    pub null_directions: Vec<String>,
+}
+
+impl DataRankReport {
+    /// The report of `rank` for `rows` data (`counted` in words) and parameters `names`.
+    pub fn new(counted: &str, rows: usize, rank: &Rank, names: &[String]) -> Self {
+        Self {
+            counted: counted.to_string(),
+            rows,
+            parameters: names.len(),
+            rank: rank.rank,
+            null_directions: Rank::said(rank.null_directions(), names),
+        }
+    }
+}
+
+/// The data rows of `modes` measured modes with shapes at `sensors` sensors (0: frequencies
+/// alone), and what was counted in words.
+pub fn counted_data(modes: usize, sensors: usize) -> (usize, String) {
+    let rows = modes * (1 + sensors);
+    let text = match sensors {
+        0 if modes == 1 => "1 measured frequency".to_string(),
+        0 => format!("{modes} measured frequencies"),
+        s => format!("{modes} measured modes × (1 frequency + {s} shape components) = {rows} data"),
+    };
+    (rows, text)
 }
 
 /// An estimation: the report and what a front end needs beside it (tables, plots, files).
@@ -310,18 +358,12 @@ pub fn run(
     let initial = model.reduce(&initial);
     let np = model.parameters().len();
     let measured_name = request.measured.display();
-    // With shapes every mode gives a row per sensor too: fewer modes than parameters may do.
+    // The data are counted, not the modes: with shapes every mode gives a row per sensor too,
+    // so fewer modes than parameters may do. Fewer data than parameters cannot determine them;
+    // otherwise the rank of the weighted Jacobian at the estimate decides (below).
     let sensors = data.sensors.as_ref().map_or(0, |s| s.sensors.len());
-    let rows = measurement.len() * (1 + sensors);
+    let (rows, counted) = counted_data(measurement.len(), sensors);
     if rows < np {
-        let counted = match sensors {
-            0 if measurement.len() == 1 => "1 measured frequency".to_string(),
-            0 => format!("{} measured frequencies", measurement.len()),
-            s => format!(
-                "{} measured modes × (1 frequency + {s} shape components) = {rows} data",
-                measurement.len()
-            ),
-        };
         return Err(input(format!(
             "{measured_name}: {counted} for {np} parameters: at least {np} are needed"
         )));
@@ -479,6 +521,19 @@ pub fn run(
     if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
         notes.extend(check_roundoff_of(&system, &modes, Some(&mode_numbers))?);
     }
+    // Whether the data determine the parameters: the numerical rank of the weighted Jacobian of
+    // every datum (frequencies and shape components) at the estimate, not a count of modes.
+    let rank = Rank::at(model.parameters(), &estimate.last);
+    let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
+    let data_rank = DataRankReport::new(&counted, rows, &rank, &names);
+    if !rank.is_full() {
+        notes.push(format!(
+            "{measured_name}: {counted} determine {} of the {np} parameter directions (the rank of the weighted \
+             Jacobian of all the data at the estimate); they cannot tell apart changes along {}",
+            rank.rank,
+            data_rank.null_directions.join("; ")
+        ));
+    }
     let converged = estimate.termination.is_converged();
     let quality = judge(&estimate.last, np);
     let limits = at_limits(model.parameters(), &estimate.parameters);
@@ -504,7 +559,6 @@ pub fn run(
     let alternatives_sigma = Equivalence::at(&estimate.last, np).sigma_source();
     let unique = !alternatives.iter().any(|a| a.judged.equally_good);
     let budget_spent = budget.exhausted();
-    let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
     let pinned: Vec<String> = (0..np).filter(|&i| limits[i] != 0).map(|i| names[i].clone()).collect();
     // A measured mode below the MAC threshold makes the result not acceptable.
     let unpaired = mac.as_ref().is_some_and(|r| !r.unpaired.is_empty());
@@ -548,6 +602,7 @@ pub fn run(
         fit: FitQualityReport::of(&quality, |k| k),
         budget: BudgetReport { limit: budget.limit(), used: budget.used(), exhausted: budget_spent },
         evaluations_by_phase: phase_counts(&phases),
+        data_rank,
         values: ParameterValues::new(&names, &initial, &estimate.parameters, status),
         at_limit: pinned,
         alternative_solutions: AlternativeSolution::list(&names, &alternatives),

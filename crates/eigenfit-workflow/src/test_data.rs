@@ -240,7 +240,8 @@ impl<'a> Fit<'a> {
 
     /// Intervals and the residual scatter they were scaled by: the frequency fit's as the
     /// statistics module gives them (within `budget`, bounds done reported to `observers`), the
-    /// shape fit's from [`ShapeFit::uncertainty_within`] (within `budget`).
+    /// shape fit's from [`ShapeFit::uncertainty_parallel`] (within `budget`); the parameters'
+    /// profiles in parallel.
     pub fn uncertainty_within(
         &mut self,
         at: &Linearisation,
@@ -248,11 +249,13 @@ impl<'a> Fit<'a> {
         observers: &mut [&mut dyn Observer],
     ) -> (Option<Uncertainty>, Option<f64>) {
         match self {
+            // Every parameter's profile bounds in parallel: the model and solvers are shared
+            // between threads (the solvers' workspaces are per thread).
             Fit::Frequencies(p) => {
-                (eigenfit_core::analysis::uncertainty_observed(p, at, budget, observers), None)
+                (eigenfit_core::analysis::uncertainty_parallel(p, at, budget, observers), None)
             }
             Fit::Shapes(s) => {
-                s.uncertainty_within(at, budget).map_or((None, None), |(u, sc)| (Some(u), Some(sc)))
+                s.uncertainty_parallel(at, budget).map_or((None, None), |(u, sc)| (Some(u), Some(sc)))
             }
         }
     }

@@ -319,6 +319,21 @@ fn print_report(est: &Estimation) {
         let sv: Vec<String> = values.iter().map(|v| format!("{v:.3e}")).collect();
         println!("scaled Jacobian: singular values [{}], condition number {condition:.3e}", sv.join(", "));
     }
+    if !r.data_rank.null_directions.is_empty() {
+        println!(
+            "the data ({}) determine {} of {} parameter directions; they cannot tell apart changes along: {}",
+            r.data_rank.counted,
+            r.data_rank.rank,
+            r.data_rank.parameters,
+            r.data_rank.null_directions.join("; ")
+        );
+    }
+    if let Some(weak) = r.uncertainty.poorly_determined_directions.as_ref().filter(|w| !w.is_empty()) {
+        println!(
+            "poorly determined combinations (95 % interval wider than ×10 along them): {}",
+            weak.join("; ")
+        );
+    }
     if !r.at_limit.is_empty() {
         println!("at a parameter limit (the data cannot determine it): {}", r.at_limit.join(", "));
     }

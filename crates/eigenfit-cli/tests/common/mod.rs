@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use serde_json::Value;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Runs the built `eigenfit` with `args` in the current folder.
@@ -75,4 +76,68 @@ pub fn estimate_with<'a>(model: &'a str, measured: &'a str, more: &[&'a str]) ->
     let mut args = vec!["estimate", "--model", model, "--measured", measured];
     args.extend_from_slice(more);
     args
+}
+
+/// Reads a Matrix Market `coordinate real symmetric` file: its size and lower-triangle entries.
+pub fn read_mtx(path: &Path) -> (usize, Vec<(usize, usize, f64)>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('%'));
+    let n: usize = lines.next().unwrap().split_whitespace().next().unwrap().parse().unwrap();
+    let entries = lines
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            (f[0].parse().unwrap(), f[1].parse().unwrap(), f[2].parse().unwrap())
+        })
+        .collect();
+    (n, entries)
+}
+
+/// The 18-storey model with one parameter per storey, written into `dir` from the committed
+/// three-zone fixture: a zone's matrix is Σ kᵢ·(storey i's shear element), so storey i ≥ 2's
+/// stiffness is minus the entry joining floors i−1 and i, storey 1's the first diagonal entry
+/// less storey 2's. Each parameter a factor on its storey (nominal 1, limits [0.1, 10], log).
+pub fn per_storey_model(dir: &Path) -> PathBuf {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/real_data/eighteen_storey_edefense");
+    let mut k = [0.0f64; 19]; // storeys from 1
+    let mut k11 = 0.0;
+    for zone in ["K_storeys_1_6.mtx", "K_storeys_7_12.mtx", "K_storeys_13_18.mtx"] {
+        let (n, entries) = read_mtx(&src.join(zone));
+        assert_eq!(n, 18);
+        for (i, j, v) in entries {
+            if i == j + 1 {
+                k[i] = -v;
+            }
+            if (i, j) == (1, 1) {
+                k11 = v;
+            }
+        }
+    }
+    k[1] = k11 - k[2];
+    assert!(k[1..].iter().all(|&x| x > 0.0), "storey stiffnesses {k:?}");
+    let mut toml = String::from(
+        "kind = \"matrices\"\nname = \"E-Defense 18-storey frame, one factor per storey\"\n\
+         stiffness = \"K0.mtx\"\nmass = \"M0.mtx\"\ndofs = \"dofs.csv\"\n",
+    );
+    for s in 1..=18 {
+        let rows = if s == 1 {
+            vec![(1, 1, k[1])]
+        } else {
+            vec![(s - 1, s - 1, k[s]), (s, s - 1, -k[s]), (s, s, k[s])]
+        };
+        let mut text = format!("%%MatrixMarket matrix coordinate real symmetric\n18 18 {}\n", rows.len());
+        for (i, j, v) in rows {
+            text.push_str(&format!("{i} {j} {v:?}\n"));
+        }
+        std::fs::write(dir.join(format!("K{s}.mtx")), text).unwrap();
+        toml.push_str(&format!(
+            "\n[[parameter]]\nname = \"storey_{s}\"\nnominal = 1.0\nlower = 0.1\nupper = 10.0\n\
+             scale = \"log\"\nstiffness = \"K{s}.mtx\"\n"
+        ));
+    }
+    for f in ["K0.mtx", "M0.mtx", "dofs.csv"] {
+        std::fs::copy(src.join(f), dir.join(f)).unwrap();
+    }
+    let path = dir.join("model.toml");
+    std::fs::write(&path, toml).unwrap();
+    path
 }

@@ -93,6 +93,27 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         crate::analysis::statistics::scatter_uncertainty(self, |fit| &mut fit.scale, at, has_std, budget)
     }
 
+    /// [`ShapeFit::uncertainty_within`] with the parameters' profiles in parallel (a model and
+    /// solver shared between threads): the same intervals and evaluations.
+    pub fn uncertainty_parallel(
+        &mut self,
+        at: &Linearisation,
+        budget: &crate::update::Budget,
+    ) -> Option<(crate::analysis::Uncertainty, f64)>
+    where
+        M: Sync,
+        S: Sync,
+    {
+        let has_std = self.has_std();
+        crate::analysis::statistics::scatter_uncertainty_parallel(
+            self,
+            |fit| &mut fit.scale,
+            at,
+            has_std,
+            budget,
+        )
+    }
+
     /// Modes solved: as many as MAC pairing considers.
     fn count(&self) -> usize {
         (2 * self.problem.measured.modes_needed() + 2).min(self.problem.model.dofs())

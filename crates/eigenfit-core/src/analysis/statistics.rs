@@ -2,8 +2,9 @@
 //! parameters the data cannot determine (with the one-sided bound they do support).
 
 use crate::analysis::chi2::Z_95;
+use crate::model::{ParameterSet, Scale};
 use crate::problem::{Linearisation, Objective};
-use crate::update::{Budget, Driver, LevenbergMarquardt, Observer};
+use crate::update::{scaled_bounds, Budget, Driver, LevenbergMarquardt, Observer};
 use nalgebra::DMatrix;
 
 /// χ² quantile of one degree of freedom at 95%: the profile-likelihood threshold.
@@ -56,6 +57,13 @@ pub struct Uncertainty {
     /// True when the evaluation budget ran out during the profile refits: the bounds of the
     /// parameters still being profiled then fall back to the parameter limits.
     pub budget_exhausted: bool,
+    /// The numerical rank of the weighted Jacobian at the estimate and the parameter directions
+    /// the data do not see.
+    pub rank: Rank,
+    /// The directions (unit vectors in scaled parameters) whose linearised 95 % interval is wider
+    /// than a factor of 10 each way for log parameters (σ = 1/singular value above the profile
+    /// trigger): combinations of parameters the data barely tell apart, null directions included.
+    pub poorly_determined: Vec<Vec<f64>>,
 }
 
 /// Evaluations one call of [`uncertainty`] may spend on profile refits.
@@ -83,8 +91,8 @@ pub fn uncertainty_within(
 /// are always weighted, by defaults where none were given); without, from the residual scatter:
 /// every row is divided by σ̂ = √(‖r‖²/dof) (through `scale`, the objective's row divisor), the
 /// usual regression estimate. `None` when there are no more rows than parameters. Profile refits
-/// are charged to `budget`. Returns the intervals and σ̂ (1 with given std). Shared by [`ShapeFit`](super::ShapeFit) and
-/// [`Joint`](super::Joint).
+/// are charged to `budget`, one parameter after another. Returns the intervals and σ̂ (1 with
+/// given std). Shared by [`ShapeFit`](super::ShapeFit) and [`Joint`](super::Joint).
 pub(crate) fn scatter_uncertainty<P: Objective>(
     problem: &mut P,
     scale: fn(&mut P) -> &mut f64,
@@ -92,8 +100,35 @@ pub(crate) fn scatter_uncertainty<P: Objective>(
     has_std: bool,
     budget: &Budget,
 ) -> Option<(Uncertainty, f64)> {
+    scatter_with(problem, scale, at, has_std, |p, lin| {
+        weighted_uncertainty(Shared::Serial(p), lin, budget, &mut [])
+    })
+}
+
+/// [`scatter_uncertainty`] with the parameters' profiles in parallel.
+pub(crate) fn scatter_uncertainty_parallel<P: Objective + Sync>(
+    problem: &mut P,
+    scale: fn(&mut P) -> &mut f64,
+    at: &Linearisation,
+    has_std: bool,
+    budget: &Budget,
+) -> Option<(Uncertainty, f64)> {
+    scatter_with(problem, scale, at, has_std, |p, lin| {
+        weighted_uncertainty(Shared::Parallel(p), lin, budget, &mut [])
+    })
+}
+
+/// The scatter rescaling of [`scatter_uncertainty`] around `weighted`, the intervals of a
+/// residual in noise units.
+fn scatter_with<P: Objective>(
+    problem: &mut P,
+    scale: fn(&mut P) -> &mut f64,
+    at: &Linearisation,
+    has_std: bool,
+    weighted: impl Fn(&P, &Linearisation) -> Option<Uncertainty>,
+) -> Option<(Uncertainty, f64)> {
     if has_std {
-        return weighted_uncertainty(problem, at, budget, &mut []).map(|u| (u, 1.0));
+        return weighted(problem, at).map(|u| (u, 1.0));
     }
     let dof = at.residual.len().checked_sub(at.parameters.len()).filter(|&d| d > 0)?;
     let scatter = (at.residual.norm_squared() / dof as f64).sqrt();
@@ -106,7 +141,7 @@ pub(crate) fn scatter_uncertainty<P: Objective>(
         .linearise(&at.parameters)
         .ok()
         // The rescaled rows are in noise units, as weights from std would put them.
-        .and_then(|lin| weighted_uncertainty(problem, &lin, budget, &mut []))
+        .and_then(|lin| weighted(problem, &lin))
         .map(|u| (u, scatter));
     *scale(problem) = old;
     result
@@ -123,22 +158,154 @@ pub fn uncertainty_observed(
     if !at.has_std {
         return None;
     }
-    weighted_uncertainty(problem, at, budget, observers)
+    weighted_uncertainty(Shared::Serial(problem), at, budget, observers)
 }
 
-/// The intervals of a residual in noise units (weighted by std, or rescaled by σ̂).
-fn weighted_uncertainty(
-    problem: &dyn Objective,
+/// [`uncertainty_observed`] with the parameters' profiles (each bound a job) on rayon's threads:
+/// the same intervals, the same evaluations, less wall time on several cores.
+pub fn uncertainty_parallel(
+    problem: &(dyn Objective + Sync),
     at: &Linearisation,
     budget: &Budget,
     observers: &mut [&mut dyn Observer],
 ) -> Option<Uncertainty> {
+    if !at.has_std {
+        return None;
+    }
+    weighted_uncertainty(Shared::Parallel(problem), at, budget, observers)
+}
+
+/// The objective the profile refits run on: one at a time, or (a `Sync` objective) every
+/// parameter's bounds in parallel.
+#[derive(Clone, Copy)]
+pub(crate) enum Shared<'a> {
+    /// Profiles one after another.
+    Serial(&'a dyn Objective),
+    /// Profiles on rayon's threads.
+    Parallel(&'a (dyn Objective + Sync)),
+}
+
+impl<'a> Shared<'a> {
+    fn objective(self) -> &'a dyn Objective {
+        match self {
+            Shared::Serial(p) => p,
+            Shared::Parallel(p) => p,
+        }
+    }
+}
+
+/// Singular values of a weighted Jacobian below this fraction of the largest count as zero (the
+/// numerical rank): above the round-off of analytic eigenvalue and eigenvector derivatives,
+/// below any direction a measurement resolves (its 95 % interval 10¹⁰ times the best-determined
+/// one's). Directions the data see but only weakly are [`Uncertainty::poorly_determined`].
+pub const RANK_TOLERANCE: f64 = 1e-10;
+
+/// What the data can tell apart at a point: the numerical rank of the weighted Jacobian in
+/// scaled parameters (log for log parameters) and the directions it does not see.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rank {
+    /// Rows of the Jacobian: the data counted (frequencies and shape components).
+    pub rows: usize,
+    /// Singular values, descending (as many as parameters; a Jacobian with fewer rows than
+    /// parameters has zeros for the rest).
+    pub singular_values: Vec<f64>,
+    /// The right singular vectors, in the order of `singular_values`: unit vectors in scaled
+    /// parameters, each signed so that its largest component is positive.
+    pub directions: Vec<Vec<f64>>,
+    /// Singular values above [`RANK_TOLERANCE`] × the largest.
+    pub rank: usize,
+}
+
+impl Rank {
+    /// The rank of `js`, a weighted Jacobian in scaled parameters.
+    pub fn of(js: &DMatrix<f64>) -> Self {
+        let (rows, np) = js.shape();
+        // Padded with zero rows to at least square, so that the SVD gives every right singular
+        // vector, the null space of a Jacobian with fewer rows than columns included.
+        let mut padded = DMatrix::zeros(rows.max(np), np);
+        padded.rows_mut(0, rows).copy_from(js);
+        let svd = padded.iter().all(|v| v.is_finite()).then(|| padded.svd(false, true));
+        let Some((svd, v_t)) = svd.as_ref().and_then(|s| s.v_t.as_ref().map(|v| (s, v))) else {
+            return Self { rows, singular_values: vec![0.0; np], directions: Vec::new(), rank: 0 };
+        };
+        let mut order: Vec<usize> = (0..np).collect();
+        order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
+        let singular_values: Vec<f64> = order.iter().map(|&k| svd.singular_values[k]).collect();
+        let smax = singular_values.first().copied().unwrap_or(0.0);
+        let rank = singular_values.iter().filter(|&&s| s > 0.0 && s > RANK_TOLERANCE * smax).count();
+        let directions = order
+            .iter()
+            .map(|&k| {
+                let v: Vec<f64> = v_t.row(k).iter().copied().collect();
+                // Signed so that the largest component is positive (an SVD's signs are arbitrary).
+                let big = v.iter().copied().fold(0.0, |m: f64, x| if x.abs() > m.abs() { x } else { m });
+                v.iter().map(|x| if big < 0.0 { -x } else { *x }).collect()
+            })
+            .collect();
+        Self { rows, singular_values, directions, rank }
+    }
+
+    /// The rank of the weighted Jacobian of `at`, in the scaled coordinates of `params`.
+    pub fn at(params: &ParameterSet, at: &Linearisation) -> Self {
+        Self::of(&at.scaled_jacobian(params))
+    }
+
+    /// True when the data see every parameter direction.
+    pub fn is_full(&self) -> bool {
+        self.rank == self.singular_values.len()
+    }
+
+    /// The directions the data do not see: moving along one changes no datum (to first order).
+    pub fn null_directions(&self) -> &[Vec<f64>] {
+        self.directions.get(self.rank..).unwrap_or_default()
+    }
+
+    /// The directions whose singular value is below `s` (in noise units, 1/s is the standard
+    /// deviation of the estimate along the direction).
+    pub fn weaker_than(&self, s: f64) -> &[Vec<f64>] {
+        let k = self.singular_values.iter().take_while(|&&v| v >= s).count().min(self.directions.len());
+        &self.directions[k..]
+    }
+
+    /// `directions` in words: each one's components of at least 0.05 in size order, e.g.
+    /// `0.71·storey_17 − 0.70·storey_18` (scaled parameters: a log parameter's component is a
+    /// relative change).
+    pub fn said(directions: &[Vec<f64>], names: &[String]) -> Vec<String> {
+        directions
+            .iter()
+            .map(|v| {
+                let mut parts: Vec<(usize, f64)> =
+                    v.iter().copied().enumerate().filter(|(_, x)| x.abs() >= 0.05).collect();
+                parts.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+                let mut text = String::new();
+                for (n, (i, x)) in parts.iter().enumerate() {
+                    let sign = match (n, *x < 0.0) {
+                        (0, false) => "",
+                        (0, true) => "−",
+                        (_, false) => " + ",
+                        (_, true) => " − ",
+                    };
+                    text.push_str(&format!("{sign}{:.2}·{}", x.abs(), names[*i]));
+                }
+                text
+            })
+            .collect()
+    }
+}
+
+/// The intervals of a residual in noise units (weighted by std, or rescaled by σ̂).
+fn weighted_uncertainty(
+    shared: Shared<'_>,
+    at: &Linearisation,
+    budget: &Budget,
+    observers: &mut [&mut dyn Observer],
+) -> Option<Uncertainty> {
+    let problem = shared.objective();
     let params = problem.parameters();
     let np = params.len();
     let js = at.scaled_jacobian(params);
-    let svd = js.clone().svd(false, false);
-    let mut singular_values: Vec<f64> = svd.singular_values.iter().copied().collect();
-    singular_values.sort_by(|a, b| b.total_cmp(a));
+    let rank = Rank::of(&js);
+    let singular_values = rank.singular_values.clone();
     let smin = singular_values.last().copied().unwrap_or(0.0);
     let condition_number = if smin > 0.0 { singular_values[0] / smin } else { f64::INFINITY };
     // Scaled covariance (JsᵀJs)⁻¹ via a pseudo-inverse so a rank-deficient Jacobian gives ∞, not NaN.
@@ -150,35 +317,87 @@ fn weighted_uncertainty(
         .unwrap_or_else(|| DMatrix::from_diagonal_element(np, np, f64::INFINITY));
     let jac: Vec<f64> = params.iter().zip(&at.parameters).map(|(p, &v)| p.scale_derivative(v)).collect();
     let covariance = DMatrix::from_fn(np, np, |i, j| scaled_cov[(i, j)] * jac[i] * jac[j]);
-    let mut intervals = Vec::with_capacity(np);
-    let mut identifiability = Vec::with_capacity(np);
-    let mut budget_exhausted = false;
-    let profiled = |i: usize| {
-        let sigma = scaled_cov[(i, i)].sqrt();
-        !(sigma.is_finite() && sigma <= PROFILE_TRIGGER)
-    };
-    // Two bounds per profiled parameter.
-    let (total, mut done) = (2 * (0..np).filter(|&i| profiled(i)).count(), 0);
+    let s_hat: Vec<f64> = params.iter().zip(&at.parameters).map(|(p, &v)| p.to_scaled(v)).collect();
+    let (lo, hi) = scaled_bounds(params);
+    let near = |a: f64, b: f64| b.is_finite() && (a - b).abs() <= 1e-9 * (1.0 + b.abs());
+    // A parameter on one of its limits: that limit is one end of its interval, the profile the
+    // other; no linearised interval may reach past the limit.
+    let on_limit: Vec<bool> = (0..np).map(|i| near(s_hat[i], lo[i]) || near(s_hat[i], hi[i])).collect();
+    // Held by its limit in a refit: on a limit with the gradient pushing outward (the damped
+    // strategy's active set); the profiles' linear predictions leave these where they are.
+    let g = js.transpose() * &at.residual;
+    let held: Vec<bool> = (0..np)
+        .map(|i| (near(s_hat[i], lo[i]) && g[i] < 0.0) || (near(s_hat[i], hi[i]) && g[i] > 0.0))
+        .collect();
+    let profiled: Vec<bool> = (0..np)
+        .map(|i| {
+            let sigma = scaled_cov[(i, i)].sqrt();
+            on_limit[i] || !(sigma.is_finite() && sigma <= PROFILE_TRIGGER)
+        })
+        .collect();
+    // The bounds to profile: both sides of an interior parameter, the side away from the limit
+    // of one on a limit.
+    let mut sides: Vec<(usize, f64)> = Vec::new();
+    for i in (0..np).filter(|&i| profiled[i]) {
+        for dir in [-1.0, 1.0] {
+            let toward = if dir < 0.0 { lo[i] } else { hi[i] };
+            if !near(s_hat[i], toward) {
+                sides.push((i, dir));
+            }
+        }
+    }
+    let total = sides.len();
     let mut report = |done: usize| observers.iter_mut().for_each(|o| o.steps_done(done, total));
     if total > 0 {
         report(0);
     }
+    let profile = |i: usize| Profile {
+        problem,
+        at,
+        i,
+        budget,
+        // σ of the profile's curvature, with the parameters held by their limits left out.
+        sigma: conditional_sigma(&js, i, &held),
+        held: &held,
+    };
+    let found: Vec<Result<Option<f64>, OutOfBudget>> = match shared {
+        Shared::Serial(_) => sides
+            .iter()
+            .enumerate()
+            .map(|(k, &(i, dir))| {
+                let b = profile(i).bound(dir);
+                report(k + 1);
+                b
+            })
+            .collect(),
+        Shared::Parallel(sync) => {
+            let job = |i: usize, dir: f64| {
+                Profile { problem: sync, at, i, budget, sigma: conditional_sigma(&js, i, &held), held: &held }
+                    .bound(dir)
+            };
+            in_parallel(&sides, job, &mut report)
+        }
+    };
+    let budget_exhausted = budget.exhausted();
+    let side_of = |i: usize, dir: f64| {
+        sides.iter().position(|&(j, d)| j == i && d == dir).map(|k| match &found[k] {
+            Ok(b) => Ok(*b),
+            Err(OutOfBudget) => Err(OutOfBudget),
+        })
+    };
+    let mut intervals = Vec::with_capacity(np);
+    let mut identifiability = Vec::with_capacity(np);
     for (i, par) in params.iter().enumerate() {
-        let s = par.to_scaled(at.parameters[i]);
         let sigma = scaled_cov[(i, i)].sqrt();
-        if !profiled(i) {
-            intervals.push([par.from_scaled(s - Z_95 * sigma), par.from_scaled(s + Z_95 * sigma)]);
+        if !profiled[i] {
+            intervals
+                .push([par.from_scaled(s_hat[i] - Z_95 * sigma), par.from_scaled(s_hat[i] + Z_95 * sigma)]);
             identifiability.push(Identifiability::Determined);
             continue;
         }
-        let profile = Profile { problem, at, i, budget, sigma };
-        let lower = profile.bound(-1.0);
-        done += 1;
-        report(done);
-        let upper = profile.bound(1.0);
-        done += 1;
-        report(done);
-        budget_exhausted |= budget.exhausted();
+        // A side not profiled lies on the limit: nothing beyond it, the data bound nothing there.
+        let lower = side_of(i, -1.0).unwrap_or(Ok(None));
+        let upper = side_of(i, 1.0).unwrap_or(Ok(None));
         let (lower, upper) = match (lower, upper) {
             (Ok(l), Ok(u)) => (l, u),
             // Out of budget: say nothing the refits did not establish.
@@ -199,19 +418,90 @@ fn weighted_uncertainty(
         condition_number,
         identifiability,
         budget_exhausted,
+        poorly_determined: rank.weaker_than(1.0 / PROFILE_TRIGGER).to_vec(),
+        rank,
     })
+}
+
+/// Runs `job` on every side on rayon's threads, telling `report` how many are done as each
+/// finishes (on the calling thread: observers are not `Send`). Results in `sides`' order.
+fn in_parallel<F>(
+    sides: &[(usize, f64)],
+    job: F,
+    report: &mut dyn FnMut(usize),
+) -> Vec<Result<Option<f64>, OutOfBudget>>
+where
+    F: Fn(usize, f64) -> Result<Option<f64>, OutOfBudget> + Sync,
+{
+    use std::sync::mpsc::{channel, RecvTimeoutError, TryRecvError};
+    let mut found: Vec<Option<Result<Option<f64>, OutOfBudget>>> = (0..sides.len()).map(|_| None).collect();
+    let (tx, rx) = channel();
+    let job = &job;
+    rayon::in_place_scope(|scope| {
+        for (k, &(i, dir)) in sides.iter().enumerate() {
+            let tx = tx.clone();
+            scope.spawn(move |_| {
+                let _ = tx.send((k, job(i, dir)));
+            });
+        }
+        drop(tx);
+        let mut done = 0;
+        loop {
+            let message = match rx.try_recv() {
+                Ok(m) => Some(m),
+                Err(TryRecvError::Disconnected) => break,
+                // On one of rayon's threads, help with the pending profiles; elsewhere wait.
+                Err(TryRecvError::Empty) => match rayon::yield_now() {
+                    Some(rayon::Yield::Executed) => None,
+                    _ => match rx.recv_timeout(std::time::Duration::from_millis(20)) {
+                        Ok(m) => Some(m),
+                        Err(RecvTimeoutError::Timeout) => None,
+                        Err(RecvTimeoutError::Disconnected) => break,
+                    },
+                },
+            };
+            if let Some((k, result)) = message {
+                found[k] = Some(result);
+                done += 1;
+                report(done);
+            }
+        }
+    });
+    found.into_iter().map(|f| f.unwrap_or(Err(OutOfBudget))).collect()
+}
+
+/// σ of parameter `i` in scaled units as its profile sees it near the estimate: the curvature
+/// of the least squares with the parameters `held` by their limits left out (a refit cannot move
+/// them), ∞ when the others can compensate it exactly.
+fn conditional_sigma(js: &DMatrix<f64>, i: usize, held: &[bool]) -> f64 {
+    let keep: Vec<usize> = (0..js.ncols()).filter(|&j| j == i || !held[j]).collect();
+    let sub = DMatrix::from_fn(js.nrows(), keep.len(), |r, c| js[(r, keep[c])]);
+    let at = keep.iter().position(|&j| j == i).expect("i is kept"); // proof: j == i kept above
+    (sub.transpose() * &sub)
+        .try_inverse()
+        .map(|c| c[(at, at)])
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .map_or(f64::INFINITY, f64::sqrt)
 }
 
 /// Iterations of one warm-started profile refit: it starts next to its solution.
 const PROFILE_REFIT_ITERATIONS: usize = 30;
-/// Refits allowed to bracket one bound (steps growing ×3 from the linearised σ).
+/// Refits allowed to bracket one bound (each step extrapolated from the last, at most ×10).
 const PROFILE_BRACKET_REFITS: usize = 8;
+/// The first step of a profile (scaled units) where the linearisation predicts no bound within
+/// the limits: a factor e^0.5 = 1.65 of a log parameter.
+const PROFILE_FIRST_STEP: f64 = 0.5;
 /// Refits allowed to locate a bracketed bound.
 const PROFILE_LOCATE_REFITS: usize = 12;
 /// A bound is located when √Δχ² is this close to 1.96 (Δχ² within 0.05 of 3.84), or the
-/// bracket this narrow (scaled units: 0.1% of a log parameter).
+/// bracket this narrow relative to the bound's distance from the estimate (0.1 %: a bound a
+/// hair from a limit the data press on is located as finely as one far away).
 const PROFILE_ROOT_TOLERANCE: f64 = 0.05 / (2.0 * Z_95);
 const PROFILE_WIDTH_TOLERANCE: f64 = 1e-3;
+/// A profile refit stops when the Gauss–Newton step would lower ½χ² by less than this: Δχ² is
+/// then known to 2·10⁻³, twenty-five times finer than the bound is located
+/// ([`PROFILE_ROOT_TOLERANCE`]).
+const PROFILE_COST_TOLERANCE: f64 = 1e-3;
 
 /// The profile likelihood of one parameter: Δχ² after refitting the others with it held fixed.
 struct Profile<'a> {
@@ -219,8 +509,10 @@ struct Profile<'a> {
     at: &'a Linearisation,
     i: usize,
     budget: &'a Budget,
-    /// Linearised σ in scaled units (may be ∞): sets the first bracketing step.
+    /// σ in scaled units of the profile near the estimate (may be ∞): sets the first step.
     sigma: f64,
+    /// The parameters a refit's linear prediction leaves on their limits.
+    held: &'a [bool],
 }
 
 /// √Δχ² − √3.84: negative inside the 95% region, zero on its boundary.
@@ -232,15 +524,56 @@ fn signed_root(delta_chi2: f64) -> f64 {
 struct OutOfBudget;
 
 impl Profile<'_> {
-    /// Δχ² at scaled value `s`, refitting the other parameters from `warm` (the solution at the
-    /// nearest point already profiled); with it, the refitted parameters. `None` when the
-    /// model cannot be evaluated there (counts as beyond the bound).
-    fn delta_chi2(&self, s: f64, warm: &[f64]) -> Result<Option<(f64, Vec<f64>)>, OutOfBudget> {
-        let par = &self.problem.parameters().as_slice()[self.i];
-        let mut p = warm.to_vec();
+    /// Where a refit at scaled value `s` starts: the solution at the nearest point already
+    /// profiled (`warm`), the others moved by the Gauss–Newton prediction of their response
+    /// from its Jacobian (damped, none further than the profiled parameter moves, within their
+    /// limits, the parameters held by a limit kept).
+    fn start(&self, s: f64, warm: &Linearisation) -> Vec<f64> {
+        let params = self.problem.parameters();
+        let np = params.len();
+        let mut p = warm.parameters.clone();
+        let par = &params.as_slice()[self.i];
         p[self.i] = par.from_scaled(s).clamp(par.lower, par.upper);
+        let free: Vec<usize> = (0..np).filter(|&j| j != self.i && !self.held[j]).collect();
+        if free.is_empty() {
+            return p;
+        }
+        let js = warm.scaled_jacobian(params);
+        let step_i = s - par.to_scaled(warm.parameters[self.i]);
+        let target = &warm.residual - js.column(self.i) * step_i;
+        let jo = DMatrix::from_fn(js.nrows(), free.len(), |r, c| js[(r, free[c])]);
+        let mut a = jo.transpose() * &jo;
+        let amax = a.diagonal().amax().max(f64::MIN_POSITIVE);
+        for k in 0..free.len() {
+            a[(k, k)] += 1e-3 * a[(k, k)].max(1e-12 * amax);
+        }
+        let Some(delta) = a.cholesky().map(|c| c.solve(&(jo.transpose() * target))) else {
+            return p;
+        };
+        // None of the others further than the profiled parameter moves: along a direction the
+        // data barely see the prediction is large and meaningless, and would start the refit in
+        // another basin (modes paired otherwise) far from the profile's.
+        let cap = step_i.abs();
+        let scale = if delta.amax() > cap { cap / delta.amax() } else { 1.0 };
+        let (lo, hi) = scaled_bounds(params);
+        for (k, &j) in free.iter().enumerate() {
+            let q = &params.as_slice()[j];
+            let sj = (q.to_scaled(warm.parameters[j]) + scale * delta[k]).clamp(lo[j], hi[j]);
+            p[j] = q.from_scaled(sj).clamp(q.lower, q.upper);
+        }
+        p
+    }
+
+    /// Δχ² at scaled value `s`, refitting the other parameters from `warm` (the solution at the
+    /// nearest point already profiled); with it, the refit's last linearisation. `None` when the
+    /// model cannot be evaluated there (counts as beyond the bound).
+    fn delta_chi2(&self, s: f64, warm: &Linearisation) -> Result<Option<(f64, Linearisation)>, OutOfBudget> {
+        let p = self.start(s, warm);
         let fixed = (0..p.len()).map(|j| j == self.i).collect();
-        let mut local = LevenbergMarquardt::default().with_fixed(fixed).with_max_restarts(0);
+        let mut local = LevenbergMarquardt::default()
+            .with_fixed(fixed)
+            .with_max_restarts(0)
+            .with_cost_tolerance(PROFILE_COST_TOLERANCE);
         let run = Driver { max_iterations: PROFILE_REFIT_ITERATIONS }.run_within(
             self.problem,
             &mut local,
@@ -250,13 +583,15 @@ impl Profile<'_> {
         if self.budget.exhausted() {
             return Err(OutOfBudget);
         }
-        Ok(run.ok().map(|est| (2.0 * (est.last.cost() - self.at.cost()), est.parameters)))
+        Ok(run.ok().map(|est| (2.0 * (est.last.cost() - self.at.cost()), est.last)))
     }
 
     /// The 95% profile-likelihood bound in direction `dir` (−1 lower, +1 upper), or `None` when
     /// Δχ² stays within the threshold all the way to the parameter's limit (or the estimate sits
-    /// on that limit). Warm-started local refits only: a handful to bracket (steps growing ×3
-    /// from the linearised σ), then a safeguarded regula falsi (Illinois) on Δχ² − threshold.
+    /// on that limit). Warm-started local refits only: the first at the bound the curvature
+    /// predicts (the limit when it predicts none), each next one extrapolated from the last
+    /// (√Δχ² is near linear in the parameter where Δχ² is near quadratic) until one is beyond
+    /// the bound, then a safeguarded regula falsi (Illinois) on √Δχ² − 1.96.
     fn bound(&self, dir: f64) -> Result<Option<f64>, OutOfBudget> {
         let par = &self.problem.parameters().as_slice()[self.i];
         let limit = if dir < 0.0 { par.lower } else { par.upper };
@@ -267,14 +602,26 @@ impl Profile<'_> {
         if span.is_nan() || span <= 1e-9 * (1.0 + s_hat.abs()) {
             return Ok(None);
         }
-        let first = if self.sigma.is_finite() { (Z_95 * self.sigma).max(0.1) } else { 1.0 };
-        let (mut inside, mut inside_val, mut warm) = (0.0, signed_root(0.0), self.at.parameters.clone());
-        let mut t = first.min(span);
+        let located = |t: f64| Ok(Some(par.from_scaled(s_hat + dir * t).clamp(par.lower, par.upper)));
+        // The bound the curvature predicts when it lies within the limits; where the others can
+        // make up for the parameter (σ beyond the span) a first step of a factor 1.65 of a log
+        // parameter (a quarter of the span of a linear one), not the limit: far from the
+        // estimate, a refit there costs many iterations and says little about where Δχ² crosses.
+        let first = match par.scale {
+            _ if Z_95 * self.sigma < span => Z_95 * self.sigma,
+            Scale::Linear if span.is_finite() => 0.25 * span,
+            _ => PROFILE_FIRST_STEP,
+        };
+        let mut t = first.clamp(1e-6 * (1.0 + s_hat.abs()), span);
+        let (mut inside, mut inside_val, mut warm) = (0.0, signed_root(0.0), self.at.clone());
         let mut outside = None;
         for _ in 0..PROFILE_BRACKET_REFITS {
             match self.delta_chi2(s_hat + dir * t, &warm)? {
-                Some((d, p)) if d <= CHI2_95_1DOF => {
-                    (inside, inside_val, warm) = (t, signed_root(d), p);
+                Some((d, lin)) if d <= CHI2_95_1DOF => {
+                    (inside, inside_val, warm) = (t, signed_root(d), lin);
+                    if -inside_val <= PROFILE_ROOT_TOLERANCE {
+                        return located(t);
+                    }
                 }
                 hit => {
                     outside = Some((t, hit.map_or(f64::INFINITY, |(d, _)| signed_root(d))));
@@ -284,11 +631,18 @@ impl Profile<'_> {
             if t >= span {
                 return Ok(None); // the limit itself fits the data
             }
-            t = (3.0 * t).min(span);
+            // Through (0, −1.96) and (t, √Δχ² − 1.96): where the line reaches 0, at least ×1.5
+            // on, at most ×10; the limit when that is nearer.
+            let root = inside_val + Z_95;
+            let grow = if root > 0.0 { (Z_95 / root).clamp(1.5, 10.0) } else { 10.0 };
+            t = (grow * t).min(span);
         }
         let Some((mut out, mut out_val)) = outside else {
             return Ok(None); // no rise within the reach of the bracketing: unbounded this side
         };
+        if out_val <= PROFILE_ROOT_TOLERANCE {
+            return located(out);
+        }
         // Illinois: regula falsi on f = √Δχ² − 1.96 (near linear in the parameter where Δχ² is
         // near quadratic; Δχ² itself rises by thousands past the bound) between `inside` (f < 0) and `out`
         // (f > 0, or ∞ where the model failed), halving the value of an end kept twice in a row
@@ -302,20 +656,20 @@ impl Profile<'_> {
             }
         };
         for _ in 0..PROFILE_LOCATE_REFITS {
-            if out - inside <= PROFILE_WIDTH_TOLERANCE {
+            if out - inside <= PROFILE_WIDTH_TOLERANCE * out {
                 break;
             }
             let next = root(inside, inside_val, out, out_val)
                 .clamp(inside + 1e-3 * (out - inside), out - 1e-3 * (out - inside));
             match self.delta_chi2(s_hat + dir * next, &warm)? {
-                Some((d, p)) if d <= CHI2_95_1DOF => {
-                    (inside, inside_val, warm) = (next, signed_root(d), p);
+                Some((d, lin)) if d <= CHI2_95_1DOF => {
+                    (inside, inside_val, warm) = (next, signed_root(d), lin);
                     if kept == Some(false) {
                         out_val *= 0.5;
                     }
                     kept = Some(false);
                     if -inside_val <= PROFILE_ROOT_TOLERANCE {
-                        return Ok(Some(par.from_scaled(s_hat + dir * inside).clamp(par.lower, par.upper)));
+                        return located(inside);
                     }
                 }
                 hit => {
@@ -326,12 +680,106 @@ impl Profile<'_> {
                     }
                     kept = Some(true);
                     if out_val <= PROFILE_ROOT_TOLERANCE {
-                        return Ok(Some(par.from_scaled(s_hat + dir * out).clamp(par.lower, par.upper)));
+                        return located(out);
                     }
                 }
             }
         }
-        let at = root(inside, inside_val, out, out_val);
-        Ok(Some(par.from_scaled(s_hat + dir * at).clamp(par.lower, par.upper)))
+        located(root(inside, inside_val, out, out_val))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{uncertainty_observed, uncertainty_parallel, Identifiability, Rank};
+    use crate::eigen::{DenseSolver, EigenSolver};
+    use crate::matrix::System;
+    use crate::measurement::{MeasuredMode, Measurement};
+    use crate::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
+    use crate::problem::Problem;
+    use crate::test_chain::Chain;
+    use crate::update::{Budget, Driver, LevenbergMarquardt};
+    use nalgebra::DMatrix;
+
+    /// The chain with its last spring's upper limit below the truth: the data push it there.
+    struct Capped {
+        chain: Chain,
+        params: ParameterSet,
+    }
+
+    impl StructuralModel for Capped {
+        fn parameters(&self) -> &ParameterSet {
+            &self.params
+        }
+        fn dofs(&self) -> usize {
+            self.chain.dofs()
+        }
+        fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+            self.params.check(p)?;
+            self.chain.assemble(p)
+        }
+    }
+
+    fn capped() -> Capped {
+        let chain = Chain::new(&[1.0, 1.5, 0.8, 1.2]);
+        let k = |i: usize, upper: f64| {
+            Parameter::new(format!("k{}", i + 1), "N/m", 3e3).with_bounds(1e2, upper).with_scale(Scale::Log)
+        };
+        let params = ParameterSet::new(vec![k(0, 1e6), k(1, 1e6), k(2, 1e6), k(3, 4e3)]).unwrap();
+        Capped { chain, params }
+    }
+
+    #[test]
+    fn a_parameter_on_its_limit_is_one_sided_and_parallel_profiles_agree_with_serial_ones() {
+        let model = capped();
+        let truth = [2e3, 5e3, 1e4, 8e3];
+        let f = DenseSolver.lowest(&model.chain.assemble(&truth).unwrap(), 4).unwrap().frequencies_hz();
+        let modes = f.iter().enumerate().map(|(i, &f)| MeasuredMode::new(i, f).with_std(1e-3 * f)).collect();
+        let problem = Problem::new(&model, DenseSolver, Measurement::new(modes).unwrap());
+        let mut lm = LevenbergMarquardt::default();
+        let at = Driver::default().run(&problem, &mut lm, &[3e3, 3e3, 3e3, 3e3]).unwrap().last;
+        let k4 = at.parameters[3];
+        assert!((k4 / 4e3 - 1.0).abs() < 1e-12, "the data push k4 onto its upper limit: {:?}", at.parameters);
+        let (serial, parallel) = (Budget::new(10_000), Budget::new(10_000));
+        let u = uncertainty_observed(&problem, &at, &serial, &mut []).unwrap();
+        let v = uncertainty_parallel(&problem, &at, &parallel, &mut []).unwrap();
+        assert_eq!(u, v, "parallel profiles differ from serial ones");
+        assert_eq!(serial.used(), parallel.used(), "the same refits, the same evaluations");
+        // The limit is the interval's upper end; the lower end the profile's, bounded by the data.
+        assert_eq!(u.intervals[3][1], 4e3);
+        let Identifiability::LowerBoundOnly { lower } = u.identifiability[3] else {
+            panic!("{:?}", u.identifiability[3])
+        };
+        assert!(lower < 4e3 && lower > 1e2 && u.intervals[3][0] == lower, "{u:?}");
+        // At the bound the profile (k4 held, the others refitted, continued from the estimate in
+        // 20 steps at the default tolerances) is 3.84 above the estimate.
+        let mut warm = at.parameters.clone();
+        let mut delta = 0.0;
+        for k in 1..=20 {
+            warm[3] = (k4.ln() + (lower.ln() - k4.ln()) * k as f64 / 20.0).exp().clamp(lower, 4e3);
+            let fixed = vec![false, false, false, true];
+            let mut refit = LevenbergMarquardt::default().with_fixed(fixed).with_max_restarts(0);
+            let there = Driver::default().run(&problem, &mut refit, &warm).unwrap().last;
+            delta = 2.0 * (there.cost() - at.cost());
+            warm = there.parameters;
+        }
+        assert!((delta - 3.841_458_820_694_124).abs() <= 0.1, "Δχ² {delta} at the lower bound");
+        eprintln!("one-sided interval of k4 in {} evaluations", serial.used());
+    }
+
+    #[test]
+    fn the_rank_names_the_direction_two_equal_columns_leave_free() {
+        // Columns 1 and 3 equal: (1, 0, −1)/√2 changes nothing.
+        let js =
+            DMatrix::from_row_slice(4, 3, &[1.0, 2.0, 1.0, 0.5, -1.0, 0.5, 2.0, 0.0, 2.0, 1.0, 1.0, 1.0]);
+        let rank = Rank::of(&js);
+        assert_eq!((rank.rank, rank.null_directions().len()), (2, 1));
+        let names: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
+        assert_eq!(Rank::said(rank.null_directions(), &names), ["0.71·a − 0.71·c"]);
+        // Fewer rows than columns: the missing directions are null directions too.
+        let wide = DMatrix::from_row_slice(1, 3, &[1.0, 0.0, 0.0]);
+        let rank = Rank::of(&wide);
+        assert_eq!((rank.rank, rank.null_directions().len()), (1, 2));
+        assert!(rank.null_directions().iter().all(|v| v[0].abs() < 1e-12), "{rank:?}");
     }
 }

@@ -22,6 +22,9 @@ pub struct LevenbergMarquardt {
     settings: LevenbergMarquardtSettings,
     /// Parameters held at their starting value (profile likelihood, partial updates).
     fixed: Vec<bool>,
+    /// Stationary when the Gauss–Newton step would lower ½‖r‖² by no more than this (0: only
+    /// the step and gradient tests): a refit whose cost is all that is read (a profile point).
+    cost_tolerance: f64,
     mu: f64,
     nu: f64,
     seeds: Option<Vec<Vec<f64>>>,
@@ -121,6 +124,7 @@ impl LevenbergMarquardt {
         Self {
             settings,
             fixed: Vec::new(),
+            cost_tolerance: 0.0,
             mu: 1e-3,
             nu: 2.0,
             seeds: None,
@@ -142,6 +146,16 @@ impl LevenbergMarquardt {
     /// Holds the parameters flagged `true` fixed.
     pub fn with_fixed(mut self, fixed: Vec<bool>) -> Self {
         self.fixed = fixed;
+        self
+    }
+
+    /// Ends the run as stationary once the undamped Gauss–Newton step predicts a decrease of
+    /// ½‖r‖² of at most `tolerance` (absolute, in the weighted residual's units; 0, the default:
+    /// never): for refits read only
+    /// for their cost, as a profile likelihood's, where Δχ² to `2 · tolerance` is all that is
+    /// needed and the default tests (steps of 1e-10) spend iterations on digits nobody reads.
+    pub fn with_cost_tolerance(mut self, tolerance: f64) -> Self {
+        self.cost_tolerance = tolerance.max(0.0);
         self
     }
 
@@ -290,7 +304,7 @@ impl UpdateStrategy for LevenbergMarquardt {
         let free = (0..problem.parameters().len()).filter(|&i| self.is_free(i)).count();
         if initial.residual.len() < free {
             return Err(UpdateError::Setup(format!(
-                "damped least squares needs at least as many measured modes as free parameters: {} modes, {free} parameters",
+                "damped least squares needs at least as many data (frequencies and shape components) as free parameters: {} data, {free} parameters",
                 initial.residual.len()
             )));
         }
@@ -398,6 +412,9 @@ impl LevenbergMarquardt {
         }
         let a = js_free.transpose() * &js_free;
         let g = js_free.transpose() * &current.residual;
+        if self.cost_tolerance > 0.0 && gauss_newton_decrease(&a, &g, &free) <= self.cost_tolerance {
+            return Ok(None);
+        }
         // Marquardt scaling, floored so a (nearly) insensitive parameter still gets damped.
         let amax = a.diagonal().amax().max(f64::MIN_POSITIVE);
         let d = DVector::from_iterator(np, (0..np).map(|i| a[(i, i)].max(1e-12 * amax)));
@@ -462,6 +479,22 @@ impl LevenbergMarquardt {
         self.mu *= self.nu;
         self.nu *= 2.0;
     }
+}
+
+/// The decrease of ½‖r‖² the Gauss–Newton step on the `free` parameters predicts: ½ gᵀA⁺g with
+/// A = JᵀJ, g = Jᵀr (a ridge of 1e-12 of A's largest diagonal keeps a flat direction finite).
+fn gauss_newton_decrease(a: &DMatrix<f64>, g: &DVector<f64>, free: &[bool]) -> f64 {
+    let n = a.nrows();
+    let amax = a.diagonal().amax().max(f64::MIN_POSITIVE);
+    let mut lhs = a.clone();
+    for i in 0..n {
+        if free[i] {
+            lhs[(i, i)] += 1e-12 * amax;
+        } else {
+            lhs[(i, i)] = 1.0;
+        }
+    }
+    lhs.cholesky().map_or(f64::INFINITY, |c| 0.5 * g.dot(&c.solve(g)))
 }
 
 /// Scaled lower and upper bounds (±∞ where a bound is infinite).
