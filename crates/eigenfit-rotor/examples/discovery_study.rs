@@ -7,8 +7,8 @@
 //! `STUDY_BUDGET=N` for another evaluation budget than the default,
 //! `STUDY_SET=heldout` for the draws of `generate.py --heldout`, `STUDY_SET=fresh` for those of
 //! `generate.py --fresh`, `STUDY_SET=fresh2` for those of `generate.py --fresh2`,
-//! `STUDY_SET=fresh3` for those of `generate.py --fresh3`, instead of the
-//! design draws)
+//! `STUDY_SET=fresh3` for those of `generate.py --fresh3`, `STUDY_SET=fresh4` for those of
+//! `generate.py --fresh4`, instead of the design draws)
 
 #[path = "../tests/common/study.rs"]
 mod study;
@@ -24,6 +24,7 @@ fn main() {
         "fresh" => (study::load_fresh(), "fresh held-out (fresh.toml, seed 60411)"),
         "fresh2" => (study::load_fresh2(), "second fresh held-out (fresh2.toml, seed 53913)"),
         "fresh3" => (study::load_fresh3(), "third fresh held-out (fresh3.toml, seed 67138)"),
+        "fresh4" => (study::load_fresh4(), "fourth fresh held-out (fresh4.toml, seed 74813)"),
         _ => (study::load(), "design (independent.toml, seed 20261123)"),
     };
     println!("draws: {name}\n");
