@@ -148,7 +148,16 @@ impl Noise {
 /// eigenfit with `effect` switched on, with 0.1 % Gaussian noise from `seed` (std 0.1 % given).
 fn discover_hidden(effect: &str, seed: u64) -> (i32, Value) {
     let (code, sim) = eigenfit(&[
-        "simulate", "--preset", "paper-rotor", "--stiffness", "2e5,5e4", "--modes", "8", "--effect", effect, "--json",
+        "simulate",
+        "--preset",
+        "paper-rotor",
+        "--stiffness",
+        "2e5,5e4",
+        "--modes",
+        "8",
+        "--effect",
+        effect,
+        "--json",
     ]);
     assert_eq!(code, 0, "{sim}");
     let mut noise = Noise(seed);
