@@ -126,6 +126,82 @@ fn discover_adds_nothing_to_a_model_that_fits() {
     assert_eq!(v["rms_residual_before_hz"], v["rms_residual_after_hz"]);
 }
 
+/// Standard normal draws from a fixed seed (SplitMix64, Box–Muller): the same noise everywhere.
+struct Noise(u64);
+
+impl Noise {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn normal(&mut self) -> f64 {
+        let u = 1.0 - self.uniform(); // in (0, 1]
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
+    }
+}
+
+/// `discover --json` on 8 frequencies of the paper rotor (K1 = 2e5, K2 = 5e4 N/m) simulated by
+/// eigenfit with `effect` switched on, with 0.1 % Gaussian noise from `seed` (std 0.1 % given).
+fn discover_hidden(effect: &str, seed: u64) -> (i32, Value) {
+    let (code, sim) = eigenfit(&[
+        "simulate",
+        "--preset",
+        "paper-rotor",
+        "--stiffness",
+        "2e5,5e4",
+        "--modes",
+        "8",
+        "--effect",
+        effect,
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{sim}");
+    let mut noise = Noise(seed);
+    let mut csv = String::from("mode,frequency_hz,std_hz\n");
+    for (m, f) in common::floats(&sim["frequencies_hz"]).iter().enumerate() {
+        let y = f * (1.0 + 1e-3 * noise.normal());
+        csv += &format!("{},{y},{}\n", m + 1, 1e-3 * y);
+    }
+    let scratch = common::scratch();
+    let data = common::write_in(&scratch, "measured.csv", &csv);
+    eigenfit(&["discover", "--preset", "paper-rotor", "--measured", data.to_str().unwrap(), "--json"])
+}
+
+/// Is `v` (a named effect or an alternative) the effect `kind@location`?
+fn is(v: &Value, kind: &str, location: u64) -> bool {
+    v["kind"] == kind && v["location"] == location
+}
+
+/// Issue 31: a bearing's tilt stiffness of thousands of N·m/rad is named first, or listed beside
+/// the first choice as an alternative the data cannot reject, and nothing else is named (no second
+/// effect making up for a wrong first one). Each candidate value's damped step was measured in its
+/// own unit before (at most ln 100 ≈ 4.6 N·m/rad per step): the tilt's fit stopped near 1770 and
+/// 5070 N·m/rad, and section changes were named with `explained: true`.
+#[test]
+fn discover_names_a_large_hidden_bearing_tilt_stiffness() {
+    for truth in [2e3, 2e4] {
+        for seed in 0..3 {
+            let (code, v) = discover_hidden(&format!("bearing-rotational-stiffness@0={truth}"), seed);
+            let tilt = |e: &Value| is(e, "bearing-rotational-stiffness", 0);
+            assert_eq!(code, 0, "{truth} N·m/rad, seed {seed}: {v}");
+            assert_eq!(v["explained"], true, "{truth}, seed {seed}");
+            let named = v["missing_effects"].as_array().unwrap();
+            assert_eq!(named.len(), 1, "{truth}, seed {seed}: one effect, nothing compensating: {named:?}");
+            let first = &named[0];
+            let listed = first["ambiguous_with"].as_array().unwrap().iter().any(tilt);
+            assert!(tilt(first) || listed, "{truth}, seed {seed}: the tilt named or listed: {first}");
+            if tilt(first) {
+                let value = first["value"].as_f64().unwrap();
+                assert!((value / truth - 1.0).abs() < 0.1, "{truth}, seed {seed}: fitted {value}");
+            }
+        }
+    }
+}
+
 /// A pedestal (a bearing on its own mass and spring) adds a degree of freedom a rotor model file
 /// cannot hold: `--write-model` is refused as a request that cannot be met (exit 2, saying why),
 /// not as an internal failure, and nothing is written.

@@ -7,8 +7,8 @@
 //! `STUDY_BUDGET=N` for another evaluation budget than the default,
 //! `STUDY_SET=heldout` for the draws of `generate.py --heldout`, `STUDY_SET=fresh` for those of
 //! `generate.py --fresh`, `STUDY_SET=fresh2` for those of `generate.py --fresh2`,
-//! `STUDY_SET=fresh3` for those of `generate.py --fresh3`, instead of the
-//! design draws)
+//! `STUDY_SET=fresh3` for those of `generate.py --fresh3`, `STUDY_SET=fresh4` for those of
+//! `generate.py --fresh4`, instead of the design draws)
 
 #[path = "../tests/common/study.rs"]
 mod study;
@@ -24,6 +24,7 @@ fn main() {
         "fresh" => (study::load_fresh(), "fresh held-out (fresh.toml, seed 60411)"),
         "fresh2" => (study::load_fresh2(), "second fresh held-out (fresh2.toml, seed 53913)"),
         "fresh3" => (study::load_fresh3(), "third fresh held-out (fresh3.toml, seed 67138)"),
+        "fresh4" => (study::load_fresh4(), "fourth fresh held-out (fresh4.toml, seed 74813)"),
         _ => (study::load(), "design (independent.toml, seed 20261123)"),
     };
     println!("draws: {name}\n");
@@ -32,6 +33,8 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|---|---|");
     let mut slowest = 0.0f64;
+    // The most CPU time of one run: on a shared machine the wall time measures the neighbours too.
+    let (mut most_cpu, mut total_cpu, mut runs) = (0.0f64, 0.0f64, 0usize);
     // STUDY_BUDGET=N gives each run N evaluations instead of the default.
     let mut options = eigenfit_core::discovery::DiscoveryOptions::default();
     if let Some(n) = std::env::var("STUDY_BUDGET").ok().and_then(|n| n.parse().ok()) {
@@ -50,9 +53,12 @@ fn main() {
             let (mut solves, mut most, mut exhausted) = (0, 0, 0);
             for draw in fixtures.draw.iter().filter(|d| d.case == case.name && d.noise == noise) {
                 let t = Instant::now();
+                let cpu = cpu_seconds();
                 let solver = study::CountingSolver::default();
                 let found = study::run_with(&draw.frequency_hz, &draw.std_hz, &solver, &options);
                 slowest = slowest.max(t.elapsed().as_secs_f64());
+                let cpu = cpu_seconds() - cpu;
+                (most_cpu, total_cpu, runs) = (most_cpu.max(cpu), total_cpu + cpu, runs + 1);
                 let spent = solver.solves.load(Ordering::Relaxed);
                 (solves, most) = (solves + spent, most.max(spent));
                 exhausted += usize::from(found.report.budget_exhausted);
@@ -94,4 +100,20 @@ fn main() {
         }
     }
     println!("\nslowest discovery run: {slowest:.2} s");
+    println!(
+        "most CPU time of one run: {most_cpu:.2} s (mean {:.3} s over {runs} runs)",
+        total_cpu / runs.max(1) as f64
+    );
+}
+
+/// CPU time of this thread (user + system), from /proc (Linux; 10 ms ticks), as
+/// `discovery_timing` measures it.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").unwrap_or_default();
+    // Fields after the parenthesised command name (the first of them, the state, is field 3);
+    // utime and stime are fields 14 and 15.
+    let after = stat.rsplit_once(')').map_or("", |(_, rest)| rest);
+    let fields: Vec<&str> = after.split_whitespace().collect();
+    let field = |n: usize| fields.get(n - 3).and_then(|f| f.parse::<f64>().ok()).unwrap_or(0.0);
+    (field(14) + field(15)) / 100.0
 }

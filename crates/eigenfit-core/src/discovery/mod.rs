@@ -1347,7 +1347,7 @@ fn refit<E: EffectSearch>(
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
         let driver = Driver { max_iterations: 60 };
-        let mut strategy = LevenbergMarquardt::default();
+        let mut strategy = LevenbergMarquardt::default().with_step_units(step_units(base_len, set));
         if !restarts {
             strategy = strategy.with_max_restarts(0);
         }
@@ -1402,6 +1402,25 @@ fn refit<E: EffectSearch>(
         None if capped.exhausted() => RefitOutcome::CutShort,
         None => RefitOutcome::Failed,
     }
+}
+
+/// The step unit of every parameter of a refit ([`LevenbergMarquardt::with_step_units`]): 1 for
+/// the `base_len` base parameters (in their own scale: a stiffness's log), and for each effect
+/// value on a linear scale the size of its plausible range (the largest |value| it admits), so
+/// the damped step's cap (ln 100 ≈ 4.6 units per step) means the same for every candidate,
+/// whatever its unit. Without it a bearing's tilt stiffness, plausible up to 1e7 N·m/rad, moved
+/// at most 4.6 N·m/rad per step: its fit stopped near 276 N·m/rad after 60 steps however large
+/// the truth, and section changes were named in its place.
+fn step_units(base_len: usize, set: &[&Candidate]) -> Vec<f64> {
+    let mut units = vec![1.0; base_len];
+    for c in set {
+        for (p, (lo, hi)) in c.parameters().zip(c.plausible_ranges()) {
+            let typical = lo.abs().max(hi.abs());
+            let linear = p.scale == crate::model::Scale::Linear;
+            units.push(if linear && typical.is_finite() && typical > 0.0 { typical } else { 1.0 });
+        }
+    }
+    units
 }
 
 #[cfg(test)]

@@ -38,6 +38,11 @@ pub const FRESH2: &str =
 pub const FRESH3: &str =
     include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/discovery/fresh3.toml"));
 
+/// Fourth fresh held-out draws (`generate.py --fresh4`, a sixth seed), scored once after the
+/// candidate values' step units (issue #31's bearing-tilt case).
+pub const FRESH4: &str =
+    include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/discovery/fresh4.toml"));
+
 #[derive(Debug, Deserialize)]
 pub struct Fixtures {
     pub case: Vec<Case>,
@@ -109,6 +114,11 @@ pub fn load_fresh2() -> Fixtures {
 /// The third fresh held-out draws.
 pub fn load_fresh3() -> Fixtures {
     parse(FRESH3)
+}
+
+/// The fourth fresh held-out draws.
+pub fn load_fresh4() -> Fixtures {
+    parse(FRESH4)
 }
 
 fn parse(text: &str) -> Fixtures {
