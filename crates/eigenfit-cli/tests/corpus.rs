@@ -25,8 +25,9 @@ fn text(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr)
 }
 
-/// One case: arguments, expected exit code, fragments stdout+stderr must contain; with
-/// `no_results`, nothing on stdout (refused before any fitting, so no result was printed).
+/// One case: arguments, expected exit code, fragments stdout+stderr must contain (and, in
+/// `says_not`, must not); with `no_results`, nothing on stdout (refused before any fitting, so no
+/// result was printed).
 #[derive(serde::Deserialize)]
 struct Case {
     args: Vec<String>,
@@ -34,6 +35,9 @@ struct Case {
     says: Vec<String>,
     #[serde(default)]
     no_results: bool,
+    /// Fragments stdout+stderr must not contain (a critical speed at 0 rpm, a `null`).
+    #[serde(default)]
+    says_not: Vec<String>,
 }
 
 #[derive(serde::Deserialize)]
@@ -79,6 +83,11 @@ fn every_corpus_case_ends_with_its_exit_code_and_message() {
         for fragment in &case.says {
             if !all.contains(fragment) {
                 failures.push(format!("{:?}: no `{fragment}` in\n{all}", case.args));
+            }
+        }
+        for fragment in &case.says_not {
+            if all.contains(fragment) {
+                failures.push(format!("{:?}: `{fragment}` in\n{all}", case.args));
             }
         }
     }

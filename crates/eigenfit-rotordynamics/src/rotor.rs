@@ -314,6 +314,34 @@ impl Rotor {
         modal::solve_lowest(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count, true)
     }
 
+    /// How many rigid-body motions the rotor has with its bearing coefficients at speed Ω
+    /// (rad/s): the modes of the undamped, non-spinning problem (symmetric parts of K and M)
+    /// that core's scale-free test calls rigid-body
+    /// ([`eigenfit_core::eigen::roundoff::rigid_body_modes`]) — 4 for a two-plane rotor without
+    /// bearings or seals (two translations, two tilts), 0 for one held in both planes. Their
+    /// zero eigenvalues are what the damped mode lists leave out ([`modal::rigid_body`]); how
+    /// many of them round-off makes oscillating varies, this count does not.
+    pub fn rigid_body_modes(&self, speed: f64) -> Result<usize, RotorDynError> {
+        use eigenfit_core::eigen::{roundoff::rigid_body_modes, BandedSolver, EigenSolver};
+        let mats = self.matrices(speed);
+        let n = self.dofs();
+        let sym = |a: &Mat<f64>| nalgebra::DMatrix::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+        let system = eigenfit_core::matrix::System::new(sym(&mats.k), sym(&mats.m))
+            .map_err(|e| RotorDynError::Model(e.to_string()))?;
+        let mut count = n.min(12);
+        loop {
+            let modes = BandedSolver::default()
+                .lowest(&system, count)
+                .map_err(|e| RotorDynError::Solver(format!("rigid-body modes: {e}")))?;
+            match rigid_body_modes(&system, &modes) {
+                Some(flags) => return Ok(flags.iter().filter(|&&r| r).count()),
+                // Every mode solved zero to round-off: more, up to all (then K is zero).
+                None if count == n => return Ok(n),
+                None => count = (2 * count).min(n),
+            }
+        }
+    }
+
     /// The `count` lowest modes at speed Ω (rad/s), by the fastest exact route for the size.
     /// With whirl-frequency tables each mode is solved at its own whirl frequency
     /// ([`Rotor::matched_modes`]).
