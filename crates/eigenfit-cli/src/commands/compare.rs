@@ -91,6 +91,10 @@ fn request(args: &CompareArgs) -> CompareRequest {
 /// Runs `compare`; returns the exit code (3 when a run ran out of its evaluation budget: the
 /// comparison is incomplete).
 pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
+    // Every output is checked writable before the runs (the stream is opened below).
+    if let Some(dir) = &args.plot {
+        crate::output::check_writable_dir(dir, "--plot")?;
+    }
     let (model, label) = args.model.load_any()?;
     let solver = args.model.solver()?;
     let np = model.parameters().len();
@@ -110,7 +114,12 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
     let mut report = report?;
     let names: Vec<String> = model.parameters().iter().map(|p| p.name.clone()).collect();
     let plots = match &args.plot {
-        Some(dir) => write_maps(dir, &label, &names, &report.raw, &plan.targets, &plan.strategies)?,
+        // A write failing after the runs says what was lost; the comparison below stands.
+        Some(dir) => write_maps(dir, &label, &names, &report.raw, &plan.targets, &plan.strategies)
+            .unwrap_or_else(|e| {
+                crate::output::report_lost("plot output", &e);
+                Vec::new()
+            }),
         None => Vec::new(),
     };
     report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
