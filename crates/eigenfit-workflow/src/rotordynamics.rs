@@ -194,14 +194,18 @@ pub fn simulate_with(
     let all = rotor.lowest_modes(rpm_to_rad(rpm), modes).map_err(to_workflow)?;
     if modes > all.len() {
         return Err(input(format!(
-            "--modes {modes}: must be between 1 and {} (the oscillating modes of this rotor at {rpm} rpm)",
-            all.len()
+            "--modes {modes}: the rotor has only {} oscillating mode{} at {rpm} rpm, of its {} DOFs (the \
+             others are overdamped, rigid-body, or lost to round-off beside an extreme coefficient)",
+            all.len(),
+            if all.len() == 1 { "" } else { "s" },
+            rotor.dofs()
         )));
     }
     let shown = &all[..modes];
     let mut notes = set_notes;
     let rigid = rotor.rigid_body_modes(rpm_to_rad(rpm)).map_err(to_workflow)?;
     notes.extend(rigid_body_note(rigid, rpm));
+    notes.extend(divergent_note(&rotor, rpm));
     notes.extend(rotor.extrapolation_notes(&[rpm]));
     notes.extend(rotor.whirl_extrapolation_notes(&shown.iter().map(|m| m.eigenvalue.im).collect::<Vec<_>>()));
     let unstable: Vec<String> = (0..modes)
@@ -225,6 +229,18 @@ pub fn simulate_with(
         rigid_body_modes_left_out: (rigid > 0).then_some(rigid),
         dofs: rotor.dofs(),
         notes,
+    })
+}
+
+/// Says that the rotor is statically unstable at `rpm` (a growing motion that no mode list
+/// holds, [`Rotor::divergent`]).
+fn divergent_note(rotor: &Rotor, rpm: f64) -> Option<String> {
+    rotor.divergent(rpm_to_rad(rpm)).map(|lambda| {
+        format!(
+            "the rotor is statically unstable at {rpm} rpm: its stiffness (symmetric part of K) has a \
+             negative eigenvalue λ = {lambda:.4e} (rad/s)² — a negative bearing or seal stiffness \
+             outweighing the shaft; that motion grows without oscillating, so it is in no mode listed"
+        )
     })
 }
 
@@ -840,6 +856,11 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
     let mut notes = rotor.extrapolation_notes(&speeds);
     let rigid = rotor.rigid_body_modes(rpm_to_rad(speeds[0])).map_err(to_workflow)?;
     notes.extend(rigid_body_note(rigid, speeds[0]));
+    // Static instability at either end of the sweep (bearing tables change with speed).
+    let ends = [speeds[0], speeds[speeds.len() - 1]];
+    notes.extend(
+        ends.iter().take(if ends[0] == ends[1] { 1 } else { 2 }).find_map(|&r| divergent_note(&rotor, r)),
+    );
     let whirl = c.frequencies_hz.iter().flatten().map(|f| 2.0 * std::f64::consts::PI * f);
     let (lo, hi) = whirl.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| (a.min(w), b.max(w)));
     if lo.is_finite() {
