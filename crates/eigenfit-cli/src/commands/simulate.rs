@@ -185,11 +185,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         return Ok(());
     }
     let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
+    // The frequencies first: a model refused there (unstable, lost to round-off) writes no file.
+    let mut report = at_point(&label, &rotor, solver.as_ref(), &p, args.modes, SweepCheck::RefuseRoundoff)?;
     if let Some(path) = &args.uff {
         let text = eigenfit_workflow::test_data::uff_text(&label, &rotor, solver.as_ref(), &p, args.modes)?;
         crate::output::write_atomically(path, text.as_bytes())?;
     }
-    let mut report = at_point(&label, &rotor, solver.as_ref(), &p, args.modes, SweepCheck::RefuseRoundoff)?;
     if args.shapes {
         report.mode_shapes = Some(rotor_mode_shapes(&rotor, solver.as_ref(), &p, args.modes)?);
     }
