@@ -168,6 +168,18 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         names.push(name);
     }
     let fixed: Vec<_> = models.iter().map(|m| fixed(m, &[])).collect::<Result<_, _>>()?;
+    // The check estimate makes: no measured mode numbered onto a rigid-body mode (a
+    // configuration without bearings), refused naming the configuration and its file.
+    for (k, (m, d)) in fixed.iter().zip(&data).enumerate() {
+        let file = format!("{}: {}", names[k], campaign.configurations[k].measured.display());
+        crate::estimate::refuse_rigid_body_pairing(
+            m,
+            solver.as_ref(),
+            &m.parameters().nominal_values(),
+            &d.measurement,
+            &file,
+        )?;
+    }
     let fits: Vec<Fit> = fixed
         .iter()
         .zip(&data)
