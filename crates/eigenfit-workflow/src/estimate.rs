@@ -262,15 +262,17 @@ pub fn refuse_rigid_body_pairing(
         .iter()
         .map(|m| format!("mode {} ({} Hz)", m.mode + 1, shown_number(m.frequency_hz)))
         .collect();
+    let one = on_rigid.len() == 1;
     Err(input(format!(
-        "{measured_name}: measured {} numbered onto rigid-body {} of the model (eigenvalues zero to \
-         round-off: nothing holds the model in {}; a free–free structure or a rotor without \
-         bearings), which no measured natural frequency pairs with. Measured modes pair with the \
-         model's by number, counting its rigid-body modes ({}): its first elastic mode is mode \
-         {first_elastic}; renumber the measured modes, or give the model supports",
+        "{measured_name}: measured {} numbered onto {} of the model ({} zero to round-off: nothing \
+         holds the model in {}; a free–free structure or a rotor without bearings), which no \
+         measured natural frequency pairs with. Measured modes pair with the model's by number, \
+         counting its rigid-body modes ({}): its first elastic mode is mode {first_elastic}; \
+         renumber the measured modes, or give the model supports",
         said.join(", "),
-        if on_rigid.len() == 1 { "a mode" } else { "modes" },
-        if on_rigid.len() == 1 { "that motion" } else { "those motions" },
+        if one { "a rigid-body mode" } else { "rigid-body modes" },
+        if one { "its eigenvalue is" } else { "their eigenvalues are" },
+        if one { "that motion" } else { "those motions" },
         numbers.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")
     )))
 }
