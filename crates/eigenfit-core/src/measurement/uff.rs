@@ -437,22 +437,50 @@ fn i10(v: i64) -> String {
     }
 }
 
-/// `%13.5E`-like with 6 significant digits kept (the standard's E13.5), as `1.23456E+02`.
+/// `%13.5E`-like with 6 significant digits kept (the standard's E13.5), as `1.23456E+02`, right
+/// aligned in its 13 characters; one too wide for them (a negative value with a three-digit
+/// exponent, `-1.38501E-201`) keeps a space before it, as [`i10`] does, so the reader never glues
+/// it to the field before (found by the `uff_file` fuzz target: `-6.06490E-03-1.38501E-201`).
 fn e13(v: f64) -> String {
     let t = format!("{v:.5E}");
     // Rust prints `1.23456E2`; the standard wants a signed two-digit exponent.
-    match t.split_once('E') {
+    let t = match t.split_once('E') {
         Some((m, e)) => {
             let e: i32 = e.parse().unwrap_or(0);
             format!("{m}E{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
         }
         None => t,
+    };
+    let field = format!("{t:>13}");
+    if field.starts_with(' ') {
+        field
+    } else {
+        format!(" {t}")
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_too_wide_for_their_field_keep_a_space_and_read_back() {
+        let nodes = vec![UffNode { label: 1, coordinates: [-1.5e-200, -2.5e-300, 1e-310] }];
+        let mode = UffMode {
+            number: 1,
+            frequency_hz: 10.0,
+            modal_mass: 1.0,
+            damping_ratio: 0.0,
+            values: vec![(1, vec![-6.0649e-3, -1.38501e-201, -1e-300, 0.0, 0.0, 0.0])],
+            complex: false,
+            realness: 1.0,
+            line: 0,
+        };
+        let text = write("t", &nodes, &[mode]);
+        let back = parse(&text).unwrap_or_else(|e| panic!("{e}:\n{text}"));
+        assert_eq!(back.modes[0].values[0].1[1], -1.38501e-201);
+        assert_eq!(back.nodes[0].coordinates[1], -2.5e-300);
+    }
 
     #[test]
     fn written_files_read_back() {
