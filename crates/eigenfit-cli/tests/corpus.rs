@@ -25,8 +25,9 @@ fn text(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr)
 }
 
-/// One case: arguments, expected exit code, fragments stdout+stderr must contain; with
-/// `no_results`, nothing on stdout (refused before any fitting, so no result was printed).
+/// One case: arguments, expected exit code, fragments stdout+stderr must contain (and, in
+/// `says_not`, must not); with `no_results`, nothing on stdout (refused before any fitting, so no
+/// result was printed).
 #[derive(serde::Deserialize)]
 struct Case {
     args: Vec<String>,
@@ -34,6 +35,9 @@ struct Case {
     says: Vec<String>,
     #[serde(default)]
     no_results: bool,
+    /// Fragments stdout+stderr must not contain (a critical speed at 0 rpm, a `null`).
+    #[serde(default)]
+    says_not: Vec<String>,
 }
 
 #[derive(serde::Deserialize)]
@@ -79,6 +83,11 @@ fn every_corpus_case_ends_with_its_exit_code_and_message() {
         for fragment in &case.says {
             if !all.contains(fragment) {
                 failures.push(format!("{:?}: no `{fragment}` in\n{all}", case.args));
+            }
+        }
+        for fragment in &case.says_not {
+            if all.contains(fragment) {
+                failures.push(format!("{:?}: `{fragment}` in\n{all}", case.args));
             }
         }
     }
@@ -306,4 +315,40 @@ fn the_uff_fuzz_properties_hold_on_the_seeds_and_their_mutations() {
         }
     }
     assert!(count > 500, "too few inputs checked: {count}");
+}
+
+/// A universal file written for a free–free rotor holds its elastic modes only (a rigid-body
+/// mode's 0 Hz is no measured frequency), with their own numbers (3 and 4), so it reads back as
+/// measured data: the same rotor on very soft updatable bearings is fitted to it (its shapes
+/// MAC-paired among the elastic modes, rigid-body ones excluded) instead of refused at its first
+/// mode or as unreachable.
+#[test]
+fn a_universal_file_of_a_free_rotor_reads_back() {
+    let scratch = tempfile::tempdir().expect("a temporary folder");
+    let file = scratch.path().join("free.unv");
+    let f = file.to_str().unwrap();
+    let out = eigenfit(&["simulate", "--model", "rotor_no_bearings.toml", "--modes", "4", "--uff", f]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let written = std::fs::read_to_string(&file).unwrap();
+    assert_eq!(
+        written.matches("\n    55").count() + usize::from(written.starts_with("    55")),
+        2,
+        "{written}"
+    );
+    let back = eigenfit(&["estimate", "--model", "rotor_soft_bearings.toml", "--measured", f, "--json"]);
+    let all = text(&back);
+    clean("free rotor's universal file read back", &all);
+    assert_ne!(back.status.code(), Some(2), "refused as input:\n{all}");
+    let report: serde_json::Value = serde_json::from_slice(&back.stdout).expect("a JSON report");
+    let measured = common_floats(&report["measured_hz"]);
+    let model = common_floats(&report["frequencies_hz"]);
+    assert_eq!(measured.len(), 2, "{all}");
+    for (m, f) in measured.iter().zip(&model) {
+        // The file holds 6 significant digits: its frequencies are rounded to 5e-6 of themselves.
+        assert!((m - f).abs() <= 1e-5 * m, "measured {m} Hz, model {f} Hz:\n{all}");
+    }
+}
+
+fn common_floats(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array().map(|a| a.iter().filter_map(serde_json::Value::as_f64).collect()).unwrap_or_default()
 }

@@ -193,7 +193,10 @@ fn read_entries(text: &str, expected: Option<usize>, symmetric: bool) -> Result<
     let (size_line, size) = lines.next().ok_or("the size line (rows columns entries) is missing")?;
     let fields: Vec<&str> = size.split_ascii_whitespace().collect();
     let number = |s: &str, line: usize, what: &str| {
-        s.parse::<usize>().map_err(|_| format!("line {line}: {what} `{s}` is not a whole number"))
+        s.parse::<usize>().map_err(|_| match s.bytes().all(|b| b.is_ascii_digit()) && !s.is_empty() {
+            true => format!("line {line}: {what} `{s}` is too large a number (at most {})", usize::MAX),
+            false => format!("line {line}: {what} `{s}` is not a whole number"),
+        })
     };
     if fields.len() != 3 {
         return Err(format!("line {size_line}: the size line must hold rows, columns, entries"));

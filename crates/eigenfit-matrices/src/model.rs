@@ -339,9 +339,12 @@ impl MatricesModel {
             let diagonal = m.get(j, j);
             diagonal < 0.0 || (diagonal == 0.0 && coupled[j])
         }) {
+            // A negative mass is wrong whatever M couples; a zero one only when M couples the DOF.
+            let why =
+                if m.get(j, j) < 0.0 { ", a negative mass" } else { ", but M couples it to other DOFs" };
             return Err(format!(
-                "{}: its mass on the diagonal is {} at the nominal values, but M couples it to other DOFs: \
-                 M is not positive semi-definite (a massless DOF has a zero row and column)",
+                "{}: its mass on the diagonal is {} at the nominal values{why}: M is not positive \
+                 semi-definite (a massless DOF has a zero row and column)",
                 self.dof_label(j),
                 m.get(j, j)
             ));

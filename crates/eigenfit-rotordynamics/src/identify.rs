@@ -355,7 +355,11 @@ pub fn evaluate_with(
         let here: Vec<usize> = (0..points.len()).filter(|&i| points[i].speed_rpm == rpm).collect();
         let highest = here.iter().map(|&i| points[i].mode).max().unwrap_or(0);
         // Spares among which to find the measured modes (a run-up may not show every mode).
-        let modes = r.lowest_modes_of(&mats, 2 * highest + 6)?;
+        // A failure names the speed it happened at (1e308 rpm overflows the gyroscopic terms).
+        let modes = r.lowest_modes_of(&mats, 2 * highest + 6).map_err(|e| match e {
+            RotorDynError::Solver(m) => RotorDynError::Solver(format!("at {rpm} rpm: {m}")),
+            other => other,
+        })?;
         let measured: Vec<&RunupPoint> = here.iter().map(|&i| &points[i]).collect();
         let pairs = pair_modes(&measured, &modes).ok_or_else(|| {
             RotorDynError::Data(format!(

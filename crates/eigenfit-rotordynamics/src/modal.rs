@@ -148,6 +148,10 @@ pub const DENSE_DOFS: usize = 160;
 /// problem — if (λ²Mᵀ + λDᵀ + Kᵀ)z = 0 then y = z̄ satisfies yᴴ(λ²M + λD + K) = 0 — matched to
 /// the problem's eigenpairs by eigenvalue (a dense solve of the compressor example's 1464
 /// states takes seconds; this, milliseconds).
+///
+/// Rigid-body modes ([`rigid_body`]: a rotor without bearings, whose eigenvalues are zero to
+/// round-off) are left out: they are no vibration, no curve of a Campbell diagram and never a
+/// critical speed ([`solve_lowest_elastic`] says how many).
 pub fn solve_lowest(
     m: &Mat<f64>,
     d: &Mat<f64>,
@@ -156,15 +160,93 @@ pub fn solve_lowest(
     count: usize,
     with_left: bool,
 ) -> Result<Vec<Mode>, RotorDynError> {
+    solve_lowest_elastic(m, d, k, pairs, count, with_left).map(|(modes, _)| modes)
+}
+
+/// [`solve_lowest`] and the number of rigid-body modes left out below the modes returned.
+pub fn solve_lowest_elastic(
+    m: &Mat<f64>,
+    d: &Mat<f64>,
+    k: &Mat<f64>,
+    pairs: &[(usize, usize)],
+    count: usize,
+    with_left: bool,
+) -> Result<(Vec<Mode>, usize), RotorDynError> {
     let n = m.nrows();
-    if n > DENSE_DOFS {
-        if let Some(modes) = lowest_shift_invert([m, d, k], pairs, count, with_left) {
-            return Ok(modes);
+    let mut ask = count;
+    loop {
+        let shift_invert =
+            if n > DENSE_DOFS { lowest_shift_invert([m, d, k], pairs, ask, with_left) } else { None };
+        // The dense route returns every oscillating mode: nothing more to ask for.
+        let (all, complete) = match shift_invert {
+            Some(modes) => (modes, false),
+            None => (solve(m.as_ref(), d.as_ref(), k.as_ref(), pairs, with_left)?, true),
+        };
+        let flags = rigid_body(&all, m, k);
+        let dropped = flags.as_ref().map_or(0, |f| f.iter().filter(|&&r| r).count());
+        let enough = flags.is_some() && all.len() - dropped >= count;
+        if enough || complete || ask >= 2 * n {
+            let flags = flags.unwrap_or_else(|| vec![false; all.len()]);
+            let mut elastic: Vec<Mode> =
+                all.into_iter().zip(flags).filter(|(_, rigid)| !rigid).map(|(mode, _)| mode).collect();
+            elastic.truncate(count);
+            return Ok((elastic, dropped));
         }
+        ask = (ask + dropped.max(4) + 4).min(2 * n);
     }
-    let mut modes = solve(m.as_ref(), d.as_ref(), k.as_ref(), pairs, with_left)?;
-    modes.truncate(count);
-    Ok(modes)
+}
+
+/// How far below the lowest resolved |λ|² (one above round-off) a mode's |λ|² must lie to be a
+/// rigid-body mode (see [`rigid_body`]).
+pub const RIGID_BODY_GAP: f64 = 1e6;
+
+/// How many times ε ‖K‖∞ ‖x‖² / |xᴴMx| a mode's |λ|² may reach and still be zero to round-off.
+/// Generous because a free rotor's zero eigenvalues are double (a rigid motion and its velocity,
+/// a Jordan block of the state matrix): round-off δ moves them by √δ, so |λ|² lands at about
+/// ε times the state matrix's scale, which the mass-weighted K norm of the shape understates by
+/// up to the ratio of the largest to the smallest inertia.
+pub const RIGID_BODY_ROUNDOFF: f64 = 1e3;
+
+/// Which of `modes` (of M λ² + D λ + K, ascending) are rigid-body modes, by a scale-free test:
+/// |λ|² zero to round-off — |λ|² |xᴴMx| ≤ [`RIGID_BODY_ROUNDOFF`] · ε ‖K‖∞ ‖x‖² — and at least
+/// [`RIGID_BODY_GAP`] below the lowest mode that is not (a rotor's elastic modes are within a
+/// few decades of each other; a rigid-body zero lies ten or more below them). `None` when no
+/// mode of `modes` is resolved from zero: the gap cannot be judged.
+pub fn rigid_body(modes: &[Mode], m: &Mat<f64>, k: &Mat<f64>) -> Option<Vec<bool>> {
+    let n = k.nrows();
+    let k_norm = (0..n).map(|i| (0..n).map(|j| k[(i, j)].abs()).sum::<f64>()).fold(0.0, f64::max);
+    let zero: Vec<bool> = modes
+        .iter()
+        .map(|mode| {
+            let x = &mode.right;
+            let x2: f64 = x.iter().map(|v| v.norm_sqr()).sum();
+            let mut xmx = c64::new(0.0, 0.0);
+            for i in 0..n {
+                let mut row = c64::new(0.0, 0.0);
+                for j in 0..n {
+                    row += x[j] * m[(i, j)];
+                }
+                xmx += x[i].conj() * row;
+            }
+            mode.eigenvalue.norm_sqr() * xmx.norm() <= RIGID_BODY_ROUNDOFF * f64::EPSILON * k_norm * x2
+        })
+        .collect();
+    let resolved = modes
+        .iter()
+        .zip(&zero)
+        .filter(|(_, &z)| !z)
+        .map(|(mode, _)| mode.eigenvalue.norm_sqr())
+        .fold(f64::INFINITY, f64::min);
+    if !resolved.is_finite() {
+        return None;
+    }
+    Some(
+        modes
+            .iter()
+            .zip(zero)
+            .map(|(mode, z)| z && mode.eigenvalue.norm_sqr() * RIGID_BODY_GAP <= resolved)
+            .collect(),
+    )
 }
 
 /// The shift-invert route; `None` (solve densely) when it fails or finds too few modes, or a

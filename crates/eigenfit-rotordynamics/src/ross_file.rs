@@ -49,15 +49,133 @@ pub fn read(path: &Path) -> Result<Rotor, RotorDynError> {
     })
 }
 
-/// The file's tables as a JSON value (TOML converted).
+/// The file's tables as a JSON value (TOML converted). A NaN or infinity in an element's table
+/// is refused here, naming the element, the key, the index and the value as the file writes it:
+/// JSON has no such numbers (the conversion would turn a TOML `nan` into `null`, read as
+/// "missing"), and ROSS's Python writes them into JSON as the bare words `NaN` and `Infinity`.
 pub fn root_of(text: &str) -> Result<Value, RotorDynError> {
     if text.trim_start().starts_with('{') {
-        serde_json::from_str(text).map_err(|e| RotorDynError::File(format!("not valid JSON: {e}")))
+        let invalid = |e: serde_json::Error| RotorDynError::File(format!("not valid JSON: {e}"));
+        match serde_json::from_str(text) {
+            Ok(root) => Ok(root),
+            Err(e) => {
+                // Only a file JSON refuses is searched for Python's bare words; the error of the
+                // file as written stands when they are not the (only) reason.
+                let (marked, any) = mark_json_non_finite(text);
+                match serde_json::from_str::<Value>(&marked)
+                    .ok()
+                    .filter(|_| any)
+                    .as_ref()
+                    .and_then(non_finite_json)
+                {
+                    Some(at) => Err(non_finite_error(at)),
+                    None => Err(invalid(e)),
+                }
+            }
+        }
     } else {
         let t: toml::Table =
             toml::from_str(text).map_err(|e| RotorDynError::File(format!("not valid TOML: {e}")))?;
+        if let Some(at) = non_finite_toml(&t) {
+            return Err(non_finite_error(at));
+        }
         serde_json::to_value(t).map_err(|e| RotorDynError::File(e.to_string()))
     }
+}
+
+fn non_finite_error(at: String) -> RotorDynError {
+    RotorDynError::Model(format!(
+        "{at} is not a finite number: element tables need finite values (ROSS writes NaN or \
+         infinity where a coefficient could not be computed; give the value, or leave the element out)"
+    ))
+}
+
+/// A TOML float as the file writes it (`nan`, `-nan`, `inf`, `-inf`).
+fn toml_written(x: f64) -> String {
+    match (x.is_nan(), x.is_sign_negative()) {
+        (true, false) => "nan".into(),
+        (true, true) => "-nan".into(),
+        (false, false) if x.is_infinite() => "inf".into(),
+        (false, true) if x.is_infinite() => "-inf".into(),
+        _ => format!("{x}"),
+    }
+}
+
+/// Where an element table of a TOML ROSS file holds its first NaN or infinity:
+/// "`<element>`: `<key>`[<index>]… = <value as written>".
+fn non_finite_toml(root: &toml::Table) -> Option<String> {
+    fn within(v: &toml::Value, at: String) -> Option<String> {
+        match v {
+            toml::Value::Float(x) if !x.is_finite() => Some(format!("{at} = {}", toml_written(*x))),
+            toml::Value::Array(a) => a.iter().enumerate().find_map(|(i, x)| within(x, format!("{at}[{i}]"))),
+            toml::Value::Table(t) => t.iter().find_map(|(k, x)| within(x, format!("{at}.{k}"))),
+            _ => None,
+        }
+    }
+    root.iter().filter(|(key, _)| !is_metadata(key)).find_map(|(key, v)| match v {
+        toml::Value::Table(t) => {
+            t.iter().find_map(|(name, x)| within(x, format!("`{name}`"))).map(|at| format!("`{key}`: {at}"))
+        }
+        _ => None,
+    })
+}
+
+/// Marks the bare words `NaN`, `Infinity` and `-Infinity` outside JSON strings (what Python's
+/// `json` writes for non-finite floats, which JSON itself does not allow) as strings starting
+/// with [`NON_FINITE_MARK`], so that the text parses and [`non_finite_json`] can say where they
+/// are. The second value says whether any was found.
+fn mark_json_non_finite(text: &str) -> (String, bool) {
+    let mut out = String::with_capacity(text.len());
+    let (mut in_string, mut escaped, mut any) = (false, false, false);
+    let mut rest = text;
+    while let Some(c) = rest.chars().next() {
+        if in_string {
+            if escaped {
+                escaped = false;
+            } else if c == '\\' {
+                escaped = true;
+            } else if c == '"' {
+                in_string = false;
+            }
+        } else if c == '"' {
+            in_string = true;
+        } else if let Some(word) = ["-Infinity", "Infinity", "NaN"].into_iter().find(|w| rest.starts_with(w))
+        {
+            out.push('"');
+            out.push(NON_FINITE_MARK);
+            out.push_str(word);
+            out.push('"');
+            rest = &rest[word.len()..];
+            any = true;
+            continue;
+        }
+        out.push(c);
+        rest = &rest[c.len_utf8()..];
+    }
+    (out, any)
+}
+
+/// Starts the strings [`mark_json_non_finite`] puts where a JSON file had a bare NaN or infinity:
+/// a private-use character (a control character would make the string invalid JSON).
+const NON_FINITE_MARK: char = '\u{E000}';
+
+/// Where an element table of a JSON ROSS file holds its first marked NaN or infinity.
+fn non_finite_json(root: &Value) -> Option<String> {
+    fn within(v: &Value, at: String) -> Option<String> {
+        match v {
+            Value::String(s) => s.strip_prefix(NON_FINITE_MARK).map(|w| format!("{at} = {w}")),
+            Value::Array(a) => a.iter().enumerate().find_map(|(i, x)| within(x, format!("{at}[{i}]"))),
+            Value::Object(t) => t.iter().find_map(|(k, x)| within(x, format!("{at}.{k}"))),
+            _ => None,
+        }
+    }
+    let Value::Object(root) = root else { return None };
+    root.iter().filter(|(key, _)| !is_metadata(key)).find_map(|(key, v)| match v {
+        Value::Object(t) => {
+            t.iter().find_map(|(name, x)| within(x, format!("`{name}`"))).map(|at| format!("`{key}`: {at}"))
+        }
+        other => within(other, format!("`{key}`")),
+    })
 }
 
 /// Parses the text of a ROSS rotor file.
@@ -262,7 +380,11 @@ impl Entry<'_> {
             None | Some(Value::Null) => Ok(None),
             Some(Value::Array(a)) => Ok(Some(
                 a.iter()
-                    .map(|v| number(v).ok_or_else(|| self.err(format!("`{name}` item {v} is not a number"))))
+                    .enumerate()
+                    .map(|(i, v)| {
+                        number(v)
+                            .ok_or_else(|| self.err(format!("`{name}`[{i}] = {v} is not a finite number")))
+                    })
                     .collect::<Result<_, _>>()?,
             )),
             Some(v) => {
@@ -273,7 +395,10 @@ impl Entry<'_> {
 
     fn numbers(&self, name: &str, a: &[Value]) -> Result<Vec<f64>, RotorDynError> {
         a.iter()
-            .map(|v| number(v).ok_or_else(|| self.err(format!("{name} item {v} is not a number"))))
+            .enumerate()
+            .map(|(i, v)| {
+                number(v).ok_or_else(|| self.err(format!("`{name}`[{i}] = {v} is not a finite number")))
+            })
             .collect()
     }
 
@@ -421,8 +546,9 @@ impl Entry<'_> {
 fn number(v: &Value) -> Option<f64> {
     match v {
         Value::Number(n) => n.as_f64(),
-        // ROSS writes complex or special values as strings at times; only plain numbers pass.
-        Value::String(s) => s.trim().parse().ok(),
+        // ROSS writes complex or special values as strings at times; only plain finite numbers
+        // pass ("nan" and "inf" parse as floats but are no coefficient).
+        Value::String(s) => s.trim().parse().ok().filter(|x: &f64| x.is_finite()),
         _ => None,
     }
 }

@@ -148,6 +148,15 @@ impl Rotor {
         extra.sort_unstable();
         extra.dedup();
         for b in &bearings {
+            // A bearing linking a node to itself adds its block and subtracts it again: it holds
+            // nothing, and the rotor would be solved as if it were not there.
+            if b.n_link == Some(b.n) {
+                return Err(RotorDynError::Model(format!(
+                    "bearing `{}`: n_link = n = {}: a bearing linking a node to itself holds nothing \
+                     (link it to a support or pedestal node, or leave n_link out to ground it)",
+                    b.tag, b.n
+                )));
+            }
             if b.n >= shaft_nodes && !extra.contains(&b.n) {
                 return Err(RotorDynError::Model(format!(
                     "bearing `{}`: node {} is neither a shaft node (0–{}) nor a point mass node",
@@ -312,6 +321,56 @@ impl Rotor {
     /// sensitivities), by the fastest exact route for the size.
     pub fn lowest_modes_of(&self, mats: &Matrices, count: usize) -> Result<Vec<Mode>, RotorDynError> {
         modal::solve_lowest(&mats.m, &mats.d, &mats.k, &self.translation_pairs(), count, true)
+    }
+
+    /// Whether the rotor is statically unstable at speed Ω (rad/s): the symmetric part of K has
+    /// an eigenvalue (against M) below zero by more than its round-off bound — a negative
+    /// bearing stiffness outweighing the shaft. Such a motion grows without oscillating (a real
+    /// positive λ of the damped problem), so it is in no mode list: the reports say so instead
+    /// of dropping it silently. Returns that eigenvalue ((rad/s)²).
+    pub fn divergent(&self, speed: f64) -> Option<f64> {
+        let mats = self.matrices(speed);
+        let n = self.dofs();
+        let sym = |a: &Mat<f64>| nalgebra::DMatrix::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+        let (k, m) = (sym(&mats.k), sym(&mats.m));
+        let l = nalgebra::Cholesky::new(m)?.l();
+        let x = l.solve_lower_triangular(&k)?;
+        let a = l.solve_lower_triangular(&x.transpose())?;
+        let a = (&a + a.transpose()) * 0.5;
+        let lowest = a.symmetric_eigenvalues().iter().copied().fold(f64::INFINITY, f64::min);
+        let a_norm = a.row_iter().map(|r| r.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
+        // Round-off of the reduced matrix's eigenvalues: ε‖A‖ times a margin for the size (as
+        // core's check_stable allows 1e3 bounds before calling a model unstable).
+        let bound = 1e3 * f64::EPSILON * a_norm;
+        (lowest < -bound).then_some(lowest)
+    }
+
+    /// How many rigid-body motions the rotor has with its bearing coefficients at speed Ω
+    /// (rad/s): the modes of the undamped, non-spinning problem (symmetric parts of K and M)
+    /// that core's scale-free test calls rigid-body
+    /// ([`eigenfit_core::eigen::roundoff::rigid_body_modes`]) — 4 for a two-plane rotor without
+    /// bearings or seals (two translations, two tilts), 0 for one held in both planes. Their
+    /// zero eigenvalues are what the damped mode lists leave out ([`modal::rigid_body`]); how
+    /// many of them round-off makes oscillating varies, this count does not.
+    pub fn rigid_body_modes(&self, speed: f64) -> Result<usize, RotorDynError> {
+        use eigenfit_core::eigen::{roundoff::rigid_body_modes, BandedSolver, EigenSolver};
+        let mats = self.matrices(speed);
+        let n = self.dofs();
+        let sym = |a: &Mat<f64>| nalgebra::DMatrix::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+        let system = eigenfit_core::matrix::System::new(sym(&mats.k), sym(&mats.m))
+            .map_err(|e| RotorDynError::Model(e.to_string()))?;
+        let mut count = n.min(12);
+        loop {
+            // A K that is not semi-definite (a negative bearing stiffness) has no rigid-body
+            // motion to count: its divergent mode is another matter, said by the mode lists.
+            let Ok(modes) = BandedSolver::default().lowest(&system, count) else { return Ok(0) };
+            match rigid_body_modes(&system, &modes) {
+                Some(flags) => return Ok(flags.iter().filter(|&&r| r).count()),
+                // Every mode solved zero to round-off: more, up to all (then K is zero).
+                None if count == n => return Ok(n),
+                None => count = (2 * count).min(n),
+            }
+        }
     }
 
     /// The `count` lowest modes at speed Ω (rad/s), by the fastest exact route for the size.

@@ -87,3 +87,77 @@ tag = "Absorber"
         assert!(k.damping_ratio < NO_PEAK_DAMPING_RATIO && (850.0..950.0).contains(&k.rpm), "{k:?}");
     }
 }
+
+/// `text` without its bearing tables: a free–free rotor.
+fn without_bearings(text: &str) -> String {
+    let mut out = String::new();
+    let mut keep = true;
+    for line in text.lines() {
+        if line.starts_with('[') {
+            keep = !line.contains("BearingElement");
+        }
+        if keep {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+#[test]
+fn a_rotor_without_bearings_lists_no_rigid_body_mode_and_no_critical_speed_at_zero() {
+    let text = without_bearings(&std::fs::read_to_string(data("rotor_example.toml")).unwrap());
+    let free = ross_file::parse(&text).unwrap();
+    let held = ross_file::read(&data("rotor_example.toml")).unwrap();
+    // Two planes, two rigid motions each (translation, tilt): four, and none with bearings.
+    assert_eq!(free.rigid_body_modes(0.0).unwrap(), 4);
+    assert_eq!(held.rigid_body_modes(0.0).unwrap(), 0);
+    // The modes listed are the free rotor's elastic ones: every one resolved from zero, within a
+    // few decades of each other (no round-off value among them), the same as the full solve's
+    // modes above its near-zero ones.
+    let listed = free.lowest_modes(0.0, 4).unwrap();
+    let all = free.modes(0.0, false).unwrap();
+    let top = listed.last().unwrap().eigenvalue.norm();
+    for mode in &listed {
+        assert!(mode.eigenvalue.norm() > 1e-3 * top, "a round-off mode listed: {}", mode.eigenvalue);
+    }
+    let elastic_full: Vec<_> = all.iter().filter(|m| m.eigenvalue.norm() > 1e-3 * top).take(4).collect();
+    for (a, b) in listed.iter().zip(&elastic_full) {
+        assert!((a.eigenvalue - b.eigenvalue).norm() <= 1e-9 * b.eigenvalue.norm());
+    }
+    // No critical speed below a tenth of the first elastic mode's (a rigid-body mode's curve
+    // would cross the 1× line at a few thousandths of an rpm).
+    let first_rpm = 60.0 * listed[0].frequency_hz();
+    let speeds: Vec<f64> = (0..=20).map(|i| 300.0 * i as f64).collect();
+    let c = campbell(&free, &speeds, 4).unwrap();
+    for k in c.critical_speeds.iter().chain(&c.overdamped_crossings) {
+        assert!(k.rpm > 0.1 * first_rpm, "a crossing at {} rpm", k.rpm);
+    }
+}
+
+#[test]
+fn nan_and_inf_in_bearing_tables_are_named_where_they_are() {
+    let text = std::fs::read_to_string(data("rotor_example.toml")).unwrap();
+    let cases = [
+        ("kxx = [ 1000000.0,]", "kxx = [ 1000000.0, nan,]\nfrequency = [0.0, 10.0]", "`kxx`[1] = nan"),
+        ("kyy = [ 800000.0,]", "kyy = -inf", "`kyy` = -inf"),
+        ("cxx = [ 0,]", "cxx = [ inf,]", "`cxx`[0] = inf"),
+    ];
+    for (from, to, said) in cases {
+        let e = ross_file::parse(&text.replacen(from, to, 1)).unwrap_err().to_string();
+        assert!(e.contains(&format!("`BearingElement_Bearing 0`: {said} is not a finite number")), "{e}");
+        assert!(!e.contains("null") && !e.contains("missing"), "{e}");
+    }
+    // A shaft's value too, and a JSON file with Python's bare NaN / Infinity.
+    let e = ross_file::parse(&text.replacen("L = 0.25", "L = nan", 1)).unwrap_err().to_string();
+    assert!(e.contains("`L` = nan is not a finite number"), "{e}");
+    let json = std::fs::read_to_string(data("rotor_example.json")).unwrap();
+    let at = json.find("\"kxx\"").expect("a kxx in the JSON file");
+    let open = at + json[at..].find('[').unwrap();
+    let bad = format!("{}[Infinity, NaN, {}", &json[..open], &json[open + 1..]);
+    let e = ross_file::parse(&bad).unwrap_err().to_string();
+    assert!(e.contains("`kxx`[0] = Infinity is not a finite number"), "{e}");
+    // The words inside a string are no number: a tag "NaN" reads.
+    let tagged = json.replacen("\"tag\": \"", "\"tag\": \"NaN ", 1);
+    assert!(ross_file::parse(&tagged).is_ok());
+}

@@ -4,10 +4,11 @@
 use crate::error::{failure, input, WorkflowError};
 use crate::model::Updatable;
 use crate::named::Named;
-use crate::outcome::{BudgetReport, Covariances, Outcome, PairedFrequencies};
+use crate::outcome::{BudgetReport, Covariances, Outcome, PairedFrequencies, Verdict};
 use crate::overrides::fixed;
 use crate::progress::Progress;
 use crate::test_data::{self, interval_basis, pairing, Fit, ShapeOptions, TestDataOptions};
+use eigenfit_core::analysis::verdict::{at_limits, judge, FitQuality};
 use eigenfit_core::analysis::Joint;
 use eigenfit_core::eigen::{BandedSolver, DenseSolver, EigenSolver};
 use eigenfit_core::model::StructuralModel;
@@ -72,6 +73,16 @@ pub struct CampaignReport {
     /// Converged (with every mode paired), why it stopped, iterations, evaluations.
     #[serde(flatten)]
     pub outcome: Outcome,
+    /// `acceptable` and `verdict` by estimate's rule (`Verdict::of`): not converged, the budget
+    /// spent, a poor fit (χ² with measured std), a parameter on a limit or an unpaired mode make
+    /// the estimate not acceptable (exit code 3), as they do for `estimate`.
+    #[serde(flatten)]
+    pub verdict: Verdict,
+    /// The joint fit's quality (χ² test when every configuration has std).
+    #[serde(skip)]
+    pub quality: FitQuality,
+    /// Parameters on a limit at the estimate.
+    pub at_limit: Vec<String>,
     /// The evaluation budget: the limit, what the fit and its intervals spent, whether it ran out
     /// (intervals cut short are incomplete).
     pub budget: BudgetReport,
@@ -163,6 +174,18 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         names.push(name);
     }
     let fixed: Vec<_> = models.iter().map(|m| fixed(m, &[])).collect::<Result<_, _>>()?;
+    // The check estimate makes: no measured mode numbered onto a rigid-body mode (a
+    // configuration without bearings), refused naming the configuration and its file.
+    for (k, (m, d)) in fixed.iter().zip(&data).enumerate() {
+        let file = format!("{}: {}", names[k], campaign.configurations[k].measured.display());
+        crate::estimate::refuse_rigid_body_pairing(
+            m,
+            solver.as_ref(),
+            &m.parameters().nominal_values(),
+            &d.measurement,
+            &file,
+        )?;
+    }
     let fits: Vec<Fit> = fixed
         .iter()
         .zip(&data)
@@ -218,9 +241,26 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
             mac_pairing: mac.map(|r| r.pairing),
         });
     }
+    // One rule for the verdict, estimate's: a campaign is a fit like any other (issue 28).
+    let converged = estimate.termination.is_converged();
+    let quality = judge(&estimate.last, pnames.len());
+    let limits = at_limits(joint.parameters(), &p);
+    let at_limit: Vec<String> =
+        (0..pnames.len()).filter(|&i| limits[i] != 0).map(|i| pnames[i].clone()).collect();
+    let verdict = Verdict::of(
+        (!converged).then(|| estimate.termination.label()),
+        budget.exhausted(),
+        quality.verdict,
+        !at_limit.is_empty(),
+        unpaired,
+        true,
+    );
     Ok(CampaignReport {
         campaign: request.campaign.display().to_string(),
         strategy: estimate.strategy,
+        verdict,
+        quality,
+        at_limit,
         outcome: Outcome::of(&estimate, estimate.termination.is_converged() && !unpaired),
         budget: BudgetReport::of(&budget),
         initial: Named::new(&pnames, initial.iter().copied()),

@@ -20,8 +20,10 @@ use eigenfit_core::analysis::alternatives::{
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};
+use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::measurement::mac::MacReport;
 use eigenfit_core::measurement::measured_csv::{shown, shown_number};
+use eigenfit_core::measurement::Measurement;
 use eigenfit_core::model::{ParameterSet, StructuralModel};
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
 use eigenfit_core::update::{registry, Budget, Driver, Estimate, LevenbergMarquardt, Method, UpdateStrategy};
@@ -277,6 +279,52 @@ pub enum EstimateOutcome {
     Done(Box<Estimation>),
 }
 
+/// Refuses, before any fitting, measured modes numbered onto rigid-body modes of the model at
+/// `p` (a free–free structure, a rotor without bearings: eigenvalues zero to round-off, see
+/// [`crate::simulate::rigid_body_flags`]): no measured natural frequency pairs with one, and
+/// its frequency sensitivity is undefined. The message names the measured modes, the model's
+/// rigid-body modes and its first elastic one. A model that cannot be solved at `p` is left to
+/// the fit, which says why.
+pub fn refuse_rigid_body_pairing(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    measurement: &Measurement,
+    measured_name: &str,
+) -> Result<(), WorkflowError> {
+    let count = measurement.modes_needed();
+    let Ok(system) = model.assemble(p) else { return Ok(()) };
+    let Ok(modes) = solver.lowest(&system, count) else { return Ok(()) };
+    if crate::simulate::check_stable(model, &system, &modes, p).is_err() {
+        return Ok(());
+    }
+    let rigid = crate::simulate::rigid_body_flags(solver, &system, &modes)?;
+    let on_rigid: Vec<&eigenfit_core::measurement::MeasuredMode> =
+        measurement.modes().iter().filter(|m| rigid.get(m.mode).copied().unwrap_or(false)).collect();
+    if on_rigid.is_empty() {
+        return Ok(());
+    }
+    let numbers = crate::simulate::rigid_numbers(&rigid);
+    let first_elastic = (1..).find(|m| !numbers.contains(m)).unwrap_or(1);
+    let said: Vec<String> = on_rigid
+        .iter()
+        .map(|m| format!("mode {} ({} Hz)", m.mode + 1, shown_number(m.frequency_hz)))
+        .collect();
+    let one = on_rigid.len() == 1;
+    Err(input(format!(
+        "{measured_name}: measured {} numbered onto {} of the model ({} zero to round-off: nothing \
+         holds the model in {}; a free–free structure or a rotor without bearings), which no \
+         measured natural frequency pairs with. Measured modes pair with the model's by number, \
+         counting its rigid-body modes ({}): its first elastic mode is mode {first_elastic}; \
+         renumber the measured modes, or give the model supports",
+        said.join(", "),
+        if one { "a rigid-body mode" } else { "rigid-body modes" },
+        if one { "its eigenvalue is" } else { "their eigenvalues are" },
+        if one { "that motion" } else { "those motions" },
+        numbers.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")
+    )))
+}
+
 /// Runs an estimation. Notes for the log (ignored columns, strategy choices, round-off) go to
 /// `notes` as they arise.
 pub fn run(
@@ -375,6 +423,7 @@ pub fn run(
             any.dofs()
         )));
     }
+    refuse_rigid_body_pairing(&model, solver.as_ref(), &initial, &measurement, &measured_name.to_string())?;
     if matches!(base_name.as_str(), "newton" | "p-step") && measurement.len() > np {
         notes.push(format!(
             "the {base_name} strategy solves the paper's square system: it uses the first {np} of the {} measured modes; \
@@ -404,8 +453,13 @@ pub fn run(
     let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
     let mut fit = Fit::new(problem, &data, options.shape.shape_std);
     let budget = Budget::new(request.budget);
-    // Data no parameter value can produce is refused before any fitting.
-    if let Err(e) = check_reachable(&fit, &mode_numbers, &budget) {
+    // Data no parameter value can produce is refused before any fitting. Frequency data only,
+    // as check_softest: with shapes each corner pairs the measured modes by MAC with whichever
+    // model modes they resemble there (a free-free bending shape pairs with a pinned mode on
+    // stiff supports), so the corners' frequencies bound nothing (a soft-supported rotor's own
+    // universal file was refused as unreachable).
+    let reach = if data.sensors.is_none() { check_reachable(&fit, &mode_numbers, &budget) } else { Ok(()) };
+    if let Err(e) = reach {
         // A reach cut short by the budget says nothing about the data.
         if budget.exhausted() {
             return Ok(EstimateOutcome::BudgetExhaustedBeforeFit { limit: budget.limit() });

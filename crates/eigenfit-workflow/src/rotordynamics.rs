@@ -8,7 +8,7 @@ use crate::outcome::{
     ParameterIdentifiability, ParameterValues, Verdict,
 };
 use eigenfit_core::analysis::alternatives::{like_exchanges, mirror_solutions, Equivalence};
-use eigenfit_core::analysis::verdict::judge;
+use eigenfit_core::analysis::verdict::{at_limits, judge};
 use eigenfit_core::analysis::{uncertainty_within, Identifiability};
 use eigenfit_core::update::Budget;
 use eigenfit_rotordynamics::fit::fit_runup;
@@ -99,6 +99,10 @@ pub struct SpeedReport {
     pub damping_ratio: Vec<f64>,
     /// Logarithmic decrements.
     pub log_dec: Vec<f64>,
+    /// Rigid-body modes below the modes listed, left out of them (a rotor without bearings or
+    /// seals: eigenvalues zero to round-off); absent when there are none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rigid_body_modes_left_out: Option<usize>,
     /// The rotor's DOFs.
     #[serde(skip)]
     pub dofs: usize,
@@ -190,12 +194,18 @@ pub fn simulate_with(
     let all = rotor.lowest_modes(rpm_to_rad(rpm), modes).map_err(to_workflow)?;
     if modes > all.len() {
         return Err(input(format!(
-            "--modes {modes}: must be between 1 and {} (the oscillating modes of this rotor at {rpm} rpm)",
-            all.len()
+            "--modes {modes}: the rotor has only {} oscillating mode{} at {rpm} rpm, of its {} DOFs (the \
+             others are overdamped, rigid-body, or lost to round-off beside an extreme coefficient)",
+            all.len(),
+            if all.len() == 1 { "" } else { "s" },
+            rotor.dofs()
         )));
     }
     let shown = &all[..modes];
     let mut notes = set_notes;
+    let rigid = rotor.rigid_body_modes(rpm_to_rad(rpm)).map_err(to_workflow)?;
+    notes.extend(rigid_body_note(rigid, rpm));
+    notes.extend(divergent_note(&rotor, rpm));
     notes.extend(rotor.extrapolation_notes(&[rpm]));
     notes.extend(rotor.whirl_extrapolation_notes(&shown.iter().map(|m| m.eigenvalue.im).collect::<Vec<_>>()));
     let unstable: Vec<String> = (0..modes)
@@ -216,8 +226,34 @@ pub fn simulate_with(
         whirl: shown.iter().map(|m| m.whirl.name()).collect(),
         damping_ratio: shown.iter().map(|m| m.damping_ratio()).collect(),
         log_dec: shown.iter().map(|m| m.log_dec()).collect(),
+        rigid_body_modes_left_out: (rigid > 0).then_some(rigid),
         dofs: rotor.dofs(),
         notes,
+    })
+}
+
+/// Says that the rotor is statically unstable at `rpm` (a growing motion that no mode list
+/// holds, [`Rotor::divergent`]).
+fn divergent_note(rotor: &Rotor, rpm: f64) -> Option<String> {
+    rotor.divergent(rpm_to_rad(rpm)).map(|lambda| {
+        format!(
+            "the rotor is statically unstable at {rpm} rpm: its stiffness (symmetric part of K) has a \
+             negative eigenvalue λ = {lambda:.4e} (rad/s)² — a negative bearing or seal stiffness \
+             outweighing the shaft; that motion grows without oscillating, so it is in no mode listed"
+        )
+    })
+}
+
+/// Says that `count` rigid-body modes were left out of the modes listed at `rpm`.
+fn rigid_body_note(count: usize, rpm: f64) -> Option<String> {
+    (count > 0).then(|| {
+        format!(
+            "{count} rigid-body mode{} at {rpm} rpm left out of the modes listed (eigenvalues zero to \
+             round-off: nothing holds the rotor in {} — no bearing or seal there); they are no \
+             vibration and never a critical speed",
+            if count == 1 { "" } else { "s" },
+            if count == 1 { "that motion" } else { "those motions" }
+        )
     })
 }
 
@@ -461,6 +497,18 @@ pub fn estimate_with(
     } else {
         None
     };
+    // A mode number no rotor of this size has: refused naming it, not paired by frequency with
+    // whatever mode is nearest (the number is the pairing's order hint).
+    if let Some(p) = points.iter().find(|p| p.mode > rotor.dofs()) {
+        return Err(input(format!(
+            "{}: mode {} measured at {} rpm but the rotor ({} DOFs) has at most {} modes",
+            measured.display(),
+            p.mode,
+            p.speed_rpm,
+            rotor.dofs(),
+            rotor.dofs()
+        )));
+    }
     check_selection(&rotor, &params, &points).map_err(to_workflow)?;
     if budget == 0 {
         return Err(input("--budget 0: at least one model evaluation is needed"));
@@ -496,11 +544,15 @@ pub fn estimate_with(
     let alternatives_sigma = Equivalence::at(lin, np).sigma_source();
     let unique = !mirrors.symmetric.iter().any(|m| m.judged.equally_good);
     let budget_spent = budget.exhausted();
+    // estimate's rule: a coefficient on a limit of its factor is no acceptable answer.
+    let on_limit = at_limits(eigenfit_core::problem::Objective::parameters(&objective), &estimate.parameters)
+        .iter()
+        .any(|&l| l != 0);
     let verdict = Verdict::of(
         (!converged).then(|| estimate.termination.label()),
         budget_spent,
         quality.verdict,
-        false,
+        on_limit,
         false,
         unique,
     );
@@ -780,6 +832,10 @@ pub struct CampbellReport {
     pub campbell: Campbell,
     /// The critical speeds (rpm).
     pub critical_speeds_rpm: Vec<f64>,
+    /// Rigid-body modes at the first speed, left out of the modes listed and of the critical
+    /// speeds (a rotor without bearings or seals); absent when there are none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rigid_body_modes_left_out: Option<usize>,
     /// Plot files written.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plots: Option<Vec<String>>,
@@ -802,6 +858,13 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
         other => input(format!("{}: {other}", path.display())),
     })?;
     let mut notes = rotor.extrapolation_notes(&speeds);
+    let rigid = rotor.rigid_body_modes(rpm_to_rad(speeds[0])).map_err(to_workflow)?;
+    notes.extend(rigid_body_note(rigid, speeds[0]));
+    // Static instability at either end of the sweep (bearing tables change with speed).
+    let ends = [speeds[0], speeds[speeds.len() - 1]];
+    notes.extend(
+        ends.iter().take(if ends[0] == ends[1] { 1 } else { 2 }).find_map(|&r| divergent_note(&rotor, r)),
+    );
     let whirl = c.frequencies_hz.iter().flatten().map(|f| 2.0 * std::f64::consts::PI * f);
     let (lo, hi) = whirl.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| (a.min(w), b.max(w)));
     if lo.is_finite() {
@@ -822,6 +885,7 @@ pub fn campbell_diagram(path: &Path, speeds: &str, modes: usize) -> Result<Campb
         model: path.display().to_string(),
         critical_speeds_rpm: c.critical_speeds.iter().map(|k| k.rpm).collect(),
         campbell: c,
+        rigid_body_modes_left_out: (rigid > 0).then_some(rigid),
         plots: None,
         notes,
         operating_range_rpm: None,

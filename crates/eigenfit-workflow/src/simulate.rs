@@ -5,7 +5,7 @@ use crate::error::{failure, input, WorkflowError};
 use crate::named::Named;
 use crate::progress::Progress;
 use eigenfit_core::eigen::roundoff::{
-    relative_roundoff, trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF,
+    relative_roundoff, rigid_body_modes, trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF,
 };
 use eigenfit_core::eigen::{EigenSolver, Modes, SolveError};
 use eigenfit_core::matrix::System;
@@ -32,8 +32,21 @@ pub fn check_roundoff_of(
     modes: &Modes,
     only: Option<&[usize]>,
 ) -> Result<Option<String>, WorkflowError> {
+    let rigid = rigid_body_modes(system, modes).unwrap_or_default();
+    check_roundoff_except(system, modes, only, &rigid)
+}
+
+/// [`check_roundoff_of`] skipping the modes flagged in `rigid` (rigid-body modes, zero to
+/// round-off by nature: reported as such, not refused).
+pub fn check_roundoff_except(
+    system: &System,
+    modes: &Modes,
+    only: Option<&[usize]>,
+    rigid: &[bool],
+) -> Result<Option<String>, WorkflowError> {
     let levels = relative_roundoff(system, modes);
-    let checked = |j: &usize| only.is_none_or(|o| o.contains(&(j + 1)));
+    let checked =
+        |j: &usize| only.is_none_or(|o| o.contains(&(j + 1))) && !rigid.get(*j).copied().unwrap_or(false);
     match (0..levels.len()).filter(checked).find(|&j| levels[j].is_nan() || levels[j] > MAX_RELATIVE_ROUNDOFF)
     {
         None => {
@@ -128,7 +141,8 @@ pub fn readable(v: f64) -> String {
     }
 }
 
-/// The lowest `modes` frequencies (Hz) at `p`, refusing round-off-lost ones (notes go to `notes`).
+/// The lowest `modes` frequencies (Hz) at `p`, refusing round-off-lost ones (notes go to `notes`);
+/// rigid-body modes are 0 Hz (see [`labelled_frequencies`]).
 pub fn frequencies(
     model: &dyn StructuralModel,
     solver: &dyn EigenSolver,
@@ -136,11 +150,65 @@ pub fn frequencies(
     modes: usize,
     notes: &mut Vec<String>,
 ) -> Result<Vec<f64>, WorkflowError> {
+    labelled_frequencies(model, solver, p, modes, notes).map(|(f, _)| f)
+}
+
+/// The lowest `modes` frequencies (Hz) at `p` and which of them are rigid-body modes: an
+/// unstable model is refused ([`check_stable`]), rigid-body modes ([`rigid_body_flags`]) are
+/// reported at exactly 0 Hz (the solver's value is round-off, not a frequency), and any other
+/// mode lost to round-off is refused.
+pub fn labelled_frequencies(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    modes: usize,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<f64>, Vec<bool>), WorkflowError> {
     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
     let m = solver.lowest(&system, modes).map_err(|e| solver_failure(&system, e))?;
     check_stable(model, &system, &m, p)?;
-    notes.extend(check_roundoff(&system, &m)?);
-    Ok(m.frequencies_hz())
+    let rigid = rigid_body_flags(solver, &system, &m)?;
+    notes.extend(check_roundoff_except(&system, &m, None, &rigid)?);
+    let f = m.frequencies_hz().into_iter().zip(&rigid).map(|(f, &r)| if r { 0.0 } else { f }).collect();
+    Ok((f, rigid))
+}
+
+/// Most modes solved beyond those asked for to find the first one resolved from zero (the
+/// rigid-body test needs one): a structure in space has at most 6 rigid-body modes per free
+/// body, so this is for a model of several free bodies.
+const MOST_EXTRA_MODES_FOR_RIGID: usize = 64;
+
+/// Which of `modes` (the lowest of `system`) are rigid-body modes
+/// ([`eigenfit_core::eigen::roundoff::rigid_body_modes`], a scale-free test); when every one of
+/// them is zero to round-off, more modes are solved until one is resolved. A system none of whose
+/// modes is resolved has a zero K: every mode is rigid-body. When the extra modes cannot be
+/// solved, none is called rigid-body (the round-off check then refuses them, naming both
+/// causes).
+pub fn rigid_body_flags(
+    solver: &dyn EigenSolver,
+    system: &System,
+    modes: &Modes,
+) -> Result<Vec<bool>, WorkflowError> {
+    let n = modes.count();
+    if let Some(flags) = rigid_body_modes(system, modes) {
+        return Ok(flags);
+    }
+    let most = (n + MOST_EXTRA_MODES_FOR_RIGID).min(system.dofs());
+    let mut count = n;
+    while count < most {
+        count = (2 * count + 4).min(most);
+        let Ok(more) = solver.lowest(system, count) else { return Ok(vec![false; n]) };
+        if let Some(flags) = rigid_body_modes(system, &more) {
+            return Ok(flags[..n].to_vec());
+        }
+    }
+    // Every mode of the system zero to round-off: nothing holds it anywhere.
+    Ok(vec![count == system.dofs(); n])
+}
+
+/// The mode numbers (from 1) flagged in `rigid`.
+pub fn rigid_numbers(rigid: &[bool]) -> Vec<usize> {
+    rigid.iter().enumerate().filter(|(_, &r)| r).map(|(j, _)| j + 1).collect()
 }
 
 /// A solver failure on matrices whose lowest mode is lost to round-off whatever the solver (a
@@ -264,8 +332,12 @@ pub struct PointReport {
     pub dofs: Option<usize>,
     /// The parameter values.
     pub parameters: Named<f64>,
-    /// Natural frequencies (Hz), lowest first.
+    /// Natural frequencies (Hz), lowest first; a rigid-body mode's is 0.
     pub frequencies_hz: Vec<f64>,
+    /// The rigid-body modes among them (numbers from 1): eigenvalues zero to round-off, far
+    /// below the first elastic mode (a free–free structure, a rotor without bearings). Absent
+    /// when there are none.
+    pub rigid_body_modes: Option<Vec<usize>>,
     /// df_k/dp_i in Hz per parameter unit, one array over modes per parameter.
     pub sensitivities_hz: Option<Named<Vec<f64>>>,
     /// Why there are no sensitivities (repeated or rigid-body modes).
@@ -362,27 +434,41 @@ pub fn at_point(
 ) -> Result<PointReport, WorkflowError> {
     let names: Vec<String> = model.parameters().iter().map(|q| q.name.clone()).collect();
     let mut notes = Vec::new();
-    let (f, sens) = match Sensitivities::compute(model, solver, p, modes) {
+    let (f, rigid, sens) = match Sensitivities::compute(model, solver, p, modes) {
         Ok(s) => {
             let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
             check_stable(model, &system, &s.modes, p)?;
             if check == SweepCheck::RefuseRoundoff {
                 notes.extend(check_roundoff(&system, &s.modes)?);
             }
-            (s.modes.frequencies_hz(), Ok(s.frequencies_hz))
+            (s.modes.frequencies_hz(), Vec::new(), Ok(s.frequencies_hz))
         }
         Err(e) => {
-            let f = match check {
-                SweepCheck::RefuseRoundoff => frequencies(model, solver, p, modes, &mut notes)?,
+            let (f, rigid) = match check {
+                SweepCheck::RefuseRoundoff => labelled_frequencies(model, solver, p, modes, &mut notes)?,
                 SweepCheck::None => {
                     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
                     let m = solver.lowest(&system, modes).map_err(failure)?;
                     check_stable(model, &system, &m, p)?;
-                    m.frequencies_hz()
+                    let rigid = rigid_body_flags(solver, &system, &m)?;
+                    let f = m.frequencies_hz().into_iter().zip(&rigid).map(|(f, &r)| if r { 0.0 } else { f });
+                    (f.collect(), rigid)
                 }
             };
-            (f, Err(e.to_string()))
+            (f, rigid, Err(e.to_string()))
         }
+    };
+    let rigid = rigid_numbers(&rigid);
+    // A rigid-body mode's zero frequency has no sensitivity: said as such, not as the round-off
+    // pair of "repeated eigenvalues" the derivative check sees.
+    let sens = match sens {
+        Err(_) if !rigid.is_empty() => Err(format!(
+            "{} {} rigid-body: a zero frequency has no sensitivity to the parameters",
+            if rigid.len() == 1 { "mode" } else { "modes" },
+            rigid.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")
+                + if rigid.len() == 1 { " is" } else { " are" }
+        )),
+        other => other,
     };
     let (sensitivities_hz, sensitivities_unavailable) = match sens {
         Ok(df) => {
@@ -396,6 +482,7 @@ pub fn at_point(
         dofs: None,
         parameters: Named::new(&names, p.iter().copied()),
         frequencies_hz: f,
+        rigid_body_modes: (!rigid.is_empty()).then_some(rigid),
         sensitivities_hz,
         sensitivities_unavailable,
         plots: None,

@@ -475,6 +475,12 @@ pub fn uff_text(
 ) -> Result<String, WorkflowError> {
     let system = rotor.assemble(p).map_err(|e| input(e.to_string()))?;
     let solved = solver.lowest(&system, modes).map_err(failure)?;
-    let (nodes, uff_modes) = rotor.uff_modes(&solved);
+    // An unstable model has no natural frequencies to write; rigid-body modes have none either
+    // (0 Hz, which no reader of measured modes takes): they are left out, the elastic modes
+    // keep their numbers, so the file reads back as measured data of this model.
+    crate::simulate::check_stable(rotor, &system, &solved, p)?;
+    let rigid = crate::simulate::rigid_body_flags(solver, &system, &solved)?;
+    let (nodes, mut uff_modes) = rotor.uff_modes(&solved);
+    uff_modes.retain(|m| !rigid.get((m.number - 1) as usize).copied().unwrap_or(false));
     Ok(uff::write(&format!("eigenfit simulate: {label}"), &nodes, &uff_modes))
 }

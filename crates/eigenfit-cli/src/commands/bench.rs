@@ -55,6 +55,13 @@ pub fn run(args: &BenchArgs) -> Result<u8, CliError> {
         budget: args.budget,
         max_iterations: args.max_iterations,
     };
+    // Every output is checked writable before the runs: a bench never runs for nothing.
+    if let Some(path) = &args.records {
+        crate::output::check_writable(path, "--records")?;
+    }
+    if let Some(dir) = &args.plot {
+        crate::output::check_writable_dir(dir, "--plot")?;
+    }
     args.html.check()?;
     let html = args.html.html.as_ref().map(|_| {
         let mut html = crate::report::Report::new("bench", "bench");
@@ -70,24 +77,38 @@ pub fn run(args: &BenchArgs) -> Result<u8, CliError> {
         html
     });
     let report = bench::run(&request)?;
-    if let Some(path) = &args.records {
-        let mut lines = String::new();
-        for r in &report.records {
-            lines.push_str(&serde_json::to_string(r).map_err(|e| CliError::Failure(e.to_string()))?);
-            lines.push('\n');
+    let code = if report.every_pair_succeeded() { EXIT_OK } else { EXIT_NOT_CONVERGED };
+    // A write failing after the runs (a disk filled meanwhile) says what was lost and keeps the
+    // bench's own exit code: the summary below stands.
+    let records_written = match &args.records {
+        Some(path) => {
+            let mut lines = String::new();
+            for r in &report.records {
+                lines.push_str(&serde_json::to_string(r).map_err(|e| CliError::Failure(e.to_string()))?);
+                lines.push('\n');
+            }
+            match crate::output::write_atomically(path, lines.as_bytes()) {
+                Ok(()) => true,
+                Err(e) => {
+                    crate::output::report_lost("the records file", &e);
+                    false
+                }
+            }
         }
-        crate::output::write_atomically(path, lines.as_bytes())?;
-    }
+        None => false,
+    };
     let plots = match &args.plot {
-        Some(dir) => crate::plot::bench::write_all(&report, dir)?,
+        Some(dir) => crate::plot::bench::write_all(&report, dir).unwrap_or_else(|e| {
+            crate::output::report_lost("plot output", &e);
+            Vec::new()
+        }),
         None => Vec::new(),
     };
-    let code = if report.every_pair_succeeded() { EXIT_OK } else { EXIT_NOT_CONVERGED };
     crate::error::set_exit_on_closed_pipe(code);
     crate::output::report(args.report.json, &report, |r| {
         print_summary(r);
         plots.iter().for_each(|w| println!("wrote {}", w.display()));
-        if let Some(path) = &args.records {
+        if let (Some(path), true) = (&args.records, records_written) {
             println!("wrote {}", path.display());
         }
     });

@@ -52,8 +52,9 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
     let html = args.html.html.as_ref().map(|_| html_inputs(&args.campaign));
     let report = campaign::run(&request, &mut Bars::new(args.report.quiet))?;
     crate::commands::simulate::print_notes(&report.file_notes);
-    let done = report.outcome.converged && !report.budget.exhausted;
-    let code = if done { 0 } else { EXIT_NOT_CONVERGED };
+    // estimate's rule: 0 only for an acceptable answer (a poor fit, a parameter on a limit, an
+    // unpaired mode, the budget spent or no convergence is 3).
+    let code = if report.verdict.is_answer() { 0 } else { EXIT_NOT_CONVERGED };
     crate::error::set_exit_on_closed_pipe(code);
     crate::output::report(args.report.json, &report, |report| {
         println!(
@@ -90,6 +91,25 @@ pub fn run(args: &CampaignArgs) -> Result<u8, CliError> {
             }
             c.notes.iter().for_each(|n| eprintln!("note: {}: {n}", c.name));
         }
+        let quality = &report.quality;
+        match quality.p_value {
+            Some(pv) => println!(
+                "fit quality: chi2 = {:.4} with {} degrees of freedom, p = {pv:.3e}",
+                report.chi2, quality.dof
+            ),
+            None if report.has_std => {
+                println!("fit quality: chi2 = {:.4} (no degree of freedom left)", report.chi2)
+            }
+            None => {}
+        }
+        if !report.at_limit.is_empty() {
+            println!("on a limit at the estimate: {}", report.at_limit.join(", "));
+        }
+        println!(
+            "verdict: {}{}",
+            report.verdict.verdict,
+            if report.verdict.acceptable { "" } else { " — not an acceptable answer (exit code 3)" }
+        );
         if let Some(s) = report.scatter.filter(|_| !report.has_std) {
             println!("intervals from the residual scatter (no std in the data): sigma_hat = {s:.3e}");
         }

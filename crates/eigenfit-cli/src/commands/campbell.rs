@@ -38,6 +38,10 @@ pub struct CampbellArgs {
 
 /// Runs `campbell`.
 pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
+    // Every output is checked writable before the diagram is computed.
+    if let Some(dir) = &args.plot {
+        crate::output::check_writable_dir(dir, "--plot")?;
+    }
     args.html.check()?;
     let html = args.html.html.as_ref().map(|_| {
         let mut html = crate::report::Report::new("campbell", "campbell");
@@ -49,7 +53,11 @@ pub fn run(args: &CampbellArgs) -> Result<(), CliError> {
     let plots = match &args.plot {
         Some(dir) => {
             let figure = CampbellPlot { title: report.model.clone(), campbell: &report.campbell };
-            plot::write(&figure, dir, "campbell")?
+            // A write failing after the diagram says what was lost; the diagram below stands.
+            plot::write(&figure, dir, "campbell").unwrap_or_else(|e| {
+                crate::output::report_lost("the Campbell plot", &e);
+                Vec::new()
+            })
         }
         None => Vec::new(),
     };

@@ -93,6 +93,10 @@ fn request(args: &CompareArgs) -> CompareRequest {
 /// Runs `compare`; returns the exit code (3 when a run ran out of its evaluation budget: the
 /// comparison is incomplete).
 pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
+    // Every output is checked writable before the runs (the stream is opened below).
+    if let Some(dir) = &args.plot {
+        crate::output::check_writable_dir(dir, "--plot")?;
+    }
     let (loaded, label) = args.model.load_any()?;
     // The parameters estimate fits: a rotor's `[[parameter]]` tables resolved.
     let model = loaded.updatable(&label)?;
@@ -113,8 +117,13 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
     pb.finish_and_clear();
     let mut report = report?;
     let plots = match &args.plot {
+        // A write failing after the runs says what was lost; the comparison below stands.
         Some(dir) => {
-            write_maps(dir, &label, model.parameters(), &report.raw, &plan.targets, &plan.strategies)?
+            write_maps(dir, &label, model.parameters(), &report.raw, &plan.targets, &plan.strategies)
+                .unwrap_or_else(|e| {
+                    crate::output::report_lost("plot output", &e);
+                    Vec::new()
+                })
         }
         None => Vec::new(),
     };

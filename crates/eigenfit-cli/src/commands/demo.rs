@@ -35,6 +35,8 @@ pub fn run(args: &DemoArgs) -> Result<(), CliError> {
     if args.grid < 2 {
         return Err(input(format!("--grid {}: must be at least 2", args.grid)));
     }
+    // The plots are the demo's output: their folder is checked before the work.
+    crate::output::check_writable_dir(&args.out, "--out")?;
     let started = std::time::Instant::now();
     let rotor = presets::paper_rotor();
     let out = &args.out;

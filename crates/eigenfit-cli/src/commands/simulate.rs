@@ -185,11 +185,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         return Ok(());
     }
     let p = parameter_vector(&rotor, "--stiffness", args.stiffness.as_deref(), &args.sets)?;
+    // The frequencies first: a model refused there (unstable, lost to round-off) writes no file.
+    let mut report = at_point(&label, &rotor, solver.as_ref(), &p, args.modes, SweepCheck::RefuseRoundoff)?;
     if let Some(path) = &args.uff {
         let text = eigenfit_workflow::test_data::uff_text(&label, &rotor, solver.as_ref(), &p, args.modes)?;
         crate::output::write_atomically(path, text.as_bytes())?;
     }
-    let mut report = at_point(&label, &rotor, solver.as_ref(), &p, args.modes, SweepCheck::RefuseRoundoff)?;
     if args.shapes {
         report.mode_shapes = Some(rotor_mode_shapes(&rotor, solver.as_ref(), &p, args.modes)?);
     }
@@ -202,7 +203,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 quiet: args.report.quiet,
                 modes: args.modes,
             };
-            write_plots(dir, &label, &rotor, solver.as_ref(), &p, options)?
+            // Checked writable before the work: a write failing now says what was lost and the
+            // frequencies below stand.
+            write_plots(dir, &label, &rotor, solver.as_ref(), &p, options).unwrap_or_else(|e| {
+                crate::output::report_lost("plot output", &e);
+                Vec::new()
+            })
         }
         None => Vec::new(),
     };
@@ -261,8 +267,21 @@ fn print_point(report: &PointReport) {
         println!("  {n} = {v:.6e}{}", if unit.is_empty() { String::new() } else { format!(" {unit}") });
     }
     println!("{:>6}{:>18}", "mode", "frequency [Hz]");
+    let rigid = report.rigid_body_modes.as_deref().unwrap_or_default();
     for (i, v) in report.frequencies_hz.iter().enumerate() {
-        println!("{:>6}{v:>18.6}", i + 1);
+        if rigid.contains(&(i + 1)) {
+            println!("{:>6}{v:>18.6}  rigid-body", i + 1);
+        } else {
+            println!("{:>6}{v:>18.6}", i + 1);
+        }
+    }
+    if !rigid.is_empty() {
+        println!(
+            "rigid-body modes: {} (eigenvalues zero to round-off: nothing holds the model in these motions; \
+             number measured modes from mode {}, the first elastic one)",
+            rigid.iter().map(ToString::to_string).collect::<Vec<_>>().join(", "),
+            (1..).find(|m| !rigid.contains(m)).unwrap_or(1)
+        );
     }
     if let Some(s) = &report.mode_shapes {
         println!("mode shapes (mass-normalised, ΦᵀMΦ = I):");

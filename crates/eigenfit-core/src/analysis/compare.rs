@@ -97,7 +97,12 @@ pub enum CompareError {
     RunPanicked,
 }
 
-/// Reference data: the lowest `modes` frequencies of `model` at `target`, optionally rounded.
+/// Modes solved beyond those asked for, for the reference data to skip a free structure's
+/// rigid-body modes (six per free body in space).
+const RIGID_BODY_SPARE: usize = 6;
+
+/// Reference data: the lowest `modes` elastic frequencies of `model` at `target` (rigid-body
+/// modes skipped), optionally rounded.
 pub fn reference_measurement<M, S>(
     model: &M,
     solver: &S,
@@ -108,15 +113,23 @@ where
     M: StructuralModel + ?Sized,
     S: EigenSolver + ?Sized,
 {
-    let modes = solver.lowest(&model.assemble(target)?, settings.reference.modes)?;
+    // A free structure's rigid-body modes (zero to round-off) are no measured frequency: the
+    // reference is its lowest elastic modes, numbered as the model numbers them (a free-free
+    // model's comparison failed every run on a 0 Hz 'mode 1').
+    let system = model.assemble(target)?;
+    let wanted = settings.reference.modes;
+    let solved = solver.lowest(&system, (wanted + RIGID_BODY_SPARE).min(system.dofs()))?;
+    let rigid = crate::eigen::roundoff::rigid_body_modes(&system, &solved).unwrap_or_default();
     let round = |f: f64| match settings.reference.decimals {
         Some(d) => (f * 10f64.powi(d)).round() / 10f64.powi(d),
         None => f,
     };
-    let measured = modes
+    let measured = solved
         .frequencies_hz()
         .into_iter()
         .enumerate()
+        .filter(|(k, _)| !rigid.get(*k).copied().unwrap_or(false))
+        .take(wanted)
         .map(|(k, f)| MeasuredMode {
             mode: k,
             frequency_hz: round(f),

@@ -35,6 +35,45 @@ pub fn relative_roundoff(system: &System, modes: &Modes) -> Vec<f64> {
         .collect()
 }
 
+/// How far below the lowest resolved eigenvalue (one above its round-off bound) an eigenvalue
+/// within its round-off bound must lie to be a rigid-body mode (see [`rigid_body_modes`]).
+pub const RIGID_BODY_GAP: f64 = 1e6;
+
+/// Which of `modes` are rigid-body modes, by a test free of any absolute scale (no Hz, no
+/// (rad/s)²): mode j is one when
+///
+/// 1. its eigenvalue is zero to round-off — [`relative_roundoff`] ≥ [`MAX_RELATIVE_ROUNDOFF`]:
+///    λ within ε (‖K‖∞/λ + ‖M‖∞) ‖φ‖² of zero, or λ ≤ 0 (a negative eigenvalue *beyond*
+///    round-off is an unstable model, which the callers refuse before asking this), and
+/// 2. the lowest mode of `modes` resolved from zero (relative round-off below the limit) lies
+///    at least [`RIGID_BODY_GAP`] times |λⱼ| above it.
+///
+/// A backward-stable solver leaves an exact zero at about ε times the spectrum's scale, ten
+/// decades or more below the first elastic mode; a fine mesh's lowest elastic mode drowned in
+/// round-off lies within a decade or two of the next (λ₂/λ₁ is the structure's), so it fails
+/// the gap and stays a mode lost to round-off (refused by the callers as such), and so does a
+/// very soft support whose mode is still resolved (it fails the first test).
+///
+/// `None` when no mode of `modes` is resolved from zero: the gap cannot be judged; solve more
+/// modes (a model whose every mode is zero to round-off has a zero K: all rigid-body).
+pub fn rigid_body_modes(system: &System, modes: &Modes) -> Option<Vec<bool>> {
+    let levels = relative_roundoff(system, modes);
+    let zero = |j: usize| levels[j].is_nan() || levels[j] >= MAX_RELATIVE_ROUNDOFF;
+    let resolved =
+        (0..modes.count()).filter(|&j| !zero(j)).map(|j| modes.eigenvalues[j]).fold(f64::INFINITY, f64::min);
+    if !resolved.is_finite() {
+        return None;
+    }
+    Some(
+        (0..modes.count())
+            .map(|j| {
+                let lambda = modes.eigenvalues[j];
+                zero(j) && !lambda.is_nan() && lambda.abs() * RIGID_BODY_GAP <= resolved
+            })
+            .collect(),
+    )
+}
+
 /// [`relative_roundoff`]'s estimate for the lowest mode with a trial vector in place of the
 /// mode, from the matrices alone: for when the solver itself failed (a mesh so fine that its
 /// iteration misses modes). The trial vectors are the all-ones vector and ones on every other
@@ -109,4 +148,62 @@ fn band_inf_norm(a: &crate::matrix::BandedSymmetric) -> f64 {
 
 fn dense_inf_norm(a: &nalgebra::DMatrix<f64>) -> f64 {
     a.row_iter().map(|r| r.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eigen::{BandedSolver, DenseSolver, EigenSolver};
+    use nalgebra::DMatrix;
+
+    /// A chain of `n` masses `m` joined by springs `k`, with a ground spring `ground` on mass 1.
+    fn chain(n: usize, k: f64, m: f64, ground: f64) -> System {
+        let mut kk = DMatrix::zeros(n, n);
+        for i in 0..n - 1 {
+            kk[(i, i)] += k;
+            kk[(i + 1, i + 1)] += k;
+            kk[(i, i + 1)] -= k;
+            kk[(i + 1, i)] -= k;
+        }
+        kk[(0, 0)] += ground;
+        System::new(kk, DMatrix::identity(n, n) * m).unwrap()
+    }
+
+    fn flags(system: &System, solver: &dyn EigenSolver, count: usize) -> Option<Vec<bool>> {
+        rigid_body_modes(system, &solver.lowest(system, count).unwrap())
+    }
+
+    #[test]
+    fn a_free_chain_has_one_rigid_body_mode_at_any_scale_and_with_any_solver() {
+        // The same chain in units 10⁹ apart (N/m and kg, or mN/mm and t): the test has no scale.
+        for (k, m) in [(1e3, 1.0), (1e12, 1e-6), (1e-3, 1e6)] {
+            for solver in [&DenseSolver as &dyn EigenSolver, &BandedSolver::default()] {
+                let f = flags(&chain(8, k, m, 0.0), solver, 4).unwrap();
+                assert_eq!(f, [true, false, false, false], "k = {k}, m = {m}, {}", solver.name());
+            }
+        }
+    }
+
+    #[test]
+    fn a_supported_or_softly_supported_chain_has_none() {
+        // A ground spring of 1e-6 k: a soft mode 10⁵ below the next, but resolved from zero.
+        for ground in [1e3, 1.0, 1e-3] {
+            let f = flags(&chain(8, 1e3, 1.0, ground), &DenseSolver, 4).unwrap();
+            assert_eq!(f, [false; 4], "ground = {ground}");
+        }
+    }
+
+    #[test]
+    fn modes_all_zero_to_round_off_cannot_be_judged_alone() {
+        // Two disconnected free masses asked for their two (zero) modes: no resolved mode to
+        // measure the gap against; with the elastic one of a third, joined pair, they can be.
+        let mut k = DMatrix::zeros(4, 4);
+        k[(2, 2)] = 1e3;
+        k[(3, 3)] = 1e3;
+        k[(2, 3)] = -1e3;
+        k[(3, 2)] = -1e3;
+        let system = System::new(k, DMatrix::identity(4, 4)).unwrap();
+        assert_eq!(flags(&system, &DenseSolver, 2), None);
+        assert_eq!(flags(&system, &DenseSolver, 4).unwrap(), [true, true, true, false]);
+    }
 }

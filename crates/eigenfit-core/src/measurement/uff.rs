@@ -130,6 +130,17 @@ impl<'a> Tokens<'a> {
         t.parse().or_else(|_| err(line, format!("{what}: `{}` is not a whole number", t.escape_debug())))
     }
 
+    /// A node label: a whole number ≥ 1 (the standard's labels are positive; `-1` is the
+    /// dataset delimiter, so a label written as `-1` would end the dataset when read back).
+    fn label(&mut self, what: &str) -> Result<i64, UffError> {
+        let (t, line) = self.token(what)?;
+        match t.parse::<i64>() {
+            Ok(v) if v >= 1 => Ok(v),
+            Ok(v) => err(line, format!("{what}: {v} is not a node label (labels are whole numbers ≥ 1)")),
+            Err(_) => err(line, format!("{what}: `{}` is not a whole number", t.escape_debug())),
+        }
+    }
+
     fn real(&mut self, what: &str) -> Result<f64, UffError> {
         let (t, line) = self.token(what)?;
         let v: f64 = t
@@ -222,7 +233,7 @@ fn read_nodes(
 ) -> Result<(), UffError> {
     let mut t = Tokens::new(block, 0);
     while !t.at_end() {
-        let label = t.int("the node label")?;
+        let label = t.label("the node label")?;
         let line = t.line;
         if let Some(first) = seen.insert(label, line) {
             return err(line, format!("node {label} has coordinates twice (first on line {first})"));
@@ -325,7 +336,7 @@ fn read_55(block: &Block, start: usize) -> Result<UffMode, UffError> {
     let mut values = Vec::new();
     let mut raw_complex: Vec<Vec<(f64, f64)>> = Vec::new();
     while !t.at_end() {
-        let node = t.int("a node label")?;
+        let node = t.label("a node label")?;
         t.next_record();
         if complex {
             let v: Vec<(f64, f64)> = (0..components)
@@ -437,22 +448,73 @@ fn i10(v: i64) -> String {
     }
 }
 
-/// `%13.5E`-like with 6 significant digits kept (the standard's E13.5), as `1.23456E+02`.
+/// `%13.5E`-like with 6 significant digits kept (the standard's E13.5), as `1.23456E+02`, right
+/// aligned in its 13 characters; one too wide for them (a negative value with a three-digit
+/// exponent, `-1.38501E-201`) keeps a space before it, as [`i10`] does, so the reader never glues
+/// it to the field before (found by the `uff_file` fuzz target: `-6.06490E-03-1.38501E-201`).
 fn e13(v: f64) -> String {
     let t = format!("{v:.5E}");
     // Rust prints `1.23456E2`; the standard wants a signed two-digit exponent.
-    match t.split_once('E') {
+    let t = match t.split_once('E') {
         Some((m, e)) => {
             let e: i32 = e.parse().unwrap_or(0);
             format!("{m}E{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
         }
         None => t,
+    };
+    let field = format!("{t:>13}");
+    if field.starts_with(' ') {
+        field
+    } else {
+        format!(" {t}")
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn node_labels_below_one_are_refused_naming_the_line() {
+        // A dataset 55 whose node record reads -1 (a value line cut short, found by the fuzz
+        // target): as a label it would be written back as the dataset delimiter.
+        let nodes = vec![UffNode { label: 1, coordinates: [0.0, 0.0, 0.0] }];
+        let mode = UffMode {
+            number: 1,
+            frequency_hz: 10.0,
+            modal_mass: 1.0,
+            damping_ratio: 0.0,
+            values: vec![(1, vec![1.0, 2.0, 3.0, 0.0, 0.0, 0.0])],
+            complex: false,
+            realness: 1.0,
+            line: 0,
+        };
+        let text = write("t", &nodes, &[mode]);
+        let at = text.rfind("         1\n").expect("the mode's node record");
+        let bad = format!("{}     -1 x{}", &text[..at], &text[at + 10..]);
+        let e = parse(&bad).unwrap_err();
+        assert!(e.message.contains("a node label: -1 is not a node label"), "{e}");
+        assert_eq!(e.line, bad[..at].matches('\n').count() + 1);
+    }
+
+    #[test]
+    fn values_too_wide_for_their_field_keep_a_space_and_read_back() {
+        let nodes = vec![UffNode { label: 1, coordinates: [-1.5e-200, -2.5e-300, 1e-310] }];
+        let mode = UffMode {
+            number: 1,
+            frequency_hz: 10.0,
+            modal_mass: 1.0,
+            damping_ratio: 0.0,
+            values: vec![(1, vec![-6.0649e-3, -1.38501e-201, -1e-300, 0.0, 0.0, 0.0])],
+            complex: false,
+            realness: 1.0,
+            line: 0,
+        };
+        let text = write("t", &nodes, &[mode]);
+        let back = parse(&text).unwrap_or_else(|e| panic!("{e}:\n{text}"));
+        assert_eq!(back.modes[0].values[0].1[1], -1.38501e-201);
+        assert_eq!(back.nodes[0].coordinates[1], -2.5e-300);
+    }
 
     #[test]
     fn written_files_read_back() {

@@ -213,15 +213,31 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             Pairing::Order => needed,
             Pairing::Mac { .. } => (2 * needed + 2).min(dofs),
         };
+        let mut rigid = vec![false; count];
         let sens = match self.pairing {
             // Only the measured modes must be distinct and elastic (free–free structures).
             Pairing::Order => {
                 let wanted: Vec<usize> = self.measured.modes().iter().map(|m| m.mode).collect();
                 Sensitivities::compute_for(&self.model, &self.solver, p, count, &wanted)?
             }
-            Pairing::Mac { .. } => Sensitivities::compute(&self.model, &self.solver, p, count)?,
+            Pairing::Mac { .. } => match Sensitivities::compute(&self.model, &self.solver, p, count) {
+                Ok(s) => s,
+                // A free structure's rigid-body modes (zero to round-off, repeated) pair with no
+                // measured mode: the elastic modes are the candidates, and only they need
+                // sensitivities.
+                Err(e) => {
+                    let system = self.model.assemble(p).map_err(SensitivityError::from)?;
+                    let modes = self.solver.lowest(&system, count).map_err(SensitivityError::from)?;
+                    match crate::eigen::roundoff::rigid_body_modes(&system, &modes) {
+                        Some(flags) if flags.iter().any(|&r| r) => rigid = flags,
+                        _ => return Err(e.into()),
+                    }
+                    let wanted: Vec<usize> = (0..count).filter(|&k| !rigid[k]).collect();
+                    Sensitivities::compute_for(&self.model, &self.solver, p, count, &wanted)?
+                }
+            },
         };
-        let paired = self.pair(&sens)?;
+        let paired = self.pair(&sens, &rigid)?;
         let m = paired.len();
         let np = self.model.parameters().len();
         let mut lin = Linearisation {
@@ -310,7 +326,9 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
         Ok(0.5 * residual.norm_squared())
     }
 
-    fn pair(&self, sens: &Sensitivities) -> Result<Vec<usize>, ResidualError> {
+    /// The model mode paired with each measured one; with MAC pairing, never a mode flagged in
+    /// `rigid` (a rigid-body mode).
+    fn pair(&self, sens: &Sensitivities, rigid: &[bool]) -> Result<Vec<usize>, ResidualError> {
         match &self.pairing {
             Pairing::Order => Ok(self.measured.modes().iter().map(|m| m.mode).collect()),
             Pairing::Mac { sensor_dofs } => {
@@ -336,7 +354,8 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
                 let model_at_sensors: Vec<Vec<f64>> = (0..sens.modes.count())
                     .map(|k| sensor_dofs.iter().map(|&d| sens.modes.shapes[(d, k)]).collect())
                     .collect();
-                let mut taken = vec![false; model_at_sensors.len()];
+                let mut taken: Vec<bool> =
+                    (0..model_at_sensors.len()).map(|k| rigid.get(k).copied().unwrap_or(false)).collect();
                 let mut out = Vec::with_capacity(shapes.len());
                 for (s, m) in shapes.into_iter().zip(self.measured.modes()) {
                     let macs: Vec<f64> = model_at_sensors.iter().map(|a| mac(s, a)).collect();
