@@ -21,7 +21,7 @@ if ! command -v chromium >/dev/null 2>&1; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium
 fi
 
-cargo test --workspace --all-features
+cargo test --workspace --all-features --exclude eigenfit-python
 
 # The Python package (python/), as a user installs it: `pip install ./python` into a fresh virtual
 # environment (pip builds the wheel with maturin), then its pytest suite. EIGENFIT_BIN is the
