@@ -1,5 +1,6 @@
 //! Criterion benchmarks: eigen-solves by backend and size, sensitivities, one paper estimation per
-//! strategy, a comparison grid, a discovery run. `cargo bench` (add `--features lapack` for the
+//! strategy, one group per registered strategy on the bench registry's small problems, a
+//! comparison grid, a discovery run. `cargo bench` (add `--features lapack` for the
 //! LAPACK backend); figures and ratios are in docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
@@ -218,5 +219,61 @@ fn discovery(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, eigen_solve, sensitivities, estimation, compare_grid, monte_carlo_study, discovery);
+/// The bench registry's small problems (docs/strategies.md): dense models of 2–13 DOFs.
+const SMALL_PROBLEMS: [&str; 3] = ["paper-table3", "shear-frame", "five-group-truss"];
+
+/// One group per registered strategy (`strategy_<name>`), one run per small problem from the
+/// bench's start 0 (seed 0), as `eigenfit bench` runs it; a sampler through the bench itself
+/// (200 samples). A strategy that refuses a problem (Tikhonov on a square system, which leaves it
+/// no residual to choose λ from) has no entry for it.
+fn strategies(c: &mut Criterion) {
+    use eigenfit::workflow::bench::{self, BenchRequest};
+    let registry = registry::registry();
+    let problems: Vec<_> = SMALL_PROBLEMS.iter().map(|n| bench::builtin(n).unwrap().unwrap()).collect();
+    for name in registry.names() {
+        let mut g = c.benchmark_group(format!("strategy_{name}"));
+        g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
+        for problem in &problems {
+            let start = problem.start(0, 0);
+            let objective = Problem::new(problem.model.as_ref(), DenseSolver, problem.measured.clone());
+            match registry::build_local(&registry, &name) {
+                Ok((_, mut strategy)) => {
+                    if Driver::default().run(&objective, strategy.as_mut(), &start).is_err() {
+                        continue;
+                    }
+                    g.bench_function(&problem.name, |b| {
+                        b.iter(|| {
+                            let mut s = registry::build_local(&registry, &name).unwrap().1;
+                            Driver::default().run(&objective, s.as_mut(), black_box(&start)).unwrap()
+                        })
+                    });
+                }
+                Err(registry::StrategyError::NotLocal(_)) => {
+                    let request = BenchRequest {
+                        problems: vec![problem.name.clone()],
+                        strategies: vec![format!("{name}:samples=200")],
+                        starts: 1,
+                        seed: 0,
+                        budget: None,
+                        max_iterations: 1000,
+                    };
+                    g.bench_function(&problem.name, |b| b.iter(|| bench::run(black_box(&request)).unwrap()));
+                }
+                Err(e) => panic!("{name}: {e}"),
+            }
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(
+    benches,
+    eigen_solve,
+    sensitivities,
+    estimation,
+    strategies,
+    compare_grid,
+    monte_carlo_study,
+    discovery
+);
 criterion_main!(benches);

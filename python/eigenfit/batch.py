@@ -17,8 +17,8 @@ from __future__ import annotations
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Union
 
 from . import _api
-from ._api import EigenfitError
-from ._results import Result
+from ._api import EXIT_NOT_CONVERGED, EigenfitError
+from ._results import BenchResult, Result
 
 #: The functions a batch may run, by name (names pickle; functions of this module would too, but
 #: a name keeps the task small and lets a new command join with one line).
@@ -28,6 +28,7 @@ FUNCTIONS: Dict[str, Callable[..., Result]] = {
     "discover": _api.discover,
     "compare": _api.compare,
     "campbell": _api.campbell,
+    "bench": _api.bench,
 }
 
 
@@ -56,7 +57,8 @@ def map(
     """Runs ``eigenfit.<function>(**common, **job)`` for every job; results in the jobs' order.
 
     Args:
-        function: ``"simulate"``, ``"estimate"``, ``"discover"`` or ``"compare"``.
+        function: ``"simulate"``, ``"estimate"``, ``"discover"``, ``"compare"``, ``"campbell"``
+            or ``"bench"``.
         jobs: keyword arguments per call.
         client: a ``dask.distributed.Client``; None runs the jobs here, one after another.
         errors: ``"raise"`` (the first failed job raises :class:`EigenfitError`) or ``"return"``
@@ -99,3 +101,60 @@ def estimate_many(
     A job that does not converge is returned like any other, with ``converged == False``.
     """
     return map("estimate", jobs, client=client, errors=errors, chunk_size=chunk_size, **common)
+
+
+def bench(
+    problems: Iterable[str],
+    *,
+    strategies: Iterable[str],
+    starts: Optional[int] = None,
+    seed: Optional[int] = None,
+    client: Optional[Any] = None,
+    chunk_size: Optional[int] = None,
+    **options: Any,
+) -> BenchResult:
+    """:func:`eigenfit.bench` spread over a Dask cluster: one job per problem and strategy.
+
+    A run's start depends on the seed and its number only (a sampler's seed is seed + start), so
+    each problem and strategy run alone gives the records and the summary line the whole bench
+    gives them; they are joined in the bench's order (problem, then strategy, then start). The
+    result equals ``eigenfit.bench(problems, strategies=…, starts=…, seed=…)`` run here (the
+    tests check this), exit code 3 when some problem and strategy never reached the truth.
+
+    Args:
+        problems: built-in names or problem-file paths (readable on the workers).
+        strategies: registered names with settings after colons.
+        starts, seed: as :func:`eigenfit.bench`.
+        client, chunk_size: as :func:`map` (None runs the jobs here, one after another).
+        **options: other ``eigenfit bench`` options shared by every job (``budget``,
+            ``max_iterations``); ``records``, ``plot`` and ``report`` write files per job and are
+            refused here.
+    """
+    for name in ("records", "plot", "report"):
+        if name in options:
+            raise TypeError(f"eigenfit.batch.bench() does not take `{name}`: every job would write it")
+    problems, strategies = list(problems), list(strategies)
+    if not problems or not strategies:
+        raise ValueError("bench needs at least one problem and one strategy")
+    jobs = [{"problems": [p], "strategies": [s]} for p in problems for s in strategies]
+    parts = map("bench", jobs, client=client, chunk_size=chunk_size, starts=starts, seed=seed, **options)
+    data = [part.to_dict() for part in parts]  # errors="raise": every part is a result
+    merged: Dict[str, Any] = {
+        "problems": [],
+        "strategies": [],
+        "starts": data[0]["starts"],
+        "seed": data[0]["seed"],
+        "records": [],
+        "summary": [],
+    }
+    for d in data:
+        for info in d["problems"]:
+            if info not in merged["problems"]:
+                merged["problems"].append(info)
+        for s in d["strategies"]:
+            if s not in merged["strategies"]:
+                merged["strategies"].append(s)
+        merged["records"].extend(d["records"])
+        merged["summary"].extend(d["summary"])
+    failed = any(s["success_rate"] == 0.0 for s in merged["summary"])
+    return BenchResult(merged, EXIT_NOT_CONVERGED if failed else 0)

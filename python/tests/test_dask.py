@@ -75,3 +75,19 @@ def test_common_arguments_and_other_functions(client):
     assert on_cluster == serial
     with pytest.raises(ValueError, match="unknown function"):
         eigenfit.batch.map("campbell-typo", jobs)
+
+
+def test_a_bench_spread_on_the_cluster_equals_the_serial_bench(client):
+    # Two problems × three strategies: six jobs, joined in the bench's order.
+    problems = ["paper-table3", "shear-frame"]
+    strategies = ["damped", "trf", "tmcmc:samples=100"]
+    serial = eigenfit.bench(problems, strategies=strategies, starts=2, seed=4)
+    for chunk_size in (None, 1, 4):
+        spread = eigenfit.batch.bench(problems, strategies=strategies, starts=2, seed=4, client=client, chunk_size=chunk_size)
+        assert isinstance(spread, eigenfit.BenchResult)
+        assert spread.to_dict() == serial.to_dict()
+        assert spread.exit_code == serial.exit_code
+    # And without a cluster, one job after another.
+    assert eigenfit.batch.bench(problems, strategies=strategies, starts=2, seed=4).to_dict() == serial.to_dict()
+    with pytest.raises(TypeError, match="records"):
+        eigenfit.batch.bench(problems, strategies=strategies, records="runs.jsonl")

@@ -303,3 +303,154 @@ fn posterior_columns_follow_the_json_parameters_keys_whatever_the_model_order() 
         assert!(c[0] < truth && truth < c[1], "{key}: {c:?} misses {truth}");
     }
 }
+
+#[test]
+fn tikhonov_runs_in_estimate_compare_and_bench_and_reports_its_lambda_and_rule() {
+    let scratch = common::scratch();
+    // Three exact modes for two stiffnesses: a well-posed problem with a residual to spare.
+    let (text, _, _) = paper_csv([1e5, 2e5], 0.01);
+    let csv = common::write_in(&scratch, "m.csv", &text);
+    let estimate = |strategy: &str| {
+        let (code, v, err) = eigenfit(&[
+            "estimate",
+            "--preset",
+            "paper-rotor",
+            "--measured",
+            csv.to_str().unwrap(),
+            "--strategy",
+            strategy,
+            "--json",
+        ]);
+        assert!(code == 0 || code == 3, "{strategy}: {code} {err}");
+        v
+    };
+    let damped = estimate("damped");
+    assert!(damped.get("regularisation").is_none(), "{damped}");
+    for (strategy, rule) in
+        [("tikhonov", "gcv"), ("tikhonov:choice=gcv", "gcv"), ("tikhonov:choice=lcurve", "lcurve")]
+    {
+        let v = estimate(strategy);
+        assert_eq!(v["strategy"], "tikhonov");
+        let reg = &v["regularisation"];
+        assert_eq!(reg["rule"], rule, "{v}");
+        assert_eq!(reg["towards"], "start");
+        let lambda = reg["lambda"].as_f64().unwrap();
+        assert!(lambda.is_finite() && lambda > 0.0, "{reg}");
+        assert!(v["converged"] == true, "{strategy}: {}", v["termination"]);
+        if rule == "gcv" {
+            // Exact data: GCV leaves the fit to the data, and it is the damped estimate.
+            for key in ["k_K1", "k_K2"] {
+                let (a, b) =
+                    (v["parameters"][key].as_f64().unwrap(), damped["parameters"][key].as_f64().unwrap());
+                assert!((a / b - 1.0).abs() < 1e-6, "{strategy} {key}: {a} vs damped {b}");
+            }
+        }
+    }
+    // The text report names λ and the rule.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_eigenfit"))
+        .args([
+            "estimate",
+            "--preset",
+            "paper-rotor",
+            "--measured",
+            csv.to_str().unwrap(),
+            "--strategy",
+            "tikhonov",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("λ = ") && text.contains("generalised cross-validation"), "{text}");
+    // Two modes for two stiffnesses leave no residual to choose λ from: refused, saying why.
+    let two = common::write_in(&scratch, "two.csv", &text_of_two_modes());
+    let (code, _, err) = eigenfit(&[
+        "estimate",
+        "--preset",
+        "paper-rotor",
+        "--measured",
+        two.to_str().unwrap(),
+        "--strategy",
+        "tikhonov",
+        "--json",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("more residuals than parameters"), "{err}");
+
+    // compare: a grid of starts with three reference modes.
+    let (code, v, err) = eigenfit(&[
+        "compare",
+        "--preset",
+        "paper-rotor",
+        "--targets",
+        "2e5:5e4",
+        "--grid",
+        "2",
+        "--modes",
+        "3",
+        "--strategies",
+        "tikhonov,damped",
+        "--json",
+    ]);
+    assert!(code == 0 || code == 3, "{code}: {err}");
+    let text = v.to_string();
+    assert!(text.contains("\"tikhonov\""), "{text}");
+
+    // bench: the truss (eight modes, five groups); records carry λ and the rule.
+    let (code, v, err) = eigenfit(&[
+        "bench",
+        "--problems",
+        "five-group-truss",
+        "--strategies",
+        "tikhonov,tikhonov:choice=lcurve,damped",
+        "--starts",
+        "2",
+        "--json",
+    ]);
+    assert!(code == 0 || code == 3, "{code}: {err}");
+    let recs = v["records"].as_array().unwrap();
+    assert_eq!(recs.len(), 6);
+    for r in recs {
+        let strategy = r["strategy"].as_str().unwrap();
+        match strategy {
+            "damped" => assert!(r.get("regularisation").is_none(), "{r}"),
+            _ => {
+                let rule = if strategy.ends_with("lcurve") { "lcurve" } else { "gcv" };
+                assert_eq!(r["regularisation"]["rule"], rule, "{r}");
+                assert!(r["regularisation"]["lambda"].as_f64().unwrap() > 0.0, "{r}");
+            }
+        }
+    }
+    // The damped runs reach the truss's truth: the problem is well posed.
+    assert!(
+        recs.iter().filter(|r| r["strategy"] == "damped").all(|r| r["reached_truth"] == true),
+        "{recs:?}"
+    );
+}
+
+fn text_of_two_modes() -> String {
+    let (text, _, _) = paper_csv([1e5, 2e5], 0.01);
+    text.lines().take(3).map(|l| format!("{l}\n")).collect()
+}
+
+#[test]
+fn bench_lists_its_problems_and_strategies() {
+    let (code, v, err) = eigenfit(&["bench", "--list", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let problems: Vec<&str> =
+        v["problems"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+    for name in
+        ["paper-table2", "paper-table3", "paper-table4", "paper-table5", "shear-frame", "five-group-truss"]
+    {
+        assert!(problems.contains(&name), "{name} not in {problems:?}");
+    }
+    let truss = v["problems"].as_array().unwrap().iter().find(|p| p["name"] == "five-group-truss").unwrap();
+    assert_eq!(truss["truth"].as_object().unwrap().len(), 5);
+    assert_eq!(truss["measured_hz"].as_array().unwrap().len(), 8);
+    let strategies: Vec<&str> =
+        v["strategies"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
+    for name in ["newton", "p-step", "damped", "trf", "gn-line-search", "tikhonov", "tmcmc"] {
+        assert!(strategies.contains(&name), "{name} not in {strategies:?}");
+    }
+    let tikhonov = v["strategies"].as_array().unwrap().iter().find(|s| s["name"] == "tikhonov").unwrap();
+    assert!(tikhonov["settings"].as_array().unwrap().iter().any(|s| s == "choice"), "{tikhonov}");
+}

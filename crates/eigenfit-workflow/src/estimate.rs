@@ -171,6 +171,9 @@ pub struct EstimateReport {
     /// estimate's residuals), or `exact` (no σ: only fits at least as good as the estimate are
     /// equally good).
     pub alternatives_sigma: &'static str,
+    /// A regularised strategy's λ and the rule that chose it (`--strategy tikhonov`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regularisation: Option<eigenfit_core::update::Regularisation>,
     /// A sampler's posterior (`--strategy tmcmc`); the fit and its verdict then start from the
     /// posterior's best sample.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -556,7 +559,20 @@ pub fn run(
             minima = local_minima(&fit, starts, &mirrors.asymmetric, &budget);
         }
         phases.push(("other_solutions", budget.used()));
-        if let Some(better) = better_minimum(&fit, &estimate.last, &minima).cloned() {
+        // A regularised estimate is not the least-squares minimum, by design: a deeper one is
+        // listed among the other solutions, never put in its place.
+        let better = better_minimum(&fit, &estimate.last, &minima).cloned();
+        if let (Some(better), Some(reg)) = (&better, &estimate.regularisation) {
+            notes.push(format!(
+                "the search for other solutions found a deeper least-squares minimum (Σr² {} → {}); the estimate \
+                 stays the regularised one (λ = {} by {})",
+                shown_number(estimate.last.chi2()),
+                shown_number(better.chi2()),
+                shown_number(reg.lambda),
+                reg.rule
+            ));
+        }
+        if let Some(better) = better.filter(|_| estimate.regularisation.is_none()) {
             notes.push(format!(
                 "the search for other solutions found a deeper minimum than the fit reached (Σr² {} → {}): \
                  it is the estimate reported",
@@ -661,6 +677,7 @@ pub fn run(
         at_limit: pinned,
         alternative_solutions: AlternativeSolution::list(&names, &alternatives),
         alternatives_sigma,
+        regularisation: estimate.regularisation.clone(),
         posterior: posterior.map(|(_, report, _)| report),
         frequencies: PairedFrequencies::of(&estimate.last),
         history: estimate

@@ -9,11 +9,15 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 pub struct BenchArgs {
     /// Problems, comma-separated: built-ins (paper-table2, paper-table3, paper-table4,
-    /// paper-table5, shear-frame) or problem files (TOML: model, measured, truth; docs/strategies.md).
-    #[arg(long, value_name = "NAMES", value_delimiter = ',', required = true)]
+    /// paper-table5, shear-frame, five-group-truss; `--list`) or problem files (TOML: model,
+    /// measured, truth; docs/strategies.md).
+    #[arg(long, value_name = "NAMES", value_delimiter = ',', required_unless_present = "list")]
     pub problems: Vec<String>,
+    /// List the built-in problems and the registered strategies, then exit.
+    #[arg(long)]
+    pub list: bool,
     /// Strategies, comma-separated, by registered name with settings after colons: newton,
-    /// p-step, damped, trf, gn-line-search, tmcmc (500 samples unless `tmcmc:samples=N`).
+    /// p-step, damped, trf, gn-line-search, tikhonov, tmcmc (500 samples unless `tmcmc:samples=N`).
     #[arg(long, value_name = "NAMES", value_delimiter = ',', default_value = "newton,p-step,damped,trf")]
     pub strategies: Vec<String>,
     /// Starts per problem and strategy (the same starts for every strategy).
@@ -47,6 +51,11 @@ pub struct BenchArgs {
 /// Runs `bench`: exit 0 when every problem and strategy reached the truth at least once, else 3
 /// (the records and summary are printed either way).
 pub fn run(args: &BenchArgs) -> Result<u8, CliError> {
+    if args.list {
+        let listing = bench::list()?;
+        crate::output::report(args.report.json, &listing, print_listing);
+        return Ok(EXIT_OK);
+    }
     let request = BenchRequest {
         problems: args.problems.iter().map(|s| s.trim().to_string()).collect(),
         strategies: args.strategies.iter().map(|s| s.trim().to_string()).collect(),
@@ -144,5 +153,28 @@ fn print_summary(r: &BenchReport) {
             s.median_evaluations_success.map_or("—".to_string(), |m| m.to_string()),
             verdicts.join(", ")
         );
+    }
+}
+
+fn print_listing(l: &bench::BenchListing) {
+    println!("built-in problems:");
+    for p in &l.problems {
+        let names: Vec<&str> = p.truth.iter().map(|(n, _)| n.as_str()).collect();
+        println!(
+            "  {:<18}{} parameters ({}), {} measured modes",
+            p.name,
+            names.len(),
+            names.join(", "),
+            p.measured_hz.len()
+        );
+    }
+    println!("strategies:");
+    for s in &l.strategies {
+        let settings = if s.settings.is_empty() {
+            String::new()
+        } else {
+            format!(" [settings: {}]", s.settings.join(", "))
+        };
+        println!("  {:<18}{}{settings}", s.name, s.summary);
     }
 }

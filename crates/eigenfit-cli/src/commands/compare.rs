@@ -32,8 +32,8 @@ pub struct CompareArgs {
     #[arg(long, value_name = "K1:K2,…")]
     pub initials: Option<String>,
     /// Strategies, comma-separated, by their registered names (`eigenfit bench --list` lists
-    /// them), settings after colons: newton, p-step, damped, trf, gn-line-search,
-    /// damped:max_trials=50, or a strategy a library user registered.
+    /// them), settings after colons: newton, p-step, damped, trf, gn-line-search, tikhonov,
+    /// tikhonov:choice=lcurve, damped:max_trials=50, or a strategy a library user registered.
     #[arg(long, default_value = "newton,p-step,damped")]
     pub strategies: String,
     /// Round the reference frequencies to this many decimals (the paper's Table 1: 3).

@@ -25,8 +25,9 @@ pub struct EstimateArgs {
     #[command(flatten)]
     pub test_data: testdata::TestDataArgs,
     /// Update strategy by name: newton, p-step, damped (Levenberg–Marquardt; `levenberg-marquardt`
-    /// is accepted too), trf, gn-line-search, tmcmc (posterior samples and evidence, then a damped
-    /// fit from the best sample), or one registered by a program; settings after colons
+    /// is accepted too), trf, gn-line-search, tikhonov (regularised towards the start, λ by
+    /// `choice=gcv` or `choice=lcurve`), tmcmc (posterior samples and evidence, then a damped fit
+    /// from the best sample), or one registered by a program; settings after colons
     /// (`damped:max_trials=50`, `tmcmc:chain=5`), docs/strategies.md.
     #[arg(long, default_value = "damped")]
     pub strategy: String,
@@ -270,6 +271,20 @@ fn print_report(est: &Estimation) {
             shown_unit(&r.units.0[i].1),
             r.values.initial.0[i].1,
             r.values.parameter_status.0[i].1
+        );
+    }
+    if let Some(reg) = &r.regularisation {
+        println!(
+            "regularised towards the {}: λ = {:.4e} chosen by {} ({:.3} effective parameters of {})",
+            reg.towards,
+            reg.lambda,
+            match reg.rule {
+                "gcv" => "generalised cross-validation",
+                "lcurve" => "the L-curve's corner",
+                other => other,
+            },
+            reg.effective_parameters,
+            names.len()
         );
     }
     if let Some(post) = &r.posterior {

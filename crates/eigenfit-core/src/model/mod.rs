@@ -9,6 +9,7 @@ pub(crate) mod candidate;
 pub(crate) mod fixed;
 pub(crate) mod parameters;
 pub(crate) mod structural_model;
+pub mod truss;
 
 pub use augmented::Augmented;
 pub use candidate::{Candidate, Companion, GradedPart, ValueLaw};

@@ -1,6 +1,6 @@
 //! The iteration loop: termination reasons, observers, history.
 
-use super::{Budget, Counted, StepStatus, UpdateError, UpdateStrategy};
+use super::{Budget, Counted, Regularisation, StepStatus, UpdateError, UpdateStrategy};
 use crate::problem::{Linearisation, Objective};
 
 /// Why a run ended.
@@ -188,6 +188,8 @@ pub struct Estimate {
     pub history: Vec<IterationRecord>,
     /// Linearisation at the final parameters.
     pub last: Linearisation,
+    /// The regularisation the strategy ended with (λ and its rule), when it regularises.
+    pub regularisation: Option<Regularisation>,
 }
 
 /// `converged`, `termination`, `iterations`, `evaluations`: how an iteration ended, as every
@@ -359,6 +361,7 @@ impl ObservedDriver<'_, '_> {
             termination,
             history,
             last: current,
+            regularisation: strategy.regularisation(),
         })
     }
 }

@@ -17,6 +17,7 @@ pub mod sampler;
 mod settings;
 #[cfg(test)]
 mod tests;
+mod tikhonov;
 mod tmcmc;
 mod trust_region_reflective;
 
@@ -34,6 +35,7 @@ pub use pstep::PStep;
 pub use registry::{Method, StrategyError, StrategyFactory, StrategySettings};
 pub use sampler::{Gaussian, LogLikelihood, Posterior, Sampler};
 pub use settings::{Guard, SettingsError};
+pub use tikhonov::{ParameterChoice, Regularisation, TikhonovGaussNewton, TikhonovProblem};
 pub use tmcmc::{Tmcmc, TmcmcSettings, MAX_STAGES as TMCMC_MAX_STAGES};
 pub use trust_region_reflective::{trust_region_step, TrustRegionReflective};
 
@@ -108,6 +110,11 @@ pub trait UpdateStrategy {
     /// Restart starts ranked once for every run on the same data, used instead of ranking its
     /// own; ignored by a strategy that does not restart (the default).
     fn share_ranked_starts(&mut self, _starts: std::sync::Arc<Vec<Vec<f64>>>) {}
+    /// The regularisation the run ended with (λ and the rule that chose it), for the report;
+    /// `None` (the default) for a strategy that does not regularise.
+    fn regularisation(&self) -> Option<Regularisation> {
+        None
+    }
 }
 
 /// Solves the paper's eq. 28, S Δk = Δλ, on the first N modes (N = number of parameters, as in

@@ -14,8 +14,8 @@
 
 use super::sampler::Sampler;
 use super::{
-    GaussNewtonLineSearch, LevenbergMarquardtSettings, Newton, PStep, SettingsError, Tmcmc, TmcmcSettings,
-    TrustRegionReflective, UpdateStrategy,
+    GaussNewtonLineSearch, LevenbergMarquardtSettings, Newton, PStep, ParameterChoice, SettingsError,
+    TikhonovGaussNewton, Tmcmc, TmcmcSettings, TrustRegionReflective, UpdateStrategy,
 };
 use std::collections::BTreeMap;
 use std::sync::{Arc, OnceLock, RwLock};
@@ -113,6 +113,25 @@ impl StrategySettings {
         self.parsed(key, default, "a whole number ≥ 0")
     }
 
+    /// The word under `key`, one of `options`, or `default` when not given.
+    pub fn one_of(
+        &self,
+        key: &str,
+        options: &[&'static str],
+        default: &'static str,
+    ) -> Result<&'static str, StrategyError> {
+        match self.values.get(key) {
+            None => Ok(default),
+            Some(v) => {
+                options.iter().copied().find(|o| *o == v.trim()).ok_or_else(|| StrategyError::BadValue {
+                    strategy: self.strategy.clone(),
+                    setting: key.to_string(),
+                    message: format!("`{v}` is not one of {}", options.join(", ")),
+                })
+            }
+        }
+    }
+
     fn parsed<T: std::str::FromStr>(&self, key: &str, default: T, what: &str) -> Result<T, StrategyError> {
         match self.values.get(key) {
             None => Ok(default),
@@ -188,7 +207,7 @@ pub struct Registry {
 
 impl Registry {
     /// The built-in strategies: `newton`, `p-step`, `damped` (alias `levenberg-marquardt`),
-    /// `trf`, `gn-line-search` and `tmcmc`.
+    /// `trf`, `gn-line-search`, `tikhonov` and `tmcmc`.
     pub fn builtin() -> Self {
         let mut r = Registry::default();
         let local = |s: Box<dyn UpdateStrategy>| Ok(Method::Local(s));
@@ -247,6 +266,20 @@ impl Registry {
                 &["tolerance", "max_step"],
                 move |s| {
                     local(Box::new(GaussNewtonLineSearch::new(
+                        s.f64("tolerance", 1e-10)?,
+                        s.f64("max_step", 100f64.ln())?,
+                    )?))
+                },
+            )),
+            Arc::new(FnFactory::new(
+                "tikhonov",
+                "Gauss–Newton regularised towards the start, λ by generalised cross-validation or the L-curve",
+                &["choice", "tolerance", "max_step"],
+                move |s| {
+                    let rule = s.one_of("choice", &["gcv", "lcurve"], "gcv")?;
+                    let rule = ParameterChoice::from_name(rule).expect("one of the rules listed"); // proof: one_of returns a listed name
+                    local(Box::new(TikhonovGaussNewton::new(
+                        rule,
                         s.f64("tolerance", 1e-10)?,
                         s.f64("max_step", 100f64.ln())?,
                     )?))
