@@ -349,7 +349,7 @@ fn every_unknown_name_lists_the_valid_ones_and_the_nearest() {
         (
             vec!["bench", "--problems", "paper-tabel3"],
             "`paper-tabel3` is neither a built-in problem (paper-table2, paper-table3, paper-table4, paper-table5, \
-             shear-frame) nor a problem file (did you mean `paper-table3`?)",
+             shear-frame, five-group-truss) nor a problem file (did you mean `paper-table3`?)",
         ),
         (
             vec!["estimate", "--preset", "paper-rotor", "--measured", &measured, "--residual", "hertz"],
@@ -509,4 +509,28 @@ fn compare_fits_the_parameters_estimate_fits_each_in_its_unit_and_range() {
 
 fn as_refs(a: &[String]) -> Vec<&str> {
     a.iter().map(String::as_str).collect()
+}
+
+#[test]
+fn compare_reports_no_error_when_no_run_converged() {
+    // tikhonov refuses data with no residual beyond the parameters (the paper's 2 modes for 2
+    // stiffnesses): no run converges, and the largest error is absent, not a perfect 0.
+    let args = [
+        "compare",
+        "--preset",
+        "paper-rotor",
+        "--targets",
+        "1e5:1e5",
+        "--grid",
+        "2",
+        "--strategies",
+        "tikhonov",
+    ];
+    let v = json(&[&args[..], &["--json"]].concat());
+    let s = &v["summary"][0];
+    assert_eq!(s["converged"], 0, "{s}");
+    assert!(s["max_relative_error"].is_null(), "{s}");
+    let out = text(&args);
+    let row = out.lines().find(|l| l.contains("tikhonov")).expect("a summary row");
+    assert!(row.split_whitespace().nth(6) == Some("-"), "{row}");
 }

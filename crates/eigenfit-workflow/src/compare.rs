@@ -241,8 +241,9 @@ pub struct Summary {
     pub median_iterations: Option<usize>,
     /// Most iterations of the converged runs.
     pub max_iterations: Option<usize>,
-    /// Largest relative error of the converged runs.
-    pub max_relative_error: f64,
+    /// Largest relative error of the converged runs (`null` when none converged: no error to
+    /// report, not a perfect one).
+    pub max_relative_error: Option<f64>,
     /// Runs cut short by their evaluation budget (`--budget`).
     pub budget_exhausted: usize,
 }
@@ -266,7 +267,7 @@ pub fn summarise(runs: &[CompareRun], targets: &[Vec<f64>], strategies: &[String
                 ambiguous: conv.iter().filter(|r| !r.alternatives.is_empty()).count(),
                 median_iterations: (!iters.is_empty()).then(|| iters[iters.len() / 2]),
                 max_iterations: iters.last().copied(),
-                max_relative_error: conv.iter().map(|r| r.relative_error).fold(0.0, f64::max),
+                max_relative_error: conv.iter().map(|r| r.relative_error).reduce(f64::max),
                 budget_exhausted: group.iter().filter(|r| r.budget_exhausted).count(),
             });
         }

@@ -164,14 +164,14 @@ pub fn run(args: &CompareArgs) -> Result<u8, CliError> {
             let target: Vec<String> = s.target.iter().map(|v| format!("{v:.0e}")).collect();
             let fmt = |v: Option<usize>| v.map_or("-".to_string(), |v| v.to_string());
             println!(
-                "{:<tw$}{:<width$}{:>11}{:>12}{:>9}{:>9}{:>15.2e}{:>11}",
+                "{:<tw$}{:<width$}{:>11}{:>12}{:>9}{:>9}{:>15}{:>11}",
                 target.join(":"),
                 s.strategy,
                 format!("{}/{}", s.converged, s.runs),
                 s.converged_within_1e6,
                 fmt(s.median_iterations),
                 fmt(s.max_iterations),
-                s.max_relative_error,
+                s.max_relative_error.map_or("-".to_string(), |e| format!("{e:.2e}")),
                 s.ambiguous
             );
         }
