@@ -627,10 +627,9 @@ class CampbellResult(Result):
 
 
 #: Result class by name, for unpickling (the name, not the class, travels in the pickle).
-RESULT_CLASSES = {
-    c.__name__: c
-    for c in (SimulateResult, EstimateResult, DiscoverResult, CompareResult, CampbellResult, Result)
-}
+# Every result class by name, for unpickling; taken from the subclasses so that a new result
+# (BenchResult was missed when listed by hand) cannot be left out.
+RESULT_CLASSES = {c.__name__: c for c in (Result, *Result.__subclasses__())}
 
 
 def _restore(class_name: str, text: str, exit_code: int) -> Result:

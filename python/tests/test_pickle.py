@@ -19,6 +19,7 @@ def results(examples):
         eigenfit.estimate("paper-rotor", examples / "measured_no_effect.csv", max_iterations=1),
         eigenfit.discover("paper-rotor", examples / "measured_hidden_effect.csv"),
         eigenfit.compare("paper-rotor", targets=[(2e5, 5e4)], initials=[(1e5, 1e5)]),
+        eigenfit.bench(["paper-table3"], strategies=["damped"], starts=1, seed=1),
     ]
 
 
