@@ -317,7 +317,7 @@ fn weighted_uncertainty(
         .unwrap_or_else(|| DMatrix::from_diagonal_element(np, np, f64::INFINITY));
     let jac: Vec<f64> = params.iter().zip(&at.parameters).map(|(p, &v)| p.scale_derivative(v)).collect();
     let covariance = DMatrix::from_fn(np, np, |i, j| scaled_cov[(i, j)] * jac[i] * jac[j]);
-    let s_hat: Vec<f64> = params.iter().zip(&at.parameters).map(|(p, &v)| p.to_scaled(v)).collect();
+    let s_hat = params.to_scaled(&at.parameters);
     let (lo, hi) = scaled_bounds(params);
     let near = |a: f64, b: f64| b.is_finite() && (a - b).abs() <= 1e-9 * (1.0 + b.abs());
     // A parameter on one of its limits: that limit is one end of its interval, the profile the

@@ -250,6 +250,12 @@ impl ParameterSet {
         })
     }
 
+    /// `values` in each parameter's scaled coordinate ([`Parameter::to_scaled`]), in order: the
+    /// coordinates every strategy steps in.
+    pub fn to_scaled(&self, values: &[f64]) -> Vec<f64> {
+        self.params.iter().zip(values).map(|(p, &v)| p.to_scaled(v)).collect()
+    }
+
     /// The nominal values in order.
     pub fn nominal_values(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.nominal).collect()

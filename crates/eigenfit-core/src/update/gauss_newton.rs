@@ -60,7 +60,7 @@ impl UpdateStrategy for GaussNewtonLineSearch {
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
         let params = problem.parameters();
         let (lo, hi) = scaled_bounds(params);
-        let x: Vec<f64> = params.iter().zip(&current.parameters).map(|(p, &v)| p.to_scaled(v)).collect();
+        let x = params.to_scaled(&current.parameters);
         let j = current.scaled_jacobian(params);
         let svd = j.clone().svd(true, true);
         let smax = svd.singular_values.max();

@@ -419,7 +419,7 @@ impl LevenbergMarquardt {
         let np = params.len();
         let js = current.scaled_jacobian(params);
         let g_full = js.transpose() * &current.residual;
-        let s0: Vec<f64> = params.iter().zip(&current.parameters).map(|(p, &v)| p.to_scaled(v)).collect();
+        let s0 = params.to_scaled(&current.parameters);
         let (lo, hi) = scaled_bounds(params);
         // Active set: a parameter on a bound whose gradient pushes outward stays there this step.
         let free: Vec<bool> = (0..np)

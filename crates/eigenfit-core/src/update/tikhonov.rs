@@ -291,10 +291,6 @@ impl TikhonovGaussNewton {
     }
 }
 
-fn scaled(problem: &dyn Objective, p: &[f64]) -> Vec<f64> {
-    problem.parameters().iter().zip(p).map(|(par, &v)| par.to_scaled(v)).collect()
-}
-
 impl UpdateStrategy for TikhonovGaussNewton {
     fn name(&self) -> &'static str {
         "tikhonov"
@@ -312,7 +308,7 @@ impl UpdateStrategy for TikhonovGaussNewton {
                 }
             )));
         }
-        self.start = scaled(problem, &initial.parameters);
+        self.start = problem.parameters().to_scaled(&initial.parameters);
         self.last = None;
         Ok(())
     }
@@ -325,7 +321,7 @@ impl UpdateStrategy for TikhonovGaussNewton {
         let params = problem.parameters();
         let n = params.len();
         let (lo, hi) = scaled_bounds(params);
-        let x = scaled(problem, &current.parameters);
+        let x = params.to_scaled(&current.parameters);
         let j = current.scaled_jacobian(params);
         let d = DVector::from_iterator(n, (0..n).map(|i| x[i] - self.start[i]));
         let b = &current.residual + &j * &d;

@@ -132,7 +132,7 @@ impl UpdateStrategy for TrustRegionReflective {
         let params = problem.parameters();
         let n = params.len();
         let (lo, hi) = scaled_bounds(params);
-        let x: Vec<f64> = params.iter().zip(&current.parameters).map(|(p, &v)| p.to_scaled(v)).collect();
+        let x = params.to_scaled(&current.parameters);
         let j = current.scaled_jacobian(params);
         // Cost ½‖r‖² with r = measured − model and J = d(model)/ds: gradient −Jᵀr.
         let g = -(j.transpose() * &current.residual);
