@@ -269,7 +269,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
         dof: estimate.last.degrees_of_freedom(),
         intervals: unc.as_ref().map(|u| Named::new(&pnames, u.intervals.iter().copied())),
         interval_basis: scatter.map(|s| interval_basis(s, has_std)),
-        units: Named(joint.parameters().iter().map(|q| (q.name.clone(), q.unit().to_string())).collect()),
+        units: crate::simulate::units_of_parameters(joint.parameters()),
         covariances: Covariances::of(&pnames, unc.as_ref().map(|u| &u.covariance)),
         configurations,
         has_std,

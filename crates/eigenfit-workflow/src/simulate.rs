@@ -429,7 +429,12 @@ fn shapes_report(
 
 /// Each parameter's unit as declared (empty when none was), by name: the reports' `units`.
 pub fn units_of(model: &dyn StructuralModel) -> Named<String> {
-    Named(model.parameters().iter().map(|q| (q.name.clone(), q.unit().to_string())).collect())
+    units_of_parameters(model.parameters())
+}
+
+/// [`units_of`] for a parameter set without its model (a campaign's joint parameters).
+pub fn units_of_parameters(params: &eigenfit_core::model::ParameterSet) -> Named<String> {
+    Named(params.iter().map(|q| (q.name.clone(), q.unit().to_string())).collect())
 }
 
 /// Frequencies and their sensitivities at `p` from one solve; a model whose modes have none
