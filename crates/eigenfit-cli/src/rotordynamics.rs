@@ -80,7 +80,16 @@ pub fn print_estimate(r: &RunupEstimateReport) {
     if !r.fit.disagreeing_modes.is_empty() {
         let list: Vec<String> =
             r.fit.disagreeing_modes.iter().map(|d| format!("{} rpm mode {}", d.speed_rpm, d.mode)).collect();
-        println!("disagreeing by more than 3σ: {}", list.join(", "));
+        match r.fit.chi2 {
+            Some(_) => println!("disagreeing by more than 3σ: {}", list.join(", ")),
+            None => println!(
+                "fit quality: POOR without std_hz: relative RMS residual {:.3e}, more than {} (no measured \
+                 frequency is that far off); points off by more than that: {}",
+                r.fit.relative_rms_residual,
+                eigenfit_core::analysis::verdict::NO_STD_POOR_RELATIVE_RMS,
+                list.join(", ")
+            ),
+        }
     }
     let undetermined: Vec<&str> = r
         .identifiable

@@ -509,7 +509,8 @@ pub fn estimate_with(
             rotor.dofs()
         )));
     }
-    check_selection(&rotor, &params, &points).map_err(to_workflow)?;
+    // Both refusals are about what the measured file holds (how many points, at which speeds).
+    check_selection(&rotor, &params, &points).map_err(|e| input(format!("{}: {e}", measured.display())))?;
     if budget == 0 {
         return Err(input("--budget 0: at least one model evaluation is needed"));
     }

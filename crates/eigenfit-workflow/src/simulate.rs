@@ -178,29 +178,19 @@ pub fn labelled_frequencies(
 /// body, so this is for a model of several free bodies.
 const MOST_EXTRA_MODES_FOR_RIGID: usize = 64;
 
-/// Rigid-body motions of one free body in space; more zeros than this are round-off (a model
-/// of several disconnected bodies is refused as untrustworthy rather than misread).
-const MAX_RIGID_BODY_MODES: usize = 6;
-
 /// Which of `modes` (the lowest of `system`) are rigid-body modes
 /// ([`eigenfit_core::eigen::roundoff::rigid_body_modes`], a scale-free test); when every one of
 /// them is zero to round-off, more modes are solved until one is resolved. A system none of whose
 /// modes is resolved has a zero K: every mode is rigid-body. When the extra modes cannot be
 /// solved, none is called rigid-body (the round-off check then refuses them, naming both
-/// causes). More than [`MAX_RIGID_BODY_MODES`] zeros are taken for round-off, not motion.
+/// causes). More than core's `MAX_RIGID_BODY_MODES` zeros are taken for round-off, not motion.
 pub fn rigid_body_flags(
     solver: &dyn EigenSolver,
     system: &System,
     modes: &Modes,
 ) -> Result<Vec<bool>, WorkflowError> {
     let n = modes.count();
-    // More zeros than one body has rigid motions (3 translations, 3 rotations) are round-off,
-    // not rigid-body modes: a stiffness of 1e50 on one DOF drowns every other mode in ε·‖K‖.
-    // Left unflagged, the round-off check refuses them as untrustworthy.
-    let checked = |flags: Vec<bool>| match flags.iter().filter(|&&r| r).count() > MAX_RIGID_BODY_MODES {
-        true => vec![false; n],
-        false => flags[..n].to_vec(),
-    };
+    let checked = |flags: Vec<bool>| flags[..n].to_vec();
     if let Some(flags) = rigid_body_modes(system, modes) {
         return Ok(checked(flags));
     }

@@ -327,7 +327,13 @@ fn print_report(est: &Estimation) {
                 format!("; modes disagreeing by more than 3σ: {}", join(&r.fit.disagreeing_modes))
             }
         ),
-        _ => {}
+        (_, None) => println!(
+            "fit quality: POOR without std_hz: relative RMS residual {:.3e}, more than {} (no measured \
+             frequency is that far off); modes off by more than that: {}",
+            r.fit.relative_rms_residual,
+            eigenfit_core::analysis::verdict::NO_STD_POOR_RELATIVE_RMS,
+            join(&r.fit.disagreeing_modes)
+        ),
     }
     if let (Some(values), Some(condition)) = (&r.uncertainty.singular_values, r.uncertainty.condition_number)
     {

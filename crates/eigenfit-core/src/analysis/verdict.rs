@@ -23,6 +23,10 @@ pub const POOR_FIT_P_VALUE: f64 = SIGNIFICANCE;
 pub const POOR_FIT_CHI2_NO_DOF: f64 = 3.841_458_820_694_124;
 /// A mode disagrees when it misses by more than this many standard deviations.
 pub const DISAGREEING_SIGMAS: f64 = 3.0;
+/// Without std a fit is still poor when its relative RMS residual exceeds this: no natural
+/// frequency is measured 10 % wrong, so a model that misses by more after fitting explains
+/// nothing, whatever the noise (a run-up of 1e-300 Hz was once "converged, not judged").
+pub const NO_STD_POOR_RELATIVE_RMS: f64 = 0.1;
 
 /// The verdict on a fit's quality.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -81,14 +85,21 @@ pub fn judge(lin: &Linearisation, free: usize) -> FitQuality {
     // Rows of the weighted residual: the frequencies, and shape entries when shapes are fitted.
     let dof = lin.residual.len().saturating_sub(free);
     if !lin.has_std {
+        let poor = relative_rms.is_nan() || relative_rms > NO_STD_POOR_RELATIVE_RMS;
+        let relative = |k: usize| ((lin.frequencies_hz[k] - lin.measured_hz[k]) / lin.measured_hz[k]).abs();
+        let mut disagreeing: Vec<usize> = match poor {
+            true => (0..n).filter(|&k| !(relative(k) <= NO_STD_POOR_RELATIVE_RMS)).collect(),
+            false => Vec::new(),
+        };
+        disagreeing.sort_by(|&a, &b| relative(b).total_cmp(&relative(a)));
         return FitQuality {
-            verdict: FitVerdict::NotJudged,
+            verdict: if poor { FitVerdict::Poor } else { FitVerdict::NotJudged },
             chi2: None,
             misfit: lin.residual.norm_squared(),
             dof,
             p_value: None,
             relative_rms,
-            disagreeing: Vec::new(),
+            disagreeing,
         };
     }
     let chi2 = lin.chi2();
@@ -466,6 +477,23 @@ mod tests {
     fn without_std_nothing_is_judged() {
         let q = judge(&lin(&[0.1, 0.2], false), 1);
         assert_eq!((q.verdict, q.chi2, q.p_value), (FitVerdict::NotJudged, None, None));
+    }
+
+    #[test]
+    fn without_std_a_model_far_from_every_frequency_is_still_poor() {
+        // Model 10 Hz against 1e-300 Hz measured (a run-up once "converged" there), and one mode
+        // of three 30 % off (RMS 17 %): no noise explains either. 5 % off on each passes.
+        let mut far = lin(&[1e301, 1e301], false);
+        far.measured_hz = vec![1e-300; 2];
+        let q = judge(&far, 1);
+        assert_eq!((q.verdict, q.disagreeing.len()), (FitVerdict::Poor, 2));
+        let mut one = lin(&[0.0, 0.3, 0.0], false);
+        one.measured_hz = vec![10.0, 10.0 / 1.3, 10.0];
+        let q = judge(&one, 1);
+        assert_eq!((q.verdict, q.disagreeing), (FitVerdict::Poor, vec![1]));
+        let mut near = lin(&[0.05, -0.05], false);
+        near.measured_hz = vec![10.0 / 1.05, 10.0 / 0.95];
+        assert_eq!(judge(&near, 1).verdict, FitVerdict::NotJudged);
     }
 
     #[test]

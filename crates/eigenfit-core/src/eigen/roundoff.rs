@@ -35,6 +35,11 @@ pub fn relative_roundoff(system: &System, modes: &Modes) -> Vec<f64> {
         .collect()
 }
 
+/// Rigid-body motions of one free body in space (3 translations, 3 rotations); more zeros than
+/// this are round-off (a model of several disconnected bodies is refused as untrustworthy rather
+/// than misread).
+pub const MAX_RIGID_BODY_MODES: usize = 6;
+
 /// How far below the lowest resolved eigenvalue (one above its round-off bound) an eigenvalue
 /// within its round-off bound must lie to be a rigid-body mode (see [`rigid_body_modes`]).
 pub const RIGID_BODY_GAP: f64 = 1e6;
@@ -54,6 +59,10 @@ pub const RIGID_BODY_GAP: f64 = 1e6;
 /// the gap and stays a mode lost to round-off (refused by the callers as such), and so does a
 /// very soft support whose mode is still resolved (it fails the first test).
 ///
+/// More than [`MAX_RIGID_BODY_MODES`] such zeros are round-off, not motion, and none is flagged
+/// (the callers' round-off checks then refuse them as untrustworthy): a stiffness of 1e50 on one
+/// DOF drowns every other mode in ε·‖K‖ and would otherwise list them all as rigid-body modes.
+///
 /// `None` when no mode of `modes` is resolved from zero: the gap cannot be judged; solve more
 /// modes (a model whose every mode is zero to round-off has a zero K: all rigid-body).
 pub fn rigid_body_modes(system: &System, modes: &Modes) -> Option<Vec<bool>> {
@@ -64,14 +73,16 @@ pub fn rigid_body_modes(system: &System, modes: &Modes) -> Option<Vec<bool>> {
     if !resolved.is_finite() {
         return None;
     }
-    Some(
-        (0..modes.count())
-            .map(|j| {
-                let lambda = modes.eigenvalues[j];
-                zero(j) && !lambda.is_nan() && lambda.abs() * RIGID_BODY_GAP <= resolved
-            })
-            .collect(),
-    )
+    let flags: Vec<bool> = (0..modes.count())
+        .map(|j| {
+            let lambda = modes.eigenvalues[j];
+            zero(j) && !lambda.is_nan() && lambda.abs() * RIGID_BODY_GAP <= resolved
+        })
+        .collect();
+    match flags.iter().filter(|&&r| r).count() > MAX_RIGID_BODY_MODES {
+        true => Some(vec![false; flags.len()]),
+        false => Some(flags),
+    }
 }
 
 /// [`relative_roundoff`]'s estimate for the lowest mode with a trial vector in place of the
@@ -205,5 +216,20 @@ mod tests {
         let system = System::new(k, DMatrix::identity(4, 4)).unwrap();
         assert_eq!(flags(&system, &DenseSolver, 2), None);
         assert_eq!(flags(&system, &DenseSolver, 4).unwrap(), [true, true, true, false]);
+    }
+
+    #[test]
+    fn more_zeros_than_one_free_body_has_are_round_off_not_motion() {
+        // Nine disconnected free masses and one on a spring: 9 zeros cannot all be rigid-body
+        // motion of one body (at most 6), so none is flagged; 6 of them can.
+        for (free, flagged) in [(9, false), (6, true)] {
+            let n = free + 1;
+            let mut k = DMatrix::zeros(n, n);
+            k[(free, free)] = 1e3;
+            let system = System::new(k, DMatrix::identity(n, n)).unwrap();
+            let f = flags(&system, &DenseSolver, n).unwrap();
+            assert_eq!(f[..free], vec![flagged; free][..], "{free} free masses");
+            assert!(!f[free]);
+        }
     }
 }

@@ -173,7 +173,7 @@ pub fn check_frequency_order(modes: &[(usize, &MeasuredMode)]) -> Result<(), Ord
                      the model's modes are distinct, so the two cannot both be paired",
                     b.mode + 1,
                     a.mode + 1,
-                    a.frequency_hz
+                    measured_csv::shown_number(a.frequency_hz)
                 ),
             });
         }
@@ -184,9 +184,9 @@ pub fn check_frequency_order(modes: &[(usize, &MeasuredMode)]) -> Result<(), Ord
                     "mode {} ({} Hz, line {l1}) is below mode {} ({} Hz, line {l0}): natural \
                      frequencies increase with mode number (a swapped row or a typing slip?)",
                     b.mode + 1,
-                    b.frequency_hz,
+                    measured_csv::shown_number(b.frequency_hz),
                     a.mode + 1,
-                    a.frequency_hz
+                    measured_csv::shown_number(a.frequency_hz)
                 ),
             });
         }
