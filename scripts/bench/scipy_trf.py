@@ -34,6 +34,11 @@ def simulate(k):
     if out.returncode != 0:
         return None
     d = json.loads(out.stdout)
+    # At a vanishing support the rotor is free to round-off: `simulate` reports rigid-body modes
+    # at 0 Hz without sensitivities. eigenfit's residual refuses pairing onto them (the step is
+    # rejected as diverged); a failed evaluation here does the same for scipy.
+    if d.get("rigid_body_modes") or not d.get("sensitivities_hz"):
+        return None
     f = np.array(d["frequencies_hz"])
     dfdk = np.array([d["sensitivities_hz"][n] for n in d["parameters"]]).T  # modes x params
     return f, dfdk
