@@ -350,6 +350,15 @@ class EstimateResult(Result):
         return None if c is None else np.asarray(c["matrix"], dtype=float)
 
     @property
+    def data_rank(self) -> Optional[Dict[str, Any]]:
+        """Whether the data determine the parameters, decided by rank: ``counted`` (what was
+        counted, in words), ``rows`` (frequencies and shape components), ``parameters``,
+        ``rank`` (of the weighted Jacobian of all the data at the estimate) and
+        ``null_directions`` (the parameter combinations the data cannot tell apart, in words;
+        empty at full rank). None from a run-up estimate, which does not report it."""
+        return copy.deepcopy(self._data.get("data_rank"))
+
+    @property
     def singular_values(self) -> Optional[np.ndarray]:
         """Singular values of the scaled Jacobian, when computed."""
         return _array(self._data.get("singular_values"))
@@ -394,8 +403,19 @@ class EstimateResult(Result):
                     _cell(status.get(name, "")),
                 ]
             )
+        rank = d.get("data_rank")
+        rank_html = ""
+        if rank:
+            unseen = rank.get("null_directions") or []
+            rank_html = (
+                f'<p class="data-rank">The data ({_esc(str(rank["counted"]))}) determine {int(rank["rank"])} of '
+                f'{int(rank["parameters"])} parameter directions'
+                + (f'; they cannot tell apart changes along: {_esc("; ".join(unseen))}' if unseen else "")
+                + ".</p>"
+            )
         parts = [
             _verdict_html(str(d.get("verdict")), self.acceptable and self.unique),
+            rank_html,
             _table(
                 "parameters",
                 "Estimated parameters with 95 % intervals",

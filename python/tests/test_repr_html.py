@@ -79,9 +79,16 @@ def test_an_estimate_shows_the_reports_tables(cli, examples: Path, tmp_path: Pat
             str(page),
         ]
     )
-    shown = _parse(EstimateResult(data, code)._repr_html_())
+    result = EstimateResult(data, code)
+    shown = _parse(result._repr_html_())
     report = _parse(page.read_text(encoding="utf-8"))
     assert shown.verdict == data["verdict"] == report.verdict
+    # What the data determine, by rank (issue 29): in the JSON, the accessor, the notebook and
+    # the CLI's page alike (two frequencies, two supports: full rank).
+    rank = result.data_rank
+    assert rank == data["data_rank"] and rank["rank"] == rank["parameters"] == 2
+    said = f"determine {rank['rank']} of {rank['parameters']} parameter directions"
+    assert said in result._repr_html_() and said in page.read_text(encoding="utf-8")
     params = shown.tables["parameters"]
     assert [row[0][0] for row in params] == list(data["parameters"])
     for row, (name, value) in zip(params, data["parameters"].items()):

@@ -237,6 +237,19 @@ pub fn fill(html: &mut Report, est: &Estimation, units: &[String], convergence: 
     if let Some(fixed) = &r.fixed {
         s.list(fixed.iter().map(|(n, v)| format!("{n} held at {} (--fix)", number(*v, 6))).collect());
     }
+    let rank = &r.data_rank;
+    s.text(format!(
+        "The data ({}) determine {} of {} parameter directions (the rank of the weighted Jacobian of all \
+         the data at the estimate){}",
+        rank.counted,
+        rank.rank,
+        rank.parameters,
+        if rank.null_directions.is_empty() {
+            ".".to_string()
+        } else {
+            format!("; they cannot tell apart changes along: {}.", rank.null_directions.join("; "))
+        }
+    ));
     if let (Some(sv), Some(c)) = (&r.uncertainty.singular_values, r.uncertainty.condition_number) {
         let sv: Vec<String> = sv.iter().map(|v| number(*v, 3)).collect();
         s.text(format!(

@@ -88,7 +88,9 @@ pub fn judge(lin: &Linearisation, free: usize) -> FitQuality {
         let poor = relative_rms.is_nan() || relative_rms > NO_STD_POOR_RELATIVE_RMS;
         let relative = |k: usize| ((lin.frequencies_hz[k] - lin.measured_hz[k]) / lin.measured_hz[k]).abs();
         let mut disagreeing: Vec<usize> = match poor {
-            true => (0..n).filter(|&k| relative(k).is_nan() || relative(k) > NO_STD_POOR_RELATIVE_RMS).collect(),
+            true => {
+                (0..n).filter(|&k| relative(k).is_nan() || relative(k) > NO_STD_POOR_RELATIVE_RMS).collect()
+            }
             false => Vec::new(),
         };
         disagreeing.sort_by(|&a, &b| relative(b).total_cmp(&relative(a)));
