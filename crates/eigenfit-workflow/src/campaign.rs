@@ -195,7 +195,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
             Fit::new(problem, d, request.shape.shape_std)
         })
         .collect();
-    let mut joint = Joint::new(fits.iter().map(|f| f as &dyn Objective).collect())
+    let mut joint = Joint::new(fits.iter().map(|f| f as &(dyn Objective + Sync)).collect())
         .map_err(|e| input(format!("{}: {e}", request.campaign.display())))?;
     let has_std = data.iter().all(|d| d.measurement.has_std() && d.sensors.is_none());
     let initial = joint.parameters().nominal_values();

@@ -9,7 +9,7 @@ use crate::outcome::{
 };
 use eigenfit_core::analysis::alternatives::{like_exchanges, mirror_solutions, Equivalence};
 use eigenfit_core::analysis::verdict::{at_limits, judge};
-use eigenfit_core::analysis::{uncertainty_within, Identifiability};
+use eigenfit_core::analysis::{uncertainty_parallel, Identifiability};
 use eigenfit_core::update::Budget;
 use eigenfit_rotordynamics::fit::fit_runup;
 use eigenfit_rotordynamics::identify::{
@@ -539,7 +539,8 @@ pub fn estimate_with(
         Default::default()
     };
     phases.push(("mirror_solutions", budget.used()));
-    let uncertainty = if converged { uncertainty_within(&objective, lin, &budget) } else { None };
+    // Every bound a job on rayon's threads: the same intervals and evaluations as in series.
+    let uncertainty = if converged { uncertainty_parallel(&objective, lin, &budget, &mut []) } else { None };
     phases.push(("intervals", budget.used()));
     let quality = judge(lin, np);
     let alternatives_sigma = Equivalence::at(lin, np).sigma_source();

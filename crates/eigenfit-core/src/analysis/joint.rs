@@ -3,7 +3,7 @@
 //! every run); one that appears in one configuration only (a bearing changed for that run) is
 //! estimated from that configuration's data alone. Rows are stacked as in [`crate::problem::multi`].
 
-use crate::analysis::statistics::{scatter_uncertainty, UNCERTAINTY_EVALUATIONS};
+use crate::analysis::statistics::{scatter_uncertainty_parallel, UNCERTAINTY_EVALUATIONS};
 use crate::analysis::Uncertainty;
 use crate::model::{Parameter, ParameterError, ParameterSet};
 use crate::problem::multi::stack;
@@ -31,7 +31,8 @@ pub enum JointError {
 
 /// Several configurations' objectives over the union of their parameters.
 pub struct Joint<'a> {
-    parts: Vec<&'a dyn Objective>,
+    /// `Sync`, so the profiles of the intervals run in parallel.
+    parts: Vec<&'a (dyn Objective + Sync)>,
     /// For each part, the joint index of each of its parameters.
     maps: Vec<Vec<usize>>,
     parameters: ParameterSet,
@@ -42,7 +43,7 @@ pub struct Joint<'a> {
 impl<'a> Joint<'a> {
     /// Joins `parts`; a shared name must have the same unit, bounds and scale everywhere (its
     /// nominal value is the first configuration's).
-    pub fn new(parts: Vec<&'a dyn Objective>) -> Result<Self, JointError> {
+    pub fn new(parts: Vec<&'a (dyn Objective + Sync)>) -> Result<Self, JointError> {
         let mut all: Vec<Parameter> = Vec::new();
         let mut maps = Vec::with_capacity(parts.len());
         for (k, part) in parts.iter().enumerate() {
@@ -101,14 +102,15 @@ impl<'a> Joint<'a> {
     }
 
     /// [`Joint::uncertainty`] charging every profile refit to `budget` (shared with the fit, so
-    /// one limit bounds the whole campaign).
+    /// one limit bounds the whole campaign), each bound a job on rayon's threads: the same
+    /// intervals and evaluations as in series.
     pub fn uncertainty_within(
         &mut self,
         at: &Linearisation,
         has_std: bool,
         budget: &Budget,
     ) -> Option<(Uncertainty, f64)> {
-        scatter_uncertainty(self, |joint| &mut joint.scale, at, has_std, budget)
+        scatter_uncertainty_parallel(self, |joint| &mut joint.scale, at, has_std, budget)
     }
 }
 
