@@ -177,7 +177,20 @@ impl Stream {
         let length =
             whole_lines(&file).map_err(|e| input(format!("{}: cannot read: {e}", path.display())))?;
         let size = file.metadata().map_err(|e| input(format!("{}: {e}", path.display())))?.len();
-        if length < size {
+        let mut length = length;
+        if length < size && complete_record(&file, length, size) {
+            // A whole record that only lacks its newline (written by hand, or by another tool)
+            // is kept: the newline is added.
+            use std::io::Write;
+            (&file)
+                .write_all(b"\n")
+                .map_err(|e| input(format!("{}: cannot end its last line: {e}", path.display())))?;
+            eprintln!(
+                "eigenfit: note: {}: its last line, a complete record, had no newline: one was added",
+                path.display()
+            );
+            length = size + 1;
+        } else if length < size {
             file.set_len(length)
                 .map_err(|e| input(format!("{}: cannot cut a torn line: {e}", path.display())))?;
             eprintln!(
@@ -241,6 +254,19 @@ impl Stream {
 
 /// The length of `file` up to and including its last newline (0 for an empty file or one
 /// without any), read backwards in blocks.
+/// Whether the bytes of `file` from `start` to `end` (its last line, without a newline) are one
+/// whole JSON record. Lines longer than any record (16 MiB) are not read: torn by definition.
+fn complete_record(file: &std::fs::File, start: u64, end: u64) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = file;
+    if end - start > 16 << 20 || f.seek(SeekFrom::Start(start)).is_err() {
+        return false;
+    }
+    let mut tail = vec![0u8; (end - start) as usize];
+    f.read_exact(&mut tail).is_ok()
+        && serde_json::from_slice::<serde_json::Value>(&tail).is_ok_and(|v| v.is_object())
+}
+
 fn whole_lines(file: &std::fs::File) -> std::io::Result<u64> {
     use std::io::{Read, Seek, SeekFrom};
     let mut f = file;

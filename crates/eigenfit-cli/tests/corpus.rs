@@ -235,6 +235,33 @@ fn a_stream_never_appends_onto_a_torn_line() {
     assert_eq!(written.lines().count(), 4, "the whole line and 3 runs:\n{written}");
 }
 
+/// A last line that is a complete record without its newline (written by hand, or by another
+/// tool) is kept and ended; only a line that does not parse is torn.
+#[test]
+fn a_streams_complete_last_record_without_a_newline_is_kept() {
+    let scratch = tempfile::tempdir().expect("a temporary folder");
+    let stream = scratch.path().join("runs.jsonl");
+    std::fs::write(&stream, "{\"whole\":1}\n{\"whole\":2}").unwrap();
+    let s = stream.to_str().unwrap();
+    let out = eigenfit(&[
+        "compare",
+        "--preset",
+        "paper-rotor",
+        "--targets",
+        "2e5:5e4",
+        "--initials",
+        "1e5:1e5",
+        "--stream",
+        s,
+    ]);
+    let all = text(&out);
+    clean("unterminated stream", &all);
+    assert!(all.contains("a complete record, had no newline: one was added"), "{all}");
+    let written = std::fs::read_to_string(&stream).unwrap();
+    assert!(written.starts_with("{\"whole\":1}\n{\"whole\":2}\n"), "{written}");
+    assert_eq!(written.lines().count(), 5, "both records and 3 runs:\n{written}");
+}
+
 /// An updated model that cannot be written after the fit (the disk fills) is said to be lost; the
 /// fit's own exit code stands, and no temporary file is left behind.
 #[cfg(target_os = "linux")]

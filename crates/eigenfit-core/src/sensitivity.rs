@@ -18,24 +18,27 @@ use thiserror::Error;
 /// Relative gap below which two eigenvalues count as repeated.
 pub const DEFAULT_REPEATED_TOLERANCE: f64 = 1e-8;
 
-/// Why a sensitivity could not be computed.
+/// Why a sensitivity could not be computed. Mode fields are 0-based indices; the messages
+/// number modes from 1, as every report does.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum SensitivityError {
     /// Mode `mode` shares its eigenvalue with mode `other` (relative gap below the tolerance).
     #[error(
-        "modes {mode} and {other} have (nearly) repeated eigenvalues {lambda_mode:e} and {lambda_other:e} \
-         (relative gap {relative_gap:e}): the derivative of an individual mode is not defined there"
+        "modes {} and {} have (nearly) repeated eigenvalues {lambda_mode:e} and {lambda_other:e} \
+         (relative gap {relative_gap:e}): the derivative of an individual mode is not defined there",
+        .mode + 1,
+        .other + 1
     )]
     RepeatedEigenvalue { mode: usize, other: usize, lambda_mode: f64, lambda_other: f64, relative_gap: f64 },
     /// A frequency sensitivity of a zero-frequency (rigid-body) mode.
-    #[error("mode {mode} has λ = {lambda:e}, zero to round-off (a rigid-body mode): its frequency sensitivity is undefined")]
+    #[error("mode {} has λ = {lambda:e}, zero to round-off (a rigid-body mode): its frequency sensitivity is undefined", .mode + 1)]
     ZeroFrequency { mode: usize, lambda: f64 },
     /// A mode index beyond the computed modes.
-    #[error("mode {mode} requested but only {count} modes were computed")]
+    #[error("mode {} requested but only {count} modes were computed", .mode + 1)]
     ModeIndex { mode: usize, count: usize },
     /// Nelson's linear system is singular.
-    #[error("Nelson's system for mode {mode} is singular")]
+    #[error("Nelson's system for mode {} is singular", .mode + 1)]
     Singular { mode: usize },
     /// The model failed to assemble or differentiate.
     #[error(transparent)]

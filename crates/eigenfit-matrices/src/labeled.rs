@@ -231,6 +231,14 @@ pub fn parse_abaqus(text: &str) -> Result<LabeledMatrix, String> {
                     i + 1
                 ));
             }
+            // Abaqus numbers structural DOFs 1–6; 0 does not exist, and 7 on (warping, pressure,
+            // temperature) are not what a modal test measures: a slip would add a phantom DOF.
+            if !(1..=6).contains(&dof) {
+                return Err(format!(
+                    "line {}: node {node} dof {dof}: only the structural DOFs 1–6 (x, y, z, rx, ry, rz) are read",
+                    i + 1
+                ));
+            }
             Ok((node as u64, dof))
         };
         let (r, c) = (label(f[0], f[1])?, label(f[2], f[3])?);
@@ -291,5 +299,15 @@ mod tests {
         assert_eq!(m.entries, vec![((1, 1), (1, 1), 2.5), ((2, 3), (1, 1), -1000.0)]);
         assert!(parse_abaqus("1 1 2.5\n").unwrap_err().contains("line 1"));
         assert!(parse_abaqus("-4,1, 1,1, 2.5\n").unwrap_err().contains("internal nodes"));
+    }
+
+    #[test]
+    fn abaqus_dofs_outside_1_to_6_are_refused_naming_the_line() {
+        for dof in [0, 7] {
+            let text = format!("** K\n1,1, 1,1, 2.0\n2,{dof}, 2,{dof}, 1.0\n");
+            let e = parse_abaqus(&text).unwrap_err();
+            assert!(e.contains(&format!("line 3: node 2 dof {dof}: only the structural DOFs 1–6")), "{e}");
+        }
+        assert!(parse_abaqus("1,6, 1,6, 1.0\n").is_ok());
     }
 }

@@ -104,6 +104,30 @@ impl Campaign {
             conf.shapes = conf.shapes.as_ref().map(|p| dir.join(p));
             conf.sensor_map = conf.sensor_map.as_ref().map(|p| dir.join(p));
         }
+        // A configuration listed twice would count its data twice: intervals √2 too narrow. (One
+        // data file with two models is left to the user: a model choice, not a repetition.)
+        for (j, b) in c.configurations.iter().enumerate() {
+            for a in &c.configurations[..j] {
+                let same = |x: &Path, y: &Path| {
+                    x == y || x.canonicalize().ok().is_some_and(|x| y.canonicalize().ok() == Some(x))
+                };
+                let why = if a.name == b.name {
+                    "two configurations have the same name"
+                } else if same(&a.measured, &b.measured) && same(&a.model, &b.model) {
+                    "two configurations are the same model with the same measured file: its data would count \
+                     twice and the intervals come out too narrow"
+                } else {
+                    continue;
+                };
+                return Err(CampaignError::Refused(format!(
+                    "{}: {why} (`{}` and `{}`, measured {})",
+                    path.display(),
+                    a.name.as_deref().unwrap_or_default(),
+                    b.name.as_deref().unwrap_or_default(),
+                    b.measured.display()
+                )));
+            }
+        }
         Ok(c)
     }
 }

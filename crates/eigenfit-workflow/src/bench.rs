@@ -624,6 +624,19 @@ pub fn run(request: &BenchRequest) -> Result<BenchReport, WorkflowError> {
         registry::build(&spec).map_err(|e| input(format!("--strategies: {e}")))?;
         strategies.push(spec);
     }
+    // Counted before the tasks are listed: 10⁹ starts would exhaust memory first.
+    let runs = request.problems.len().saturating_mul(strategies.len()).saturating_mul(request.starts);
+    if runs > crate::compare::MAX_RUNS {
+        return Err(input(format!(
+            "--starts {}: {} problems × {} strategies × {} starts = {runs} runs, more than the {} a bench accepts; \
+             use fewer starts",
+            request.starts,
+            request.problems.len(),
+            strategies.len(),
+            request.starts,
+            crate::compare::MAX_RUNS
+        )));
+    }
     let problems: Vec<BenchProblem> =
         request.problems.iter().map(|n| problem(n)).collect::<Result<_, _>>()?;
     let tasks: Vec<(usize, usize, usize)> = (0..problems.len())

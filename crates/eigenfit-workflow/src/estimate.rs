@@ -335,6 +335,16 @@ pub fn run(
     notes: &mut Vec<String>,
     progress: &mut dyn Progress,
 ) -> Result<EstimateOutcome, WorkflowError> {
+    // Each start of the search for other minima costs at least one evaluation, so more starts
+    // than the budget allows are a slip; refused before the design (starts × parameters) is
+    // allocated.
+    if let Some(n) = request.alternative_starts.filter(|&n| n > request.budget) {
+        return Err(input(format!(
+            "--alternative-starts {n}: more starts than the evaluation budget ({}) can run, each start being \
+             at least one model evaluation; use fewer, or raise --budget",
+            request.budget
+        )));
+    }
     // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
     if let Some(path) = rotordynamics::ross_model(request.source.model.as_deref()) {
         // A run-up fit on a large rotor takes minutes (each evaluation solves every speed):
@@ -402,6 +412,11 @@ pub fn run(
     };
     if request.budget == 0 {
         return Err(input("--budget 0: at least one model evaluation is needed"));
+    }
+    // Refused before the fit: the updated file is written for rotor models only, and a user who
+    // asked for it must not wait through a fit whose result is then not written.
+    if request.write_model {
+        any.rotor("--write-model")?;
     }
     let updatable = any.updatable(&label)?;
     let initial = parameter_vector(&updatable, "--initial", request.initial.as_deref(), &[])?;

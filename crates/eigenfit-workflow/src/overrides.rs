@@ -44,6 +44,7 @@ pub fn parameter_vector(
         }
         p = values;
     }
+    refuse_repeated("--set", sets)?;
     for s in sets {
         let (name, value) =
             s.split_once('=').ok_or_else(|| input(format!("--set `{s}`: expected NAME=VALUE")))?;
@@ -52,6 +53,17 @@ pub fn parameter_vector(
     }
     params.check(&p).map_err(|e| input(format!("{flag}: {e}")))?;
     Ok(p)
+}
+
+/// Refuses `NAME=VALUE` items (`flag`'s) that name one parameter twice: which value was meant
+/// cannot be known, and the last one silently winning is a slip hidden.
+pub fn refuse_repeated(flag: &str, items: &[String]) -> Result<(), WorkflowError> {
+    let names: Vec<&str> =
+        items.iter().map(|s| s.split_once('=').map_or(s.as_str(), |(n, _)| n).trim()).collect();
+    match (1..names.len()).find(|&j| names[..j].contains(&names[j])) {
+        Some(j) => Err(input(format!("{flag}: `{}` is given twice; give each name once", names[j]))),
+        None => Ok(()),
+    }
 }
 
 /// `model` with the `--fix NAME=VALUE` parameters held.

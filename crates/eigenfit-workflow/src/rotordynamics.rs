@@ -133,10 +133,23 @@ const SETTABLE: [&str; 12] =
 /// [`settable_names`] is refused, listing them.
 pub fn apply_sets(rotor: &mut Rotor, sets: &[String]) -> Result<Vec<String>, WorkflowError> {
     let mut notes = Vec::new();
+    crate::overrides::refuse_repeated("--set", sets)?;
     for item in sets {
         let (name, value) =
             item.split_once('=').ok_or_else(|| input(format!("--set `{item}`: expected NAME=VALUE")))?;
         let name = name.trim();
+        // Two bearings with one tag: the name would set only the first, silently.
+        let tagged: Vec<usize> = (0..rotor.bearings.len())
+            .filter(|&i| SETTABLE.iter().any(|c| format!("{c}_{}", rotor.bearings[i].tag) == name))
+            .collect();
+        if tagged.len() > 1 {
+            return Err(input(format!(
+                "--set {name}: {} bearings share the tag `{}` (at nodes {}); give them distinct tags in the rotor file",
+                tagged.len(),
+                rotor.bearings[tagged[0]].tag,
+                tagged.iter().map(|&i| rotor.bearings[i].n.to_string()).collect::<Vec<_>>().join(", ")
+            )));
+        }
         let value: f64 = value
             .trim()
             .parse()
@@ -421,6 +434,10 @@ fn initial_factors(
     let items: Vec<&str> = text.split(',').map(str::trim).filter(|s| !s.is_empty()).collect();
     let mut values: Vec<(usize, f64)> = Vec::new();
     if items.iter().any(|i| i.contains('=')) {
+        crate::overrides::refuse_repeated(
+            "--initial",
+            &items.iter().map(|s| s.to_string()).collect::<Vec<_>>(),
+        )?;
         for item in &items {
             let (name, value) = item.split_once('=').ok_or_else(|| {
                 input(format!("--initial `{item}`: expected NAME=VALUE like the other items"))

@@ -276,6 +276,18 @@ fn build(
         let dirs: Vec<&str> = (1..=6u8).filter(|&d| layout.dof(0, d).is_some()).map(direction_name).collect();
         return Err(SensorError::NoSensor(dirs.join(", ")));
     }
+    // One measured channel read into two model DOFs would count its data twice.
+    let mut channels = HashMap::new();
+    for s in &set.sensors {
+        if let Some(node) = channels.insert((s.label, s.direction), s.model_node) {
+            return Err(SensorError::Measurement(format!(
+                "{} is mapped twice (to model nodes {node} and {}): each measured node and direction \
+                 may be read once",
+                s.name(),
+                s.model_node
+            )));
+        }
+    }
     let mut seen = HashMap::new();
     for s in &set.sensors {
         if let Some(other) = seen.insert(s.dof, s.name()) {

@@ -37,6 +37,13 @@ impl Default for TmcmcSettings {
 /// informative than the prior (ten parameters each narrowed 60-fold).
 pub const MAX_STAGES: usize = 60;
 
+/// Most posterior samples: the samples are held in memory (samples × parameters) and each
+/// costs 1 + stages × chain evaluations, so 10⁶ is far beyond any study; more is a slip,
+/// refused before anything is allocated.
+pub const MAX_SAMPLES: usize = 1_000_000;
+/// Longest Markov chain per sample and stage (the default is 3).
+pub const MAX_CHAIN: usize = 1_000;
+
 /// Transitional MCMC with settings checked when built.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Tmcmc {
@@ -56,6 +63,22 @@ impl Tmcmc {
                 setting: "samples",
                 value: settings.samples.to_string(),
                 requirement: "must be at least 2",
+            });
+        }
+        if settings.samples > MAX_SAMPLES {
+            return Err(SettingsError {
+                owner: "TMCMC",
+                setting: "samples",
+                value: settings.samples.to_string(),
+                requirement: "must be at most 1000000",
+            });
+        }
+        if settings.chain_length > MAX_CHAIN {
+            return Err(SettingsError {
+                owner: "TMCMC",
+                setting: "chain",
+                value: settings.chain_length.to_string(),
+                requirement: "must be at most 1000",
             });
         }
         Ok(Self { settings })
