@@ -1,6 +1,7 @@
 //! [`MatricesModel`]: K(p) = K₀ + Σ pᵢKᵢ, M(p) = M₀ + Σ pᵢMᵢ from Matrix Market files, as a
 //! [`StructuralModel`].
 
+use eigenfit_core::measurement::measured_csv::shown_number;
 use crate::condensation::{Partition, MAX_CONDENSED_DOFS};
 use crate::error::MatricesError;
 use crate::layout::{Dof, DofLayout};
@@ -270,7 +271,11 @@ impl MatricesModel {
                     return Err(MatricesError::invalid(
                         path,
                         format!(
-                            "{table}: plausible = [{a}, {b}] lies outside the candidate's bounds [{lower}, {upper}] (`lower`, `upper`): a value outside them is never fitted"
+                            "{table}: plausible = [{}, {}] lies outside the candidate's bounds [{}, {}] (`lower`, `upper`): a value outside them is never fitted",
+                            shown_number(a),
+                            shown_number(b),
+                            shown_number(lower),
+                            shown_number(upper)
                         ),
                     ))
                 }
@@ -706,16 +711,16 @@ fn parameter(
     if !nominal.is_finite() || lower.is_nan() || upper.is_nan() {
         return Err("nominal, lower and upper must be numbers (nominal finite)".into());
     }
+    // Bounds are shown as numbers a reader can take in (1e-300, not 300 digits).
+    let (n, lo, hi) = (shown_number(nominal), shown_number(lower), shown_number(upper));
     if scale == Scale::Log && (nominal <= 0.0 || lower < 0.0) {
-        return Err(format!(
-            "scale = \"log\" needs a positive nominal and lower bound (nominal = {nominal}, lower = {lower})"
-        ));
+        return Err(format!("scale = \"log\" needs a positive nominal and lower bound (nominal = {n}, lower = {lo})"));
     }
     if lower > upper {
-        return Err(format!("lower = {lower} is above upper = {upper}"));
+        return Err(format!("lower = {lo} is above upper = {hi}"));
     }
     if nominal < lower || nominal > upper {
-        return Err(format!("nominal = {nominal} lies outside [{lower}, {upper}]"));
+        return Err(format!("nominal = {n} lies outside [{lo}, {hi}]"));
     }
     let lower = if scale == Scale::Log { lower.max(f64::MIN_POSITIVE) } else { lower };
     Ok(Parameter::new(name, unit.unwrap_or(""), nominal).with_bounds(lower, upper).with_scale(scale))
