@@ -1,12 +1,12 @@
 //! [`MatricesModel`]: K(p) = K₀ + Σ pᵢKᵢ, M(p) = M₀ + Σ pᵢMᵢ from Matrix Market files, as a
 //! [`StructuralModel`].
 
-use eigenfit_core::measurement::measured_csv::shown_number;
 use crate::condensation::{Partition, MAX_CONDENSED_DOFS};
 use crate::error::MatricesError;
 use crate::layout::{Dof, DofLayout};
 use crate::market::read_symmetric;
 use eigenfit_core::matrix::{CscSymmetric, SparseSymmetric, System, SystemDerivative};
+use eigenfit_core::measurement::measured_csv::shown_number;
 use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use nalgebra::DMatrix;
 use serde::Deserialize;
@@ -714,7 +714,9 @@ fn parameter(
     // Bounds are shown as numbers a reader can take in (1e-300, not 300 digits).
     let (n, lo, hi) = (shown_number(nominal), shown_number(lower), shown_number(upper));
     if scale == Scale::Log && (nominal <= 0.0 || lower < 0.0) {
-        return Err(format!("scale = \"log\" needs a positive nominal and lower bound (nominal = {n}, lower = {lo})"));
+        return Err(format!(
+            "scale = \"log\" needs a positive nominal and lower bound (nominal = {n}, lower = {lo})"
+        ));
     }
     if lower > upper {
         return Err(format!("lower = {lo} is above upper = {hi}"));

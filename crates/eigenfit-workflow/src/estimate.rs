@@ -15,8 +15,8 @@ use crate::simulate::check_roundoff_of;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
-    better_minimum, like_exchanges, local_minima, mirror_solutions, other_solutions, scaled_distance,
-    search_starts, Equivalence, Mirrors, OtherSolution, SAME_MINIMUM,
+    better_minimum, like_exchanges, listed_alternatives, local_minima, mirror_solutions, search_starts,
+    Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};
@@ -641,13 +641,7 @@ pub fn run(
     phases.push(("intervals", budget.used()));
     let mac = fit.mac(&estimate.parameters, options.shape.mac_threshold);
     // Mirrors first, then the other minima not already listed, each judged against the estimate.
-    let mut alternatives: Vec<OtherSolution> = Vec::new();
-    let same = |a: &[f64], b: &[f64]| scaled_distance(&fit, a, b) <= SAME_MINIMUM;
-    for o in mirrors.symmetric.into_iter().chain(other_solutions(&fit, &estimate.last, &minima)) {
-        if !alternatives.iter().any(|a| same(&a.parameters, &o.parameters)) {
-            alternatives.push(o);
-        }
-    }
+    let alternatives = listed_alternatives(&fit, &estimate.last, mirrors.symmetric, &minima);
     let alternatives_sigma = Equivalence::at(&estimate.last, np).sigma_source();
     let unique = !alternatives.iter().any(|a| a.judged.equally_good);
     let budget_spent = budget.exhausted();

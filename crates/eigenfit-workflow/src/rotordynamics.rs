@@ -7,7 +7,10 @@ use crate::outcome::{
     phase_counts, AlternativeSolution, BudgetReport, Covariances, FitQualityReport, Outcome,
     ParameterIdentifiability, ParameterValues, Verdict,
 };
-use eigenfit_core::analysis::alternatives::{like_exchanges, mirror_solutions, Equivalence};
+use eigenfit_core::analysis::alternatives::{
+    better_minimum, like_exchanges, listed_alternatives, mirror_solutions, screened_local_minima,
+    Equivalence, Mirrors,
+};
 use eigenfit_core::analysis::verdict::{at_limits, judge};
 use eigenfit_core::analysis::{uncertainty_parallel, Identifiability};
 use eigenfit_core::update::Budget;
@@ -547,21 +550,45 @@ pub fn estimate_with(
         Err(e) => return Err(input(format!("{}: {e}", measured.display()))),
     };
     phases.push(("fit", budget.used()));
+    let mut estimate = estimate;
     let converged = estimate.termination.is_converged();
-    let lin = &estimate.last;
-    // Mirrors: exchanges of like coefficients the rotor is symmetric under (two bearings alike).
-    let mirrors = if converged {
-        mirror_solutions(&objective, lin, &like_exchanges(&objective), &budget)
+    // Mirrors (exchanges of like coefficients the rotor is symmetric under: two bearings alike),
+    // then the search for other minima from a space-filling design, as for every model kind: a
+    // run-up at one speed fits as many factors as frequencies, and another exact fit may exist.
+    let (mut mirrors, mut minima) = (Mirrors::default(), Vec::new());
+    let mut better_note = None;
+    if converged {
+        let exchanges = like_exchanges(&objective);
+        mirrors = mirror_solutions(&objective, &estimate.last, &exchanges, &budget);
+        phases.push(("mirror_solutions", budget.used()));
+        // Screened: a run-up evaluation solves every speed, so the design is ranked by misfit and
+        // only its best np + 1 points are fitted locally (fitting all cost ~300× the fit itself).
+        let starts = crate::estimate::default_alternative_starts(np);
+        minima = screened_local_minima(&objective, starts, np + 1, &mirrors.asymmetric, &budget);
+        phases.push(("other_solutions", budget.used()));
+        if let Some(better) = better_minimum(&objective, &estimate.last, &minima).cloned() {
+            better_note = Some(format!(
+                "the search for other solutions found a deeper minimum than the fit reached (χ² or Σr² {:.6e} → \
+                 {:.6e}): it is the estimate reported",
+                estimate.last.chi2(),
+                better.chi2()
+            ));
+            minima.push(estimate.last.clone());
+            estimate.parameters = better.parameters.clone();
+            estimate.last = better;
+            mirrors = mirror_solutions(&objective, &estimate.last, &exchanges, &budget);
+        }
     } else {
-        Default::default()
-    };
-    phases.push(("mirror_solutions", budget.used()));
+        phases.push(("mirror_solutions", budget.used()));
+    }
+    let lin = &estimate.last;
     // Every bound a job on rayon's threads: the same intervals and evaluations as in series.
     let uncertainty = if converged { uncertainty_parallel(&objective, lin, &budget, &mut []) } else { None };
     phases.push(("intervals", budget.used()));
     let quality = judge(lin, np);
     let alternatives_sigma = Equivalence::at(lin, np).sigma_source();
-    let unique = !mirrors.symmetric.iter().any(|m| m.judged.equally_good);
+    let mut alternatives = listed_alternatives(&objective, lin, mirrors.symmetric, &minima);
+    let unique = !alternatives.iter().any(|m| m.judged.equally_good);
     let budget_spent = budget.exhausted();
     // estimate's rule: a coefficient on a limit of its factor is no acceptable answer.
     let on_limit = at_limits(eigenfit_core::problem::Objective::parameters(&objective), &estimate.parameters)
@@ -611,7 +638,6 @@ pub fn estimate_with(
             _ => "(no std given)".into(),
         }
     };
-    let mut alternatives = mirrors.symmetric.clone();
     for a in &mut alternatives {
         a.parameters = physical(&a.parameters);
     }
@@ -685,6 +711,7 @@ pub fn estimate_with(
                 notes.push(format!("the fit started from --initial: {}", start.join(", ")));
             }
             notes.extend(rotor.extrapolation_notes(&points.iter().map(|p| p.speed_rpm).collect::<Vec<_>>()));
+            notes.extend(better_note);
             notes
         },
         points: points

@@ -166,11 +166,42 @@ pub fn local_minima(
     extra: &[Vec<f64>],
     budget: &Budget,
 ) -> Vec<Linearisation> {
+    let points = extra.iter().cloned().chain(design(problem, starts)).collect();
+    fitted_minima(problem, points, budget)
+}
+
+/// [`local_minima`] for an objective whose local fits are dear (a run-up solves every speed
+/// per evaluation, and a fit from a far start wanders for dozens): the design's `starts` points
+/// are ranked by their misfit (one evaluation each) and only the best `keep`, with `extra`, are
+/// fitted locally. Charged to `budget`.
+pub fn screened_local_minima(
+    problem: &dyn Objective,
+    starts: usize,
+    keep: usize,
+    extra: &[Vec<f64>],
+    budget: &Budget,
+) -> Vec<Linearisation> {
+    let budgeted = budget.wrap(problem);
+    let mut ranked: Vec<(f64, Vec<f64>)> = design(problem, starts)
+        .filter(|p| problem.parameters().check(p).is_ok())
+        .filter_map(|p| budgeted.cost(&p).filter(|c| c.is_finite()).map(|c| (c, p)))
+        .collect();
+    ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let points = extra.iter().cloned().chain(ranked.into_iter().take(keep).map(|(_, p)| p)).collect();
+    fitted_minima(problem, points, budget)
+}
+
+/// The Halton design of `starts` points over `problem`'s search ranges.
+fn design(problem: &dyn Objective, starts: usize) -> impl Iterator<Item = Vec<f64>> + '_ {
     let params = problem.parameters();
-    let design = crate::update::grid::halton(starts, params.len());
-    let points = extra.iter().cloned().chain(design.into_iter().map(|t| {
+    crate::update::grid::halton(starts, params.len()).into_iter().map(move |t| {
         params.iter().zip(&t).map(|(p, &ti)| crate::update::grid::search_point(p, ti)).collect::<Vec<f64>>()
-    }));
+    })
+}
+
+/// Local damped fits without restarts from `points`: the distinct converged minima, best first.
+fn fitted_minima(problem: &dyn Objective, points: Vec<Vec<f64>>, budget: &Budget) -> Vec<Linearisation> {
+    let params = problem.parameters();
     let mut minima: Vec<Linearisation> = Vec::new();
     for start in points {
         if budget.exhausted() {
@@ -243,6 +274,24 @@ pub fn other_solutions(
         .collect();
     out.sort_by(|a, b| a.misfit.total_cmp(&b.misfit));
     out.truncate(MOST_LISTED);
+    out
+}
+
+/// What a report lists as other solutions of the estimate `at`: the symmetric model's mirrors
+/// first, then the other minima of `minima` ([`other_solutions`]) not already listed (within
+/// [`SAME_MINIMUM`] of a mirror), each judged against `at`. The same for every model kind.
+pub fn listed_alternatives(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    mirrors: Vec<OtherSolution>,
+    minima: &[Linearisation],
+) -> Vec<OtherSolution> {
+    let mut out: Vec<OtherSolution> = Vec::new();
+    for o in mirrors.into_iter().chain(other_solutions(problem, at, minima)) {
+        if !out.iter().any(|a| scaled_distance(problem, &a.parameters, &o.parameters) <= SAME_MINIMUM) {
+            out.push(o);
+        }
+    }
     out
 }
 
