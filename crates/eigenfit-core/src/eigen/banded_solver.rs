@@ -136,7 +136,8 @@ impl EigenSolver for BandedSolver {
     /// returned lies below it, at no extra cost. Eigenvalues only are iterated less far
     /// (`request_tolerance`).
     fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
-        match self.banded(system, request.count, request_tolerance(request, self.tolerance))? {
+        let banded = self.banded(system, request.count, request_tolerance(request, self.tolerance));
+        match banded.map_err(|e| e.located(system))? {
             Some((modes, next)) => Ok(SolvedModes::answering(request, modes, next)),
             None => DenseSolver.solve(system, request),
         }
@@ -219,7 +220,7 @@ impl BandedSolver {
     ) -> Result<Option<(Modes, f64)>, SolveError> {
         if ws.checked_mass.as_ref() != Some(m) {
             if !ws.factor.factor_shifted(m, 0.0, m) {
-                return Err(SolveError::MassNotPositiveDefinite { detail: None });
+                return Err(SolveError::MassNotPositiveDefinite { detail: None, dof: None });
             }
             ws.checked_mass = Some(m.clone());
         }

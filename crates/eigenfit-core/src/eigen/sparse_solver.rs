@@ -265,7 +265,8 @@ impl EigenSolver for SparseSolver {
     /// less far (`request_tolerance`).
     fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
         let tolerance = request_tolerance(request, self.tolerance);
-        let (modes, next) = self.solve_with_tolerance(system, request.count, tolerance)?;
+        let (modes, next) =
+            self.solve_with_tolerance(system, request.count, tolerance).map_err(|e| e.located(system))?;
         Ok(SolvedModes::answering(request, modes, next))
     }
 }
@@ -327,7 +328,7 @@ impl SparseSolver {
         let m = &with_pattern(&pattern, m);
         if ws.checked_mass.as_ref() != Some(m) {
             if !ws.cholesky(m, false)? {
-                return Err(SolveError::MassNotPositiveDefinite { detail: None });
+                return Err(SolveError::MassNotPositiveDefinite { detail: None, dof: None });
             }
             ws.checked_mass = Some(m.clone());
         }
