@@ -228,6 +228,16 @@ pub fn solve_failure_at(model: &dyn StructuralModel, p: &[f64], system: &System,
     }
 }
 
+/// Refuses `p` when M(p) is not positive definite there (said as [`solve_failure_at`] says);
+/// a model that fails at `p` otherwise passes, for the fit to say. One eigenvalue solved.
+pub fn check_mass_at(model: &dyn StructuralModel, solver: &dyn EigenSolver, p: &[f64]) -> Result<(), WorkflowError> {
+    let Ok(system) = model.assemble(p) else { return Ok(()) };
+    match solver.lowest_eigenvalues(&system, 1) {
+        Err(e @ SolveError::MassNotPositiveDefinite { .. }) => Err(solve_failure_at(model, p, &system, e)),
+        _ => Ok(()),
+    }
+}
+
 /// The words for M(p) not positive definite at `p`, its factorisation failing at DOF `dof`.
 pub fn mass_not_definite(model: &dyn StructuralModel, p: &[f64], dof: Option<usize>) -> String {
     let at = match dof {
@@ -269,7 +279,7 @@ pub fn modes_at(
     count: usize,
 ) -> Result<Modes, WorkflowError> {
     let system = model.assemble(p).map_err(failure)?;
-    solver.lowest(&system, count).map_err(failure)
+    solver.lowest(&system, count).map_err(|e| solve_failure_at(model, p, &system, e))
 }
 
 /// How a sweep treats round-off: the table refuses lost frequencies, the plot draws what it gets.
@@ -302,7 +312,7 @@ pub fn sweep(
             SweepCheck::None => model
                 .assemble(&p)
                 .map_err(failure)
-                .and_then(|s| solver.lowest(&s, modes).map_err(failure))
+                .and_then(|s| solver.lowest(&s, modes).map_err(|e| solve_failure_at(model, &p, &s, e)))
                 .map(|m| m.frequencies_hz()),
         };
         match row {
@@ -487,7 +497,7 @@ pub fn at_point(
                 SweepCheck::RefuseRoundoff => labelled_frequencies(model, solver, p, modes, &mut notes)?,
                 SweepCheck::None => {
                     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-                    let m = solver.lowest(&system, modes).map_err(failure)?;
+                    let m = solver.lowest(&system, modes).map_err(|e| solve_failure_at(model, p, &system, e))?;
                     check_stable(model, &system, &m, p)?;
                     let rigid = rigid_body_flags(solver, &system, &m)?;
                     let f = m.frequencies_hz().into_iter().zip(&rigid).map(|(f, &r)| if r { 0.0 } else { f });
