@@ -772,7 +772,11 @@ impl StructuralModel for MatricesModel {
     /// condensed model too.
     fn dof_label(&self, j: usize) -> String {
         match &self.condensation {
-            Some(c) => c.partition.kept().get(j).map_or_else(|| format!("DOF {}", j + 1), |&f| self.full_dof_label(f)),
+            Some(c) => c
+                .partition
+                .kept()
+                .get(j)
+                .map_or_else(|| format!("DOF {}", j + 1), |&f| self.full_dof_label(f)),
             None => self.full_dof_label(j),
         }
     }

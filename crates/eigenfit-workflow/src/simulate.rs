@@ -221,7 +221,12 @@ pub fn rigid_numbers(rigid: &[bool]) -> Vec<usize> {
 /// parameter values and the model's label for the DOF at which M's factorisation fails
 /// ([`SolveError::MassNotPositiveDefinite`]'s `dof`, the same for every solver); any other
 /// failure as [`solver_failure`] says.
-pub fn solve_failure_at(model: &dyn StructuralModel, p: &[f64], system: &System, e: SolveError) -> WorkflowError {
+pub fn solve_failure_at(
+    model: &dyn StructuralModel,
+    p: &[f64],
+    system: &System,
+    e: SolveError,
+) -> WorkflowError {
     match e {
         SolveError::MassNotPositiveDefinite { dof, .. } => input(mass_not_definite(model, p, dof)),
         e => solver_failure(system, e),
@@ -230,7 +235,11 @@ pub fn solve_failure_at(model: &dyn StructuralModel, p: &[f64], system: &System,
 
 /// Refuses `p` when M(p) is not positive definite there (said as [`solve_failure_at`] says);
 /// a model that fails at `p` otherwise passes, for the fit to say. One eigenvalue solved.
-pub fn check_mass_at(model: &dyn StructuralModel, solver: &dyn EigenSolver, p: &[f64]) -> Result<(), WorkflowError> {
+pub fn check_mass_at(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+) -> Result<(), WorkflowError> {
     let Ok(system) = model.assemble(p) else { return Ok(()) };
     match solver.lowest_eigenvalues(&system, 1) {
         Err(e @ SolveError::MassNotPositiveDefinite { .. }) => Err(solve_failure_at(model, p, &system, e)),
@@ -497,7 +506,8 @@ pub fn at_point(
                 SweepCheck::RefuseRoundoff => labelled_frequencies(model, solver, p, modes, &mut notes)?,
                 SweepCheck::None => {
                     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-                    let m = solver.lowest(&system, modes).map_err(|e| solve_failure_at(model, p, &system, e))?;
+                    let m =
+                        solver.lowest(&system, modes).map_err(|e| solve_failure_at(model, p, &system, e))?;
                     check_stable(model, &system, &m, p)?;
                     let rigid = rigid_body_flags(solver, &system, &m)?;
                     let f = m.frequencies_hz().into_iter().zip(&rigid).map(|(f, &r)| if r { 0.0 } else { f });

@@ -150,7 +150,8 @@ fn inverted_solve(
 /// All or most modes: the textbook reduction M = LLᵀ, A = L⁻¹KL⁻ᵀ, accurate to ε·λ_max in
 /// absolute terms for every mode, so the whole basis stays M-orthonormal (modal expansions).
 fn mass_reduction(k: &DMatrix<f64>, m: &DMatrix<f64>, count: usize) -> Result<Modes, SolveError> {
-    let chol = Cholesky::new(m.clone()).ok_or(SolveError::MassNotPositiveDefinite { detail: None, dof: None })?;
+    let chol =
+        Cholesky::new(m.clone()).ok_or(SolveError::MassNotPositiveDefinite { detail: None, dof: None })?;
     let l = chol.l();
     let x = l.solve_lower_triangular(k).ok_or_else(|| not_pd("zero pivot in L"))?;
     let a = l.solve_lower_triangular(&x.transpose()).ok_or_else(|| not_pd("zero pivot in L"))?;
