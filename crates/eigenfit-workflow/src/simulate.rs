@@ -265,8 +265,17 @@ pub fn mass_not_definite(model: &dyn StructuralModel, p: &[f64], dof: Option<usi
 }
 
 /// A solver failure on matrices whose lowest mode is lost to round-off whatever the solver (a
-/// mesh so fine that the iteration misses modes) is bad input, said as such; otherwise internal.
+/// mesh so fine that the iteration misses modes) is bad input, said as such; a solver that did
+/// not converge on valid input is no answer (exit 3, with what to try); otherwise internal.
 pub fn solver_failure(system: &System, e: SolveError) -> WorkflowError {
+    if let SolveError::NotConverged { .. } = e {
+        let dense = eigenfit_core::eigen::DENSE_MAX_DOFS;
+        let dense = if system.dofs() <= dense { "--solver dense, " } else { "" };
+        return WorkflowError::NoAnswer(format!(
+            "{e}; the model is valid but this solver cannot resolve its modes to its tolerance: try {dense}fewer \
+             modes (--modes), or check whether the model should have so many nearly equal frequencies"
+        ));
+    }
     let level = trial_vector_roundoff(system);
     if level.is_nan() || level > MAX_RELATIVE_ROUNDOFF {
         input(format!(

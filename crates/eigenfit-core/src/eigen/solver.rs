@@ -27,6 +27,10 @@ pub enum SolveError {
     /// The backend produced NaN or did not converge.
     #[error("eigen-solver `{backend}` failed: {detail}")]
     Backend { backend: &'static str, detail: String },
+    /// The iteration did not reach its tolerance within its step limit (closely spaced
+    /// eigenvalues at the modes asked for) on valid input: another solver, or fewer modes, may.
+    #[error("eigen-solver `{backend}` did not converge: {detail}")]
+    NotConverged { backend: &'static str, detail: String },
 }
 
 impl SolveError {
