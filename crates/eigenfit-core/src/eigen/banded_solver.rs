@@ -364,7 +364,9 @@ impl BandedSolver {
 }
 
 /// Sturm check: exactly `count` eigenvalues lie below a point σ′ just above the highest one
-/// found. Returns σ′ — a lower bound on the next eigenvalue — or `None` when a mode was missed.
+/// found. Returns σ′ — a lower bound on the next eigenvalue — or `None` when a mode was missed;
+/// the highest one itself when the extra eigenvalues below σ′ are all copies of it (a second
+/// count just below it finds nothing missed).
 fn sturm_bound(
     k: &BandedSymmetric,
     m: &BandedSymmetric,
@@ -375,8 +377,20 @@ fn sturm_bound(
     let top = modes.eigenvalues[count - 1];
     // Above round-off of a rigid-body zero, and 1e-6 relative above an elastic eigenvalue.
     let floor = 1e-11 * k.diagonal_max() / m.diagonal_max();
-    let sigma = top + (1e-6 * top.abs()).max(floor);
-    (k.count_below(m, sigma, scratch) == Some(count)).then_some(sigma)
+    let margin = (1e-6 * top.abs()).max(floor);
+    let sigma = top + margin;
+    match k.count_below(m, sigma, scratch)? {
+        below if below == count => Some(sigma),
+        // More below σ than found: when a count just below `top` finds only the modes found
+        // there, the rest are copies of `top` (an eigenvalue of high multiplicity, K = cI), not
+        // missed modes; the next eigenvalue is one of them (the sparse solver's rule).
+        below if below > count => {
+            let low = top - margin;
+            let known_low = modes.eigenvalues.iter().filter(|&&l| l < low).count();
+            (k.count_below(m, low, scratch)? == known_low).then_some(top)
+        }
+        _ => None,
+    }
 }
 
 /// max over the wanted modes of ‖νᵢ zᵢ − xᵢ‖∞ / ‖xᵢ‖∞ (blocks row-major, p columns).
