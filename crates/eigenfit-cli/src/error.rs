@@ -23,6 +23,9 @@ pub enum CliError {
     /// The evaluation budget ran out before any result (exit code 3, like a fit cut short).
     #[error("budget-exhausted: {0}")]
     BudgetExhausted(String),
+    /// Valid input with no acceptable answer (an eigen-solver that did not converge), exit 3.
+    #[error("{0}")]
+    NoAnswer(String),
 }
 
 impl CliError {
@@ -31,7 +34,7 @@ impl CliError {
         match self {
             CliError::Input(_) => EXIT_BAD_INPUT,
             CliError::Failure(_) => EXIT_FAILURE,
-            CliError::BudgetExhausted(_) => EXIT_NOT_CONVERGED,
+            CliError::BudgetExhausted(_) | CliError::NoAnswer(_) => EXIT_NOT_CONVERGED,
         }
     }
 }
@@ -42,6 +45,7 @@ impl From<eigenfit_workflow::WorkflowError> for CliError {
             eigenfit_workflow::WorkflowError::Input(m) => CliError::Input(m),
             eigenfit_workflow::WorkflowError::Failure(m) => CliError::Failure(m),
             eigenfit_workflow::WorkflowError::BudgetExhausted(m) => CliError::BudgetExhausted(m),
+            eigenfit_workflow::WorkflowError::NoAnswer(m) => CliError::NoAnswer(m),
         }
     }
 }

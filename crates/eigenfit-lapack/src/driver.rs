@@ -130,6 +130,7 @@ fn check_info(routine: &str, info: i32, n: usize, ifail: Option<&[i32]>) -> Resu
                 "the leading minor of order {} of M is not positive definite ({routine} info = {info})",
                 i - n
             )),
+            dof: Some(i - n - 1),
         })
     } else if let Some(ifail) = ifail {
         let which: Vec<i32> = ifail.iter().take(i).copied().collect();

@@ -129,7 +129,7 @@ impl Method {
 /// let mut m = DMatrix::identity(n, n);
 /// m[(5, 5)] = 0.0;
 /// let err = LapackSolver::default().lowest(&System::new(DMatrix::identity(n, n), m)?, 3);
-/// assert!(matches!(err, Err(SolveError::MassNotPositiveDefinite { detail: Some(_) })));
+/// assert!(matches!(err, Err(SolveError::MassNotPositiveDefinite { detail: Some(_), .. })));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
@@ -183,6 +183,7 @@ fn solve(k: &DMatrix<f64>, m: &DMatrix<f64>, count: usize, method: Method) -> Re
             detail: Some(format!(
                 "the leading minor of order {order} of M is not positive definite (dpotrf)"
             )),
+            dof: order.checked_sub(1),
         });
     }
     let inverted = |sigma: f64| {

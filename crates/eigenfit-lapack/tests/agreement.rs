@@ -481,11 +481,15 @@ fn mass_not_positive_definite_is_a_typed_error_naming_the_minor() {
     indefinite[(1, 0)] = 2.0;
     for (m, order) in [(negative, 4), (massless, 1), (indefinite, 2)] {
         let system = System::new(k.clone(), m).unwrap();
-        assert!(matches!(DenseSolver.lowest(&system, 2), Err(SolveError::MassNotPositiveDefinite { .. })));
+        assert!(matches!(
+            DenseSolver.lowest(&system, 2),
+            Err(SolveError::MassNotPositiveDefinite { dof: Some(j), .. }) if j + 1 == order
+        ));
         for solver in [ALL, SUBSET, LapackSolver::default()] {
             match solver.lowest(&system, 2) {
-                Err(SolveError::MassNotPositiveDefinite { detail: Some(d) }) => {
-                    assert!(d.contains(&format!("leading minor of order {order} of M")), "{solver:?}: {d}")
+                Err(SolveError::MassNotPositiveDefinite { detail: Some(d), dof }) => {
+                    assert!(d.contains(&format!("leading minor of order {order} of M")), "{solver:?}: {d}");
+                    assert_eq!(dof, Some(order - 1), "{solver:?}");
                 }
                 other => panic!("{solver:?}: expected MassNotPositiveDefinite, got {other:?}"),
             }

@@ -350,7 +350,7 @@ impl MatricesModel {
             return Err(format!(
                 "{}: its mass on the diagonal is {} at the nominal values{why}: M is not positive \
                  semi-definite (a massless DOF has a zero row and column)",
-                self.dof_label(j),
+                self.full_dof_label(j),
                 m.get(j, j)
             ));
         }
@@ -371,7 +371,7 @@ impl MatricesModel {
     }
 
     /// `DOF j (node N direction D)` with the DOF map, `DOF j` without (j from 1).
-    fn dof_label(&self, j: usize) -> String {
+    fn full_dof_label(&self, j: usize) -> String {
         match self.dofs.as_deref().and_then(|d| d.get(j)) {
             Some(d) => format!("DOF {} (node {} direction {})", j + 1, d.node, d.direction),
             None => format!("DOF {}", j + 1),
@@ -388,7 +388,7 @@ impl MatricesModel {
                 "massless {} is held by no stiffness once the massless DOFs before it are (K_ss, the stiffness \
                  among the {} massless DOFs, is singular there) at {}: its static condensation does not exist; \
                  give it a mass or a stiffness",
-                self.dof_label(at.0),
+                self.full_dof_label(at.0),
                 c.partition.massless().len(),
                 self.values_text(p)
             ))
@@ -443,7 +443,7 @@ impl MatricesModel {
                             return Err(format!(
                                 "its `mass` gives massless {} a mass; the model condenses its massless DOFs out, \
                                  so a candidate's mass must lie on DOFs that have mass",
-                                self.dof_label(j)
+                                self.full_dof_label(j)
                             ));
                         }
                         c.partition.restrict(&m).to_sparse_symmetric()
@@ -772,6 +772,19 @@ impl StructuralModel for MatricesModel {
         match &self.condensation {
             Some(c) => c.partition.kept().len(),
             None => self.pattern.dim(),
+        }
+    }
+
+    /// `DOF j (node N direction D)` in the file's numbering (from 1), for the massed DOF `j` of a
+    /// condensed model too.
+    fn dof_label(&self, j: usize) -> String {
+        match &self.condensation {
+            Some(c) => c
+                .partition
+                .kept()
+                .get(j)
+                .map_or_else(|| format!("DOF {}", j + 1), |&f| self.full_dof_label(f)),
+            None => self.full_dof_label(j),
         }
     }
 

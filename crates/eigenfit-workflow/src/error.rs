@@ -1,6 +1,7 @@
 //! The one error type of the workflows: bad input (the user can fix it), a failure inside
-//! eigenfit on valid input, or a user budget too small to produce any result. The CLI maps them
-//! to exit codes 2, 1 and 3.
+//! eigenfit on valid input, a user budget too small to produce any result, or valid input with
+//! no acceptable answer (a solver that did not converge). The CLI maps them to exit codes 2, 1
+//! and 3.
 
 use thiserror::Error;
 
@@ -16,6 +17,10 @@ pub enum WorkflowError {
     /// The evaluation budget ran out before there was any result to report.
     #[error("{0}")]
     BudgetExhausted(String),
+    /// Valid input for which no acceptable answer was reached (an eigen-solver that did not
+    /// converge); the message says what to try. Exit code 3, as a fit that did not converge.
+    #[error("{0}")]
+    NoAnswer(String),
 }
 
 /// Shorthand for an input error.

@@ -63,6 +63,12 @@ macro_rules! delegate_structural_model {
                     $name::Matrices(m) => m.candidates(),
                 }
             }
+            fn dof_label(&self, j: usize) -> String {
+                match self {
+                    $name::Rotor(m) => m.dof_label(j),
+                    $name::Matrices(m) => m.dof_label(j),
+                }
+            }
         }
     };
 }

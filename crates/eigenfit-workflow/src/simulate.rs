@@ -112,23 +112,28 @@ pub fn check_stable(
         let phi2 = if modes.shapes.ncols() > j { modes.shapes.column(j).norm_squared() } else { 1.0 };
         let bound = f64::EPSILON * (k_max + lambda.abs() * m_max) * phi2;
         if -lambda > UNSTABLE_MARGIN * bound {
-            let values: Vec<String> = model
-                .parameters()
-                .iter()
-                .zip(p)
-                .map(|(q, v)| format!("{} = {}", q.name, readable(*v)))
-                .collect();
             return Err(input(format!(
                 "the model is unstable at {}: mode {} has a negative eigenvalue λ = {} (rad/s)², \
                  so K(p) is not positive semi-definite — a divergent mode, not a vibration (a \
                  rigid-body mode is zero to round-off); no natural frequency exists there",
-                if values.is_empty() { "its nominal values".to_string() } else { values.join(", ") },
+                values_at(model, p),
                 j + 1,
                 readable(lambda)
             )));
         }
     }
     Ok(())
+}
+
+/// `name = value, …` of `p`, for messages ("its nominal values" for a model without parameters).
+pub fn values_at(model: &dyn StructuralModel, p: &[f64]) -> String {
+    let values: Vec<String> =
+        model.parameters().iter().zip(p).map(|(q, v)| format!("{} = {}", q.name, readable(*v))).collect();
+    if values.is_empty() {
+        "its nominal values".to_string()
+    } else {
+        values.join(", ")
+    }
 }
 
 /// A number as a person reads it: the shortest text that reads back to it, in exponent form
@@ -165,7 +170,7 @@ pub fn labelled_frequencies(
     notes: &mut Vec<String>,
 ) -> Result<(Vec<f64>, Vec<bool>), WorkflowError> {
     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-    let m = solver.lowest(&system, modes).map_err(|e| solver_failure(&system, e))?;
+    let m = solver.lowest(&system, modes).map_err(|e| solve_failure_at(model, p, &system, e))?;
     check_stable(model, &system, &m, p)?;
     let rigid = rigid_body_flags(solver, &system, &m)?;
     notes.extend(check_roundoff_except(&system, &m, None, &rigid)?);
@@ -212,9 +217,65 @@ pub fn rigid_numbers(rigid: &[bool]) -> Vec<usize> {
     rigid.iter().enumerate().filter(|(_, &r)| r).map(|(j, _)| j + 1).collect()
 }
 
+/// A solve of `model` at `p` that failed: M(p) not positive definite is bad input, said with the
+/// parameter values and the model's label for the DOF at which M's factorisation fails
+/// ([`SolveError::MassNotPositiveDefinite`]'s `dof`, the same for every solver); any other
+/// failure as [`solver_failure`] says.
+pub fn solve_failure_at(
+    model: &dyn StructuralModel,
+    p: &[f64],
+    system: &System,
+    e: SolveError,
+) -> WorkflowError {
+    match e {
+        SolveError::MassNotPositiveDefinite { dof, .. } => input(mass_not_definite(model, p, dof)),
+        e => solver_failure(system, e),
+    }
+}
+
+/// Refuses `p` when M(p) is not positive definite there (said as [`solve_failure_at`] says);
+/// a model that fails at `p` otherwise passes, for the fit to say. One eigenvalue solved.
+pub fn check_mass_at(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+) -> Result<(), WorkflowError> {
+    let Ok(system) = model.assemble(p) else { return Ok(()) };
+    match solver.lowest_eigenvalues(&system, 1) {
+        Err(e @ SolveError::MassNotPositiveDefinite { .. }) => Err(solve_failure_at(model, p, &system, e)),
+        _ => Ok(()),
+    }
+}
+
+/// The words for M(p) not positive definite at `p`, its factorisation failing at DOF `dof`.
+pub fn mass_not_definite(model: &dyn StructuralModel, p: &[f64], dof: Option<usize>) -> String {
+    let at = match dof {
+        Some(j) => format!(
+            ": its Cholesky factorisation fails at {} (the mass of the DOFs up to it, in the model's order, is \
+             singular or indefinite: a zero or negative mass there, or a coupling larger than the masses it couples)",
+            model.dof_label(j)
+        ),
+        None => String::new(),
+    };
+    format!(
+        "the mass matrix M(p) is not positive definite at {}{at}; no natural frequency exists there (check the \
+         mass matrices, and the bounds of any parameter that changes the mass)",
+        values_at(model, p)
+    )
+}
+
 /// A solver failure on matrices whose lowest mode is lost to round-off whatever the solver (a
-/// mesh so fine that the iteration misses modes) is bad input, said as such; otherwise internal.
+/// mesh so fine that the iteration misses modes) is bad input, said as such; a solver that did
+/// not converge on valid input is no answer (exit 3, with what to try); otherwise internal.
 pub fn solver_failure(system: &System, e: SolveError) -> WorkflowError {
+    if let SolveError::NotConverged { .. } = e {
+        let dense = eigenfit_core::eigen::DENSE_MAX_DOFS;
+        let dense = if system.dofs() <= dense { "--solver dense, " } else { "" };
+        return WorkflowError::NoAnswer(format!(
+            "{e}; the model is valid but this solver cannot resolve its modes to its tolerance: try {dense}fewer \
+             modes (--modes), or check whether the model should have so many nearly equal frequencies"
+        ));
+    }
     let level = trial_vector_roundoff(system);
     if level.is_nan() || level > MAX_RELATIVE_ROUNDOFF {
         input(format!(
@@ -236,7 +297,7 @@ pub fn modes_at(
     count: usize,
 ) -> Result<Modes, WorkflowError> {
     let system = model.assemble(p).map_err(failure)?;
-    solver.lowest(&system, count).map_err(failure)
+    solver.lowest(&system, count).map_err(|e| solve_failure_at(model, p, &system, e))
 }
 
 /// How a sweep treats round-off: the table refuses lost frequencies, the plot draws what it gets.
@@ -269,7 +330,7 @@ pub fn sweep(
             SweepCheck::None => model
                 .assemble(&p)
                 .map_err(failure)
-                .and_then(|s| solver.lowest(&s, modes).map_err(failure))
+                .and_then(|s| solver.lowest(&s, modes).map_err(|e| solve_failure_at(model, &p, &s, e)))
                 .map(|m| m.frequencies_hz()),
         };
         match row {
@@ -454,7 +515,8 @@ pub fn at_point(
                 SweepCheck::RefuseRoundoff => labelled_frequencies(model, solver, p, modes, &mut notes)?,
                 SweepCheck::None => {
                     let system = model.assemble(p).map_err(|e| input(e.to_string()))?;
-                    let m = solver.lowest(&system, modes).map_err(failure)?;
+                    let m =
+                        solver.lowest(&system, modes).map_err(|e| solve_failure_at(model, p, &system, e))?;
                     check_stable(model, &system, &m, p)?;
                     let rigid = rigid_body_flags(solver, &system, &m)?;
                     let f = m.frequencies_hz().into_iter().zip(&rigid).map(|(f, &r)| if r { 0.0 } else { f });

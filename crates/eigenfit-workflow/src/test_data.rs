@@ -474,7 +474,8 @@ pub fn uff_text(
     modes: usize,
 ) -> Result<String, WorkflowError> {
     let system = rotor.assemble(p).map_err(|e| input(e.to_string()))?;
-    let solved = solver.lowest(&system, modes).map_err(failure)?;
+    let solved =
+        solver.lowest(&system, modes).map_err(|e| crate::simulate::solve_failure_at(rotor, p, &system, e))?;
     // An unstable model has no natural frequencies to write; rigid-body modes have none either
     // (0 Hz, which no reader of measured modes takes): they are left out, the elastic modes
     // keep their numbers, so the file reads back as measured data of this model.

@@ -34,3 +34,17 @@ write("uff_empty.unv", [])
 write("uff_blank.unv", ["\n", "   \n"])
 # Mode 3 numbered 999999999999 (record 7 of its dataset 55).
 write("uff_huge_mode_number.unv", head + m1 + m2 + m3[:8] + ["         2         4         1 999999999999\n"] + m3[9:])
+
+def scaled(block, factor):
+    """The block with every shape value multiplied by `factor` (records 12, 14, … of dataset 55)."""
+    out = list(block)
+    for i in range(11, len(out) - 1, 2):
+        out[i] = "".join(f" {float(v) * factor:.5e}" for v in out[i].split()) + "\n"
+    return out
+
+# Mode 2's shape scaled by 1e200 (a test system's own normalisation): the MAC does not care.
+write("uff_scaled_1e200.unv", head + m1 + scaled(m2, 1e200) + m3)
+# One value of mode 2 (node 101, y) typed as -2.45341e+300: a spike that pairs with nothing.
+spike = list(m2)
+spike[11] = spike[11].replace("-2.45341e+00", "-2.45341e+300")
+write("uff_huge_value.unv", head + m1 + spike + m3)

@@ -153,7 +153,14 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
                 .as_ref()
                 .ok_or_else(|| ResidualError::Mac(format!("mode {} has no shape", meas.mode + 1)))?;
             let s = DVector::from_iterator(ns, sensor_dofs.iter().map(|&dof| modes.shapes[(dof, k)]));
+            // Divided by its largest |entry| first: a test system's shape scaled by 1e200 has a
+            // norm that overflows (its unit vector would be zero), one scaled by 1e-200 one
+            // that underflows; the unit vector is the same either way.
             let d = DVector::from_column_slice(d);
+            let d = match d.amax() {
+                top if top > 0.0 && top.is_finite() => d / top,
+                _ => d,
+            };
             let (sn, dn) = (s.norm(), d.norm());
             if sn == 0.0 || dn == 0.0 {
                 return Err(ResidualError::Mac(format!(

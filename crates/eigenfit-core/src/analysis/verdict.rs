@@ -2,11 +2,12 @@
 //! the data cannot say, and the relative RMS residual is all that is reported.
 
 use crate::analysis::chi2_upper_tail;
-use crate::eigen::EigenSolver;
+use crate::eigen::{EigenSolver, SolveError};
 use crate::measurement::measured_csv::shown_number;
 use crate::measurement::Measurement;
 use crate::model::{ParameterSet, StructuralModel};
-use crate::problem::{Linearisation, Objective};
+use crate::problem::{Linearisation, Objective, ResidualError};
+use crate::sensitivity::SensitivityError;
 use crate::update::Budget;
 use thiserror::Error;
 
@@ -211,10 +212,15 @@ fn reachable_ranges(problem: &dyn Objective, budget: &Budget) -> Option<(Vec<f64
     let budgeted = budget.wrap(problem);
     let mut range: Option<(Vec<f64>, Vec<f64>, Vec<f64>)> = None;
     let mut all_corners = true;
+    let mut mass_failed = false;
     for mask in masks {
-        let Ok(lin) = budgeted.linearise(&corner(mask)) else {
-            all_corners = false;
-            continue;
+        let lin = match budgeted.linearise(&corner(mask)) {
+            Ok(lin) => lin,
+            Err(e) => {
+                all_corners = false;
+                mass_failed |= mass_not_definite(&e);
+                continue;
+            }
         };
         let (lo, hi, _) = range.get_or_insert_with(|| {
             (
@@ -228,13 +234,27 @@ fn reachable_ranges(problem: &dyn Objective, budget: &Budget) -> Option<(Vec<f64
             hi[k] = hi[k].max(f);
         }
     }
-    let (mut lo, hi, measured) = range?;
+    let (mut lo, mut hi, measured) = range?;
     if !all_corners {
         // A corner that could not be evaluated is a soft one (a support going to zero): the
         // upper frequencies are still known, the lower ones are not (see [`check_softest`]).
         lo.iter_mut().for_each(|l| *l = 0.0);
     }
+    if mass_failed {
+        // M(p) is not positive definite at a corner (a mass parameter's lower limit below what
+        // the mass can lose): towards it the frequencies grow without bound, so the corners
+        // evaluated bound nothing from above either.
+        hi.iter_mut().for_each(|h| *h = f64::INFINITY);
+    }
     Some((lo, hi, measured))
+}
+
+/// Whether `e` is an eigen-solve refused because M is not positive definite.
+fn mass_not_definite(e: &ResidualError) -> bool {
+    matches!(
+        e,
+        ResidualError::Sensitivity(SensitivityError::Solve(SolveError::MassNotPositiveDefinite { .. }))
+    )
 }
 
 /// Units a frequency is mistyped in, each with the factor that turns its number into Hz: a

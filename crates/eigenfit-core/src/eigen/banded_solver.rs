@@ -136,7 +136,8 @@ impl EigenSolver for BandedSolver {
     /// returned lies below it, at no extra cost. Eigenvalues only are iterated less far
     /// (`request_tolerance`).
     fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
-        match self.banded(system, request.count, request_tolerance(request, self.tolerance))? {
+        let banded = self.banded(system, request.count, request_tolerance(request, self.tolerance));
+        match banded.map_err(|e| e.located(system))? {
             Some((modes, next)) => Ok(SolvedModes::answering(request, modes, next)),
             None => DenseSolver.solve(system, request),
         }
@@ -219,7 +220,7 @@ impl BandedSolver {
     ) -> Result<Option<(Modes, f64)>, SolveError> {
         if ws.checked_mass.as_ref() != Some(m) {
             if !ws.factor.factor_shifted(m, 0.0, m) {
-                return Err(SolveError::MassNotPositiveDefinite { detail: None });
+                return Err(SolveError::MassNotPositiveDefinite { detail: None, dof: None });
             }
             ws.checked_mass = Some(m.clone());
         }
@@ -363,7 +364,9 @@ impl BandedSolver {
 }
 
 /// Sturm check: exactly `count` eigenvalues lie below a point σ′ just above the highest one
-/// found. Returns σ′ — a lower bound on the next eigenvalue — or `None` when a mode was missed.
+/// found. Returns σ′ — a lower bound on the next eigenvalue — or `None` when a mode was missed;
+/// the highest one itself when the extra eigenvalues below σ′ are all copies of it (a second
+/// count just below it finds nothing missed).
 fn sturm_bound(
     k: &BandedSymmetric,
     m: &BandedSymmetric,
@@ -374,8 +377,20 @@ fn sturm_bound(
     let top = modes.eigenvalues[count - 1];
     // Above round-off of a rigid-body zero, and 1e-6 relative above an elastic eigenvalue.
     let floor = 1e-11 * k.diagonal_max() / m.diagonal_max();
-    let sigma = top + (1e-6 * top.abs()).max(floor);
-    (k.count_below(m, sigma, scratch) == Some(count)).then_some(sigma)
+    let margin = (1e-6 * top.abs()).max(floor);
+    let sigma = top + margin;
+    match k.count_below(m, sigma, scratch)? {
+        below if below == count => Some(sigma),
+        // More below σ than found: when a count just below `top` finds only the modes found
+        // there, the rest are copies of `top` (an eigenvalue of high multiplicity, K = cI), not
+        // missed modes; the next eigenvalue is one of them (the sparse solver's rule).
+        below if below > count => {
+            let low = top - margin;
+            let known_low = modes.eigenvalues.iter().filter(|&&l| l < low).count();
+            (k.count_below(m, low, scratch)? == known_low).then_some(top)
+        }
+        _ => None,
+    }
 }
 
 /// max over the wanted modes of ‖νᵢ zᵢ − xᵢ‖∞ / ‖xᵢ‖∞ (blocks row-major, p columns).

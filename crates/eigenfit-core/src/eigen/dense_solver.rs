@@ -41,6 +41,7 @@ impl EigenSolver for DenseSolver {
                 Ok(Modes { eigenvalues, shapes: DMatrix::zeros(system.dofs(), 0) })
             }
         })
+        .map_err(|e| e.located(system))
     }
 }
 
@@ -51,7 +52,7 @@ impl DenseSolver {
         let (k, m) = (system.stiffness(), system.mass());
         // M must be positive definite for the problem to be symmetric-definite at all.
         if Cholesky::new(m.clone()).is_none() {
-            return Err(SolveError::MassNotPositiveDefinite { detail: None });
+            return Err(SolveError::MassNotPositiveDefinite { detail: None, dof: None });
         }
         if 2 * count > system.dofs() {
             return mass_reduction(k, m, count);
@@ -70,7 +71,7 @@ impl DenseSolver {
         check_count(system, count)?;
         let (k, m) = (system.stiffness(), system.mass());
         if Cholesky::new(m.clone()).is_none() {
-            return Err(SolveError::MassNotPositiveDefinite { detail: None });
+            return Err(SolveError::MassNotPositiveDefinite { detail: None, dof: None });
         }
         if 2 * count <= system.dofs() {
             if let Some(chol) = Cholesky::new(k.clone()).filter(well_conditioned) {
@@ -149,7 +150,8 @@ fn inverted_solve(
 /// All or most modes: the textbook reduction M = LLᵀ, A = L⁻¹KL⁻ᵀ, accurate to ε·λ_max in
 /// absolute terms for every mode, so the whole basis stays M-orthonormal (modal expansions).
 fn mass_reduction(k: &DMatrix<f64>, m: &DMatrix<f64>, count: usize) -> Result<Modes, SolveError> {
-    let chol = Cholesky::new(m.clone()).ok_or(SolveError::MassNotPositiveDefinite { detail: None })?;
+    let chol =
+        Cholesky::new(m.clone()).ok_or(SolveError::MassNotPositiveDefinite { detail: None, dof: None })?;
     let l = chol.l();
     let x = l.solve_lower_triangular(k).ok_or_else(|| not_pd("zero pivot in L"))?;
     let a = l.solve_lower_triangular(&x.transpose()).ok_or_else(|| not_pd("zero pivot in L"))?;
@@ -187,7 +189,7 @@ fn finish(eigenvalues: DVector<f64>, mut shapes: DMatrix<f64>) -> Result<Modes, 
 }
 
 fn not_pd(detail: &str) -> SolveError {
-    SolveError::MassNotPositiveDefinite { detail: Some(detail.into()) }
+    SolveError::MassNotPositiveDefinite { detail: Some(detail.into()), dof: None }
 }
 
 #[cfg(test)]

@@ -9,9 +9,15 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum SolveError {
-    /// M is not positive definite (a massless DOF, a negative mass, …).
-    #[error("the mass matrix is not positive definite{}", .detail.as_deref().map(|d| format!(" ({d})")).unwrap_or_default())]
-    MassNotPositiveDefinite { detail: Option<String> },
+    /// M is not positive definite (a massless DOF, a negative mass, …). `dof` (from 0, in the
+    /// system's numbering) is where its Cholesky factorisation fails
+    /// ([`System::mass_failure_dof`]), filled by [`SolveError::located`].
+    #[error(
+        "the mass matrix is not positive definite{}{}",
+        .dof.map(|j| format!(" at DOF {} (its Cholesky factorisation fails at that pivot)", j + 1)).unwrap_or_default(),
+        .detail.as_deref().map(|d| format!(" ({d})")).unwrap_or_default()
+    )]
+    MassNotPositiveDefinite { detail: Option<String>, dof: Option<usize> },
     /// More modes were requested than the system has.
     #[error("{requested} modes requested but the system has only {available} degrees of freedom")]
     TooManyModes { requested: usize, available: usize },
@@ -21,6 +27,24 @@ pub enum SolveError {
     /// The backend produced NaN or did not converge.
     #[error("eigen-solver `{backend}` failed: {detail}")]
     Backend { backend: &'static str, detail: String },
+    /// The iteration did not reach its tolerance within its step limit (closely spaced
+    /// eigenvalues at the modes asked for) on valid input: another solver, or fewer modes, may.
+    #[error("eigen-solver `{backend}` did not converge: {detail}")]
+    NotConverged { backend: &'static str, detail: String },
+}
+
+impl SolveError {
+    /// The same error with the DOF at which M's factorisation fails filled in (for
+    /// [`MassNotPositiveDefinite`](Self::MassNotPositiveDefinite) without one); every solver
+    /// passes its errors through this, so the failure names a DOF whatever the backend.
+    pub fn located(self, system: &System) -> Self {
+        match self {
+            Self::MassNotPositiveDefinite { detail, dof: None } => {
+                Self::MassNotPositiveDefinite { detail, dof: system.mass_failure_dof() }
+            }
+            other => other,
+        }
+    }
 }
 
 /// What one eigen-solve is asked for: how many of the lowest modes, whether their shapes are

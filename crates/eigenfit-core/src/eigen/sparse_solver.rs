@@ -88,6 +88,10 @@ fn backend(detail: impl Into<String>) -> SolveError {
     SolveError::Backend { backend: "sparse", detail: detail.into() }
 }
 
+fn not_converged(detail: impl Into<String>) -> SolveError {
+    SolveError::NotConverged { backend: "sparse", detail: detail.into() }
+}
+
 /// Reusable state of one thread's solves.
 #[derive(Default)]
 struct Workspace {
@@ -265,7 +269,8 @@ impl EigenSolver for SparseSolver {
     /// less far (`request_tolerance`).
     fn solve(&self, system: &System, request: ModeRequest) -> Result<SolvedModes, SolveError> {
         let tolerance = request_tolerance(request, self.tolerance);
-        let (modes, next) = self.solve_with_tolerance(system, request.count, tolerance)?;
+        let (modes, next) =
+            self.solve_with_tolerance(system, request.count, tolerance).map_err(|e| e.located(system))?;
         Ok(SolvedModes::answering(request, modes, next))
     }
 }
@@ -302,10 +307,12 @@ impl SparseSolver {
         });
         match found {
             Ok(Some(found)) => Ok(found),
-            Ok(None) | Err(SolveError::Backend { .. }) if n <= MAX_DENSE_FALLBACK => {
+            Ok(None) | Err(SolveError::Backend { .. } | SolveError::NotConverged { .. })
+                if n <= MAX_DENSE_FALLBACK =>
+            {
                 DenseSolver.lowest_with_next(system, count)
             }
-            Ok(None) => Err(backend(
+            Ok(None) => Err(not_converged(
                 "a mode was missed by Lanczos (Sturm count) and the system is too large for the dense solver",
             )),
             Err(e) => Err(e),
@@ -327,7 +334,7 @@ impl SparseSolver {
         let m = &with_pattern(&pattern, m);
         if ws.checked_mass.as_ref() != Some(m) {
             if !ws.cholesky(m, false)? {
-                return Err(SolveError::MassNotPositiveDefinite { detail: None });
+                return Err(SolveError::MassNotPositiveDefinite { detail: None, dof: None });
             }
             ws.checked_mass = Some(m.clone());
         }
@@ -376,6 +383,16 @@ impl SparseSolver {
             if below < known || found.eigenvalues.len() >= n {
                 return Ok(None);
             }
+            // The missed modes may all be copies of the highest one found (a cluster at `top`:
+            // K = cI has one eigenvalue of multiplicity n). A count just below the cluster says
+            // so; then the lowest `count` are found (to the count's margin, 1e-6 relative) and
+            // the copies, up to n of them, are not chased: the next eigenvalue is one of them.
+            let low = top - (1e-6 * top.abs()).max(floor);
+            let known_low = found.eigenvalues.iter().filter(|&&l| l < low).count();
+            if known_low < count && ws.count_below(k, m, low)? == Some(known_low) {
+                let modes = finish(to_modes(&found, n, count))?;
+                return Ok(Some((modes, found.eigenvalues.get(count).copied().unwrap_or(top))));
+            }
             // Missed modes: rerun M-orthogonally to the modes found, on the same factor of
             // K + σM (the count's LDLᵀ has its own values).
             let mut m_vectors = vec![0.0; found.vectors.len()];
@@ -407,7 +424,12 @@ impl SparseSolver {
             buffer: ws.buffer.as_mut().expect("factored"),
         };
         let ritz = lanczos::largest(&mut op, m, count, self.tolerance, locked, &mut ws.lanczos)
-            .ok_or_else(|| backend("Lanczos did not converge in its step limit"))?;
+            .ok_or_else(|| {
+                not_converged(
+                    "Lanczos did not reach its tolerance within its step limit (eigenvalues too closely spaced at \
+                     the modes asked for)",
+                )
+            })?;
         let eigenvalues: Vec<f64> = ritz.mu.iter().map(|&mu| 1.0 / mu - sigma).collect();
         if !eigenvalues.windows(2).all(|w| w[1] >= w[0] - 1e-12 * w[0].abs()) {
             return Err(backend("Lanczos returned eigenvalues out of order"));

@@ -161,6 +161,14 @@ impl BandedSymmetric {
         s
     }
 
+    /// Where A stops being positive definite: the first j (from 0) whose leading
+    /// (j + 1)×(j + 1) block, in this numbering, is not positive definite — the pivot at which
+    /// its Cholesky factorisation fails; `None` when A is positive definite. O(n·b²).
+    pub fn first_failed_pivot(&self) -> Option<usize> {
+        let mut l = self.data.clone();
+        band_cholesky(&mut l, self.dim, self.bandwidth).err()
+    }
+
     /// Cholesky factor A = LLᵀ, or `None` when A is not (numerically) positive definite.
     pub fn cholesky(&self) -> Option<BandCholesky> {
         let mut f = BandCholesky::default();
@@ -313,7 +321,7 @@ fn solve_band_3(l: &[f64], inverse_diagonal: &[f64], x: &mut [f64]) {
 /// lowest eigenvalue depends on the factor's rounding — the LDLᵀ recurrence, or multiplying by
 /// 1/L[j, j] instead of dividing, moved λ₁ of a 302-DOF shaft by 2e-9 — so identical arithmetic
 /// is what keeps the backends agreeing there (to 3e-15); neither answer is more exact than 1e-9.
-fn band_cholesky(l: &mut [f64], n: usize, b: usize) -> bool {
+fn band_cholesky(l: &mut [f64], n: usize, b: usize) -> Result<(), usize> {
     let w = b + 1;
     for j in 0..n {
         // L[j, j] = sqrt(A[j, j] − Σₖ L[j, k]²), k = j − b … j − 1.
@@ -323,7 +331,7 @@ fn band_cholesky(l: &mut [f64], n: usize, b: usize) -> bool {
             d -= v * v;
         }
         if !(d > 0.0 && d.is_finite()) {
-            return false;
+            return Err(j);
         }
         let djj = d.sqrt();
         l[j * w] = djj;
@@ -336,7 +344,7 @@ fn band_cholesky(l: &mut [f64], n: usize, b: usize) -> bool {
             l[j * w + (i - j)] = s / djj;
         }
     }
-    true
+    Ok(())
 }
 
 /// In-place LDLᵀ of a band array (column j at `a[j·w..]`, diagonal first, w = b + 1): on return
@@ -394,7 +402,7 @@ impl BandCholesky {
         self.dim = k.dim;
         self.bandwidth = b;
         k.shifted_into(sigma, m, b, &mut self.data);
-        if !band_cholesky(&mut self.data, self.dim, b) {
+        if band_cholesky(&mut self.data, self.dim, b).is_err() {
             return false;
         }
         // L = L̃ D^½: scale each column by its pivot.

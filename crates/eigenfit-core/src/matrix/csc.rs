@@ -266,6 +266,24 @@ impl CscSymmetric {
         )
     }
 
+    /// Band copy in this numbering, or `None` when its band would hold more than `max_entries`
+    /// values (a matrix whose nonzeros lie far from the diagonal).
+    pub fn to_banded_within(&self, max_entries: usize) -> Option<BandedSymmetric> {
+        let n = self.dim;
+        let b = (0..n).map(|j| self.column(j).0.first().map_or(0, |&i| j - i)).max().unwrap_or(0);
+        if n.saturating_mul(b + 1) > max_entries {
+            return None;
+        }
+        let mut a = BandedSymmetric::zeros(n, b);
+        for j in 0..n {
+            let (rows, values) = self.column(j);
+            for (&i, &v) in rows.iter().zip(values) {
+                a.add(i, j, v);
+            }
+        }
+        Some(a)
+    }
+
     /// Sparse copy of a band matrix (nonzero entries).
     pub fn from_banded(a: &BandedSymmetric) -> Self {
         let (n, b) = (a.dim(), a.bandwidth());

@@ -11,4 +11,4 @@ pub(crate) mod system;
 pub use banded::{BandCholesky, BandedSymmetric};
 pub use csc::CscSymmetric;
 pub use sparse::SparseSymmetric;
-pub use system::{System, SystemDerivative, SystemError};
+pub use system::{System, SystemDerivative, SystemError, MAX_BAND_ENTRIES_FOR_PIVOT};

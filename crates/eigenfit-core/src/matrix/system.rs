@@ -23,6 +23,9 @@ pub enum SystemError {
     NotSymmetric { matrix: &'static str, row: usize, col: usize, a: f64, b: f64 },
 }
 
+/// Most values (8 bytes each) [`System::mass_failure_dof`] stores to factor a sparse M by band.
+pub const MAX_BAND_ENTRIES_FOR_PIVOT: usize = 1 << 24;
+
 /// Stiffness K and mass M of a structure (n×n, symmetric; M positive definite for a solve).
 ///
 /// Stored densely ([`System::new`]), by band ([`System::banded`], for large beam-like models
@@ -140,6 +143,22 @@ impl System {
             Storage::Sparse { stiffness, mass, dense } => {
                 let (k, m) = dense.get_or_init(|| (stiffness.to_dense(), mass.to_dense()));
                 (k, m)
+            }
+        }
+    }
+
+    /// Where M stops being positive definite, for a message naming the DOF: the first DOF j (from
+    /// 0) whose leading (j + 1)×(j + 1) block of M is not positive definite, the pivot at which
+    /// a Cholesky factorisation of M in the model's own numbering fails (LAPACK's "leading minor
+    /// of order j + 1"). `None` when M is positive definite, or when M is sparse with a band too
+    /// wide to factor here (more than [`MAX_BAND_ENTRIES_FOR_PIVOT`] values). Solvers call it
+    /// after their own factorisation of M failed, so it costs nothing on a good model.
+    pub fn mass_failure_dof(&self) -> Option<usize> {
+        match &self.storage {
+            Storage::Dense { mass, .. } => BandedSymmetric::from_dense(mass).first_failed_pivot(),
+            Storage::Banded { mass, .. } => mass.first_failed_pivot(),
+            Storage::Sparse { mass, .. } => {
+                mass.to_banded_within(MAX_BAND_ENTRIES_FOR_PIVOT).and_then(|m| m.first_failed_pivot())
             }
         }
     }

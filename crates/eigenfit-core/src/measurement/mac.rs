@@ -38,10 +38,16 @@ impl MacReport {
             .collect();
         // A NaN MAC (a zero shape) counts as unpaired too.
         let unpaired = pairing.iter().filter(|p| p.2 < threshold || p.2.is_nan()).map(|p| p.0).collect();
+        // Only modes that pair (MAC at or above the threshold) can be swapped: an unpaired one
+        // is said as such, its partner is no claim.
+        let paired_well = |p: &(usize, usize, f64)| p.2 >= threshold;
         let mut swapped = Vec::new();
         for a in 0..pairing.len() {
             for b in a + 1..pairing.len() {
-                if (pairing[a].0 < pairing[b].0) != (pairing[a].1 < pairing[b].1) {
+                if paired_well(&pairing[a])
+                    && paired_well(&pairing[b])
+                    && (pairing[a].0 < pairing[b].0) != (pairing[a].1 < pairing[b].1)
+                {
                     swapped.push((pairing[a].0.min(pairing[b].0), pairing[a].0.max(pairing[b].0)));
                 }
             }
@@ -52,15 +58,28 @@ impl MacReport {
     }
 }
 
-/// Modal assurance criterion (aᵀb)² / (aᵀa · bᵀb), in [0, 1].
+/// Modal assurance criterion (aᵀb)² / (aᵀa · bᵀb), in [0, 1]; 0 for a zero vector.
+///
+/// Scale-free: each vector is divided by its largest |entry| before any product is formed, so a
+/// shape scaled by 10²⁰⁰ (or 10⁻²⁰⁰) gives the MAC of the unscaled one instead of overflowing
+/// (or underflowing) to NaN. NaN when an entry is not finite.
 pub fn mac(a: &[f64], b: &[f64]) -> f64 {
-    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
-    let den = dot(a, a) * dot(b, b);
-    if den > 0.0 {
-        dot(a, b).powi(2) / den
-    } else {
-        0.0
+    if a.iter().chain(b).any(|v| !v.is_finite()) {
+        return f64::NAN;
     }
+    let largest = |x: &[f64]| x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let (sa, sb) = (largest(a), largest(b));
+    if sa == 0.0 || sb == 0.0 {
+        return 0.0;
+    }
+    let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
+    for (p, q) in a.iter().zip(b) {
+        let (p, q) = (p / sa, q / sb);
+        ab += p * q;
+        aa += p * p;
+        bb += q * q;
+    }
+    (ab * ab / (aa * bb)).min(1.0)
 }
 
 #[cfg(test)]
@@ -81,9 +100,26 @@ mod tests {
         // c·e1 = 1, |c|² = 2.09.
         assert!((r.matrix[2][2] - 1.0 / 2.09).abs() < 1e-15);
         assert_eq!(r.unpaired, [3]);
-        assert_eq!(r.swapped, [(1, 2), (1, 3), (2, 3)]);
+        // Measured mode 3 is unpaired: no swap is claimed with it, only between modes 1 and 2.
+        assert_eq!(r.swapped, [(1, 2)]);
         assert!(r.missing.is_empty());
         let r = MacReport::new(&measured[..1], &model, &[2], 0.6);
         assert_eq!(r.missing, [1, 2]);
+    }
+
+    #[test]
+    fn mac_does_not_care_about_scale() {
+        let a = [1.0, -2.0, 0.5, 3.0];
+        let b = [0.9, -2.2, 0.4, 3.1];
+        let reference = mac(&a, &b);
+        assert!(reference > 0.9 && reference < 1.0, "{reference}");
+        for scale in [1e200, 1e-200, -1e300, 1e-300] {
+            let scaled: Vec<f64> = a.iter().map(|v| v * scale).collect();
+            let m = mac(&scaled, &b);
+            assert!((m - reference).abs() <= 1e-15, "scale {scale:e}: {m} vs {reference}");
+            assert!((mac(&b, &scaled) - reference).abs() <= 1e-15);
+        }
+        assert_eq!(mac(&[0.0; 4], &b), 0.0);
+        assert!(mac(&[f64::INFINITY, 0.0, 0.0, 0.0], &b).is_nan());
     }
 }

@@ -109,6 +109,15 @@ impl<M: StructuralModel + ?Sized> StructuralModel for Augmented<'_, M> {
         &self.params
     }
 
+    /// The base model's label for its DOFs, the default for any an effect adds.
+    fn dof_label(&self, j: usize) -> String {
+        if j < self.base.dofs() {
+            self.base.dof_label(j)
+        } else {
+            format!("DOF {}", j + 1)
+        }
+    }
+
     fn dofs(&self) -> usize {
         self.dofs
     }

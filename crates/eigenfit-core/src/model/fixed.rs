@@ -80,6 +80,9 @@ impl<M: StructuralModel> StructuralModel for Fixed<M> {
     fn candidates(&self) -> Vec<crate::model::Candidate> {
         self.inner.candidates()
     }
+    fn dof_label(&self, j: usize) -> String {
+        self.inner.dof_label(j)
+    }
 }
 
 #[cfg(test)]

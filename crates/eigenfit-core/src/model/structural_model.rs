@@ -69,6 +69,13 @@ pub trait StructuralModel {
     fn candidates(&self) -> Vec<crate::model::Candidate> {
         Vec::new()
     }
+
+    /// A name for DOF `j` (from 0, in the numbering of [`assemble`](Self::assemble)'s
+    /// matrices) in messages, e.g. where M stops being positive definite. `DOF j + 1` by
+    /// default; a model that knows its nodes and directions says them.
+    fn dof_label(&self, j: usize) -> String {
+        format!("DOF {}", j + 1)
+    }
 }
 
 impl<T: StructuralModel + ?Sized> StructuralModel for &T {
@@ -86,6 +93,9 @@ impl<T: StructuralModel + ?Sized> StructuralModel for &T {
     }
     fn candidates(&self) -> Vec<crate::model::Candidate> {
         (**self).candidates()
+    }
+    fn dof_label(&self, j: usize) -> String {
+        (**self).dof_label(j)
     }
 }
 
