@@ -563,7 +563,7 @@ pub fn estimate_with(
         phases.push(("mirror_solutions", budget.used()));
         // Screened: a run-up evaluation solves every speed, so the design is ranked by misfit and
         // only its best np + 1 points are fitted locally (fitting all cost ~300× the fit itself).
-        let starts = crate::estimate::default_alternative_starts(np);
+        let starts = eigenfit_core::analysis::alternatives::search_starts(np);
         minima = screened_local_minima(&objective, starts, np + 1, &mirrors.asymmetric, &budget);
         phases.push(("other_solutions", budget.used()));
         if let Some(better) = better_minimum(&objective, &estimate.last, &minima).cloned() {
