@@ -117,7 +117,7 @@ pub fn solve(
     for (j, &lambda) in values.iter().enumerate() {
         // Keep the member of each conjugate pair with positive damped frequency. A tolerance
         // relative to |λ| keeps a real eigenvalue's round-off imaginary part out.
-        if lambda.im <= 1e-9 * lambda.norm().max(1e-12) {
+        if !crate::shift_invert::oscillates(lambda) {
             continue;
         }
         let x: Vec<c64> = (0..n).map(|i| right[(i, j)]).collect();
@@ -162,8 +162,7 @@ pub fn solve_lowest(
     with_left: bool,
 ) -> Result<Vec<Mode>, RotorDynError> {
     let [m, d, k] = [m, d, k].map(Band::from_dense);
-    solve_lowest_elastic(Quadratic { m: &m, d: &d, k: &k }, pairs, count, with_left, None)
-        .map(|(modes, _)| modes)
+    solve_lowest_elastic(Quadratic { m: &m, d: &d, k: &k }, pairs, count, with_left).map(|(modes, _)| modes)
 }
 
 /// The quadratic problem (λ²M + λD + K)x = 0 in band storage.
@@ -178,20 +177,17 @@ pub struct Quadratic<'a> {
 }
 
 /// [`solve_lowest`] on band matrices, and the number of rigid-body modes left out below the
-/// modes returned. `start` (the modes of a nearby speed, [`krylov_start`]) starts the
-/// shift-invert route's Krylov space; it changes how fast the modes are found, not which.
+/// modes returned.
 pub fn solve_lowest_elastic(
     q: Quadratic<'_>,
     pairs: &[(usize, usize)],
     count: usize,
     with_left: bool,
-    start: Option<&[f64]>,
 ) -> Result<(Vec<Mode>, usize), RotorDynError> {
     let n = q.m.dim();
     let mut ask = count;
     loop {
-        let shift_invert =
-            if n > DENSE_DOFS { lowest_shift_invert(q, pairs, ask, with_left, start) } else { None };
+        let shift_invert = if n > DENSE_DOFS { lowest_shift_invert(q, pairs, ask, with_left) } else { None };
         // The dense route returns every oscillating mode: nothing more to ask for.
         let (all, complete) = match shift_invert {
             Some(modes) => (modes, false),
@@ -212,25 +208,6 @@ pub fn solve_lowest_elastic(
         }
         ask = (ask + dropped.max(4) + 4).min(2 * n);
     }
-}
-
-/// A Krylov start vector (displacements, then velocities λx) from the modes of a nearby speed:
-/// the sum of their state vectors' real and imaginary parts, each normalised, with a generic
-/// vector of the same weight as one mode, so that a mode none of them resembles is still found.
-pub fn krylov_start(modes: &[Mode]) -> Vec<f64> {
-    let n = modes.first().map_or(0, |m| m.right.len());
-    let mut start = crate::shift_invert::generic_start(2 * n);
-    for mode in modes {
-        let state: Vec<c64> =
-            mode.right.iter().copied().chain(mode.right.iter().map(|x| x * mode.eigenvalue)).collect();
-        let norm = state.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
-        if norm > 0.0 {
-            for (s, z) in start.iter_mut().zip(&state) {
-                *s += (z.re + z.im) / norm;
-            }
-        }
-    }
-    start
 }
 
 /// How far below the lowest resolved |λ|² (one above round-off) a mode's |λ|² must lie to be a
@@ -285,15 +262,14 @@ fn lowest_shift_invert(
     pairs: &[(usize, usize)],
     count: usize,
     with_left: bool,
-    start: Option<&[f64]>,
 ) -> Option<Vec<Mode>> {
     // Both members of each pair, plus spares so that heavily damped modes (|λ| well above
     // their damped frequency) are inside the computed set.
     let wanted = 2 * count + 16;
     let oscillating = |found: Vec<(c64, Vec<c64>)>| -> Vec<(c64, Vec<c64>)> {
-        found.into_iter().filter(|(l, _)| l.im > 1e-9 * l.norm().max(1e-12)).collect()
+        found.into_iter().filter(|(l, _)| crate::shift_invert::oscillates(*l)).collect()
     };
-    let found = oscillating(crate::shift_invert::nearest_zero(q.m, q.d, q.k, wanted, start)?);
+    let found = oscillating(crate::shift_invert::nearest_zero(q.m, q.d, q.k, wanted, count)?);
     let mut modes: Vec<Mode> = found
         .into_iter()
         .map(|(lambda, x)| {
@@ -308,7 +284,7 @@ fn lowest_shift_invert(
     modes.truncate(count);
     if with_left {
         let [mt, dt, kt] = [q.m, q.d, q.k].map(Band::transpose);
-        let mut transposed = oscillating(crate::shift_invert::nearest_zero(&mt, &dt, &kt, wanted, None)?);
+        let mut transposed = oscillating(crate::shift_invert::nearest_zero(&mt, &dt, &kt, wanted, count)?);
         for mode in &mut modes {
             // The nearest unused eigenvalue of the transposed problem: the same to round-off.
             let (at, dist) = transposed

@@ -442,24 +442,23 @@ impl Rotor {
     }
 
     /// The `count` lowest modes at several speeds, assembling the speed-independent part once.
-    /// Each speed's Krylov space starts from the previous speed's modes ([`modal::krylov_start`]),
-    /// which speeds the solve and changes no result beyond the solver's tolerance.
+    /// Speeds are solved in parallel (rayon; `RAYON_NUM_THREADS=1` for one thread), each on its
+    /// own: the results do not depend on the number of threads.
     pub fn lowest_modes_over(&self, speeds: &[f64], count: usize) -> Result<Vec<Vec<Mode>>, RotorDynError> {
+        use rayon::prelude::*;
         let f = self.fixed();
         let pairs = self.translation_pairs();
         let whirl = self.has_whirl_tables();
-        let mut out: Vec<Vec<Mode>> = Vec::with_capacity(speeds.len());
-        for &s in speeds {
-            let modes = if whirl {
-                self.matched_from(&f, &pairs, s, count)?
-            } else {
+        speeds
+            .par_iter()
+            .map(|&s| {
+                if whirl {
+                    return self.matched_from(&f, &pairs, s, count);
+                }
                 let mats = self.band_matrices(&f, s, s);
-                let start = out.last().map(|previous| modal::krylov_start(previous));
-                modal::solve_lowest_elastic(mats.quadratic(), &pairs, count, false, start.as_deref())?.0
-            };
-            out.push(modes);
-        }
-        Ok(out)
+                modal::solve_lowest_elastic(mats.quadratic(), &pairs, count, false).map(|(modes, _)| modes)
+            })
+            .collect()
     }
 
     /// The `count` lowest modes at speed Ω (rad/s), each with the bearing coefficients at its own
@@ -480,7 +479,7 @@ impl Rotor {
     ) -> Result<Vec<Mode>, RotorDynError> {
         let solve = |whirl: f64| {
             let mats = self.band_matrices(f, speed, whirl);
-            modal::solve_lowest_elastic(mats.quadratic(), pairs, count + WHIRL_SPARE_MODES, false, None)
+            modal::solve_lowest_elastic(mats.quadratic(), pairs, count + WHIRL_SPARE_MODES, false)
                 .map(|(modes, _)| modes)
         };
         let start = solve(speed)?;

@@ -15,21 +15,27 @@ use faer::{c64, Accum, Col, Mat, Par};
 /// Krylov steps between two convergence checks (each check is a small dense eigen-solve).
 const CHECK_EVERY: usize = 6;
 
-/// Relative Arnoldi residual a wanted Ritz pair must reach: |β sₘ|/‖s‖ ≤ this · |θ|.
+/// Relative Arnoldi residual the modes returned must reach: |β sₘ|/‖s‖ ≤ this · |θ|.
 const RESIDUAL: f64 = 1e-10;
 
+/// Relative Arnoldi residual the other wanted Ritz pairs must reach: enough to rank them by
+/// damped frequency against the modes returned (their eigenvalues are then good to ~1e-8).
+const RANKING_RESIDUAL: f64 = 1e-8;
+
 /// Eigenpairs (λ, right state-vector's displacement part) of (λ²M + λD + K)x = 0 nearest 0:
-/// at least `wanted` eigenvalues (counting each conjugate separately), all with Arnoldi
-/// residual below 1e-10 relative. `start` (2n long: displacements then velocities) is the
-/// Krylov start vector, e.g. the modes of a nearby speed; without it a fixed generic vector, so
-/// results do not depend on a random seed. `None` when the band LU fails (K singular: a free
+/// the `wanted` eigenvalues nearest 0 (counting each conjugate separately), of which the `exact`
+/// oscillating ones (Im λ > 0) of lowest damped frequency Im λ have converged to an Arnoldi
+/// residual below 1e-10 relative and the others, which only rank them, below 1e-8. The Krylov
+/// space starts from a fixed generic vector: results do not depend on a random seed (nor on
+/// other speeds: starting from the modes of the previous speed of a sweep was tried and saved
+/// no step on ROSS's compressor). `None` when the band LU fails (K singular: a free
 /// rotor) or the Krylov space would exceed the problem; the caller then solves densely.
 pub fn nearest_zero(
     m: &Band,
     d: &Band,
     k: &Band,
     wanted: usize,
-    start: Option<&[f64]>,
+    exact: usize,
 ) -> Option<Vec<(c64, Vec<c64>)>> {
     let n = m.dim();
     // A band wider than a quarter of the matrix gains nothing over the dense solve.
@@ -40,7 +46,9 @@ pub fn nearest_zero(
     let lu = BandLu::new(k)?;
     let size = 2 * n;
     let max_dim = size - 1;
-    let first_check = (wanted + 2 * CHECK_EVERY).min(max_dim);
+    // Shift-invert Arnoldi needs about 1.8 steps per wanted eigenvalue on a rotor (66 for 36
+    // on ROSS's compressor): checking before that would only cost small eigen-solves.
+    let first_check = (wanted * 7 / 4).max(wanted + CHECK_EVERY).min(max_dim);
     // Op u = A⁻¹u: x2 = u1, K x1 = −M u2 − D u1.
     let op = |u: &[f64], out: &mut [f64]| {
         let (u1, u2) = u.split_at(n);
@@ -55,12 +63,7 @@ pub fn nearest_zero(
     // megabytes of zeros for the few dozen vectors a solve takes).
     let mut cap = (2 * first_check).min(max_dim);
     let mut v = Mat::<f64>::zeros(size, cap + 1);
-    let v0: Vec<f64> = match start {
-        Some(s) if s.len() == size && s.iter().any(|x| *x != 0.0) => s.to_vec(),
-        _ => generic_start(size),
-    };
-    let nrm = v0.iter().map(|x| x * x).sum::<f64>().sqrt();
-    v0.iter().enumerate().for_each(|(i, x)| v[(i, 0)] = x / nrm);
+    generic_start(size).iter().enumerate().for_each(|(i, x)| v[(i, 0)] = *x);
     let mut h = Mat::<f64>::zeros(cap + 1, cap);
     let mut w = Col::<f64>::zeros(size);
     let mut c = Col::<f64>::zeros(max_dim + 1);
@@ -75,6 +78,7 @@ pub fn nearest_zero(
             v.col(j).try_as_col_major().unwrap().as_slice(),
             w.as_mut().try_as_col_major_mut().unwrap().as_slice_mut(),
         );
+        count(1, 0);
         // Classical Gram–Schmidt twice, by matrix–vector products, keeps the basis orthogonal to
         // working precision.
         let basis = v.as_ref().subcols(0, j + 1);
@@ -101,7 +105,8 @@ pub fn nearest_zero(
             v.col_mut(j + 1).copy_from(w.as_ref() * faer::Scale(1.0 / beta));
         }
         if invariant || steps == next_check || steps == max_dim {
-            if let Some(found) = ritz(&v, &h, n, steps, wanted) {
+            count(0, 1);
+            if let Some(found) = ritz(&v, &h, n, steps, wanted, exact) {
                 return Some(found);
             }
             if invariant {
@@ -113,6 +118,41 @@ pub fn nearest_zero(
     None
 }
 
+/// Work done by [`nearest_zero`] on this thread since it started: how many times the shifted
+/// operator was applied (one band solve each) and how many convergence checks (small dense
+/// eigen-solves) were made. For tests and benchmarks that bound the work of a sweep.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Work {
+    /// Applications of the shift-inverted operator (Krylov steps).
+    pub applications: u64,
+    /// Convergence checks.
+    pub checks: u64,
+}
+
+thread_local! {
+    static WORK: std::cell::Cell<Work> = const { std::cell::Cell::new(Work { applications: 0, checks: 0 }) };
+}
+
+/// The work [`nearest_zero`] has done on this thread so far (see [`Work`]).
+pub fn work() -> Work {
+    WORK.with(|w| w.get())
+}
+
+fn count(applications: u64, checks: u64) {
+    WORK.with(|w| {
+        let mut v = w.get();
+        v.applications += applications;
+        v.checks += checks;
+        w.set(v);
+    });
+}
+
+/// Whether an eigenvalue is the positive-frequency member of an oscillating pair: Im λ > 0 by
+/// more than round-off relative to |λ| (a real eigenvalue's round-off imaginary part is not).
+pub fn oscillates(lambda: c64) -> bool {
+    lambda.im > 1e-9 * lambda.norm().max(1e-12)
+}
+
 /// A fixed, generic unit vector of `size` entries (no random seed: results are reproducible).
 pub fn generic_start(size: usize) -> Vec<f64> {
     let v: Vec<f64> = (0..size).map(|i| 1.0 + 0.5 * ((i as f64) * 0.73).sin()).collect();
@@ -121,8 +161,16 @@ pub fn generic_start(size: usize) -> Vec<f64> {
 }
 
 /// The `wanted` Ritz pairs of largest |θ| of the Arnoldi factorisation with `steps` vectors, as
-/// (λ = 1/θ, displacement part of the Ritz vector); `None` while any has not converged.
-fn ritz(v: &Mat<f64>, h: &Mat<f64>, n: usize, steps: usize, wanted: usize) -> Option<Vec<(c64, Vec<c64>)>> {
+/// (λ = 1/θ, displacement part of the Ritz vector); `None` while any has not converged (the
+/// `exact` of lowest damped frequency to [`RESIDUAL`], the others to [`RANKING_RESIDUAL`]).
+fn ritz(
+    v: &Mat<f64>,
+    h: &Mat<f64>,
+    n: usize,
+    steps: usize,
+    wanted: usize,
+    exact: usize,
+) -> Option<Vec<(c64, Vec<c64>)>> {
     if steps < wanted {
         return None;
     }
@@ -161,6 +209,7 @@ fn ritz(v: &Mat<f64>, h: &Mat<f64>, n: usize, steps: usize, wanted: usize) -> Op
     // Each chosen Ritz vector's coefficients (real and imaginary parts as columns).
     let mut s_parts = Mat::<f64>::zeros(steps, 2 * chosen.len());
     let mut thetas = Vec::with_capacity(chosen.len());
+    let mut residuals = Vec::with_capacity(chosen.len());
     for (col, &idx) in chosen.iter().enumerate() {
         let theta = c64::new(s_re[idx], s_im[idx]);
         let complex_first =
@@ -180,10 +229,19 @@ fn ritz(v: &Mat<f64>, h: &Mat<f64>, n: usize, steps: usize, wanted: usize) -> Op
             snorm += re * re + im * im;
         }
         let last = c64::new(s_parts[(steps - 1, 2 * col)], s_parts[(steps - 1, 2 * col + 1)]);
-        if beta_last * last.norm() / snorm.sqrt() > RESIDUAL * theta.norm() {
+        let residual = beta_last * last.norm() / snorm.sqrt() / theta.norm();
+        if residual.is_nan() || residual > RANKING_RESIDUAL {
             return None;
         }
         thetas.push(theta);
+        residuals.push(residual);
+    }
+    // The modes returned: the oscillating ones of lowest damped frequency.
+    let lambdas: Vec<c64> = thetas.iter().map(|t| t.inv()).collect();
+    let mut oscillating: Vec<usize> = (0..lambdas.len()).filter(|&i| oscillates(lambdas[i])).collect();
+    oscillating.sort_by(|&a, &b| lambdas[a].im.total_cmp(&lambdas[b].im));
+    if oscillating.iter().take(exact).any(|&i| residuals[i] > RESIDUAL) {
+        return None;
     }
     // Ritz vectors' displacement halves: X = V[..n] S, one product for all.
     let mut x = Mat::<f64>::zeros(n, 2 * chosen.len());
