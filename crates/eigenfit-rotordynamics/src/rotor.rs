@@ -258,9 +258,8 @@ impl Rotor {
     pub fn add_bearing_block(&self, target: &mut impl Assemble, b: &Bearing, block: [[f64; 2]; 2]) {
         let i = self.x_dof(b.n);
         let link = b.n_link.map(|l| self.x_dof(l));
-        for r in 0..2 {
-            for c in 0..2 {
-                let v = block[r][c];
+        for (r, row) in block.iter().enumerate() {
+            for (c, &v) in row.iter().enumerate() {
                 target.add(i + r, i + c, v);
                 if let Some(j) = link {
                     target.add(j + r, j + c, v);
