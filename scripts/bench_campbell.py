@@ -5,6 +5,7 @@ same speeds (50, linear 0-12000 rpm), 6 modes, same machine, one run each after 
     # ROSS 3 on the compressor ROSS 3 saved:
     BENCH_FILE=crates/eigenfit-rotordynamics/tests/data/ross3/compressor.toml \
         OPENBLAS_NUM_THREADS=1 /work/venvs/ross3/bin/python scripts/bench_campbell.py [path/to/eigenfit]
+    # eigenfit solves the speeds in parallel (rayon); RAYON_NUM_THREADS=1 for one thread.
 
 Prints both wall times, their ratio, and how far eigenfit's frequencies are from ROSS's
 (ROSS's lateral modes, sorted per speed; ROSS also has axial/torsional DOFs whose modes are

@@ -7,6 +7,7 @@
 //! modes tracked by MAC, reads rotors saved by ROSS, and identifies the bearings' kxx and kyy
 //! from whirl frequencies measured over a run-up with analytic eigenvalue sensitivities.
 
+pub mod band;
 pub mod campbell;
 pub mod effects;
 pub mod elements;

@@ -2,6 +2,7 @@
 //! state-space form, solved densely with faer's general (non-symmetric) eigendecomposition, which
 //! also returns the left eigenvectors the sensitivities need.
 
+use crate::band::Band;
 use crate::error::RotorDynError;
 use faer::diag::Diag;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -116,7 +117,7 @@ pub fn solve(
     for (j, &lambda) in values.iter().enumerate() {
         // Keep the member of each conjugate pair with positive damped frequency. A tolerance
         // relative to |λ| keeps a real eigenvalue's round-off imaginary part out.
-        if lambda.im <= 1e-9 * lambda.norm().max(1e-12) {
+        if !crate::shift_invert::oscillates(lambda) {
             continue;
         }
         let x: Vec<c64> = (0..n).map(|i| right[(i, j)]).collect();
@@ -160,29 +161,42 @@ pub fn solve_lowest(
     count: usize,
     with_left: bool,
 ) -> Result<Vec<Mode>, RotorDynError> {
-    solve_lowest_elastic(m, d, k, pairs, count, with_left).map(|(modes, _)| modes)
+    let [m, d, k] = [m, d, k].map(Band::from_dense);
+    solve_lowest_elastic(Quadratic { m: &m, d: &d, k: &k }, pairs, count, with_left).map(|(modes, _)| modes)
 }
 
-/// [`solve_lowest`] and the number of rigid-body modes left out below the modes returned.
+/// The quadratic problem (λ²M + λD + K)x = 0 in band storage.
+#[derive(Debug, Clone, Copy)]
+pub struct Quadratic<'a> {
+    /// Mass M.
+    pub m: &'a Band,
+    /// Velocity matrix D = C + ΩG.
+    pub d: &'a Band,
+    /// Stiffness K.
+    pub k: &'a Band,
+}
+
+/// [`solve_lowest`] on band matrices, and the number of rigid-body modes left out below the
+/// modes returned.
 pub fn solve_lowest_elastic(
-    m: &Mat<f64>,
-    d: &Mat<f64>,
-    k: &Mat<f64>,
+    q: Quadratic<'_>,
     pairs: &[(usize, usize)],
     count: usize,
     with_left: bool,
 ) -> Result<(Vec<Mode>, usize), RotorDynError> {
-    let n = m.nrows();
+    let n = q.m.dim();
     let mut ask = count;
     loop {
-        let shift_invert =
-            if n > DENSE_DOFS { lowest_shift_invert([m, d, k], pairs, ask, with_left) } else { None };
+        let shift_invert = if n > DENSE_DOFS { lowest_shift_invert(q, pairs, ask, with_left) } else { None };
         // The dense route returns every oscillating mode: nothing more to ask for.
         let (all, complete) = match shift_invert {
             Some(modes) => (modes, false),
-            None => (solve(m.as_ref(), d.as_ref(), k.as_ref(), pairs, with_left)?, true),
+            None => {
+                let [m, d, k] = [q.m, q.d, q.k].map(Band::to_dense);
+                (solve(m.as_ref(), d.as_ref(), k.as_ref(), pairs, with_left)?, true)
+            }
         };
-        let flags = rigid_body(&all, m, k);
+        let flags = rigid_body(&all, q.m, q.k);
         let dropped = flags.as_ref().map_or(0, |f| f.iter().filter(|&&r| r).count());
         let enough = flags.is_some() && all.len() - dropped >= count;
         if enough || complete || ask >= 2 * n {
@@ -212,22 +226,14 @@ pub const RIGID_BODY_ROUNDOFF: f64 = 1e3;
 /// [`RIGID_BODY_GAP`] below the lowest mode that is not (a rotor's elastic modes are within a
 /// few decades of each other; a rigid-body zero lies ten or more below them). `None` when no
 /// mode of `modes` is resolved from zero: the gap cannot be judged.
-pub fn rigid_body(modes: &[Mode], m: &Mat<f64>, k: &Mat<f64>) -> Option<Vec<bool>> {
-    let n = k.nrows();
-    let k_norm = (0..n).map(|i| (0..n).map(|j| k[(i, j)].abs()).sum::<f64>()).fold(0.0, f64::max);
+pub fn rigid_body(modes: &[Mode], m: &Band, k: &Band) -> Option<Vec<bool>> {
+    let k_norm = k.norm_inf();
     let zero: Vec<bool> = modes
         .iter()
         .map(|mode| {
             let x = &mode.right;
             let x2: f64 = x.iter().map(|v| v.norm_sqr()).sum();
-            let mut xmx = c64::new(0.0, 0.0);
-            for i in 0..n {
-                let mut row = c64::new(0.0, 0.0);
-                for j in 0..n {
-                    row += x[j] * m[(i, j)];
-                }
-                xmx += x[i].conj() * row;
-            }
+            let xmx = m.quadratic_form(x);
             mode.eigenvalue.norm_sqr() * xmx.norm() <= RIGID_BODY_ROUNDOFF * f64::EPSILON * k_norm * x2
         })
         .collect();
@@ -251,9 +257,8 @@ pub fn rigid_body(modes: &[Mode], m: &Mat<f64>, k: &Mat<f64>) -> Option<Vec<bool
 
 /// The shift-invert route; `None` (solve densely) when it fails or finds too few modes, or a
 /// left vector cannot be matched.
-/// `[m, d, k]`: the quadratic problem's matrices, as [`solve_lowest`] takes them.
 fn lowest_shift_invert(
-    [m, d, k]: [&Mat<f64>; 3],
+    q: Quadratic<'_>,
     pairs: &[(usize, usize)],
     count: usize,
     with_left: bool,
@@ -262,9 +267,9 @@ fn lowest_shift_invert(
     // their damped frequency) are inside the computed set.
     let wanted = 2 * count + 16;
     let oscillating = |found: Vec<(c64, Vec<c64>)>| -> Vec<(c64, Vec<c64>)> {
-        found.into_iter().filter(|(l, _)| l.im > 1e-9 * l.norm().max(1e-12)).collect()
+        found.into_iter().filter(|(l, _)| crate::shift_invert::oscillates(*l)).collect()
     };
-    let found = oscillating(crate::shift_invert::nearest_zero(m, d, k, wanted)?);
+    let found = oscillating(crate::shift_invert::nearest_zero(q.m, q.d, q.k, wanted, count)?);
     let mut modes: Vec<Mode> = found
         .into_iter()
         .map(|(lambda, x)| {
@@ -278,12 +283,8 @@ fn lowest_shift_invert(
     }
     modes.truncate(count);
     if with_left {
-        let mut transposed = oscillating(crate::shift_invert::nearest_zero(
-            &m.transpose().to_owned(),
-            &d.transpose().to_owned(),
-            &k.transpose().to_owned(),
-            wanted,
-        )?);
+        let [mt, dt, kt] = [q.m, q.d, q.k].map(Band::transpose);
+        let mut transposed = oscillating(crate::shift_invert::nearest_zero(&mt, &dt, &kt, wanted, count)?);
         for mode in &mut modes {
             // The nearest unused eigenvalue of the transposed problem: the same to round-off.
             let (at, dist) = transposed

@@ -1,9 +1,10 @@
 //! A two-plane rotor: elements on a line of nodes, its DOF numbering (x, y, α, β per shaft node,
 //! then x, y per extra support node, as ROSS orders them) and its matrices at a speed.
 
+use crate::band::{Assemble, Band};
 use crate::elements::{Bearing, Disk, Mat8, PointMass, ShaftElement};
 use crate::error::RotorDynError;
-use crate::modal::{self, Mode};
+use crate::modal::{self, Mode, Quadratic};
 use faer::Mat;
 
 /// A rotor model.
@@ -29,13 +30,28 @@ pub const WHIRL_MAX_ITERATIONS: usize = 200;
 /// Modes solved beyond those asked for, so that a mode followed by MAC stays among the solved.
 const WHIRL_SPARE_MODES: usize = 4;
 
-/// The speed-independent part of the matrices, assembled once.
+/// The speed-independent part of the matrices, assembled once, in band storage (the band's
+/// shape — the whole sparsity structure — is fixed by the rotor's layout, not by a speed).
 #[derive(Debug, Clone)]
 struct Fixed {
-    m: Mat<f64>,
-    k: Mat<f64>,
-    c: Mat<f64>,
-    g: Mat<f64>,
+    m: Band,
+    k: Band,
+    c: Band,
+    g: Band,
+}
+
+/// Mass, velocity and stiffness matrices at one speed, in band storage.
+#[derive(Debug, Clone)]
+struct BandMatrices {
+    m: Band,
+    d: Band,
+    k: Band,
+}
+
+impl BandMatrices {
+    fn quadratic(&self) -> Quadratic<'_> {
+        Quadratic { m: &self.m, d: &self.d, k: &self.k }
+    }
 }
 
 /// Mass, damping (C + ΩG), stiffness at one speed.
@@ -199,10 +215,21 @@ impl Rotor {
         (0..self.shaft_nodes).map(|n| (4 * n, 4 * n + 1)).collect()
     }
 
+    /// How far from the diagonal any matrix entry lies: 7 within a shaft element (two nodes of
+    /// four DOFs), more for a bearing linking a shaft node to a support node numbered after the
+    /// shaft.
+    fn half_bandwidth(&self) -> usize {
+        let links = self
+            .bearings
+            .iter()
+            .filter_map(|b| b.n_link.map(|l| self.x_dof(b.n).abs_diff(self.x_dof(l)) + 1));
+        links.fold(7, usize::max).min(self.dofs().saturating_sub(1))
+    }
+
     fn fixed(&self) -> Fixed {
-        let n = self.dofs();
-        let mut f =
-            Fixed { m: Mat::zeros(n, n), k: Mat::zeros(n, n), c: Mat::zeros(n, n), g: Mat::zeros(n, n) };
+        let (n, b) = (self.dofs(), self.half_bandwidth());
+        let zero = Band::zeros(n, b, b);
+        let mut f = Fixed { m: zero.clone(), k: zero.clone(), c: zero.clone(), g: zero };
         for s in &self.shafts {
             let o = 4 * s.n;
             scatter8(&mut f.m, o, &s.mass());
@@ -212,33 +239,32 @@ impl Rotor {
         }
         for d in &self.disks {
             let o = 4 * d.n;
-            f.m[(o, o)] += d.m;
-            f.m[(o + 1, o + 1)] += d.m;
-            f.m[(o + 2, o + 2)] += d.id;
-            f.m[(o + 3, o + 3)] += d.id;
-            f.g[(o + 2, o + 3)] += d.ip;
-            f.g[(o + 3, o + 2)] -= d.ip;
+            f.m.add(o, o, d.m);
+            f.m.add(o + 1, o + 1, d.m);
+            f.m.add(o + 2, o + 2, d.id);
+            f.m.add(o + 3, o + 3, d.id);
+            f.g.add(o + 2, o + 3, d.ip);
+            f.g.add(o + 3, o + 2, -d.ip);
         }
         for p in &self.point_masses {
             let o = self.x_dof(p.n);
-            f.m[(o, o)] += p.mx;
-            f.m[(o + 1, o + 1)] += p.my;
+            f.m.add(o, o, p.mx);
+            f.m.add(o + 1, o + 1, p.my);
         }
         f
     }
 
     /// Adds a bearing's 2×2 block (between its node and its link node, or to ground).
-    pub fn add_bearing_block(&self, target: &mut Mat<f64>, b: &Bearing, block: [[f64; 2]; 2]) {
+    pub fn add_bearing_block(&self, target: &mut impl Assemble, b: &Bearing, block: [[f64; 2]; 2]) {
         let i = self.x_dof(b.n);
         let link = b.n_link.map(|l| self.x_dof(l));
-        for r in 0..2 {
-            for c in 0..2 {
-                let v = block[r][c];
-                target[(i + r, i + c)] += v;
+        for (r, row) in block.iter().enumerate() {
+            for (c, &v) in row.iter().enumerate() {
+                target.add(i + r, i + c, v);
                 if let Some(j) = link {
-                    target[(j + r, j + c)] += v;
-                    target[(i + r, j + c)] -= v;
-                    target[(j + r, i + c)] -= v;
+                    target.add(j + r, j + c, v);
+                    target.add(i + r, j + c, -v);
+                    target.add(j + r, i + c, -v);
                 }
             }
         }
@@ -289,6 +315,13 @@ impl Rotor {
     }
 
     fn matrices_from(&self, f: &Fixed, speed: f64, whirl: f64) -> Matrices {
+        let b = self.band_matrices(f, speed, whirl);
+        Matrices { m: b.m.to_dense(), d: b.d.to_dense(), k: b.k.to_dense(), g: f.g.to_dense() }
+    }
+
+    /// M, C + ΩG and K at speed Ω with the bearing coefficients at whirl frequency ω, by band:
+    /// O(n·b) per speed, nothing of size n².
+    fn band_matrices(&self, f: &Fixed, speed: f64, whirl: f64) -> BandMatrices {
         let mut m = f.m.clone();
         let mut k = f.k.clone();
         let mut d = f.c.clone();
@@ -297,13 +330,8 @@ impl Rotor {
             self.add_bearing_block(&mut d, b, Bearing::block_at(&b.c, speed, whirl));
             self.add_bearing_block(&mut m, b, Bearing::block_at(&b.m, speed, whirl));
         }
-        let n = self.dofs();
-        for j in 0..n {
-            for i in 0..n {
-                d[(i, j)] += speed * f.g[(i, j)];
-            }
-        }
-        Matrices { m, d, k, g: f.g.clone() }
+        d.add_scaled(speed, &f.g);
+        BandMatrices { m, d, k }
     }
 
     /// The oscillating modes at speed Ω (rad/s), ascending in damped frequency.
@@ -328,21 +356,54 @@ impl Rotor {
     /// bearing stiffness outweighing the shaft. Such a motion grows without oscillating (a real
     /// positive λ of the damped problem), so it is in no mode list: the reports say so instead
     /// of dropping it silently. Returns that eigenvalue ((rad/s)²).
+    ///
+    /// By band, without a dense solve: Sturm counts (the negative pivots of K − σM = LDLᵀ,
+    /// Sylvester's law of inertia) bound the largest eigenvalue ρ by doubling, say whether any
+    /// lies below −1e3·ε·ρ (the reduced matrix's round-off ε‖A‖₂ times core's margin for
+    /// "unstable"), and only then find the lowest by bisection. `None` too when M's symmetric
+    /// part is not positive definite (the question has no answer).
     pub fn divergent(&self, speed: f64) -> Option<f64> {
-        let mats = self.matrices(speed);
+        let b = self.band_matrices(&self.fixed(), speed, speed);
+        let (k, m) = (b.k.symmetric_part(), b.m.symmetric_part());
+        m.cholesky()?;
         let n = self.dofs();
-        let sym = |a: &Mat<f64>| nalgebra::DMatrix::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
-        let (k, m) = (sym(&mats.k), sym(&mats.m));
-        let l = nalgebra::Cholesky::new(m)?.l();
-        let x = l.solve_lower_triangular(&k)?;
-        let a = l.solve_lower_triangular(&x.transpose())?;
-        let a = (&a + a.transpose()) * 0.5;
-        let lowest = a.symmetric_eigenvalues().iter().copied().fold(f64::INFINITY, f64::min);
-        let a_norm = a.row_iter().map(|r| r.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
-        // Round-off of the reduced matrix's eigenvalues: ε‖A‖ times a margin for the size (as
-        // core's check_stable allows 1e3 bounds before calling a model unstable).
-        let bound = 1e3 * f64::EPSILON * a_norm;
-        (lowest < -bound).then_some(lowest)
+        let mut scratch = Vec::new();
+        let mut below = |sigma: f64| k.count_below(&m, sigma, &mut scratch);
+        let scale = (k.amax() / m.amax()).max(f64::MIN_POSITIVE);
+        let mut rho = scale;
+        // Doubling from ‖K‖/‖M‖ to above every eigenvalue (a vanishing pivot: σ is one; go on).
+        for _ in 0..2100 {
+            if below(rho) == Some(n) {
+                break;
+            }
+            rho *= 2.0;
+        }
+        let bound = 1e3 * f64::EPSILON * rho;
+        // A vanishing pivot at −bound: an eigenvalue there, not below it by more than round-off.
+        if below(-bound).unwrap_or(0) == 0 {
+            return None;
+        }
+        let mut lo = -2.0 * bound;
+        for _ in 0..2100 {
+            if below(lo) == Some(0) {
+                break;
+            }
+            lo *= 2.0;
+        }
+        // Bisection: the lowest eigenvalue lies in [lo, hi).
+        let mut hi = -bound;
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if hi - lo <= 1e-13 * lo.abs() || mid == lo || mid == hi {
+                break;
+            }
+            match below(mid) {
+                Some(0) => lo = mid,
+                _ => hi = mid,
+            }
+        }
+        let lowest = 0.5 * (lo + hi);
+        (lowest < -1e3 * f64::EPSILON * rho.max(lowest.abs())).then_some(lowest)
     }
 
     /// How many rigid-body motions the rotor has with its bearing coefficients at speed Ω
@@ -354,10 +415,9 @@ impl Rotor {
     /// many of them round-off makes oscillating varies, this count does not.
     pub fn rigid_body_modes(&self, speed: f64) -> Result<usize, RotorDynError> {
         use eigenfit_core::eigen::{roundoff::rigid_body_modes, BandedSolver, EigenSolver};
-        let mats = self.matrices(speed);
+        let b = self.band_matrices(&self.fixed(), speed, speed);
         let n = self.dofs();
-        let sym = |a: &Mat<f64>| nalgebra::DMatrix::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
-        let system = eigenfit_core::matrix::System::new(sym(&mats.k), sym(&mats.m))
+        let system = eigenfit_core::matrix::System::banded(b.k.symmetric_part(), b.m.symmetric_part())
             .map_err(|e| RotorDynError::Model(e.to_string()))?;
         let mut count = n.min(12);
         loop {
@@ -381,18 +441,21 @@ impl Rotor {
     }
 
     /// The `count` lowest modes at several speeds, assembling the speed-independent part once.
+    /// Speeds are solved in parallel (rayon; `RAYON_NUM_THREADS=1` for one thread), each on its
+    /// own: the results do not depend on the number of threads.
     pub fn lowest_modes_over(&self, speeds: &[f64], count: usize) -> Result<Vec<Vec<Mode>>, RotorDynError> {
+        use rayon::prelude::*;
         let f = self.fixed();
         let pairs = self.translation_pairs();
         let whirl = self.has_whirl_tables();
         speeds
-            .iter()
+            .par_iter()
             .map(|&s| {
                 if whirl {
                     return self.matched_from(&f, &pairs, s, count);
                 }
-                let mats = self.matrices_from(&f, s, s);
-                modal::solve_lowest(&mats.m, &mats.d, &mats.k, &pairs, count, false)
+                let mats = self.band_matrices(&f, s, s);
+                modal::solve_lowest_elastic(mats.quadratic(), &pairs, count, false).map(|(modes, _)| modes)
             })
             .collect()
     }
@@ -414,8 +477,9 @@ impl Rotor {
         count: usize,
     ) -> Result<Vec<Mode>, RotorDynError> {
         let solve = |whirl: f64| {
-            let mats = self.matrices_from(f, speed, whirl);
-            modal::solve_lowest(&mats.m, &mats.d, &mats.k, pairs, count + WHIRL_SPARE_MODES, false)
+            let mats = self.band_matrices(f, speed, whirl);
+            modal::solve_lowest_elastic(mats.quadratic(), pairs, count + WHIRL_SPARE_MODES, false)
+                .map(|(modes, _)| modes)
         };
         let start = solve(speed)?;
         let mut out = Vec::with_capacity(count);
@@ -453,10 +517,10 @@ impl Rotor {
     }
 }
 
-fn scatter8(target: &mut Mat<f64>, offset: usize, e: &Mat8) {
-    for i in 0..8 {
-        for j in 0..8 {
-            target[(offset + i, offset + j)] += e[i][j];
+fn scatter8(target: &mut impl Assemble, offset: usize, e: &Mat8) {
+    for (i, row) in e.iter().enumerate() {
+        for (j, v) in row.iter().enumerate() {
+            target.add(offset + i, offset + j, *v);
         }
     }
 }

@@ -1,203 +1,178 @@
 //! The lowest modes of a large rotor without the dense 2n eigen-solve: Arnoldi on the
-//! shift-inverted state-space operator (A − σI)⁻¹, applied through a banded LU of the n×n
-//! quadratic matrix K + σD + σ²M (a rotor's matrices are banded: each node couples to its
-//! neighbours only). The eigenvalues nearest σ = 0 converge first; they are the low modes.
-//!
-//! Own banded LU (LAPACK's dgbtrf scheme) because faer's sparse LU needs its heavy
-//! `sparse-linalg` feature and the band here is narrow (about 8) and known.
+//! shift-inverted state-space operator A⁻¹, applied through a band LU of the n×n stiffness K
+//! (a rotor's matrices are banded: each node couples to its neighbours only), with the mass and
+//! velocity matrices applied by band. The eigenvalues nearest 0 converge first; they are the
+//! low modes. The Krylov basis grows only until every wanted Ritz pair has converged (checked
+//! every few steps), and is orthogonalised by matrix–vector products (faer's SIMD kernels).
 
+use crate::band::{Band, BandLu};
 use faer::diag::Diag;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::{evd_real, evd_scratch, ComputeEigenvectors};
-use faer::{c64, Mat, MatRef, Par};
+use faer::linalg::matmul::matmul;
+use faer::{c64, Accum, Col, Mat, Par};
 
-/// LU factors of a banded matrix with partial pivoting (band storage, LAPACK layout in spirit).
-struct BandLu {
-    n: usize,
-    kl: usize,
-    /// Upper bandwidth of U after pivoting: ku + kl.
-    ku2: usize,
-    w: usize,
-    band: Vec<f64>,
-    piv: Vec<usize>,
-}
+/// Krylov steps between two convergence checks (each check is a small dense eigen-solve).
+const CHECK_EVERY: usize = 6;
 
-impl BandLu {
-    /// Factors the n×n matrix `a` whose nonzeros lie within `kl` below and `ku` above the
-    /// diagonal. Returns `None` when a pivot vanishes (singular matrix).
-    fn new(a: &Mat<f64>, kl: usize, ku: usize) -> Option<Self> {
-        let n = a.nrows();
-        let ku2 = ku + kl;
-        let w = kl + ku2 + 1;
-        let mut band = vec![0.0; n * w];
-        let idx = |i: usize, j: usize| i * w + (j + kl - i);
-        for i in 0..n {
-            for j in i.saturating_sub(kl)..(i + ku + 1).min(n) {
-                band[idx(i, j)] = a[(i, j)];
-            }
-        }
-        let scale = band.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let mut piv = vec![0; n];
-        for k in 0..n {
-            let last_row = (k + kl + 1).min(n);
-            let last_col = (k + ku2 + 1).min(n);
-            let mut p = k;
-            for i in k + 1..last_row {
-                if band[idx(i, k)].abs() > band[idx(p, k)].abs() {
-                    p = i;
-                }
-            }
-            piv[k] = p;
-            if band[idx(p, k)].abs() <= 1e-14 * scale {
-                return None;
-            }
-            if p != k {
-                for j in k..last_col {
-                    band.swap(idx(k, j), idx(p, j));
-                }
-            }
-            let d = band[idx(k, k)];
-            for i in k + 1..last_row {
-                let l = band[idx(i, k)] / d;
-                band[idx(i, k)] = l;
-                if l != 0.0 {
-                    for j in k + 1..last_col {
-                        band[idx(i, j)] -= l * band[idx(k, j)];
-                    }
-                }
-            }
-        }
-        Some(BandLu { n, kl, ku2, w, band, piv })
-    }
+/// Relative Arnoldi residual the modes returned must reach: |β sₘ|/‖s‖ ≤ this · |θ|.
+const RESIDUAL: f64 = 1e-10;
 
-    // `b` and the band are indexed together (row i of the band holds b[i]'s coefficients).
-    #[allow(clippy::needless_range_loop)]
-    fn solve(&self, b: &mut [f64]) {
-        let (n, kl, w) = (self.n, self.kl, self.w);
-        let idx = |i: usize, j: usize| i * w + (j + kl - i);
-        for k in 0..n {
-            b.swap(k, self.piv[k]);
-            let bk = b[k];
-            if bk != 0.0 {
-                for i in k + 1..(k + kl + 1).min(n) {
-                    b[i] -= self.band[idx(i, k)] * bk;
-                }
-            }
-        }
-        for i in (0..n).rev() {
-            let mut s = b[i];
-            for j in i + 1..(i + self.ku2 + 1).min(n) {
-                s -= self.band[idx(i, j)] * b[j];
-            }
-            b[i] = s / self.band[idx(i, i)];
-        }
-    }
-}
-
-/// Lower and upper bandwidths of the nonzeros of some matrices.
-fn bandwidths(mats: &[MatRef<'_, f64>]) -> (usize, usize) {
-    let (mut kl, mut ku) = (0, 0);
-    for a in mats {
-        for j in 0..a.ncols() {
-            for i in 0..a.nrows() {
-                if a[(i, j)] != 0.0 {
-                    if i > j {
-                        kl = kl.max(i - j);
-                    } else {
-                        ku = ku.max(j - i);
-                    }
-                }
-            }
-        }
-    }
-    (kl, ku)
-}
+/// Relative Arnoldi residual the other wanted Ritz pairs must reach: enough to rank them by
+/// damped frequency against the modes returned (their eigenvalues are then good to ~1e-8).
+const RANKING_RESIDUAL: f64 = 1e-8;
 
 /// Eigenpairs (λ, right state-vector's displacement part) of (λ²M + λD + K)x = 0 nearest 0:
-/// at least `wanted` eigenvalues (counting each conjugate separately), all with Arnoldi
-/// residual below 1e-10 relative. `None` when the band LU fails (K singular: a free rotor) or
-/// the Krylov space would exceed the problem; the caller then solves densely.
-pub fn nearest_zero(m: &Mat<f64>, d: &Mat<f64>, k: &Mat<f64>, wanted: usize) -> Option<Vec<(c64, Vec<c64>)>> {
-    let n = m.nrows();
-    let (kl, ku) = bandwidths(&[m.as_ref(), d.as_ref(), k.as_ref()]);
+/// the `wanted` eigenvalues nearest 0 (counting each conjugate separately), of which the `exact`
+/// oscillating ones (Im λ > 0) of lowest damped frequency Im λ have converged to an Arnoldi
+/// residual below 1e-10 relative and the others, which only rank them, below 1e-8. The Krylov
+/// space starts from a fixed generic vector: results do not depend on a random seed (nor on
+/// other speeds: starting from the modes of the previous speed of a sweep was tried and saved
+/// no step on ROSS's compressor). `None` when the band LU fails (K singular: a free
+/// rotor) or the Krylov space would exceed the problem; the caller then solves densely.
+pub fn nearest_zero(
+    m: &Band,
+    d: &Band,
+    k: &Band,
+    wanted: usize,
+    exact: usize,
+) -> Option<Vec<(c64, Vec<c64>)>> {
+    let n = m.dim();
     // A band wider than a quarter of the matrix gains nothing over the dense solve.
-    if 4 * (kl + ku) > n {
+    let width = [m, d, k].iter().map(|a| a.lower() + a.upper()).max().unwrap_or(0);
+    if 4 * width > n {
         return None;
     }
-    let lu = BandLu::new(k, kl, ku)?;
-    let mut dim = (2 * wanted + 20).max(40);
-    loop {
-        if dim + 1 >= 2 * n {
-            return None;
-        }
-        if let Some(found) = arnoldi(&lu, m, d, n, dim, wanted) {
-            return Some(found);
-        }
-        dim *= 2;
-    }
-}
-
-fn matvec(a: &Mat<f64>, x: &[f64], out: &mut [f64], kl: usize, ku: usize) {
-    let n = a.nrows();
-    for i in 0..n {
-        let mut s = 0.0;
-        for j in i.saturating_sub(kl)..(i + ku + 1).min(n) {
-            s += a[(i, j)] * x[j];
-        }
-        out[i] = s;
-    }
-}
-
-fn arnoldi(
-    lu: &BandLu,
-    m: &Mat<f64>,
-    d: &Mat<f64>,
-    n: usize,
-    dim: usize,
-    wanted: usize,
-) -> Option<Vec<(c64, Vec<c64>)>> {
-    let (kl, ku) = (lu.kl, lu.ku2 - lu.kl);
+    let lu = BandLu::new(k)?;
     let size = 2 * n;
+    let max_dim = size - 1;
+    // Shift-invert Arnoldi needs about 1.8 steps per wanted eigenvalue on a rotor (66 for 36
+    // on ROSS's compressor): checking before that would only cost small eigen-solves.
+    let first_check = (wanted * 7 / 4).max(wanted + CHECK_EVERY).min(max_dim);
     // Op u = A⁻¹u: x2 = u1, K x1 = −M u2 − D u1.
     let op = |u: &[f64], out: &mut [f64]| {
         let (u1, u2) = u.split_at(n);
-        let mut t = vec![0.0; n];
-        let mut rhs = vec![0.0; n];
-        matvec(m, u2, &mut t, kl, ku);
-        matvec(d, u1, &mut rhs, kl, ku);
-        for i in 0..n {
-            rhs[i] = -t[i] - rhs[i];
-        }
-        lu.solve(&mut rhs);
-        out[..n].copy_from_slice(&rhs);
-        out[n..].copy_from_slice(u1);
+        let (o1, o2) = out.split_at_mut(n);
+        o1.iter_mut().for_each(|v| *v = 0.0);
+        m.mul_add(-1.0, u2, o1);
+        d.mul_add(-1.0, u1, o1);
+        lu.solve(o1);
+        o2.copy_from_slice(u1);
     };
-    let mut v: Vec<Vec<f64>> = Vec::with_capacity(dim + 1);
-    // A fixed, generic start vector: results do not depend on a random seed.
-    let mut v0: Vec<f64> = (0..size).map(|i| 1.0 + 0.5 * ((i as f64) * 0.73).sin()).collect();
-    let nrm = v0.iter().map(|x| x * x).sum::<f64>().sqrt();
-    v0.iter_mut().for_each(|x| *x /= nrm);
-    v.push(v0);
-    let mut h = Mat::<f64>::zeros(dim + 1, dim);
-    let mut w = vec![0.0; size];
-    let mut steps = dim;
-    for j in 0..dim {
-        op(&v[j], &mut w);
-        // Two passes of Gram–Schmidt keep the basis orthogonal to working precision.
+    // Basis and Hessenberg matrix grow as the steps need them (a whole 2n × 2n basis would be
+    // megabytes of zeros for the few dozen vectors a solve takes).
+    let mut cap = (2 * first_check).min(max_dim);
+    let mut v = Mat::<f64>::zeros(size, cap + 1);
+    generic_start(size).iter().enumerate().for_each(|(i, x)| v[(i, 0)] = *x);
+    let mut h = Mat::<f64>::zeros(cap + 1, cap);
+    let mut w = Col::<f64>::zeros(size);
+    let mut c = Col::<f64>::zeros(max_dim + 1);
+    let mut next_check = first_check;
+    for j in 0..max_dim {
+        if j == cap {
+            cap = (2 * cap).min(max_dim);
+            v.resize_with(size, cap + 1, |_, _| 0.0);
+            h.resize_with(cap + 1, cap, |_, _| 0.0);
+        }
+        op(
+            v.col(j).try_as_col_major().unwrap().as_slice(),
+            w.as_mut().try_as_col_major_mut().unwrap().as_slice_mut(),
+        );
+        count(1, 0);
+        // Classical Gram–Schmidt twice, by matrix–vector products, keeps the basis orthogonal to
+        // working precision.
+        let basis = v.as_ref().subcols(0, j + 1);
         for _ in 0..2 {
-            for (i, vi) in v.iter().enumerate() {
-                let c: f64 = vi.iter().zip(&w).map(|(a, b)| a * b).sum();
-                h[(i, j)] += c;
-                w.iter_mut().zip(vi).for_each(|(x, y)| *x -= c * y);
+            matmul(
+                c.as_mut().subrows_mut(0, j + 1),
+                Accum::Replace,
+                basis.transpose(),
+                w.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            let cj = c.as_ref().subrows(0, j + 1);
+            matmul(w.as_mut(), Accum::Add, basis, cj, -1.0, Par::Seq);
+            for i in 0..=j {
+                h[(i, j)] += cj[i];
             }
         }
-        let beta = w.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let beta = w.norm_l2();
         h[(j + 1, j)] = beta;
-        if beta < 1e-300 {
-            steps = j + 1;
-            break;
+        let steps = j + 1;
+        let invariant = beta < 1e-300;
+        if !invariant {
+            v.col_mut(j + 1).copy_from(w.as_ref() * faer::Scale(1.0 / beta));
         }
-        v.push(w.iter().map(|x| x / beta).collect());
+        if invariant || steps == next_check || steps == max_dim {
+            count(0, 1);
+            if let Some(found) = ritz(&v, &h, n, steps, wanted, exact) {
+                return Some(found);
+            }
+            if invariant {
+                return None;
+            }
+            next_check = steps + CHECK_EVERY;
+        }
+    }
+    None
+}
+
+/// Work done by [`nearest_zero`] on this thread since it started: how many times the shifted
+/// operator was applied (one band solve each) and how many convergence checks (small dense
+/// eigen-solves) were made. For tests and benchmarks that bound the work of a sweep.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Work {
+    /// Applications of the shift-inverted operator (Krylov steps).
+    pub applications: u64,
+    /// Convergence checks.
+    pub checks: u64,
+}
+
+thread_local! {
+    static WORK: std::cell::Cell<Work> = const { std::cell::Cell::new(Work { applications: 0, checks: 0 }) };
+}
+
+/// The work [`nearest_zero`] has done on this thread so far (see [`Work`]).
+pub fn work() -> Work {
+    WORK.with(|w| w.get())
+}
+
+fn count(applications: u64, checks: u64) {
+    WORK.with(|w| {
+        let mut v = w.get();
+        v.applications += applications;
+        v.checks += checks;
+        w.set(v);
+    });
+}
+
+/// Whether an eigenvalue is the positive-frequency member of an oscillating pair: Im λ > 0 by
+/// more than round-off relative to |λ| (a real eigenvalue's round-off imaginary part is not).
+pub fn oscillates(lambda: c64) -> bool {
+    lambda.im > 1e-9 * lambda.norm().max(1e-12)
+}
+
+/// A fixed, generic unit vector of `size` entries (no random seed: results are reproducible).
+pub fn generic_start(size: usize) -> Vec<f64> {
+    let v: Vec<f64> = (0..size).map(|i| 1.0 + 0.5 * ((i as f64) * 0.73).sin()).collect();
+    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    v.into_iter().map(|x| x / norm).collect()
+}
+
+/// The `wanted` Ritz pairs of largest |θ| of the Arnoldi factorisation with `steps` vectors, as
+/// (λ = 1/θ, displacement part of the Ritz vector); `None` while any has not converged (the
+/// `exact` of lowest damped frequency to [`RESIDUAL`], the others to [`RANKING_RESIDUAL`]).
+fn ritz(
+    v: &Mat<f64>,
+    h: &Mat<f64>,
+    n: usize,
+    steps: usize,
+    wanted: usize,
+    exact: usize,
+) -> Option<Vec<(c64, Vec<c64>)>> {
+    if steps < wanted {
+        return None;
     }
     let hm = h.as_ref().submatrix(0, 0, steps, steps).to_owned();
     let beta_last = h[(steps, steps - 1)];
@@ -223,43 +198,61 @@ fn arnoldi(
     )
     .ok()?;
     let (s_re, s_im) = (s_re.column_vector(), s_im.column_vector());
-    // The wanted eigenvalues are the largest |θ| (nearest λ = 0); each must have converged:
-    // residual |β sₘ|/‖s‖ ≤ 1e-10 |θ|.
+    // The wanted eigenvalues are the largest |θ| (nearest λ = 0); each must have converged.
     let mut order: Vec<usize> = (0..steps).collect();
     order.sort_by(|&a, &b| {
         let ta = c64::new(s_re[a], s_im[a]).norm();
         let tb = c64::new(s_re[b], s_im[b]).norm();
         tb.total_cmp(&ta)
     });
-    let mut out = Vec::new();
-    for &idx in order.iter().take(wanted.min(steps)) {
+    let chosen = &order[..wanted.min(steps)];
+    // Each chosen Ritz vector's coefficients (real and imaginary parts as columns).
+    let mut s_parts = Mat::<f64>::zeros(steps, 2 * chosen.len());
+    let mut thetas = Vec::with_capacity(chosen.len());
+    let mut residuals = Vec::with_capacity(chosen.len());
+    for (col, &idx) in chosen.iter().enumerate() {
         let theta = c64::new(s_re[idx], s_im[idx]);
         let complex_first =
             s_im[idx] != 0.0 && idx + 1 < steps && s_im[idx] > 0.0 && s_im[idx + 1] == -s_im[idx];
         let complex_second = s_im[idx] != 0.0 && idx > 0 && s_im[idx - 1] == -s_im[idx] && s_im[idx] < 0.0;
-        let s: Vec<c64> = (0..steps)
-            .map(|i| {
-                if complex_first {
-                    c64::new(ur[(i, idx)], ur[(i, idx + 1)])
-                } else if complex_second {
-                    c64::new(ur[(i, idx - 1)], -ur[(i, idx)])
-                } else {
-                    c64::new(ur[(i, idx)], 0.0)
-                }
-            })
-            .collect();
-        let snorm = s.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
-        if beta_last * s[steps - 1].norm() / snorm > 1e-10 * theta.norm() {
+        let mut snorm = 0.0;
+        for i in 0..steps {
+            let (re, im) = if complex_first {
+                (ur[(i, idx)], ur[(i, idx + 1)])
+            } else if complex_second {
+                (ur[(i, idx - 1)], -ur[(i, idx)])
+            } else {
+                (ur[(i, idx)], 0.0)
+            };
+            s_parts[(i, 2 * col)] = re;
+            s_parts[(i, 2 * col + 1)] = im;
+            snorm += re * re + im * im;
+        }
+        let last = c64::new(s_parts[(steps - 1, 2 * col)], s_parts[(steps - 1, 2 * col + 1)]);
+        let residual = beta_last * last.norm() / snorm.sqrt() / theta.norm();
+        if residual.is_nan() || residual > RANKING_RESIDUAL {
             return None;
         }
-        // Ritz vector's displacement half: x = V[..n] s.
-        let mut x = vec![c64::new(0.0, 0.0); n];
-        for (i, vi) in v.iter().take(steps).enumerate() {
-            for r in 0..n {
-                x[r] += s[i] * vi[r];
-            }
-        }
-        out.push((theta.inv(), x));
+        thetas.push(theta);
+        residuals.push(residual);
     }
-    Some(out)
+    // The modes returned: the oscillating ones of lowest damped frequency.
+    let lambdas: Vec<c64> = thetas.iter().map(|t| t.inv()).collect();
+    let mut oscillating: Vec<usize> = (0..lambdas.len()).filter(|&i| oscillates(lambdas[i])).collect();
+    oscillating.sort_by(|&a, &b| lambdas[a].im.total_cmp(&lambdas[b].im));
+    if oscillating.iter().take(exact).any(|&i| residuals[i] > RESIDUAL) {
+        return None;
+    }
+    // Ritz vectors' displacement halves: X = V[..n] S, one product for all.
+    let mut x = Mat::<f64>::zeros(n, 2 * chosen.len());
+    matmul(x.as_mut(), Accum::Replace, v.as_ref().submatrix(0, 0, n, steps), s_parts.as_ref(), 1.0, Par::Seq);
+    Some(
+        thetas
+            .into_iter()
+            .enumerate()
+            .map(|(col, theta)| {
+                (theta.inv(), (0..n).map(|r| c64::new(x[(r, 2 * col)], x[(r, 2 * col + 1)])).collect())
+            })
+            .collect(),
+    )
 }
