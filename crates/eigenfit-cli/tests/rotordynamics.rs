@@ -673,7 +673,29 @@ fn estimate_on_a_ross_rotor_plots_the_runup_fit() {
         "--json",
     ]));
     let plots: Vec<&str> = v["plots"].as_array().unwrap().iter().map(|p| p.as_str().unwrap()).collect();
-    assert_eq!(plots.len(), 2, "{plots:?}");
+    assert_eq!(plots.len(), 4, "{plots:?}");
+    // The estimated rotor's Campbell diagram (0 to 1.2 × the top measured speed, as many modes as
+    // measured): the fit reaches the truth, so it is the truth file's diagram drawn by `campbell
+    // --plot` over the same speeds, line for line but the title.
+    let truth = scratch.path().join("truth-plots");
+    run(&[
+        "campbell",
+        "--model",
+        &data("ross3/pchip_speed.toml"),
+        "--speeds",
+        "0:10800:41",
+        "--modes",
+        "4",
+        "--plot",
+        truth.to_str().unwrap(),
+    ]);
+    let body = |path: std::path::PathBuf| -> Vec<String> {
+        let svg = std::fs::read_to_string(path).unwrap();
+        svg.lines().filter(|l| !l.contains("Campbell diagram")).map(str::to_string).collect()
+    };
+    let (at_estimate, of_truth) = (body(dir.join("campbell-estimate.svg")), body(truth.join("campbell.svg")));
+    assert!(at_estimate.iter().any(|l| l.contains("critical speed")));
+    assert_eq!(at_estimate, of_truth, "the Campbell diagram at the estimate is not the truth's");
     let svg = std::fs::read_to_string(dir.join("runup-fit.svg")).unwrap();
     let modes: std::collections::BTreeSet<u64> =
         v["points"].as_array().unwrap().iter().map(|p| p["mode"].as_u64().unwrap()).collect();

@@ -1052,6 +1052,30 @@ pub fn campbell_diagram_with(
     Ok(report)
 }
 
+/// Speeds of the Campbell diagram drawn at a run-up estimate: 0 to 20 % above the highest
+/// measured speed, so the critical speeds just above the run-up show.
+const ESTIMATE_CAMPBELL_SPEEDS: usize = 41;
+
+/// The Campbell diagram of the rotor at a run-up estimate (`report`: its model file and its
+/// estimated factors), from 0 to 1.2 × the highest measured speed, with as many modes as the
+/// run-up measured: what `estimate --plot` draws beside the run-up fit.
+pub fn campbell_at_estimate(report: &RunupEstimateReport) -> Result<Campbell, WorkflowError> {
+    let rotor = load(Path::new(&report.model))?;
+    let names: Vec<&str> = report.scales.iter().map(|(n, _)| n.as_str()).collect();
+    let params = bearing_parameters(&rotor, &names).map_err(to_workflow)?;
+    let scales: Vec<f64> = params
+        .iter()
+        .map(|p| report.scales.iter().find(|(n, _)| *n == p.name).map_or(1.0, |(_, s)| *s))
+        .collect();
+    let estimated = eigenfit_rotordynamics::identify::scaled_rotor(&rotor, &params, &scales);
+    let top = report.points.iter().map(|p| p.speed_rpm).fold(0.0, f64::max) * 1.2;
+    let speeds: Vec<f64> = (0..ESTIMATE_CAMPBELL_SPEEDS)
+        .map(|i| top * i as f64 / (ESTIMATE_CAMPBELL_SPEEDS - 1) as f64)
+        .collect();
+    let modes = report.points.iter().map(|p| p.mode).max().unwrap_or(1).min(rotor.dofs());
+    campbell(&estimated, &speeds, modes).map_err(to_workflow)
+}
+
 #[cfg(test)]
 mod margin_tests {
     use super::*;

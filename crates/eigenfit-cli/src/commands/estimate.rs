@@ -61,7 +61,8 @@ pub struct EstimateArgs {
     pub alternative_starts: Option<usize>,
     /// Write the plots into this folder: the convergence history (convergence.svg/.png) and,
     /// with shapes, the MAC matrix (mac.svg/.png); for a run-up on a ROSS rotor the run-up fit
-    /// (runup-fit.svg/.png: measured and model frequencies against speed).
+    /// (runup-fit.svg/.png: measured and model frequencies against speed) and the estimated
+    /// rotor's Campbell diagram with its critical speeds (campbell-estimate.svg/.png).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
     /// `--quiet`, `--json`.
@@ -132,10 +133,25 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 Some(dir) => {
                     let figure =
                         plot::runup::RunupFit { title: report.model.clone(), points: &report.points };
-                    plot::write(&figure, dir, "runup-fit").unwrap_or_else(|e| {
+                    let mut written = plot::write(&figure, dir, "runup-fit").unwrap_or_else(|e| {
                         crate::output::report_lost("the run-up fit plot", &e);
                         Vec::new()
-                    })
+                    });
+                    // The estimated rotor's Campbell diagram, critical speeds on the 1× line.
+                    match eigenfit_workflow::rotordynamics::campbell_at_estimate(&report) {
+                        Ok(campbell) => {
+                            let title = format!("{} at the estimate", report.model);
+                            let figure = plot::campbell::CampbellPlot { title, campbell: &campbell };
+                            written.extend(plot::write(&figure, dir, "campbell-estimate").unwrap_or_else(
+                                |e| {
+                                    crate::output::report_lost("the Campbell plot at the estimate", &e);
+                                    Vec::new()
+                                },
+                            ));
+                        }
+                        Err(e) => crate::output::report_lost("the Campbell plot at the estimate", &e.into()),
+                    }
+                    written
                 }
                 None => Vec::new(),
             };
