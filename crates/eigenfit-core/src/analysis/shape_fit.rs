@@ -61,12 +61,10 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     /// The model shapes at the sensors, one per computed mode, and the paired model modes,
     /// at `p`.
     pub fn model_at_sensors(&self, p: &[f64]) -> Result<(Vec<Vec<f64>>, Vec<usize>), ResidualError> {
-        let lin = self.problem.linearise(p)?;
+        let (lin, modes) = self.problem.linearise_with_modes(p)?;
         let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
             return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
         };
-        let system = self.problem.model.assemble(p).map_err(SensitivityError::from)?;
-        let modes = self.problem.solver.lowest(&system, self.count()).map_err(SensitivityError::from)?;
         let shapes =
             (0..modes.count()).map(|k| sensor_dofs.iter().map(|&d| modes.shapes[(d, k)]).collect()).collect();
         Ok((shapes, lin.paired_modes))
@@ -113,11 +111,6 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
             budget,
         )
     }
-
-    /// Modes solved: as many as MAC pairing considers.
-    fn count(&self) -> usize {
-        (2 * self.problem.measured.modes_needed() + 2).min(self.problem.model.dofs())
-    }
 }
 
 impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
@@ -126,13 +119,13 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
     }
 
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
-        let mut lin = self.problem.linearise(p)?;
+        // The modes the frequency rows were paired on: one eigen-solve per linearisation.
+        let (mut lin, modes) = self.problem.linearise_with_modes(p)?;
         let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
             return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
         };
         let model = &self.problem.model;
         let system = model.assemble(p).map_err(SensitivityError::from)?;
-        let modes = self.problem.solver.lowest(&system, self.count()).map_err(SensitivityError::from)?;
         let np = p.len();
         let derivatives = (0..np)
             .map(|i| model.derivative(p, i))

@@ -1,6 +1,6 @@
 //! The update problem: a model, a solver and measured modes; its residual and Jacobian at a point.
 
-use crate::eigen::EigenSolver;
+use crate::eigen::{EigenSolver, Modes};
 use crate::measurement::mac::mac;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::{ParameterSet, StructuralModel};
@@ -204,6 +204,13 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
 
     /// Residual and Jacobian at `p`.
     pub fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        self.linearise_with_modes(p).map(|(lin, _)| lin)
+    }
+
+    /// [`linearise`](Self::linearise) and the model modes it solved (the lowest
+    /// `modes_needed`, or with MAC pairing 2·`modes_needed` + 2, mass-normalised), for residuals
+    /// built on them (shapes) without a second solve.
+    pub fn linearise_with_modes(&self, p: &[f64]) -> Result<(Linearisation, Modes), ResidualError> {
         let needed = self.measured.modes_needed();
         let dofs = self.model.dofs();
         if needed > dofs {
@@ -268,7 +275,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             lin.residual[row] = r / sigma;
             lin.jacobian.row_mut(row).copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));
         }
-        Ok(lin)
+        Ok((lin, sens.modes))
     }
 
     /// Residual value, Jacobian scale and weight of one measured mode against model eigenvalue λ.
