@@ -129,6 +129,11 @@ pub struct Sensitivities {
     /// Relative accuracy of each wanted λₖ as the matrices define it ([`eigenvalue_round_off`];
     /// NaN for the modes not wanted).
     pub eigenvalue_round_off: DVector<f64>,
+    /// ∂K/∂pᵢ, ∂M/∂pᵢ at the point, one per parameter: kept for what is built on the same
+    /// linearisation (the shapes' derivatives) without asking the model again.
+    pub derivatives: Vec<SystemDerivative>,
+    /// K and M at the point, as the model assembled them.
+    pub system: System,
 }
 
 impl Sensitivities {
@@ -176,11 +181,13 @@ impl Sensitivities {
                 return Err(SensitivityError::ZeroFrequency { mode: k, lambda });
             }
         }
+        let mut derivatives = Vec::with_capacity(np);
         for i in 0..np {
             let d = model.derivative(p, i)?;
             for &k in wanted {
                 dl[(k, i)] = eigenvalue_derivative(&modes, k, &d);
             }
+            derivatives.push(d);
         }
         for &k in wanted {
             let f = crate::units::eigenvalue_to_hz(modes.eigenvalues[k]);
@@ -191,7 +198,14 @@ impl Sensitivities {
         for &k in wanted {
             round_off[k] = eigenvalue_round_off(&system, &modes, k);
         }
-        Ok(Self { modes, eigenvalues: dl, frequencies_hz: df, eigenvalue_round_off: round_off })
+        Ok(Self {
+            modes,
+            eigenvalues: dl,
+            frequencies_hz: df,
+            eigenvalue_round_off: round_off,
+            derivatives,
+            system,
+        })
     }
 }
 

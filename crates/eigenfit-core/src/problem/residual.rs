@@ -1,6 +1,6 @@
 //! The update problem: a model, a solver and measured modes; its residual and Jacobian at a point.
 
-use crate::eigen::{EigenSolver, Modes};
+use crate::eigen::EigenSolver;
 use crate::measurement::mac::mac;
 use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::{ParameterSet, StructuralModel};
@@ -207,10 +207,11 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
         self.linearise_with_modes(p).map(|(lin, _)| lin)
     }
 
-    /// [`linearise`](Self::linearise) and the model modes it solved (the lowest
-    /// `modes_needed`, or with MAC pairing 2·`modes_needed` + 2, mass-normalised), for residuals
-    /// built on them (shapes) without a second solve.
-    pub fn linearise_with_modes(&self, p: &[f64]) -> Result<(Linearisation, Modes), ResidualError> {
+    /// [`linearise`](Self::linearise) and the [`Sensitivities`] it was built from: the model
+    /// modes it solved (the lowest `modes_needed`, or with MAC pairing 2·`modes_needed` + 2,
+    /// mass-normalised) and the parameter derivatives of K and M, for residuals built on them
+    /// (shapes) without a second solve.
+    pub fn linearise_with_modes(&self, p: &[f64]) -> Result<(Linearisation, Sensitivities), ResidualError> {
         let needed = self.measured.modes_needed();
         let dofs = self.model.dofs();
         if needed > dofs {
@@ -275,7 +276,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             lin.residual[row] = r / sigma;
             lin.jacobian.row_mut(row).copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));
         }
-        Ok((lin, sens.modes))
+        Ok((lin, sens))
     }
 
     /// Residual value, Jacobian scale and weight of one measured mode against model eigenvalue λ.
