@@ -18,6 +18,8 @@ factorisation runs sequentially).
 
     cargo build --release -p eigenfit-matrices --example sparse_bench
     nice -n 10 /work/venvs/h17/bin/python scripts/bench_sparse.py --dofs 10000,100000
+    # against CHOLMOD + ARPACK too (pip install "scikit-sparse<0.5": Debian 12's SuiteSparse 5)
+    python scripts/bench_sparse.py --dofs 100000 --peers superlu,cholmod
 """
 
 import argparse
@@ -40,8 +42,10 @@ def peak_kb():
     return 0
 
 
-def scipy_worker(folder, modes):
-    """Runs in a child process: the scipy side on one model folder, one JSON line out."""
+def scipy_worker(folder, modes, peer="superlu"):
+    """Runs in a child process: the scipy side on one model folder, one JSON line out. `peer`:
+    `superlu` — eigsh's own shift-invert (SuperLU of K); `cholmod` — eigsh (ARPACK) with
+    OPinv = CHOLMOD's Cholesky of K (scikit-sparse; supernodal, its own choice of ordering)."""
     import tomllib
 
     import numpy as np
@@ -60,7 +64,14 @@ def scipy_worker(folder, modes):
     K = (K0 + sum(pi * Ki for pi, Ki in zip(p, Ks))).tocsc()
     assemble_s = time.perf_counter() - t
     t, c = time.perf_counter(), time.process_time()
-    lam, phi = sla.eigsh(K, modes, M, sigma=0, which="LM")
+    if peer == "cholmod":
+        from sksparse.cholmod import cholesky
+
+        factor = cholesky(K)
+        op = sla.LinearOperator(K.shape, matvec=lambda x: factor(x), dtype=float)
+        lam, phi = sla.eigsh(K, modes, M, sigma=0, which="LM", OPinv=op)
+    else:
+        lam, phi = sla.eigsh(K, modes, M, sigma=0, which="LM")
     order = np.argsort(lam)
     lam, phi = lam[order], phi[:, order]
     modes_s = time.perf_counter() - t
@@ -86,29 +97,35 @@ def main():
     ap.add_argument("--modes", type=int, default=10)
     ap.add_argument("--zones", default="2x3")
     ap.add_argument("--bench", default=os.path.join(ROOT, "target/release/examples/sparse_bench"))
+    ap.add_argument("--peers", default="superlu",
+                    help="comma-separated: superlu (scipy eigsh shift-invert), cholmod (ARPACK on CHOLMOD, scikit-sparse)")
     ap.add_argument("--scipy-worker", help=argparse.SUPPRESS)
+    ap.add_argument("--peer", default="superlu", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.scipy_worker:
-        return scipy_worker(args.scipy_worker, args.modes)
+        return scipy_worker(args.scipy_worker, args.modes, args.peer)
     rows = []
     for dofs in (int(v) for v in args.dofs.split(",")):
         with tempfile.TemporaryDirectory(prefix="eigenfit-plate-") as folder:
             subprocess.run([sys.executable, os.path.join(HERE, "plate_matrices.py"), "--dofs", str(dofs),
                             "--zones", args.zones, "--out", folder], check=True, capture_output=True)
-            sp = run_json([sys.executable, __file__, "--scipy-worker", folder, "--modes", str(args.modes)])
             ef = run_json([args.bench, os.path.join(folder, "model.toml"), str(args.modes)])
-            diff = max(abs(a / b - 1) for a, b in zip(ef["frequencies_hz"], sp["frequencies_hz"]))
-            row = {"dofs": ef["dofs"], "nnz_upper": ef["nnz"], "scipy": sp, "eigenfit": ef, "max_rel_diff": diff}
-            rows.append(row)
-            print(f"{ef['dofs']:>8} DOFs  nnz {ef['nnz']:>9}  CPU seconds (wall in brackets): "
-                  f"scipy: read {sp['load_cpu_s']:.2f} ({sp['load_s']:.2f}), "
-                  f"modes+sens {sp['modes_and_sensitivities_cpu_s']:.3f} ({sp['modes_and_sensitivities_s']:.3f}), "
-                  f"peak {sp['peak_rss_kb'] / 1024:.0f} MB | "
-                  f"eigenfit: read {ef['load_cpu_s']:.2f} ({ef['load_s']:.2f}), "
-                  f"modes+sens {ef['modes_and_sensitivities_cpu_s']:.3f} ({ef['modes_and_sensitivities_s']:.3f}), "
-                  f"warm modes {ef['warm_modes_cpu_s']:.3f}, peak {ef['peak_rss_kb'] / 1024:.0f} MB | "
-                  f"CPU speed-up {sp['modes_and_sensitivities_cpu_s'] / ef['modes_and_sensitivities_cpu_s']:.2f}×, "
-                  f"max rel. freq. diff {diff:.1e}", flush=True)
+            for peer in args.peers.split(","):
+                sp = run_json([sys.executable, __file__, "--scipy-worker", folder, "--modes", str(args.modes),
+                               "--peer", peer])
+                diff = max(abs(a / b - 1) for a, b in zip(ef["frequencies_hz"], sp["frequencies_hz"]))
+                row = {"dofs": ef["dofs"], "nnz_upper": ef["nnz"], "peer": peer, "scipy": sp, "eigenfit": ef,
+                       "max_rel_diff": diff}
+                rows.append(row)
+                print(f"{ef['dofs']:>8} DOFs  nnz {ef['nnz']:>9}  CPU seconds (wall in brackets): "
+                      f"{peer}: read {sp['load_cpu_s']:.2f} ({sp['load_s']:.2f}), "
+                      f"modes+sens {sp['modes_and_sensitivities_cpu_s']:.3f} ({sp['modes_and_sensitivities_s']:.3f}), "
+                      f"peak {sp['peak_rss_kb'] / 1024:.0f} MB | "
+                      f"eigenfit: read {ef['load_cpu_s']:.2f} ({ef['load_s']:.2f}), "
+                      f"modes+sens {ef['modes_and_sensitivities_cpu_s']:.3f} ({ef['modes_and_sensitivities_s']:.3f}), "
+                      f"warm modes {ef['warm_modes_cpu_s']:.3f}, peak {ef['peak_rss_kb'] / 1024:.0f} MB | "
+                      f"CPU speed-up {sp['modes_and_sensitivities_cpu_s'] / ef['modes_and_sensitivities_cpu_s']:.2f}×, "
+                      f"max rel. freq. diff {diff:.1e}", flush=True)
     json.dump(rows, sys.stderr)
 
 

@@ -166,6 +166,32 @@ def lowest(K, M, count):
     return lam[order], phi[:, order]
 
 
+def write_shapes(path, phi, dof_map, nx, ny, count):
+    """shapes.csv: w of every mode at `count` interior nodes spread over the plate (an
+    a × b grid of sensors, a·b = count, a/b ≈ nx/ny), node counted from 0 in the order nodes
+    first appear in the DOF map (as `--shapes` reads it)."""
+    a = max(1, round(np.sqrt(count * nx / ny)))
+    while count % a:
+        a -= 1
+    b = count // a
+    order, w_dof = {}, {}
+    for d, (nd, direction, _, _) in enumerate(dof_map):
+        order.setdefault(nd, len(order))
+        if direction == "z":
+            w_dof[nd] = d
+    sensors = []
+    for i in range(a):
+        for j in range(b):
+            ix = 1 + round((i + 0.5) * (nx - 2) / a - 0.5)
+            jy = 1 + round((j + 0.5) * (ny - 2) / b - 0.5)
+            sensors.append(ix * ny + jy)
+    with open(path, "w") as f:
+        f.write("mode,node,direction,value\n")
+        for k in range(phi.shape[1]):
+            for nd in sensors:
+                f.write(f"{k + 1},{order[nd]},z,{phi[w_dof[nd], k]:.12g}\n")
+
+
 def hz(lam):
     return np.sqrt(np.maximum(lam, 0)) / (2 * np.pi)
 
@@ -178,11 +204,15 @@ def main():
     ap.add_argument("--measured", help="P1,P2,…: write measured.csv (scipy) at these zone factors")
     ap.add_argument("--modes", type=int, default=10, help="modes in measured.csv (default 10)")
     ap.add_argument("--dof-map", action="store_true", help="also write dofs.csv (node, direction, x, y, z)")
+    ap.add_argument("--shapes", type=int, default=0,
+                    help="with --measured: also write shapes.csv, w of every measured mode at this many "
+                         "sensors (a grid of interior nodes; implies --dof-map)")
     ap.add_argument("--symmetric", action="store_true",
                     help="stiffeners on the centre lines (a nearly doubly symmetric plate: mirrored zones fit alike)")
     ap.add_argument("--reference", action="store_true",
                     help="also write scipy_reference.json: nominal frequencies and df/dp by scipy")
     args = ap.parse_args()
+    args.dof_map = args.dof_map or args.shapes > 0
     zx, zy = (int(v) for v in args.zones.lower().split("x"))
     layout = "symmetric" if args.symmetric else "off-centre"
     K0, M, zones, dof_map, (nx, ny) = build(args.dofs, zx, zy, layout)
@@ -228,7 +258,9 @@ def main():
         if len(p) != len(zones):
             sys.exit(f"--measured: {len(p)} values for {len(zones)} zones")
         K = K0 + sum(pi * Z for pi, Z in zip(p, zones))
-        lam, _ = lowest(K, M, args.modes)
+        lam, phi = lowest(K, M, args.modes)
+        if args.shapes:
+            write_shapes(os.path.join(args.out, "shapes.csv"), phi, dof_map, nx, ny, args.shapes)
         with open(os.path.join(args.out, "measured.csv"), "w") as f:
             f.write(f"# scipy eigsh(K, {args.modes}, M, sigma=0) at zone factors {args.measured}\n")
             f.write("mode,frequency_hz\n")

@@ -132,6 +132,11 @@ pub struct Sensitivities {
     /// Relative accuracy of each wanted λₖ as the matrices define it ([`eigenvalue_round_off`];
     /// NaN for the modes not wanted).
     pub eigenvalue_round_off: DVector<f64>,
+    /// ∂K/∂pᵢ, ∂M/∂pᵢ at the point, one per parameter: kept for what is built on the same
+    /// linearisation (the shapes' derivatives) without asking the model again.
+    pub derivatives: Vec<SystemDerivative>,
+    /// K and M at the point, as the model assembled them.
+    pub system: System,
 }
 
 impl Sensitivities {
@@ -179,11 +184,13 @@ impl Sensitivities {
                 return Err(SensitivityError::ZeroFrequency { mode: k, lambda });
             }
         }
+        let mut derivatives = Vec::with_capacity(np);
         for i in 0..np {
             let d = model.derivative(p, i)?;
             for &k in wanted {
                 dl[(k, i)] = eigenvalue_derivative(&modes, k, &d);
             }
+            derivatives.push(d);
         }
         for &k in wanted {
             let f = crate::units::eigenvalue_to_hz(modes.eigenvalues[k]);
@@ -194,7 +201,14 @@ impl Sensitivities {
         for &k in wanted {
             round_off[k] = eigenvalue_round_off(&system, &modes, k);
         }
-        Ok(Self { modes, eigenvalues: dl, frequencies_hz: df, eigenvalue_round_off: round_off })
+        Ok(Self {
+            modes,
+            eigenvalues: dl,
+            frequencies_hz: df,
+            eigenvalue_round_off: round_off,
+            derivatives,
+            system,
+        })
     }
 }
 
@@ -250,8 +264,10 @@ pub fn eigenvector_derivative_nelson(
     Ok(one.remove(0))
 }
 
-/// [`eigenvector_derivative_nelson`] for several parameters' derivatives at once: the dense
-/// O(n³) factorisation of K − λₖM is done once for all of them.
+/// [`eigenvector_derivative_nelson`] for several parameters' derivatives at once: K − λₖM is
+/// factored once for all of them — densely (LU, O(n³)) for a dense system; for a banded or
+/// sparse one by a sparse LDLᵀ on the eigen-solver's own ordering (`SparseSolver`'s symbolic
+/// factorisation reused), in the factor's memory, so shapes are fitted at any size.
 pub fn eigenvector_derivatives_nelson(
     system: &System,
     modes: &Modes,
@@ -260,30 +276,60 @@ pub fn eigenvector_derivatives_nelson(
 ) -> Result<Vec<DVector<f64>>, SensitivityError> {
     check_distinct(modes, k, DEFAULT_REPEATED_TOLERANCE, rigid_body_tolerance(system))?;
     let lk = modes.eigenvalues[k];
-    let phi = DVector::from_column_slice(modes.shape(k));
-    let m_phi = system.mass() * &phi;
+    let phi = modes.shape(k);
+    let n = phi.len();
+    let mut m_phi = vec![0.0; n];
+    system.mass_mul_add(1.0, phi, &mut m_phi);
+    let pivot = modes.shapes.column(k).iamax();
+    let mut solutions: Vec<Vec<f64>> = derivatives
+        .iter()
+        .map(|d| {
+            let dlk = eigenvalue_derivative(modes, k, d);
+            let mut rhs: Vec<f64> = m_phi.iter().map(|v| v * dlk).collect();
+            d.stiffness.mul_add(-1.0, phi, &mut rhs);
+            d.mass.mul_add(lk, phi, &mut rhs);
+            rhs[pivot] = 0.0;
+            rhs
+        })
+        .collect();
+    solve_pinned(system, lk, pivot, &mut solutions, k)?;
+    solutions
+        .into_iter()
+        .zip(derivatives)
+        .map(|(v, d)| {
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(SensitivityError::Singular { mode: k });
+            }
+            let c = -m_phi.iter().zip(&v).map(|(a, b)| a * b).sum::<f64>() - 0.5 * d.mass.bilinear(phi, phi);
+            Ok(DVector::from_iterator(n, v.iter().zip(phi).map(|(vi, pi)| vi + c * pi)))
+        })
+        .collect()
+}
+
+/// Solves Nelson's system (K − λₖM) v = b, DOF `pivot` pinned to zero, for every b in `rhs`.
+fn solve_pinned(
+    system: &System,
+    lk: f64,
+    pivot: usize,
+    rhs: &mut [Vec<f64>],
+    k: usize,
+) -> Result<(), SensitivityError> {
+    if system.band().is_some() || system.sparse_pair().is_some() {
+        return match crate::eigen::sparse_solver::solve_pinned(system, lk, pivot, rhs)? {
+            true => Ok(()),
+            false => Err(SensitivityError::Singular { mode: k }),
+        };
+    }
     let mut a = system.stiffness() - system.mass() * lk;
-    let pivot = phi.iamax();
     a.row_mut(pivot).fill(0.0);
     a.column_mut(pivot).fill(0.0);
     a[(pivot, pivot)] = 1.0;
     let lu = a.lu();
-    derivatives
-        .iter()
-        .map(|d| {
-            let dlk = eigenvalue_derivative(modes, k, d);
-            let mut rhs = &m_phi * dlk;
-            d.stiffness.mul_add(-1.0, phi.as_slice(), rhs.as_mut_slice());
-            d.mass.mul_add(lk, phi.as_slice(), rhs.as_mut_slice());
-            rhs[pivot] = 0.0;
-            let v = lu.solve(&rhs).ok_or(SensitivityError::Singular { mode: k })?;
-            if v.iter().any(|x| !x.is_finite()) {
-                return Err(SensitivityError::Singular { mode: k });
-            }
-            let c = -m_phi.dot(&v) - 0.5 * d.mass.bilinear(phi.as_slice(), phi.as_slice());
-            Ok(v + &phi * c)
-        })
-        .collect()
+    for b in rhs.iter_mut() {
+        let v = lu.solve(&DVector::from_column_slice(b)).ok_or(SensitivityError::Singular { mode: k })?;
+        b.copy_from_slice(v.as_slice());
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -325,6 +371,93 @@ mod tests {
             let a = eigenvector_derivative_nelson(&sys, &modes, k, &d).unwrap();
             let b = eigenvector_derivative_modal(&modes, k, &d, 0.0).unwrap();
             assert!((&a - &b).amax() < 1e-12 * a.amax().max(1.0), "mode {k}: {a} vs {b}");
+        }
+    }
+
+    /// A 2-D grid of masses and springs (nx·ny DOFs, fixed edges), K and M at parameter `p`
+    /// (which stiffens the springs of the left third and weighs its masses: ∂K and ∂M ≠ 0),
+    /// and the derivative: a pattern no band keeps narrow, non-uniform so no mode repeats.
+    fn grid(nx: usize, ny: usize, p: f64) -> (DMatrix<f64>, DMatrix<f64>, SystemDerivative) {
+        let n = nx * ny;
+        let id = |i: usize, j: usize| i * ny + j;
+        let zone = |i: usize| i < nx / 3;
+        let (mut k, mut dk) = (DMatrix::zeros(n, n), SparseSymmetric::zeros(n));
+        let mut spring = |a: usize, b: Option<usize>, s: f64, inside: bool| {
+            let s = if inside { s * p } else { s };
+            let ds = if inside { s / p } else { 0.0 };
+            k[(a, a)] += s;
+            dk.add(a, a, ds);
+            if let Some(b) = b {
+                k[(b, b)] += s;
+                k[(a, b)] -= s;
+                k[(b, a)] -= s;
+                dk.add(b, b, ds);
+                dk.add(a, b, -ds);
+            }
+        };
+        for i in 0..nx {
+            for j in 0..ny {
+                let (kx, ky) = (1.0 + 0.05 * j as f64, 1.37);
+                if i + 1 < nx {
+                    spring(id(i, j), Some(id(i + 1, j)), kx, zone(i) && zone(i + 1));
+                }
+                if j + 1 < ny {
+                    spring(id(i, j), Some(id(i, j + 1)), ky, zone(i));
+                }
+                if i == 0 || i + 1 == nx || j == 0 || j + 1 == ny {
+                    spring(id(i, j), None, kx, zone(i));
+                }
+            }
+        }
+        let mut m = DMatrix::zeros(n, n);
+        let mut dm = SparseSymmetric::zeros(n);
+        for i in 0..nx {
+            for j in 0..ny {
+                let base = 1.0 + 0.1 * ((id(i, j) * 7919) % 13) as f64;
+                m[(id(i, j), id(i, j))] = if zone(i) { base * p.sqrt() } else { base };
+                if zone(i) {
+                    dm.add(id(i, j), id(i, j), 0.5 * base / p.sqrt());
+                }
+            }
+        }
+        (k, m, SystemDerivative { stiffness: dk, mass: dm })
+    }
+
+    #[test]
+    fn nelson_on_sparse_and_banded_storage_matches_dense_and_finite_differences() {
+        use crate::eigen::SparseSolver;
+        use crate::matrix::{BandedSymmetric, CscSymmetric};
+        let (nx, ny, p) = (18, 13, 1.7);
+        let (k, m, d) = grid(nx, ny, p);
+        let dense = System::new(k.clone(), m.clone()).unwrap();
+        let sparse = System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap();
+        let banded =
+            System::banded(BandedSymmetric::from_dense(&k), BandedSymmetric::from_dense(&m)).unwrap();
+        let count = 6;
+        let modes = SparseSolver::default().lowest(&sparse, count).unwrap();
+        // The mode as the sparse solver returns it, sign-aligned with `modes`, at parameter q.
+        let shape_at = |q: f64, kk: usize| {
+            let (k, m, _) = grid(nx, ny, q);
+            let s = System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap();
+            let mut phi = SparseSolver::default().lowest(&s, count).unwrap().shapes.column(kk).into_owned();
+            if phi.dot(&modes.shapes.column(kk)) < 0.0 {
+                phi = -phi;
+            }
+            phi
+        };
+        for kk in 0..count {
+            let reference = eigenvector_derivative_nelson(&dense, &modes, kk, &d).unwrap();
+            let scale = reference.amax();
+            assert!(scale > 0.0);
+            for (name, system) in [("sparse", &sparse), ("banded", &banded)] {
+                let v = eigenvector_derivative_nelson(system, &modes, kk, &d).unwrap();
+                let err = (&v - &reference).amax() / scale;
+                assert!(err < 1e-9, "{name} mode {kk}: {err:e} from the dense LU");
+            }
+            let fd = crate::testing::richardson(&[p], 0, 1e-3, |q| shape_at(q[0], kk));
+            let v = eigenvector_derivative_nelson(&sparse, &modes, kk, &d).unwrap();
+            let err = (&v - &fd).amax() / scale;
+            assert!(err < 1e-6, "mode {kk}: {err:e} from the finite difference");
         }
     }
 

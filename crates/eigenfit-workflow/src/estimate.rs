@@ -30,10 +30,6 @@ use eigenfit_core::update::{registry, Budget, Driver, Estimate, LevenbergMarquar
 use serde::Serialize;
 use std::path::PathBuf;
 
-/// Most DOFs of a model updated from measured shapes: their derivatives (Nelson's method) take
-/// a dense factorisation per mode and iteration, seconds each at this size and O(n³) beyond.
-pub const SHAPE_DOF_LIMIT: usize = 2000;
-
 /// Starts of the search for other solutions when not given: a space-filling design sized to the
 /// free parameters ([`search_starts`]: 4 per parameter and 8 more).
 pub fn default_alternative_starts(free: usize) -> usize {
@@ -386,15 +382,6 @@ pub fn run(
     let solver = request.source.solver()?;
     let options = &request.test_data;
     let data = test_data::read(&request.measured, any.layout(), options)?;
-    if data.sensors.is_some() && any.dofs() > SHAPE_DOF_LIMIT {
-        return Err(input(format!(
-            "{}: measured shapes need the shapes' derivatives, computed here by Nelson's method on \
-             dense matrices (O(n³) per mode and iteration): the model has {} DOFs, more than the {SHAPE_DOF_LIMIT} \
-             this is done for; estimate from the frequencies alone (a CSV of mode,frequency_hz)",
-            request.measured.display(),
-            any.dofs()
-        )));
-    }
     notes.extend(data.file_notes.iter().cloned());
     let measurement = data.measurement.clone();
     let (strategy_name, method) = build_strategy(&request.strategy, request.samples)?;

@@ -10,7 +10,7 @@
 use crate::eigen::EigenSolver;
 use crate::model::{ParameterSet, StructuralModel};
 use crate::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
-use crate::sensitivity::{eigenvector_derivatives_nelson, SensitivityError};
+use crate::sensitivity::eigenvector_derivatives_nelson;
 use nalgebra::{DMatrix, DVector};
 
 /// Default standard deviation of a unit-length measured shape's entries.
@@ -61,12 +61,11 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     /// The model shapes at the sensors, one per computed mode, and the paired model modes,
     /// at `p`.
     pub fn model_at_sensors(&self, p: &[f64]) -> Result<(Vec<Vec<f64>>, Vec<usize>), ResidualError> {
-        let lin = self.problem.linearise(p)?;
+        let (lin, sens) = self.problem.linearise_with_modes(p)?;
+        let modes = &sens.modes;
         let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
             return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
         };
-        let system = self.problem.model.assemble(p).map_err(SensitivityError::from)?;
-        let modes = self.problem.solver.lowest(&system, self.count()).map_err(SensitivityError::from)?;
         let shapes =
             (0..modes.count()).map(|k| sensor_dofs.iter().map(|&d| modes.shapes[(d, k)]).collect()).collect();
         Ok((shapes, lin.paired_modes))
@@ -113,11 +112,6 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
             budget,
         )
     }
-
-    /// Modes solved: as many as MAC pairing considers.
-    fn count(&self) -> usize {
-        (2 * self.problem.measured.modes_needed() + 2).min(self.problem.model.dofs())
-    }
 }
 
 impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
@@ -126,18 +120,14 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
     }
 
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
-        let mut lin = self.problem.linearise(p)?;
+        // The modes the frequency rows were paired on: one eigen-solve per linearisation.
+        let (mut lin, sens) = self.problem.linearise_with_modes(p)?;
+        let (modes, derivatives) = (&sens.modes, &sens.derivatives);
         let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
             return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
         };
-        let model = &self.problem.model;
-        let system = model.assemble(p).map_err(SensitivityError::from)?;
-        let modes = self.problem.solver.lowest(&system, self.count()).map_err(SensitivityError::from)?;
+        let system = &sens.system;
         let np = p.len();
-        let derivatives = (0..np)
-            .map(|i| model.derivative(p, i))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(SensitivityError::from)?;
         let m = lin.residual.len();
         let ns = sensor_dofs.len();
         let rows = m + m * ns;
@@ -175,8 +165,7 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
             let row0 = m + j * ns;
             residual.rows_mut(row0, ns).copy_from(&((ud - &u) * ws));
             // One factorisation of K − λₖM for every parameter.
-            for (i, dphi) in
-                eigenvector_derivatives_nelson(&system, &modes, k, &derivatives)?.iter().enumerate()
+            for (i, dphi) in eigenvector_derivatives_nelson(system, modes, k, derivatives)?.iter().enumerate()
             {
                 let ds = DVector::from_iterator(ns, sensor_dofs.iter().map(|&dof| dphi[dof]));
                 let du = (&ds - &u * u.dot(&ds)) / sn;

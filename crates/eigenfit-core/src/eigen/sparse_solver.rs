@@ -14,12 +14,13 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
+    SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use nalgebra::{DMatrix, DVector};
+use std::borrow::Cow;
 use std::cell::RefCell;
 
 /// Lowest modes of general sparse systems ([`System::sparse`]; dense and banded systems are
@@ -185,7 +186,16 @@ impl Workspace {
         sigma: f64,
     ) -> Result<Option<usize>, SolveError> {
         let a = CscSymmetric::combination(1.0, k, -sigma, m);
-        self.prepare(&a)?;
+        if !self.ldlt_factor(&a)? {
+            return Ok(None);
+        }
+        Ok(Some(self.diagonal.iter().filter(|&&d| d < 0.0).count()))
+    }
+
+    /// Factors the symmetric (possibly indefinite) `a` = LDLᵀ into `ldlt`, without pivoting,
+    /// its D in `diagonal`; false when a pivot is zero or not finite.
+    fn ldlt_factor(&mut self, a: &CscSymmetric) -> Result<bool, SolveError> {
+        self.prepare(a)?;
         let (symbolic, buffer) =
             (self.symbolic.as_ref().expect("prepared"), self.buffer.as_mut().expect("prepared"));
         self.ldlt.resize(symbolic.len_val(), 0.0);
@@ -204,13 +214,23 @@ impl Workspace {
             Default::default(),
         );
         if factored.is_err() {
-            return Ok(None);
+            return Ok(false);
         }
         factor_diagonal(symbolic, &self.ldlt, &mut self.diagonal);
-        if self.diagonal.iter().any(|d| !d.is_finite() || *d == 0.0) {
-            return Ok(None);
-        }
-        Ok(Some(self.diagonal.iter().filter(|&&d| d < 0.0).count()))
+        Ok(self.diagonal.iter().all(|d| d.is_finite() && *d != 0.0))
+    }
+
+    /// Solves with the LDLᵀ factor held in `ldlt`, in place.
+    fn ldlt_solve(&mut self, x: &mut [f64]) {
+        let (symbolic, buffer) =
+            (self.symbolic.as_ref().expect("factored"), self.buffer.as_mut().expect("factored"));
+        let n = x.len();
+        LdltRef::new(symbolic, &self.ldlt).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(x, n, 1),
+            Par::Seq,
+            MemStack::new(buffer),
+        );
     }
 }
 
@@ -284,19 +304,8 @@ impl SparseSolver {
     ) -> Result<(Modes, f64), SolveError> {
         check_count(system, count)?;
         let n = system.dofs();
-        let converted;
-        let (k, m) = match (system.sparse_pair(), system.band()) {
-            (Some(pair), _) => pair,
-            (None, Some((k, m))) => {
-                converted = (CscSymmetric::from_banded(k), CscSymmetric::from_banded(m));
-                (&converted.0, &converted.1)
-            }
-            (None, None) => {
-                converted =
-                    (CscSymmetric::from_dense(system.stiffness()), CscSymmetric::from_dense(system.mass()));
-                (&converted.0, &converted.1)
-            }
-        };
+        let pair = csc_pair(system);
+        let (k, m): (&CscSymmetric, &CscSymmetric) = (&pair.0, &pair.1);
         // More than half the spectrum: Lanczos has no advantage, the dense solver is exact.
         if 2 * count > n && n <= MAX_DENSE_FALLBACK {
             return DenseSolver.lowest_with_next(system, count);
@@ -435,6 +444,83 @@ impl SparseSolver {
             return Err(backend("Lanczos returned eigenvalues out of order"));
         }
         Ok(Found { eigenvalues, vectors: ritz.vectors[..count * n].to_vec() })
+    }
+}
+
+/// (K, M) of `system` as general sparse matrices: borrowed when stored so, converted from a
+/// band or dense storage otherwise.
+fn csc_pair(system: &System) -> (Cow<'_, CscSymmetric>, Cow<'_, CscSymmetric>) {
+    match (system.sparse_pair(), system.band()) {
+        (Some((k, m)), _) => (Cow::Borrowed(k), Cow::Borrowed(m)),
+        (None, Some((k, m))) => {
+            (Cow::Owned(CscSymmetric::from_banded(k)), Cow::Owned(CscSymmetric::from_banded(m)))
+        }
+        (None, None) => (
+            Cow::Owned(CscSymmetric::from_dense(system.stiffness())),
+            Cow::Owned(CscSymmetric::from_dense(system.mass())),
+        ),
+    }
+}
+
+/// Solves (K − σM) xⱼ = bⱼ for every right-hand side in `rhs`, in place, with DOF `pinned`
+/// held at zero (its row and column of K − σM replaced by the identity's, its entry of every bⱼ
+/// zeroed): the system of Nelson's method, non-singular when σ is a simple eigenvalue and the
+/// eigenvector is not zero at `pinned`.
+///
+/// One sparse LDLᵀ (no pivoting; K − σM is indefinite) of K − σM on the pattern of K ∪ M — the
+/// pattern the eigen-solves factor, so the thread's symbolic factorisation (AMD ordering,
+/// elimination tree) is reused — and per right-hand side one solve and one step of iterative
+/// refinement against the matrix itself. Banded and dense systems are converted. False when a
+/// pivot vanishes (σ not simple, or `pinned` a node of the mode).
+pub(crate) fn solve_pinned(
+    system: &System,
+    sigma: f64,
+    pinned: usize,
+    rhs: &mut [Vec<f64>],
+) -> Result<bool, SolveError> {
+    let pair = csc_pair(system);
+    let pattern = CscSymmetric::combination(0.0, &pair.0, 0.0, &pair.1);
+    let mut a = CscSymmetric::combination(
+        1.0,
+        &with_pattern(&pattern, &pair.0),
+        -sigma,
+        &with_pattern(&pattern, &pair.1),
+    );
+    pin(&mut a, pinned);
+    WORKSPACE.with(|ws| {
+        let ws = &mut *ws.try_borrow_mut().map_err(|_| backend("workspace in use (re-entrant solve)"))?;
+        if !ws.ldlt_factor(&a)? {
+            return Ok(false);
+        }
+        let n = a.dim();
+        let mut residual = vec![0.0; n];
+        for b in rhs.iter_mut() {
+            b[pinned] = 0.0;
+            residual.copy_from_slice(b);
+            ws.ldlt_solve(b);
+            // r = b − A x, then x += A⁻¹ r: recovers the digits an unpivoted LDLᵀ of an
+            // indefinite matrix may lose.
+            a.mul_add(-1.0, b, &mut residual);
+            ws.ldlt_solve(&mut residual);
+            b.iter_mut().zip(&residual).for_each(|(x, dx)| *x += dx);
+        }
+        Ok(true)
+    })
+}
+
+/// Replaces row and column `j` of `a` by the identity's (the pattern kept).
+fn pin(a: &mut CscSymmetric, j: usize) {
+    let n = a.dim();
+    let col_ptr = a.col_ptr().to_vec();
+    let rows = a.row_idx().to_vec();
+    let values = a.values_mut();
+    for c in 0..n {
+        for p in col_ptr[c]..col_ptr[c + 1] {
+            let r = rows[p];
+            if r == j || c == j {
+                values[p] = if r == c { 1.0 } else { 0.0 };
+            }
+        }
     }
 }
 

@@ -198,6 +198,22 @@ impl System {
         }
     }
 
+    /// `out += alpha · M x` in the system's own storage (no dense copy of a banded or sparse M).
+    pub fn mass_mul_add(&self, alpha: f64, x: &[f64], out: &mut [f64]) {
+        match &self.storage {
+            Storage::Dense { mass, .. } => {
+                for (j, &xj) in x.iter().enumerate() {
+                    let a = alpha * xj;
+                    for (o, &v) in out.iter_mut().zip(mass.column(j).iter()) {
+                        *o += v * a;
+                    }
+                }
+            }
+            Storage::Banded { mass, .. } => mass.mul_add(alpha, x, out),
+            Storage::Sparse { mass, .. } => mass.mul_add(alpha, x, out),
+        }
+    }
+
     /// Consumes the system, returning (K, M) dense.
     pub fn into_parts(self) -> (DMatrix<f64>, DMatrix<f64>) {
         match self.storage {
@@ -316,6 +332,9 @@ mod tests {
         let x = [1.0, -2.0, 3.0];
         for system in [&dense, &banded, &sparse] {
             assert_eq!(system.abs_quadratic(&x), (35.0, 7.0));
+            let mut mx = vec![1.0; 3];
+            system.mass_mul_add(2.0, &x, &mut mx);
+            assert_eq!(mx, [2.0, -1.0, 4.0]);
         }
         let mut bad = BandedSymmetric::zeros(3, 1);
         bad.add(2, 1, f64::INFINITY);

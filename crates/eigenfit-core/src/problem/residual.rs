@@ -204,6 +204,14 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
 
     /// Residual and Jacobian at `p`.
     pub fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        self.linearise_with_modes(p).map(|(lin, _)| lin)
+    }
+
+    /// [`linearise`](Self::linearise) and the [`Sensitivities`] it was built from: the model
+    /// modes it solved (the lowest `modes_needed`, or with MAC pairing 2·`modes_needed` + 2,
+    /// mass-normalised) and the parameter derivatives of K and M, for residuals built on them
+    /// (shapes) without a second solve.
+    pub fn linearise_with_modes(&self, p: &[f64]) -> Result<(Linearisation, Sensitivities), ResidualError> {
         let needed = self.measured.modes_needed();
         let dofs = self.model.dofs();
         if needed > dofs {
@@ -268,7 +276,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             lin.residual[row] = r / sigma;
             lin.jacobian.row_mut(row).copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));
         }
-        Ok(lin)
+        Ok((lin, sens))
     }
 
     /// Residual value, Jacobian scale and weight of one measured mode against model eigenvalue λ.
