@@ -1,32 +1,20 @@
 //! The 12-coefficient run-up fit (kxx, kyy, kxy, kyx, cxx, cyy of both bearings) from starts
-//! 30–50 % off the truth (issue 30 item 4): ROSS's run-up of `runup_nominal.toml` with known
-//! factors (`runup_truth.csv`, `runup_truth.json`, scripts/ross_runup_reference.py), fitted as
-//! `estimate --parameters kxx,kyy,kxy,kyx,cxx,cyy` fits it ([`fit_runup`], its default 6
-//! restarts), from every start of [`starts`]: each factor the truth's × (1 ± u), u in 0.3…0.5.
+//! 30–50 % off the truth (issue 30 item 4): ROSS's run-ups of the truth rotor (factors
+//! `runup_truth.json` on `runup_nominal.toml`: `runup_truth6.csv`, 6 modes at 10 speeds with
+//! whirl; `runup_truth.csv`, 4 modes at 6 speeds without), fitted as `estimate --parameters
+//! kxx,kyy,kxy,kyx,cxx,cyy` fits them ([`fit_runup`], 6 restarts), from every start of a design:
+//! each factor the truth's × (1 ± u), u in 0.3…0.5 (`tests/support/starts.rs`).
 //!
-//! `cargo run --release -p eigenfit-rotordynamics --example runup12_starts -- [STARTS]`
-//! (default 24; the first 4 are the test's, `tests/identify.rs`).
-use eigenfit_core::update::{halton, Budget};
+//! `cargo run --release -p eigenfit-rotordynamics --example runup12_starts -- [CSV] [STARTS]`
+//! (CSV in tests/data, default runup_truth6.csv; STARTS default 24, the first 3 are the test's).
+use eigenfit_core::update::Budget;
 use eigenfit_rotordynamics::fit::fit_runup;
 use eigenfit_rotordynamics::identify::{bearing_parameters, read_runup};
 use eigenfit_rotordynamics::objective::RunupObjective;
 use std::path::Path;
 
-/// `count` starts, each factor the truth's × (1 + u) or × (1 − u) with u in 0.3…0.5: first all
-/// up 40 %, all down 40 %, then a Halton design for the sign and size of each factor's error.
-fn starts(truth: &[f64], count: usize) -> Vec<Vec<f64>> {
-    let n = truth.len();
-    let uniform = [1.4, 0.6].into_iter().map(|f| truth.iter().map(|t| t * f).collect::<Vec<_>>());
-    let mixed = halton(count, 2 * n).into_iter().map(|u| {
-        (0..n)
-            .map(|i| {
-                let size = 0.3 + 0.2 * u[n + i];
-                truth[i] * if u[i] < 0.5 { 1.0 - size } else { 1.0 + size }
-            })
-            .collect::<Vec<_>>()
-    });
-    uniform.chain(mixed).take(count).collect()
-}
+#[path = "../tests/support/starts.rs"]
+mod starts;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -44,7 +32,7 @@ fn main() {
     let (mut recovered, mut evaluations) = (0, Vec::new());
     println!("| start | largest start error | termination | χ² | largest factor error | restarts | evaluations |");
     println!("|---|---|---|---|---|---|---|");
-    for (k, start) in starts(&t, count).iter().enumerate() {
+    for (k, start) in starts::starts_off(&t, count).iter().enumerate() {
         let off = start.iter().zip(&t).map(|(s, t)| (s / t - 1.0).abs()).fold(0.0, f64::max);
         let (est, restarts) =
             fit_runup(&objective, &params, start, 200, 6, &Budget::unlimited()).expect("fit");
