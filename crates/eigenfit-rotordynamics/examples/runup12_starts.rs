@@ -30,7 +30,9 @@ fn main() {
     let t: Vec<f64> = params.iter().map(|p| truth["factors"][&p.name].as_f64().expect("factor")).collect();
     let objective = RunupObjective::new(&rotor, params.clone(), &points, None).expect("objective");
     let (mut recovered, mut evaluations) = (0, Vec::new());
-    println!("| start | largest start error | termination | χ² | largest factor error | restarts | evaluations |");
+    println!(
+        "| start | largest start error | termination | χ² | largest factor error | restarts | evaluations |"
+    );
     println!("|---|---|---|---|---|---|---|");
     for (k, start) in starts::starts_off(&t, count).iter().enumerate() {
         let off = start.iter().zip(&t).map(|(s, t)| (s / t - 1.0).abs()).fold(0.0, f64::max);

@@ -24,9 +24,10 @@ pub const SCREEN_RANGE_LN: f64 = 1.098_612_288_668_109_8;
 /// (ranked once, only when the fit from the file's bearings does not pass).
 pub const SCREENED_PER_RESTART: usize = 8;
 /// Iterations of every stage but the last (a warm-up): it only has to bring the factors it frees
-/// near their basin, not to converge with the weaker factors still held wrong. Measured on the
-/// 12-factor run-up of `runup_truth6.csv` from 8 starts 30–50 % off: warm-ups of 10 iterations
-/// reached the truth from all 8 in 59–72 evaluations, of 40 iterations in 68–607.
+/// near their basin, not to converge with the weaker factors still held wrong (during
+/// development, on the 12-factor run-up of `runup_truth6.csv` from 8 starts 30–50 % off, warm-ups
+/// of 40 iterations spent up to 607 evaluations where 10 spent at most 72; that comparison is not
+/// kept as a study — `examples/runup12_starts.rs` measures the setting in use).
 pub const WARM_UP_ITERATIONS: usize = 10;
 
 /// The stages of a fit: which factors are free, and whether on the lowest modes only.
@@ -138,10 +139,11 @@ impl<'o, 'a> Plan<'o, 'a> {
 /// Core's damped least squares with the run-up's step cap, `restarts` restarts from `seeds`,
 /// and the factors not `free` held.
 fn strategy(restarts: usize, seeds: Vec<Vec<f64>>, free: &[bool]) -> Result<LevenbergMarquardt, UpdateError> {
-    let lm = LevenbergMarquardtSettings { max_step: MAX_LN_STEP, max_restarts: restarts, ..Default::default() }
-        .build()
-        .map_err(|e| UpdateError::Setup(e.to_string()))?
-        .with_seeds(Arc::new(seeds));
+    let lm =
+        LevenbergMarquardtSettings { max_step: MAX_LN_STEP, max_restarts: restarts, ..Default::default() }
+            .build()
+            .map_err(|e| UpdateError::Setup(e.to_string()))?
+            .with_seeds(Arc::new(seeds));
     Ok(if free.iter().all(|&f| f) { lm } else { lm.with_fixed(free.iter().map(|f| !f).collect()) })
 }
 

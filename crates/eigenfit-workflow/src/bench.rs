@@ -32,8 +32,10 @@
 //! the same points. A sampler ignores the start and uses seed + `i` as its seed; its `final` is
 //! its best sample.
 
+use crate::bench_runup::RunupCase;
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
+use crate::posterior::SamplingError;
 use crate::source::ModelSource;
 use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 use eigenfit_core::matrix::System;
@@ -43,8 +45,6 @@ use eigenfit_core::measurement::{MeasuredMode, Measurement};
 use eigenfit_core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
 use eigenfit_core::update::{registry, Budget, Driver, Method, Posterior, Sampler};
-use crate::bench_runup::RunupCase;
-use crate::posterior::SamplingError;
 use eigenfit_rotor::presets;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -309,8 +309,7 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(at(format!("tolerance = {tolerance}: must be a number greater than zero")));
     }
-    let mut problem =
-        BenchProblem { name: String::new(), data, truth, start_range: Vec::new(), tolerance };
+    let mut problem = BenchProblem { name: String::new(), data, truth, start_range: Vec::new(), tolerance };
     let params = problem.parameters();
     let mut start_range: Vec<(f64, f64)> = params.iter().map(|p| p.search_range()).collect();
     for (key, value) in file.starts.iter().flatten() {
@@ -400,22 +399,27 @@ fn runup_file(
     dir: &Path,
     at: &dyn Fn(String) -> WorkflowError,
 ) -> Result<(ProblemData, Vec<f64>), WorkflowError> {
-    for (key, given) in
-        [("modes", file.modes.is_some()), ("relative_std", file.relative_std.is_some()), ("solver", file.solver.is_some())]
-    {
+    for (key, given) in [
+        ("modes", file.modes.is_some()),
+        ("relative_std", file.relative_std.is_some()),
+        ("solver", file.solver.is_some()),
+    ] {
         if given {
             return Err(at(format!(
                 "`{key}` does not apply to a ROSS run-up (the data are the run-up CSV in `measured`)"
             )));
         }
     }
-    let measured = file
-        .measured
-        .as_ref()
-        .ok_or_else(|| at("a ROSS rotor's problem needs `measured`, a run-up CSV (speed_rpm,mode,frequency_hz,std_hz)".into()))?;
+    let measured = file.measured.as_ref().ok_or_else(|| {
+        at("a ROSS rotor's problem needs `measured`, a run-up CSV (speed_rpm,mode,frequency_hz,std_hz)"
+            .into())
+    })?;
     let names: Vec<&str> = file.truth.keys().map(String::as_str).collect();
     if names.is_empty() {
-        return Err(at("truth: name at least one factor (e.g. `kxx_DE = 1.2`, a factor on the file's kxx of bearing DE)".into()));
+        return Err(at(
+            "truth: name at least one factor (e.g. `kxx_DE = 1.2`, a factor on the file's kxx of bearing DE)"
+                .into(),
+        ));
     }
     let case = crate::bench_runup::from_files(&dir.join(&file.model), &dir.join(measured), &names)
         .map_err(|e| at(e.to_string()))?;
@@ -587,7 +591,15 @@ impl BenchProblem {
         match &self.data {
             ProblemData::Modal { model, measured, solver } => {
                 let solver = solver_by_name(solver).map_err(SamplingError::Failed)?;
-                crate::posterior::sample(model.as_ref(), solver.as_ref(), measured, &self.name, sampler, seed, budget)
+                crate::posterior::sample(
+                    model.as_ref(),
+                    solver.as_ref(),
+                    measured,
+                    &self.name,
+                    sampler,
+                    seed,
+                    budget,
+                )
             }
             ProblemData::Runup(case) => case.sample(sampler, seed, budget),
         }
@@ -646,8 +658,9 @@ fn run_one(
         Method::Local(mut strategy) => {
             let budget = Budget::new(request.budget.unwrap_or(DEFAULT_RUN_BUDGET));
             let driver = Driver { max_iterations: request.max_iterations };
-            let run = problem
-                .with_objective(|objective| driver.run_within(objective, strategy.as_mut(), &initial, &budget))?;
+            let run = problem.with_objective(|objective| {
+                driver.run_within(objective, strategy.as_mut(), &initial, &budget)
+            })?;
             Ok(match run {
                 Ok(est) => {
                     let why = (!est.termination.is_converged()).then(|| est.termination.to_string());
