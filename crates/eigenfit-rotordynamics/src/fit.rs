@@ -78,6 +78,18 @@ impl<'o, 'a> Plan<'o, 'a> {
         Self { full: objective, lowest, stages }
     }
 
+    /// `estimate` as the whole run-up sees it: a chain that ended in a stage on the lowest
+    /// modes has its last point evaluated again on every point (what the verdict, the intervals
+    /// and the report's rows read), one more evaluation counted in `evaluations` and not charged
+    /// to the budget, which has run out or met a failed model.
+    fn on_every_point(&self, mut estimate: Estimate, on_lowest: bool) -> Result<Estimate, UpdateError> {
+        if on_lowest && self.lowest.is_some() {
+            estimate.last = self.full.linearise(&estimate.parameters).map_err(UpdateError::Residual)?;
+            estimate.evaluations += 1;
+        }
+        Ok(estimate)
+    }
+
     fn objective(&self, lowest: bool) -> &dyn Objective {
         match (&self.lowest, lowest) {
             (Some(low), true) => low,
@@ -112,7 +124,8 @@ impl<'o, 'a> Plan<'o, 'a> {
                 Err(_) if budget.exhausted() && done.is_some() => {
                     let mut so_far = done.expect("checked just above"); // proof: is_some() in the guard
                     so_far.termination = Termination::BudgetExhausted { limit: budget.limit() };
-                    return Ok((so_far, taken));
+                    let on_lowest = self.stages[k - 1].1;
+                    return Ok((self.on_every_point(so_far, on_lowest)?, taken));
                 }
                 Err(e) => return Err(e),
             };
@@ -128,7 +141,7 @@ impl<'o, 'a> Plan<'o, 'a> {
             // before the stages). A warm-up stage's iteration limit or stall only hands its point
             // on; the budget's end or a model that failed ends the chain.
             if k < last && (budget.exhausted() || diverged) {
-                return Ok((stage, taken));
+                return Ok((self.on_every_point(stage, *lowest)?, taken));
             }
             done = Some(stage);
         }
