@@ -235,7 +235,8 @@ fn strategies(c: &mut Criterion) {
         g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
         for problem in &problems {
             let start = problem.start(0, 0);
-            let objective = Problem::new(problem.model.as_ref(), DenseSolver, problem.measured.clone());
+            let bench::ProblemData::Modal { model, measured, .. } = &problem.data else { continue };
+            let objective = Problem::new(model.as_ref(), DenseSolver, measured.clone());
             match registry::build_local(&registry, &name) {
                 Ok((_, mut strategy)) => {
                     if Driver::default().run(&objective, strategy.as_mut(), &start).is_err() {

@@ -438,9 +438,15 @@ fn bench_lists_its_problems_and_strategies() {
     assert_eq!(code, 0, "{err}");
     let problems: Vec<&str> =
         v["problems"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
-    for name in
-        ["paper-table2", "paper-table3", "paper-table4", "paper-table5", "shear-frame", "five-group-truss"]
-    {
+    for name in [
+        "paper-table2",
+        "paper-table3",
+        "paper-table4",
+        "paper-table5",
+        "shear-frame",
+        "five-group-truss",
+        "ross-runup",
+    ] {
         assert!(problems.contains(&name), "{name} not in {problems:?}");
     }
     let truss = v["problems"].as_array().unwrap().iter().find(|p| p["name"] == "five-group-truss").unwrap();
@@ -453,4 +459,108 @@ fn bench_lists_its_problems_and_strategies() {
     }
     let tikhonov = v["strategies"].as_array().unwrap().iter().find(|s| s["name"] == "tikhonov").unwrap();
     assert!(tikhonov["settings"].as_array().unwrap().iter().any(|s| s == "choice"), "{tikhonov}");
+}
+
+/// Issue 32 item 1: a ROSS run-up in the registry (`ross-runup`) and as a problem file (a ROSS
+/// rotor as `model`, a run-up CSV as `measured`, the truth as factors on the file's curves):
+/// local strategies run on the run-up and reach the truth from its starts (0.6–1.5× the truth),
+/// the paper's eigenvalue strategies are recorded refused, a sampler is bounded by the budget,
+/// and a run-up problem file without data is refused naming `measured`.
+#[test]
+fn bench_runs_a_ross_runup_builtin_and_from_a_problem_file() {
+    let (code, v, err) = eigenfit(&[
+        "bench",
+        "--problems",
+        "ross-runup",
+        "--strategies",
+        "damped,newton,tmcmc",
+        "--starts",
+        "1",
+        "--seed",
+        "1",
+        "--budget",
+        "80",
+        "--json",
+    ]);
+    assert!(code == 0 || code == 3, "{code}: {err}");
+    let info = &v["problems"][0];
+    assert_eq!(info["truth"].as_object().unwrap().len(), 12);
+    assert_eq!(info["measured_hz"].as_array().unwrap().len(), 60);
+    let record =
+        |s: &str| v["records"].as_array().unwrap().iter().find(|r| r["strategy"] == s).unwrap().clone();
+    let damped = record("damped");
+    assert_eq!(damped["verdict"], "converged", "{damped}");
+    assert_eq!(damped["reached_truth"], true, "{damped}");
+    assert!(damped["chi2"].as_f64().unwrap() < 1e-6, "{damped}");
+    assert!(damped["evaluations"].as_u64().unwrap() <= 80);
+    let newton = record("newton");
+    assert_eq!(newton["verdict"], "refused");
+    assert_eq!(newton["evaluations"], 0);
+    assert!(newton["reason"].as_str().unwrap().contains("not applicable"), "{newton}");
+    let tmcmc = v["records"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["strategy"].as_str().unwrap().starts_with("tmcmc"))
+        .unwrap();
+    assert_eq!(tmcmc["verdict"], "budget-exhausted", "{tmcmc}");
+    assert!(tmcmc["evaluations"].as_u64().unwrap() <= 80);
+    assert_eq!(v["summary"].as_array().unwrap().len(), 3);
+
+    // The same problem from a file: ROSS rotor, run-up CSV, truth and starts as factors.
+    let data = |name: &str| {
+        std::fs::canonicalize(format!(
+            "{}/../eigenfit-rotordynamics/tests/data/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap()
+    };
+    let truth: Value =
+        serde_json::from_str(&std::fs::read_to_string(data("runup_truth.json")).unwrap()).unwrap();
+    let factors = truth["factors"].as_object().unwrap();
+    let list = |f: &dyn Fn(f64) -> String, separator: &str| {
+        factors
+            .iter()
+            .map(|(k, t)| format!("{k} = {}", f(t.as_f64().unwrap())))
+            .collect::<Vec<_>>()
+            .join(separator)
+    };
+    let text = format!(
+        "model = {:?}\nmeasured = {:?}\ntruth = {{ {} }}\ntolerance = 1e-3\n[starts]\n{}\n",
+        data("runup_nominal.toml"),
+        data("runup_truth6.csv"),
+        list(&|t| format!("{t}"), ", "),
+        list(&|t| format!("[{}, {}]", 0.6 * t, 1.5 * t), "\n"),
+    );
+    let scratch = common::scratch();
+    let problem = common::write_in(&scratch, "runup.toml", &text);
+    let (code, v, err) = eigenfit(&[
+        "bench",
+        "--problems",
+        problem.to_str().unwrap(),
+        "--strategies",
+        "trf",
+        "--starts",
+        "1",
+        "--seed",
+        "1",
+        "--budget",
+        "80",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let r = &v["records"][0];
+    assert_eq!(r["reached_truth"], true, "{r}");
+    assert!(
+        (r["final"]["kxy_NDE"].as_f64().unwrap() / factors["kxy_NDE"].as_f64().unwrap() - 1.0).abs() < 1e-3
+    );
+
+    let bad = common::write_in(
+        &scratch,
+        "no_data.toml",
+        &format!("model = {:?}\ntruth = {{ kxx_DE = 1.2 }}\n", data("runup_nominal.toml")),
+    );
+    let (code, _, err) = eigenfit(&["bench", "--problems", bad.to_str().unwrap(), "--strategies", "damped"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("measured") && err.contains("no_data.toml"), "{err}");
 }

@@ -225,6 +225,11 @@ impl Parameter {
         matches!(self.coefficient, 0 | 3)
     }
 
+    /// Whether it scales a damping coefficient (cxx … cyy).
+    pub fn is_damping(&self) -> bool {
+        self.coefficient >= 4
+    }
+
     /// The nominal value of this coefficient at speed Ω (rad/s).
     pub fn nominal(&self, rotor: &Rotor, speed: f64) -> f64 {
         self.curve(rotor).at(speed)

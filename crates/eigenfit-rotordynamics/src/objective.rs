@@ -84,6 +84,18 @@ impl<'a> RunupObjective<'a> {
         })
     }
 
+    /// The same objective on the points of modes `1..=highest` only (a continuation's first
+    /// stages: [`crate::fit::fit_runup`]).
+    pub fn lowest_modes(&self, highest: usize) -> Self {
+        Self {
+            rotor: self.rotor,
+            factors: self.factors.clone(),
+            effects: self.effects.clone(),
+            points: self.points.iter().filter(|p| p.mode <= highest).cloned().collect(),
+            parameters: self.parameters.clone(),
+        }
+    }
+
     /// The run-up points (with the assumed std filled in).
     pub fn points(&self) -> &[RunupPoint] {
         &self.points

@@ -11,6 +11,9 @@ use eigenfit_rotordynamics::objective::RunupObjective;
 use eigenfit_rotordynamics::{ross_file, Rotor};
 use std::path::PathBuf;
 
+#[path = "support/starts.rs"]
+mod starts;
+
 /// A run-up fit by core's driver ([`fit_runup`]) with what the tests read of it.
 struct Fitted {
     estimate: Estimate,
@@ -322,4 +325,36 @@ fn every_bearing_means_the_bearings_and_seals_are_named_one_by_one() {
         ["kxx_Bearing 0", "kyy_Bearing 0", "kxx_Bearing 13", "kyy_Bearing 13"]
     );
     assert_eq!(names(&["kxx", "kxx_Seal 1"]), ["kxx_Bearing 0", "kxx_Bearing 13", "kxx_Seal 1"]);
+}
+
+/// Issue 30 item 4: all twelve coefficients (kxx, kyy, kxy, kyx, cxx, cyy of both bearings)
+/// from starts 30–50 % off the truth, against ROSS's run-up of the truth rotor with 6 modes
+/// (5 and 6 cross near 4000 rpm at these starts) at 10 speeds with whirl (`runup_truth6.csv`,
+/// scripts/ross_realistic_runups.py). Each start as `estimate` runs it (6 restarts), within a
+/// budget of evaluations; each must end converged, pass the χ² test and give every factor to
+/// 1e-5. The starts are the first 3 of the study's design (every factor 40 % up, 40 % down, one
+/// mixed); the study over 24 starts, where 2 do not come back, is `examples/runup12_starts.rs`.
+#[test]
+fn twelve_coefficients_come_back_from_starts_thirty_to_fifty_percent_off() {
+    use eigenfit_core::analysis::verdict::{judge, FitVerdict};
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let r = ross_file::read(&dir.join("runup_nominal.toml")).unwrap();
+    let points = parse_runup(&std::fs::read_to_string(dir.join("runup_truth6.csv")).unwrap()).unwrap();
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("runup_truth.json")).unwrap()).unwrap();
+    let params = bearing_parameters(&r, &["kxx", "kyy", "kxy", "kyx", "cxx", "cyy"]).unwrap();
+    let t: Vec<f64> = params.iter().map(|p| truth["factors"][&p.name].as_f64().unwrap()).collect();
+    const BUDGET: usize = 1000;
+    for (k, start) in starts::starts_off(&t, 3).into_iter().enumerate() {
+        let id = fit(&r, &params, &points, &start, 200, 6, BUDGET).unwrap();
+        let worst = id.scales.iter().zip(&t).map(|(s, t)| (s / t - 1.0).abs()).fold(0.0, f64::max);
+        eprintln!(
+            "start {k}: {}, χ² {:.2e}, worst factor error {worst:.1e}, {} restarts, {} evaluations",
+            id.estimate.termination, id.cost, id.restarts, id.estimate.evaluations
+        );
+        assert!(id.estimate.termination.is_converged(), "start {k}: {}", id.estimate.termination);
+        assert_eq!(judge(&id.estimate.last, params.len()).verdict, FitVerdict::Acceptable, "start {k}");
+        assert!(worst < 1e-5, "start {k}: worst relative factor error {worst:.2e}: {:?}", id.scales);
+        assert!(id.estimate.evaluations < BUDGET, "start {k}: {} evaluations", id.estimate.evaluations);
+    }
 }

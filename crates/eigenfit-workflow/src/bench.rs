@@ -7,7 +7,9 @@
 //! [1e2, 1e8] N/m, the span of the paper's initial guesses; reached within 1 %, Table 4 within
 //! 2 %), a 3-storey shear frame (three modes, 0.1 % std, starts in [2e6, 2e8] N/m) and the
 //! five-group truss (`eigenfit_core::model::truss`: five EA from eight modes, 0.2 % std, starts
-//! within a decade of the design); a path to a problem file (TOML) is a problem too:
+//! within a decade of the design) and a ROSS run-up (`ross-runup`, [`crate::bench_runup`]: twelve
+//! factors on two bearings' coefficient curves from 60 whirl frequencies, std 0.01 Hz, starts
+//! 0.6–1.5× the truth; reached within 1e-3); a path to a problem file (TOML) is a problem too:
 //!
 //! ```toml
 //! model = "rotor.toml"          # relative to this file: a rotor or a kind = "matrices" model
@@ -20,13 +22,20 @@
 //! k_A = [1e3, 1e7]
 //! ```
 //!
+//! A problem file whose `model` is a ROSS rotor takes a run-up CSV as `measured` (required) and
+//! its `truth` as factors on the file's coefficient curves by parameter name (`kxx_DE = 1.2`,
+//! `estimate`'s `scales`): the truth's names are the parameters fitted. On a run-up the paper's
+//! eigenvalue strategies ([`crate::bench_runup::EIGENVALUE_STRATEGIES`]) are recorded `refused`.
+//!
 //! Start `i` of a problem is drawn uniformly in each parameter's scaled coordinate (ln p for a
 //! log parameter) within the start range, from the seed and `i` only: every strategy starts from
 //! the same points. A sampler ignores the start and uses seed + `i` as its seed; its `final` is
 //! its best sample.
 
+use crate::bench_runup::RunupCase;
 use crate::error::{input, WorkflowError};
 use crate::named::Named;
+use crate::posterior::SamplingError;
 use crate::source::ModelSource;
 use eigenfit_core::eigen::{DenseSolver, EigenSolver};
 use eigenfit_core::matrix::System;
@@ -34,8 +43,8 @@ use eigenfit_core::measurement::measured_csv::{self, shown};
 use eigenfit_core::measurement::synthetic::{synthesise, NoiseRng};
 use eigenfit_core::measurement::{MeasuredMode, Measurement};
 use eigenfit_core::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
-use eigenfit_core::problem::{Problem, ResidualKind};
-use eigenfit_core::update::{registry, Budget, Driver, Method};
+use eigenfit_core::problem::{Objective, Problem, ResidualKind};
+use eigenfit_core::update::{registry, Budget, Driver, Method, Posterior, Sampler};
 use eigenfit_rotor::presets;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -43,8 +52,15 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// The built-in problems.
-pub const BUILTIN_PROBLEMS: [&str; 6] =
-    ["paper-table2", "paper-table3", "paper-table4", "paper-table5", "shear-frame", "five-group-truss"];
+pub const BUILTIN_PROBLEMS: [&str; 7] = [
+    "paper-table2",
+    "paper-table3",
+    "paper-table4",
+    "paper-table5",
+    "shear-frame",
+    "five-group-truss",
+    "ross-runup",
+];
 
 /// Evaluations one local run may spend when no budget is given.
 pub const DEFAULT_RUN_BUDGET: usize = 5000;
@@ -55,29 +71,49 @@ pub const DEFAULT_BENCH_SAMPLES: usize = 500;
 /// A model that can be shared by the parallel runs.
 pub type SharedModel = Arc<dyn StructuralModel + Send + Sync>;
 
+/// What a problem fits.
+#[derive(Clone)]
+pub enum ProblemData {
+    /// A structural model's natural frequencies.
+    Modal {
+        /// The model.
+        model: SharedModel,
+        /// The measured frequencies, with standard deviations.
+        measured: Measurement,
+        /// The solver by name (as `--solver`).
+        solver: String,
+    },
+    /// A ROSS rotor's run-up: factors on its bearings' coefficient curves.
+    Runup(Arc<RunupCase>),
+}
+
 /// One benchmark problem.
 #[derive(Clone)]
 pub struct BenchProblem {
     /// Its name in records.
     pub name: String,
-    /// The model.
-    pub model: SharedModel,
-    /// The measured frequencies, with standard deviations.
-    pub measured: Measurement,
+    /// The model and the data.
+    pub data: ProblemData,
     /// The true parameters (the model's order).
     pub truth: Vec<f64>,
     /// Where starts are drawn, per parameter (values, not scaled).
     pub start_range: Vec<(f64, f64)>,
     /// Relative error within which every parameter has reached the truth.
     pub tolerance: f64,
-    /// The solver by name (as `--solver`).
-    pub solver: String,
 }
 
 impl BenchProblem {
+    /// The parameters.
+    pub fn parameters(&self) -> &ParameterSet {
+        match &self.data {
+            ProblemData::Modal { model, .. } => model.parameters(),
+            ProblemData::Runup(case) => case.parameters(),
+        }
+    }
+
     /// The parameters' names.
     pub fn names(&self) -> Vec<String> {
-        self.model.parameters().iter().map(|p| p.name.clone()).collect()
+        self.parameters().iter().map(|p| p.name.clone()).collect()
     }
 
     /// Start `i` under `seed`: uniform in each parameter's scaled coordinate within the start
@@ -86,8 +122,7 @@ impl BenchProblem {
         let mut rng = NoiseRng(
             seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (i as u64).wrapping_mul(0xD1B5_4A32_D192_ED03),
         );
-        self.model
-            .parameters()
+        self.parameters()
             .iter()
             .zip(&self.start_range)
             .map(|(p, &(lo, hi))| {
@@ -102,10 +137,11 @@ impl BenchProblem {
         p.len() == self.truth.len()
             && p.iter().zip(&self.truth).all(|(v, t)| ((v - t) / t).abs() <= self.tolerance)
     }
+}
 
-    fn solver(&self) -> Result<Box<dyn EigenSolver>, WorkflowError> {
-        ModelSource { solver: self.solver.clone(), ..ModelSource::default() }.solver()
-    }
+/// A structural problem's data.
+fn modal(model: SharedModel, measured: Measurement, solver: &str) -> ProblemData {
+    ProblemData::Modal { model, measured, solver: solver.to_string() }
 }
 
 /// A 3-storey shear frame: floor masses 1e4, 1e4 and 8e3 kg on storey stiffnesses k1 (ground
@@ -180,13 +216,11 @@ pub fn builtin(name: &str) -> Option<Result<BenchProblem, WorkflowError>> {
         let measured = synthetic(model.as_ref(), &truth, 2, 1e-3, Some(3))?;
         Ok(BenchProblem {
             name: name.to_string(),
-            model,
-            measured,
+            data: modal(model, measured, "dense"),
             truth: truth.to_vec(),
             // The paper's initial guesses span 1e2 to 1e8 N/m.
             start_range: vec![(1e2, 1e8); 2],
             tolerance,
-            solver: "dense".into(),
         })
     };
     Some(match name {
@@ -201,12 +235,10 @@ pub fn builtin(name: &str) -> Option<Result<BenchProblem, WorkflowError>> {
             let truth = vec![2e7, 1.8e7, 1.5e7];
             synthetic(model.as_ref(), &truth, 3, 1e-3, None).map(|measured| BenchProblem {
                 name: name.to_string(),
-                model,
-                measured,
+                data: modal(model, measured, "dense"),
                 truth,
                 start_range: vec![(2e6, 2e8); 3],
                 tolerance: 0.01,
-                solver: "dense".into(),
             })
         }
         // Five member groups' EA from the 8 lowest modes (0.2 % std, the example's noise level,
@@ -217,14 +249,29 @@ pub fn builtin(name: &str) -> Option<Result<BenchProblem, WorkflowError>> {
             let model: SharedModel = Arc::new(Truss::new());
             synthetic(model.as_ref(), &TRUTH, 8, 2e-3, None).map(|measured| BenchProblem {
                 name: name.to_string(),
-                model,
-                measured,
+                data: modal(model, measured, "dense"),
                 truth: TRUTH.to_vec(),
                 start_range: DESIGN.iter().map(|&d| (d / 10.0, d * 10.0)).collect(),
                 tolerance: 0.01,
-                solver: "dense".into(),
             })
         }
+        // Twelve bearing factors from ROSS's run-up (6 modes at 10 speeds with whirl); starts
+        // 0.6–1.5× the truth, the range `fit_runup`'s staging is measured on (docs/rotordynamics.md).
+        "ross-runup" => crate::bench_runup::builtin().and_then(|(case, truth)| {
+            let names: Vec<String> = case.parameters().iter().map(|p| p.name.clone()).collect();
+            let truth: Vec<f64> = names
+                .iter()
+                .map(|n| truth.iter().find(|(t, _)| t == n).map(|(_, v)| *v))
+                .collect::<Option<_>>()
+                .ok_or_else(|| WorkflowError::Failure("runup_truth.json lacks a factor".into()))?;
+            Ok(BenchProblem {
+                name: name.to_string(),
+                start_range: truth.iter().map(|&t| (0.6 * t, 1.5 * t)).collect(),
+                truth,
+                data: ProblemData::Runup(Arc::new(case)),
+                tolerance: 1e-3,
+            })
+        }),
         _ => return None,
     })
 }
@@ -256,16 +303,63 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
     let file: ProblemFile = toml::from_str(&text)
         .map_err(|e| at(eigenfit_core::names::with_serde_hint(e.to_string().trim_end())))?;
     let dir = path.parent().unwrap_or(Path::new("."));
+    let ross = crate::rotordynamics::ross_model(Some(&dir.join(&file.model))).is_some();
+    let (data, truth) = if ross { runup_file(&file, dir, &at)? } else { modal_file(&file, dir, &at)? };
+    let tolerance = file.tolerance.unwrap_or(0.01);
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return Err(at(format!("tolerance = {tolerance}: must be a number greater than zero")));
+    }
+    let mut problem = BenchProblem { name: String::new(), data, truth, start_range: Vec::new(), tolerance };
+    let params = problem.parameters();
+    let mut start_range: Vec<(f64, f64)> = params.iter().map(|p| p.search_range()).collect();
+    for (key, value) in file.starts.iter().flatten() {
+        let i = params.index_of(key).map_err(|e| at(format!("starts: {e}")))?;
+        let pair =
+            value.as_array().filter(|a| a.len() == 2).and_then(|a| Some((number(&a[0])?, number(&a[1])?)));
+        let (lo, hi) = pair.ok_or_else(|| at(format!("starts: `{key}` must be [low, high]")))?;
+        let p = &params.as_slice()[i];
+        if !(lo < hi && lo >= p.lower && hi <= p.upper && (p.scale == Scale::Linear || lo > 0.0)) {
+            return Err(at(format!(
+                "starts: `{key}` = [{lo}, {hi}] must be increasing and within the bounds"
+            )));
+        }
+        start_range[i] = (lo, hi);
+    }
+    problem.start_range = start_range;
+    problem.name = file.name.clone().unwrap_or_else(|| path.display().to_string());
+    Ok(problem)
+}
+
+/// The truth of a problem file in the order of `params`: every parameter given, each a finite
+/// number within its bounds.
+fn truth_of(
+    params: &ParameterSet,
+    table: &toml::Table,
+    at: &dyn Fn(String) -> WorkflowError,
+) -> Result<Vec<f64>, WorkflowError> {
+    let mut truth = vec![f64::NAN; params.len()];
+    for (key, value) in table {
+        let i = params.index_of(key).map_err(|e| at(format!("truth: {e}")))?;
+        truth[i] = number(value).ok_or_else(|| at(format!("truth: `{key}` must be a finite number")))?;
+    }
+    if let Some(missing) = params.iter().zip(&truth).find(|(_, t)| t.is_nan()) {
+        return Err(at(format!("truth: no value for parameter `{}`", missing.0.name)));
+    }
+    params.check(&truth).map_err(|e| at(format!("truth: {e}")))?;
+    Ok(truth)
+}
+
+/// A problem file on a planar rotor or a matrices model: its data and truth.
+fn modal_file(
+    file: &ProblemFile,
+    dir: &Path,
+    at: &dyn Fn(String) -> WorkflowError,
+) -> Result<(ProblemData, Vec<f64>), WorkflowError> {
     let source = ModelSource {
         model: Some(dir.join(&file.model)),
         solver: file.solver.clone().unwrap_or_else(|| "auto".into()),
         ..ModelSource::default()
     };
-    if crate::rotordynamics::ross_model(source.model.as_deref()).is_some() {
-        return Err(at(
-            "ROSS run-up models are not bench problems yet (their fit is not a core strategy)".into()
-        ));
-    }
     let (any, label) = source.load_any()?;
     let model: SharedModel = match any {
         crate::model::AnyModel::Rotor(rotor) => {
@@ -274,19 +368,7 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
         crate::model::AnyModel::Matrices(m) => Arc::new(m),
     };
     let params = model.parameters();
-    let mut truth = vec![f64::NAN; params.len()];
-    for (key, value) in &file.truth {
-        let i = params.index_of(key).map_err(|e| at(format!("truth: {e}")))?;
-        truth[i] = number(value).ok_or_else(|| at(format!("truth: `{key}` must be a finite number")))?;
-    }
-    if let Some(missing) = params.iter().zip(&truth).find(|(_, t)| t.is_nan()) {
-        return Err(at(format!("truth: no value for parameter `{}`", missing.0.name)));
-    }
-    params.check(&truth).map_err(|e| at(format!("truth: {e}")))?;
-    let tolerance = file.tolerance.unwrap_or(0.01);
-    if !(tolerance.is_finite() && tolerance > 0.0) {
-        return Err(at(format!("tolerance = {tolerance}: must be a number greater than zero")));
-    }
+    let truth = truth_of(params, &file.truth, at)?;
     let measured = match &file.measured {
         Some(csv) => {
             let csv = dir.join(csv);
@@ -307,22 +389,42 @@ pub fn load_problem_file(path: &Path) -> Result<BenchProblem, WorkflowError> {
             synthetic(model.as_ref(), &truth, modes, rel, None).map_err(|e| at(e.to_string()))?
         }
     };
-    let mut start_range: Vec<(f64, f64)> = params.iter().map(|p| p.search_range()).collect();
-    for (key, value) in file.starts.iter().flatten() {
-        let i = params.index_of(key).map_err(|e| at(format!("starts: {e}")))?;
-        let pair =
-            value.as_array().filter(|a| a.len() == 2).and_then(|a| Some((number(&a[0])?, number(&a[1])?)));
-        let (lo, hi) = pair.ok_or_else(|| at(format!("starts: `{key}` must be [low, high]")))?;
-        let p = &params.as_slice()[i];
-        if !(lo < hi && lo >= p.lower && hi <= p.upper && (p.scale == Scale::Linear || lo > 0.0)) {
+    Ok((ProblemData::Modal { model, measured, solver: source.solver }, truth))
+}
+
+/// A problem file on a ROSS rotor: the run-up CSV at `measured` (required: a run-up is not
+/// synthesised), the factors named by the truth's keys.
+fn runup_file(
+    file: &ProblemFile,
+    dir: &Path,
+    at: &dyn Fn(String) -> WorkflowError,
+) -> Result<(ProblemData, Vec<f64>), WorkflowError> {
+    for (key, given) in [
+        ("modes", file.modes.is_some()),
+        ("relative_std", file.relative_std.is_some()),
+        ("solver", file.solver.is_some()),
+    ] {
+        if given {
             return Err(at(format!(
-                "starts: `{key}` = [{lo}, {hi}] must be increasing and within the bounds"
+                "`{key}` does not apply to a ROSS run-up (the data are the run-up CSV in `measured`)"
             )));
         }
-        start_range[i] = (lo, hi);
     }
-    let name = file.name.unwrap_or_else(|| path.display().to_string());
-    Ok(BenchProblem { name, model, measured, truth, start_range, tolerance, solver: source.solver })
+    let measured = file.measured.as_ref().ok_or_else(|| {
+        at("a ROSS rotor's problem needs `measured`, a run-up CSV (speed_rpm,mode,frequency_hz,std_hz)"
+            .into())
+    })?;
+    let names: Vec<&str> = file.truth.keys().map(String::as_str).collect();
+    if names.is_empty() {
+        return Err(at(
+            "truth: name at least one factor (e.g. `kxx_DE = 1.2`, a factor on the file's kxx of bearing DE)"
+                .into(),
+        ));
+    }
+    let case = crate::bench_runup::from_files(&dir.join(&file.model), &dir.join(measured), &names)
+        .map_err(|e| at(e.to_string()))?;
+    let truth = truth_of(case.parameters(), &file.truth, at)?;
+    Ok((ProblemData::Runup(Arc::new(case)), truth))
 }
 
 /// A problem by built-in name or file path.
@@ -456,14 +558,69 @@ impl BenchReport {
     }
 }
 
-/// χ² in Hz at `p` (NaN where the model cannot be evaluated or a std is missing).
-fn chi2_at(problem: &BenchProblem, solver: &dyn EigenSolver, p: &[f64]) -> f64 {
-    if !problem.measured.has_std() {
-        return f64::NAN;
+impl BenchProblem {
+    /// χ² in Hz at `p` (NaN where the model cannot be evaluated or a std is missing).
+    fn chi2(&self, p: &[f64]) -> f64 {
+        match &self.data {
+            ProblemData::Modal { model, measured, solver } => {
+                let Ok(solver) = solver_by_name(solver) else { return f64::NAN };
+                if !measured.has_std() {
+                    return f64::NAN;
+                }
+                let hz = Problem::new(model.as_ref(), solver.as_ref(), measured.clone())
+                    .with_kind(ResidualKind::FrequencyHz);
+                hz.cost(p).map_or(f64::NAN, |c| 2.0 * c)
+            }
+            ProblemData::Runup(case) => case.chi2(p),
+        }
     }
-    let hz = Problem::new(problem.model.as_ref(), solver, problem.measured.clone())
-        .with_kind(ResidualKind::FrequencyHz);
-    hz.cost(p).map_or(f64::NAN, |c| 2.0 * c)
+
+    /// `f` on the least-squares objective a local strategy minimises.
+    fn with_objective<T>(&self, f: impl FnOnce(&dyn Objective) -> T) -> Result<T, WorkflowError> {
+        Ok(match &self.data {
+            ProblemData::Modal { model, measured, solver } => {
+                let solver = solver_by_name(solver)?;
+                f(&Problem::new(model.as_ref(), solver.as_ref(), measured.clone()))
+            }
+            ProblemData::Runup(case) => f(&case.objective()),
+        })
+    }
+
+    /// The posterior under `sampler` (Gaussian in Hz with the measured std).
+    fn sample(&self, sampler: &dyn Sampler, seed: u64, budget: &Budget) -> Result<Posterior, SamplingError> {
+        match &self.data {
+            ProblemData::Modal { model, measured, solver } => {
+                let solver = solver_by_name(solver).map_err(SamplingError::Failed)?;
+                crate::posterior::sample(
+                    model.as_ref(),
+                    solver.as_ref(),
+                    measured,
+                    &self.name,
+                    sampler,
+                    seed,
+                    budget,
+                )
+            }
+            ProblemData::Runup(case) => case.sample(sampler, seed, budget),
+        }
+    }
+
+    /// Why `strategy` (a registry name, settings after colons) does not apply, if it does not.
+    fn refuses(&self, strategy: &str) -> Option<String> {
+        let base = strategy.split(':').next().unwrap_or(strategy).trim();
+        match &self.data {
+            ProblemData::Runup(_) if crate::bench_runup::EIGENVALUE_STRATEGIES.contains(&base) => Some(format!(
+                "not applicable: {base} solves the paper's square eigenvalue system (the first N modes of one \
+                 configuration); a run-up's rows are whirl frequencies at many speeds"
+            )),
+            _ => None,
+        }
+    }
+}
+
+/// The eigen-solver by name (as `--solver`).
+fn solver_by_name(name: &str) -> Result<Box<dyn EigenSolver>, WorkflowError> {
+    ModelSource { solver: name.to_string(), ..ModelSource::default() }.solver()
 }
 
 /// One run of `strategy` on `problem` from start `start`.
@@ -475,7 +632,6 @@ fn run_one(
 ) -> Result<BenchRecord, WorkflowError> {
     let names = problem.names();
     let (name, method) = registry::build(spec).map_err(|e| input(format!("--strategies: {e}")))?;
-    let solver = problem.solver()?;
     let initial = problem.start(request.seed, start);
     let record =
         |verdict: &str, reason: Option<String>, evaluations, iterations, fin: &[f64], log_evidence| {
@@ -489,18 +645,23 @@ fn run_one(
                 evaluations,
                 iterations,
                 final_parameters: Named::new(&names, fin.iter().copied()),
-                chi2: chi2_at(problem, solver.as_ref(), fin),
+                chi2: problem.chi2(fin),
                 reached_truth: problem.reached(fin),
                 log_evidence,
                 regularisation: None,
             }
         };
+    if let Some(why) = problem.refuses(spec) {
+        return Ok(record("refused", Some(why), 0, 0, &initial, None));
+    }
     match method {
         Method::Local(mut strategy) => {
             let budget = Budget::new(request.budget.unwrap_or(DEFAULT_RUN_BUDGET));
-            let objective = Problem::new(problem.model.as_ref(), solver.as_ref(), problem.measured.clone());
             let driver = Driver { max_iterations: request.max_iterations };
-            Ok(match driver.run_within(&objective, strategy.as_mut(), &initial, &budget) {
+            let run = problem.with_objective(|objective| {
+                driver.run_within(objective, strategy.as_mut(), &initial, &budget)
+            })?;
+            Ok(match run {
                 Ok(est) => {
                     let why = (!est.termination.is_converged()).then(|| est.termination.to_string());
                     BenchRecord {
@@ -524,16 +685,7 @@ fn run_one(
         Method::Sampler(sampler) => {
             let budget = Budget::new(request.budget.unwrap_or_else(|| sampler.most_evaluations()));
             let seed = request.seed.wrapping_add(start as u64);
-            let post = crate::posterior::sample(
-                problem.model.as_ref(),
-                solver.as_ref(),
-                &problem.measured,
-                &problem.name,
-                sampler.as_ref(),
-                seed,
-                &budget,
-            );
-            Ok(match post {
+            Ok(match problem.sample(sampler.as_ref(), seed, &budget) {
                 Ok(post) => {
                     let best = post.best_sample().map_or_else(|| post.mean.clone(), <[f64]>::to_vec);
                     record(
@@ -545,7 +697,7 @@ fn run_one(
                         Some(post.log_evidence),
                     )
                 }
-                Err(crate::posterior::SamplingError::BudgetExhausted { limit }) => record(
+                Err(SamplingError::BudgetExhausted { limit }) => record(
                     "budget-exhausted",
                     Some(format!("the budget of {limit} model evaluations ran out while sampling")),
                     budget.used(),
@@ -553,7 +705,7 @@ fn run_one(
                     &initial,
                     None,
                 ),
-                Err(crate::posterior::SamplingError::Failed(e)) => {
+                Err(SamplingError::Failed(e)) => {
                     record("refused", Some(e.to_string()), budget.used(), 0, &initial, None)
                 }
             })
@@ -699,11 +851,17 @@ pub fn list() -> Result<BenchListing, WorkflowError> {
 }
 
 fn info(p: &BenchProblem) -> ProblemInfo {
+    let (measured_hz, std_hz) = match &p.data {
+        ProblemData::Modal { measured, .. } => {
+            measured.modes().iter().map(|m| (m.frequency_hz, m.std_hz)).unzip()
+        }
+        ProblemData::Runup(case) => case.points().iter().map(|q| (q.frequency_hz, q.std_hz)).unzip(),
+    };
     ProblemInfo {
         name: p.name.clone(),
         truth: Named::new(&p.names(), p.truth.iter().copied()),
-        measured_hz: p.measured.modes().iter().map(|m| m.frequency_hz).collect(),
-        std_hz: p.measured.modes().iter().map(|m| m.std_hz).collect(),
+        measured_hz,
+        std_hz,
         tolerance: p.tolerance,
     }
 }

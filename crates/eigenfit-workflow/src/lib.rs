@@ -22,6 +22,7 @@
 //! ```
 
 pub mod bench;
+pub mod bench_runup;
 pub mod campaign;
 pub mod compare;
 pub mod demo;

@@ -10,7 +10,7 @@ use crate::named::Named;
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::measurement::Measurement;
 use eigenfit_core::model::StructuralModel;
-use eigenfit_core::problem::{Problem, ResidualError, ResidualKind};
+use eigenfit_core::problem::{Objective, Problem, ResidualError, ResidualKind};
 use eigenfit_core::update::{Budget, Gaussian, Posterior, Sampler, UpdateError};
 use serde::Serialize;
 
@@ -92,15 +92,28 @@ pub fn sample(
     budget: &Budget,
 ) -> Result<Posterior, SamplingError> {
     let sigma: Vec<Option<f64>> = measured.modes().iter().map(|m| m.std_hz).collect();
-    let likelihood = Gaussian::hz(&sigma).ok_or_else(|| {
+    let problem = Problem::new(model, solver, measured.clone()).with_kind(ResidualKind::FrequencyHz);
+    sample_objective(&problem, &sigma, measured_name, sampler, seed, budget)
+}
+
+/// [`sample`] on any objective whose residual rows are (f_measured − f_model)/σ in Hz with the
+/// row's `sigma_hz` (a run-up's, [`crate::bench_runup`]).
+pub fn sample_objective(
+    problem: &dyn Objective,
+    sigma_hz: &[Option<f64>],
+    measured_name: &str,
+    sampler: &dyn Sampler,
+    seed: u64,
+    budget: &Budget,
+) -> Result<Posterior, SamplingError> {
+    let likelihood = Gaussian::hz(sigma_hz).ok_or_else(|| {
         SamplingError::Failed(input(format!(
             "{measured_name}: the {} likelihood is Gaussian in Hz with the measured standard deviations: \
              every mode needs a std_hz greater than zero (a column `std_hz`)",
             sampler.name()
         )))
     })?;
-    let problem = Problem::new(model, solver, measured.clone()).with_kind(ResidualKind::FrequencyHz);
-    sampler.sample(&problem, &likelihood, seed, budget).map_err(|e| match e {
+    sampler.sample(problem, &likelihood, seed, budget).map_err(|e| match e {
         UpdateError::Residual(ResidualError::BudgetExhausted { limit }) => {
             SamplingError::BudgetExhausted { limit }
         }

@@ -9,8 +9,8 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 pub struct BenchArgs {
     /// Problems, comma-separated: built-ins (paper-table2, paper-table3, paper-table4,
-    /// paper-table5, shear-frame, five-group-truss; `--list`) or problem files (TOML: model,
-    /// measured, truth; docs/strategies.md).
+    /// paper-table5, shear-frame, five-group-truss, ross-runup; `--list`) or problem files
+    /// (TOML: model, measured, truth; a ROSS rotor with a run-up CSV too; docs/strategies.md).
     #[arg(long, value_name = "NAMES", value_delimiter = ',', required_unless_present = "list")]
     pub problems: Vec<String>,
     /// List the built-in problems and the registered strategies, then exit.
