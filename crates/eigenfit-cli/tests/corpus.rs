@@ -237,13 +237,12 @@ fn a_stream_on_a_full_disk_holds_whole_lines_and_says_how_many() {
     assert!(lines < 12, "the limit should have cut the stream: {lines}");
 }
 
-/// A torn last line left by an earlier run is cut off before the next run appends, so no line
-/// glues onto it.
-#[test]
-fn a_stream_never_appends_onto_a_torn_line() {
+/// A comparison of 3 runs streamed into a file that already holds `before`: what eigenfit said
+/// and what the file then holds.
+fn stream_onto(before: &str) -> (String, String) {
     let scratch = tempfile::tempdir().expect("a temporary folder");
     let stream = scratch.path().join("runs.jsonl");
-    std::fs::write(&stream, "{\"whole\":1}\n{\"torn\":").unwrap();
+    std::fs::write(&stream, before).unwrap();
     let s = stream.to_str().unwrap();
     let out = eigenfit(&[
         "compare",
@@ -257,9 +256,16 @@ fn a_stream_never_appends_onto_a_torn_line() {
         s,
     ]);
     let all = text(&out);
-    clean("torn stream", &all);
+    clean(before, &all);
+    (all, std::fs::read_to_string(&stream).unwrap())
+}
+
+/// A torn last line left by an earlier run is cut off before the next run appends, so no line
+/// glues onto it.
+#[test]
+fn a_stream_never_appends_onto_a_torn_line() {
+    let (all, written) = stream_onto("{\"whole\":1}\n{\"torn\":");
     assert!(all.contains("its last line was torn"), "{all}");
-    let written = std::fs::read_to_string(&stream).unwrap();
     assert!(written.starts_with("{\"whole\":1}\n"), "{written}");
     for l in written.lines() {
         serde_json::from_str::<serde_json::Value>(l).unwrap_or_else(|e| panic!("{e}: {l}"));
@@ -271,25 +277,8 @@ fn a_stream_never_appends_onto_a_torn_line() {
 /// tool) is kept and ended; only a line that does not parse is torn.
 #[test]
 fn a_streams_complete_last_record_without_a_newline_is_kept() {
-    let scratch = tempfile::tempdir().expect("a temporary folder");
-    let stream = scratch.path().join("runs.jsonl");
-    std::fs::write(&stream, "{\"whole\":1}\n{\"whole\":2}").unwrap();
-    let s = stream.to_str().unwrap();
-    let out = eigenfit(&[
-        "compare",
-        "--preset",
-        "paper-rotor",
-        "--targets",
-        "2e5:5e4",
-        "--initials",
-        "1e5:1e5",
-        "--stream",
-        s,
-    ]);
-    let all = text(&out);
-    clean("unterminated stream", &all);
+    let (all, written) = stream_onto("{\"whole\":1}\n{\"whole\":2}");
     assert!(all.contains("a complete record, had no newline: one was added"), "{all}");
-    let written = std::fs::read_to_string(&stream).unwrap();
     assert!(written.starts_with("{\"whole\":1}\n{\"whole\":2}\n"), "{written}");
     assert_eq!(written.lines().count(), 5, "both records and 3 runs:\n{written}");
 }

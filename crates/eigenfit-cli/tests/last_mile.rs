@@ -349,7 +349,7 @@ fn every_unknown_name_lists_the_valid_ones_and_the_nearest() {
         (
             vec!["bench", "--problems", "paper-tabel3"],
             "`paper-tabel3` is neither a built-in problem (paper-table2, paper-table3, paper-table4, paper-table5, \
-             shear-frame, five-group-truss) nor a problem file (did you mean `paper-table3`?)",
+             shear-frame, five-group-truss, ross-runup) nor a problem file (did you mean `paper-table3`?)",
         ),
         (
             vec!["estimate", "--preset", "paper-rotor", "--measured", &measured, "--residual", "hertz"],

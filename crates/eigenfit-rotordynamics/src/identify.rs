@@ -99,6 +99,7 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, RunupError> {
     }
     let (cstd, cw) = (col("std_hz"), col("whirl"));
     let mut out = Vec::new();
+    let mut at_line = Vec::new();
     for (i, line) in lines {
         let at = i + 1;
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
@@ -152,6 +153,24 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, RunupError> {
             return Err(line_error(at, format!("mode {mode} at {speed_rpm} rpm appears twice")));
         }
         out.push(RunupPoint { speed_rpm, mode, frequency_hz, std_hz, whirl });
+        at_line.push(at);
+    }
+    // Modes are numbered in ascending damped frequency at each speed: a higher-numbered mode
+    // below a lower one is a swapped row or a typing slip (as the CSV path of a modal test says).
+    let mut order: Vec<usize> = (0..out.len()).collect();
+    order.sort_by(|&a, &b| out[a].speed_rpm.total_cmp(&out[b].speed_rpm).then(out[a].mode.cmp(&out[b].mode)));
+    for w in order.windows(2) {
+        let (a, b) = (&out[w[0]], &out[w[1]]);
+        if a.speed_rpm == b.speed_rpm && b.frequency_hz < a.frequency_hz {
+            return Err(line_error(
+                at_line[w[0]].max(at_line[w[1]]),
+                format!(
+                    "at {} rpm mode {} ({} Hz, line {}) is below mode {} ({} Hz, line {}): modes are numbered in \
+                     ascending frequency at each speed (a swapped row or a typing slip?)",
+                    b.speed_rpm, b.mode, b.frequency_hz, at_line[w[1]], a.mode, a.frequency_hz, at_line[w[0]]
+                ),
+            ));
+        }
     }
     if out.is_empty() {
         return Err(RunupError { line: None, message: "no data rows".into() });

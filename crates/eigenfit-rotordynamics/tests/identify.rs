@@ -162,6 +162,11 @@ fn runup_csv_errors_name_the_line() {
         ("speed_rpm,mode,frequency_hz,whirl\n1000,1,20,sideways\n", "sideways"),
         ("speed_rpm,mode,frequency_hz\n1000,1,20\n1000,1,21\n", "twice"),
         ("speed_rpm,mode,frequency_hz,std_hz\n1000,1,20,0.1\n1000,2,21,\n", "every row"),
+        // Mode 2 below mode 1 at one speed (a swapped row), named by the later line.
+        (
+            "speed_rpm,mode,frequency_hz\n1000,1,30\n2000,1,20\n1000,2,21\n",
+            "line 4: at 1000 rpm mode 2 (21 Hz, line 4) is below mode 1",
+        ),
     ] {
         let e = parse_runup(text).unwrap_err().to_string();
         assert!(e.contains(needle), "{text:?}: {e}");

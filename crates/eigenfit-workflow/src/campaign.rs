@@ -185,6 +185,7 @@ pub fn run(request: &CampaignRequest, progress: &mut dyn Progress) -> Result<Cam
             &d.measurement,
             &file,
         )?;
+        crate::estimate::refuse_unit_slip(m, solver.as_ref(), &d.measurement, &file)?;
     }
     let fits: Vec<Fit> = fixed
         .iter()

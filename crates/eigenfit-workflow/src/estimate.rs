@@ -30,6 +30,22 @@ use eigenfit_core::update::{registry, Budget, Driver, Estimate, LevenbergMarquar
 use serde::Serialize;
 use std::path::PathBuf;
 
+/// Refuses measured frequencies that one unit slip explains (every one entered in kHz, say:
+/// [`check_softest`]'s slip), naming `file`: what estimate refuses before any fit, for the
+/// configurations of a campaign too.
+pub fn refuse_unit_slip(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    measurement: &Measurement,
+    file: &str,
+) -> Result<(), WorkflowError> {
+    let numbers: Vec<usize> = measurement.modes().iter().map(|m| m.mode + 1).collect();
+    match check_softest(model, solver, measurement, &numbers) {
+        Some(e) if e.slip.is_some() => Err(input(format!("{file}: {e}"))),
+        _ => Ok(()),
+    }
+}
+
 /// Starts of the search for other solutions when not given: a space-filling design sized to the
 /// free parameters ([`search_starts`]: 4 per parameter and 8 more).
 pub fn default_alternative_starts(free: usize) -> usize {
@@ -457,16 +473,16 @@ pub fn run(
     // are refused naming the unit before anything is fitted; without such a slip they may be a
     // model error, said in a note. With shapes a measured mode may pair with another model mode,
     // so the mode-by-mode bounds are checked on frequency data only.
-    if data.sensors.is_none() {
-        match check_softest(&model, solver.as_ref(), &measurement, &mode_numbers) {
-            Some(e) if e.slip.is_some() => return Err(input(format!("{measured_name}: {e}"))),
-            Some(e) => notes.push(format!(
-                "{measured_name}: no stiffness within the limits can produce {}: the fit cannot reach these \
-                 modes; a missing effect (`eigenfit discover`) or modes numbered differently from the model's?",
-                e.modes_said()
-            )),
-            None => {}
-        }
+    // A unit slip moves every frequency by one factor, which no pairing explains: refused for
+    // universal files (shapes) too, as one path for measured modes whatever the format.
+    match check_softest(&model, solver.as_ref(), &measurement, &mode_numbers) {
+        Some(e) if e.slip.is_some() => return Err(input(format!("{measured_name}: {e}"))),
+        Some(e) if data.sensors.is_none() => notes.push(format!(
+            "{measured_name}: no stiffness within the limits can produce {}: the fit cannot reach these \
+             modes; a missing effect (`eigenfit discover`) or modes numbered differently from the model's?",
+            e.modes_said()
+        )),
+        _ => {}
     }
     let problem = Problem::new(&model, solver.as_ref(), measurement).with_kind(kind);
     let mut fit = Fit::new(problem, &data, options.shape.shape_std);

@@ -127,7 +127,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
     let mut est = match outcome? {
         EstimateOutcome::Runup(mut report) => {
             print_notes(&report.notes);
-            let code = if report.verdict.acceptable { EXIT_OK } else { EXIT_NOT_CONVERGED };
+            let code = if report.verdict.is_answer() { EXIT_OK } else { EXIT_NOT_CONVERGED };
             let plots = match &args.plot {
                 // A plot that fails after the fit is lost, said so; the fit's exit code stands.
                 Some(dir) => {

@@ -48,3 +48,13 @@ write("uff_scaled_1e200.unv", head + m1 + scaled(m2, 1e200) + m3)
 spike = list(m2)
 spike[11] = spike[11].replace("-2.45341e+00", "-2.45341e+300")
 write("uff_huge_value.unv", head + m1 + spike + m3)
+
+def in_khz(block):
+    """The block with its frequency (record 8) divided by 1000: entered in kHz."""
+    out = list(block)
+    hz = out[9].split()[0]
+    out[9] = out[9].replace(hz, f"{float(hz) / 1000:.5e}", 1)
+    return out
+
+# Every frequency in kHz: a unit slip, refused as the CSV path refuses it.
+write("uff_in_khz.unv", head + in_khz(m1) + in_khz(m2) + in_khz(m3))

@@ -57,29 +57,17 @@ impl Tmcmc {
         guard.at_least_one("chain", settings.chain_length)?;
         guard.positive("scale", settings.proposal_scale)?;
         guard.positive("target_cov", settings.target_cov)?;
+        let refuse = |setting: &'static str, value: usize, requirement: &'static str| {
+            Err(SettingsError { owner: "TMCMC", setting, value: value.to_string(), requirement })
+        };
         if settings.samples < 2 {
-            return Err(SettingsError {
-                owner: "TMCMC",
-                setting: "samples",
-                value: settings.samples.to_string(),
-                requirement: "must be at least 2",
-            });
+            return refuse("samples", settings.samples, "must be at least 2");
         }
         if settings.samples > MAX_SAMPLES {
-            return Err(SettingsError {
-                owner: "TMCMC",
-                setting: "samples",
-                value: settings.samples.to_string(),
-                requirement: "must be at most 1000000",
-            });
+            return refuse("samples", settings.samples, "must be at most 1000000");
         }
         if settings.chain_length > MAX_CHAIN {
-            return Err(SettingsError {
-                owner: "TMCMC",
-                setting: "chain",
-                value: settings.chain_length.to_string(),
-                requirement: "must be at most 1000",
-            });
+            return refuse("chain", settings.chain_length, "must be at most 1000");
         }
         Ok(Self { settings })
     }
