@@ -57,9 +57,9 @@ pub fn parameter_vector(
 
 /// Refuses `NAME=VALUE` items (`flag`'s) that name one parameter twice: which value was meant
 /// cannot be known, and the last one silently winning is a slip hidden.
-pub fn refuse_repeated(flag: &str, items: &[String]) -> Result<(), WorkflowError> {
+pub fn refuse_repeated<S: AsRef<str>>(flag: &str, items: &[S]) -> Result<(), WorkflowError> {
     let names: Vec<&str> =
-        items.iter().map(|s| s.split_once('=').map_or(s.as_str(), |(n, _)| n).trim()).collect();
+        items.iter().map(|s| s.as_ref().split_once('=').map_or(s.as_ref(), |(n, _)| n).trim()).collect();
     match (1..names.len()).find(|&j| names[..j].contains(&names[j])) {
         Some(j) => Err(input(format!("{flag}: `{}` is given twice; give each name once", names[j]))),
         None => Ok(()),

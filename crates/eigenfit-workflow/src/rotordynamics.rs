@@ -437,10 +437,7 @@ fn initial_factors(
     let items: Vec<&str> = text.split(',').map(str::trim).filter(|s| !s.is_empty()).collect();
     let mut values: Vec<(usize, f64)> = Vec::new();
     if items.iter().any(|i| i.contains('=')) {
-        crate::overrides::refuse_repeated(
-            "--initial",
-            &items.iter().map(|s| s.to_string()).collect::<Vec<_>>(),
-        )?;
+        crate::overrides::refuse_repeated("--initial", &items)?;
         for item in &items {
             let (name, value) = item.split_once('=').ok_or_else(|| {
                 input(format!("--initial `{item}`: expected NAME=VALUE like the other items"))

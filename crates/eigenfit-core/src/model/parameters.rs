@@ -256,6 +256,12 @@ impl ParameterSet {
         self.params.iter().zip(values).map(|(p, &v)| p.to_scaled(v)).collect()
     }
 
+    /// The inverse of [`ParameterSet::to_scaled`]: the values at `scaled`, each kept within its
+    /// limits (a scaled step to a limit may overshoot it by round-off on the way back).
+    pub fn from_scaled(&self, scaled: &[f64]) -> Vec<f64> {
+        self.params.iter().zip(scaled).map(|(p, &s)| p.from_scaled(s).clamp(p.lower, p.upper)).collect()
+    }
+
     /// The nominal values in order.
     pub fn nominal_values(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.nominal).collect()

@@ -80,11 +80,7 @@ impl UpdateStrategy for GaussNewtonLineSearch {
         let mut alpha = 1.0;
         for _ in 0..HALVINGS {
             let s: Vec<f64> = (0..x.len()).map(|i| (x[i] + alpha * delta[i]).clamp(lo[i], hi[i])).collect();
-            let p: Vec<f64> = params
-                .iter()
-                .zip(&s)
-                .map(|(par, &v)| par.from_scaled(v).clamp(par.lower, par.upper))
-                .collect();
+            let p = params.from_scaled(&s);
             match problem.linearise(&p) {
                 Ok(next) if next.cost() <= cost0 + 1e-4 * alpha * slope => {
                     let moved = s.iter().zip(&x).fold(0.0, |m: f64, (a, b)| m.max((a - b).abs()));
