@@ -42,6 +42,7 @@ fn request(model: &Path) -> EstimateRequest {
         write_model: false,
         alternative_starts: Some(0),
         bearing_parameters: None,
+        refit: None,
     }
 }
 

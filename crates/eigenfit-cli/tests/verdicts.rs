@@ -195,37 +195,37 @@ fn a_symmetric_rotor_always_gets_its_mirror() {
 /// each equally good, and the verdict says the data do not determine the stiffnesses.
 #[test]
 fn every_exact_solution_of_a_shear_frame_is_listed_by_a_default_run() {
+    every_exact_solution_of_the_shear_frame_is_listed(&[]);
+}
+
+/// The search for other solutions with its local fits made by another registered strategy
+/// (`--refit`, issue 27 item 6): the trust-region strategy finds the same four solutions.
+#[test]
+fn the_search_for_other_solutions_runs_on_a_refit_strategy_of_the_users_choice() {
+    every_exact_solution_of_the_shear_frame_is_listed(&["--refit", "trf"]);
+    let out = eigenfit(&["estimate", "--preset", "paper-rotor", "--measured", "x.csv", "--refit", "tmcmc"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--refit tmcmc"), "{out:?}");
+}
+
+/// The shear frame of [`every_exact_solution_of_a_shear_frame_is_listed_by_a_default_run`],
+/// estimated with `more` arguments.
+fn every_exact_solution_of_the_shear_frame_is_listed(more: &[&str]) {
     let reference: Value = serde_json::from_str(
         &std::fs::read_to_string(common::data_file("tests/verdicts_data", "shear_frame_solutions.json"))
             .unwrap(),
     )
     .unwrap();
     let dir = common::scratch();
-    let mtx = |pairs: &[(usize, usize, f64)]| {
-        let mut s = format!("%%MatrixMarket matrix coordinate real symmetric\n3 3 {}\n", pairs.len());
-        for (i, j, v) in pairs {
-            s.push_str(&format!("{i} {j} {v}\n"));
-        }
-        s
-    };
-    common::write_in(&dir, "K0.mtx", &mtx(&[(1, 1, 0.0)]));
-    common::write_in(&dir, "M.mtx", &mtx(&[(1, 1, 1.0), (2, 2, 1.0), (3, 3, 1.0)]));
-    common::write_in(&dir, "K1.mtx", &mtx(&[(1, 1, 1.0)]));
-    common::write_in(&dir, "K2.mtx", &mtx(&[(1, 1, 1.0), (2, 1, -1.0), (2, 2, 1.0)]));
-    common::write_in(&dir, "K3.mtx", &mtx(&[(2, 2, 1.0), (3, 2, -1.0), (3, 3, 1.0)]));
-    let mut toml = String::from("kind = \"matrices\"\nstiffness = \"K0.mtx\"\nmass = \"M.mtx\"\n");
-    for i in 1..=3 {
-        toml.push_str(&format!(
-            "\n[[parameter]]\nname = \"k{i}\"\nnominal = 1e4\nlower = 1e2\nupper = 1e6\nscale = \"log\"\nunit = \"N/m\"\nstiffness = \"K{i}.mtx\"\n"
-        ));
-    }
-    let model = common::write_in(&dir, "frame.toml", &toml);
-    let model = model.to_str().unwrap();
+    let model = write_shear_frame(&dir, 1e4, [(1e2, 1e6); 3]);
+    let model = model.as_str();
     let f: Vec<f64> =
         reference["frequencies_hz"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
     let csv = format!("mode,frequency_hz\n1,{:.15}\n2,{:.15}\n3,{:.15}\n", f[0], f[1], f[2]);
     let csv = common::write_in(&dir, "frame.csv", &csv);
-    let out = eigenfit(&["estimate", "--model", model, "--measured", csv.to_str().unwrap(), "--json"]);
+    let mut args = vec!["estimate", "--model", model, "--measured", csv.to_str().unwrap(), "--json"];
+    args.extend_from_slice(more);
+    let out = eigenfit(&args);
     let v = json(&out);
     let mut found = vec![named(&v["parameters"]).into_iter().map(|(_, x)| x).collect::<Vec<_>>()];
     for a in v["alternative_solutions"].as_array().unwrap() {
@@ -244,6 +244,84 @@ fn every_exact_solution_of_a_shear_frame_is_listed_by_a_default_run() {
     assert_eq!(v["verdict"], "not-unique", "{v}");
     assert_eq!(out.status.code(), Some(3));
     assert_contract_keys(&v);
+}
+
+/// The 3-storey shear frame (unit masses, storey stiffnesses k1…k3 as a matrices model) in
+/// `dir`, every stiffness starting at `nominal` within its `(lower, upper)`; returns the model
+/// file's path.
+fn write_shear_frame(dir: &tempfile::TempDir, nominal: f64, limits: [(f64, f64); 3]) -> String {
+    let mtx = |pairs: &[(usize, usize, f64)]| {
+        let mut s = format!("%%MatrixMarket matrix coordinate real symmetric\n3 3 {}\n", pairs.len());
+        for (i, j, v) in pairs {
+            s.push_str(&format!("{i} {j} {v}\n"));
+        }
+        s
+    };
+    common::write_in(dir, "K0.mtx", &mtx(&[(1, 1, 0.0)]));
+    common::write_in(dir, "M.mtx", &mtx(&[(1, 1, 1.0), (2, 2, 1.0), (3, 3, 1.0)]));
+    common::write_in(dir, "K1.mtx", &mtx(&[(1, 1, 1.0)]));
+    common::write_in(dir, "K2.mtx", &mtx(&[(1, 1, 1.0), (2, 1, -1.0), (2, 2, 1.0)]));
+    common::write_in(dir, "K3.mtx", &mtx(&[(2, 2, 1.0), (3, 2, -1.0), (3, 3, 1.0)]));
+    let mut toml = String::from("kind = \"matrices\"\nstiffness = \"K0.mtx\"\nmass = \"M.mtx\"\n");
+    for (i, (lower, upper)) in limits.iter().enumerate() {
+        toml.push_str(&format!(
+            "\n[[parameter]]\nname = \"k{}\"\nnominal = {nominal:e}\nlower = {lower:e}\nupper = {upper:e}\nscale = \"log\"\nunit = \"N/m\"\nstiffness = \"K{}.mtx\"\n",
+            i + 1,
+            i + 1
+        ));
+    }
+    common::write_in(dir, "frame.toml", &toml).display().to_string()
+}
+
+/// The intervals' profile-likelihood refits made by another registered strategy (`--refit`,
+/// issue 27 item 6): the shear frame's second storey held by its upper limit below the truth,
+/// so its interval is profiled. The trust-region and line-search strategies spend their own
+/// evaluations (the refits really are theirs) and reach the same bounds as the default damped
+/// refits, to the profile's tolerance.
+#[test]
+fn intervals_are_profiled_by_a_refit_strategy_of_the_users_choice() {
+    let dir = common::scratch();
+    let model = write_shear_frame(&dir, 1.2e4, [(5e3, 1.5e4), (1e4, 2.8e4), (1e4, 3e4)]);
+    let csv = common::write_in(
+        &dir,
+        "frame.csv",
+        "mode,frequency_hz,std_hz\n1,8.295509195865234,0.041478\n2,26.526329086627367,0.132632\n3,44.876173439070655,0.224381\n",
+    );
+    let run = |more: &[&str]| {
+        let mut args = vec![
+            "estimate",
+            "--model",
+            &model,
+            "--measured",
+            csv.to_str().unwrap(),
+            "--json",
+            "--alternative-starts",
+            "0",
+        ];
+        args.extend_from_slice(more);
+        json(&eigenfit(&args))
+    };
+    let damped = run(&[]);
+    assert_eq!(damped["parameters"]["k2"], 2.8e4, "{damped}");
+    let profiled = damped["evaluations_by_phase"]["intervals"].as_u64().unwrap();
+    assert!(profiled > 0, "{damped}");
+    for strategy in ["trf", "gn-line-search"] {
+        let other = run(&["--refit", strategy]);
+        assert_ne!(
+            other["evaluations_by_phase"]["intervals"].as_u64().unwrap(),
+            profiled,
+            "{strategy}: {other}"
+        );
+        for k in ["k1", "k2", "k3"] {
+            for end in 0..2 {
+                let (a, b) = (
+                    damped["intervals"][k][end].as_f64().unwrap(),
+                    other["intervals"][k][end].as_f64().unwrap(),
+                );
+                assert!((a / b - 1.0).abs() < 1e-6, "{strategy}: {k} {a} against {b}");
+            }
+        }
+    }
 }
 
 /// Contract: `estimate --json` carries the same verdict keys for every model kind.

@@ -86,3 +86,24 @@ fn the_truss_discovery_with_a_small_budget_stops_and_says_so() {
         }
     }
 }
+
+/// Discovery's calibration and candidate refits made by another registered strategy
+/// (`DiscoveryOptions::refit`, issue 27 item 6): the trust-region strategy names the same hidden
+/// mass at the same place within the same budget.
+#[test]
+fn the_truss_discovery_runs_on_a_refit_strategy_of_the_users_choice() {
+    use eigenfit_core::discovery::{discover, DiscoveryOptions};
+    use eigenfit_core::eigen::DenseSolver;
+    use eigenfit_core::model::StructuralModel;
+    use eigenfit_core::update::refit::{RefitChoice, Registered};
+    let measured = truss::measurement(truss::HIDDEN_KG, truss::SEED);
+    let refit = RefitChoice(std::sync::Arc::new(Registered::new("trf").unwrap()));
+    let options = DiscoveryOptions { max_evaluations: 10_000, refit, ..Default::default() };
+    let model = truss::Truss::new();
+    let report =
+        discover(&model, &DenseSolver, &measured, &model.candidates(), &truss::DESIGN, &options).unwrap();
+    assert!(!report.budget_exhausted, "{} evaluations", report.evaluations);
+    let first = report.effects.first().expect("an effect named");
+    assert_eq!((first.place.kind.as_str(), first.place.location), ("added-node-mass", Some(2)));
+    assert!((first.value.unwrap() - 0.5).abs() < 0.1, "θ = {:?}", first.value);
+}

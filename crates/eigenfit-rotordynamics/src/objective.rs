@@ -12,7 +12,6 @@ use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale
 use eigenfit_core::problem::{Linearisation, Objective, ResidualError};
 use eigenfit_core::sensitivity::SensitivityError;
 use nalgebra::{DMatrix, DVector};
-use std::f64::consts::PI;
 
 /// Widest factor range searched on a coefficient curve: three decades either way.
 const FACTOR_RANGE: (f64, f64) = (1e-3, 1e3);
@@ -125,19 +124,9 @@ impl Objective for RunupObjective<'_> {
             np,
             |i, j| if j < nf { e.jacobian[(i, j)] / p[j] } else { e.jacobian[(i, j)] },
         );
-        let omega = |f: f64| 2.0 * PI * f;
         Ok(Linearisation {
             parameters: p.to_vec(),
             paired_modes: self.points.iter().map(|q| q.mode - 1).collect(),
-            model_eigenvalues: DVector::from_iterator(m, e.frequencies_hz.iter().map(|&f| omega(f).powi(2))),
-            measured_eigenvalues: DVector::from_iterator(
-                m,
-                self.points.iter().map(|q| omega(q.frequency_hz).powi(2)),
-            ),
-            // dλ/dp with λ = ω²: 2ω · 2π d f/d p.
-            eigenvalue_jacobian: DMatrix::from_fn(m, np, |i, j| {
-                2.0 * omega(e.frequencies_hz[i]) * 2.0 * PI * df[(i, j)]
-            }),
             frequencies_hz: e.frequencies_hz.clone(),
             measured_hz: self.points.iter().map(|q| q.frequency_hz).collect(),
             residual: DVector::from_fn(m, |i, _| {
@@ -147,6 +136,9 @@ impl Objective for RunupObjective<'_> {
             has_std,
             rows_weighted: has_std,
             round_off: Vec::new(),
+            // A run-up's frequencies are eigenvalues of the quadratic problem at each speed, not
+            // of K − λM: the paper's eigenvalue strategies do not apply, the others need none.
+            eigen: None,
         })
     }
 }

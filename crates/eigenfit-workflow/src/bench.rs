@@ -366,6 +366,7 @@ fn modal_file(
             Arc::new(eigenfit_rotor::UpdatableRotor::new(rotor).map_err(|e| at(format!("{label}: {e}")))?)
         }
         crate::model::AnyModel::Matrices(m) => Arc::new(m),
+        crate::model::AnyModel::Registered(m) => Arc::from(m),
     };
     let params = model.parameters();
     let truth = truth_of(params, &file.truth, at)?;

@@ -184,6 +184,11 @@ pub fn run(
             discover(m, &solver, &data, &m.candidates(), &m.parameters().nominal_values(), &options)
                 .map(|report| RotorDiscovery { effects: report.effects.clone(), report, mesh_factor: 1 })
         }
+        AnyModel::Registered(m) => {
+            let m = m.as_ref();
+            discover(&m, &solver, &data, &m.candidates(), &m.parameters().nominal_values(), &options)
+                .map(|report| RotorDiscovery { effects: report.effects.clone(), report, mesh_factor: 1 })
+        }
     };
     progress.end();
     // A calibration cut short by the budget is no input error: the user's budget was too small.

@@ -15,8 +15,8 @@ use crate::simulate::check_roundoff_of;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
-    better_minimum, like_exchanges, listed_alternatives, local_minima, mirror_solutions, search_starts,
-    Equivalence, Mirrors,
+    adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, local_minima_refit,
+    mirror_solutions, search_starts, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};
@@ -26,6 +26,7 @@ use eigenfit_core::measurement::measured_csv::{shown, shown_number};
 use eigenfit_core::measurement::Measurement;
 use eigenfit_core::model::{ParameterSet, StructuralModel};
 use eigenfit_core::problem::{Objective, Problem, ResidualKind};
+use eigenfit_core::update::refit::{RefitChoice, Registered};
 use eigenfit_core::update::{registry, Budget, Driver, Estimate, LevenbergMarquardt, Method, UpdateStrategy};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -87,6 +88,11 @@ pub struct EstimateRequest {
     /// ROSS rotors: the bearing coefficients to estimate (`kxx,kyy,…` or `kxy_<bearing>`; `None`:
     /// kxx and kyy of every bearing). Refused for other models.
     pub bearing_parameters: Option<String>,
+    /// The strategy of the local refits behind the intervals (profile likelihood) and the search
+    /// for other solutions: a registered name with settings after colons, run as registered
+    /// (`None`: damped least squares without restarts). Lets a user's own strategy be the one
+    /// the analysis trusts; refused for ROSS run-ups.
+    pub refit: Option<String>,
 }
 
 pub use crate::outcome::BudgetReport;
@@ -357,6 +363,13 @@ pub fn run(
             request.budget
         )));
     }
+    // The refit strategy by name, checked before anything is read.
+    let refit = match &request.refit {
+        None => RefitChoice::default(),
+        Some(spec) => RefitChoice(std::sync::Arc::new(
+            Registered::new(spec).map_err(|e| input(format!("--refit {}: {e}", shown(spec))))?,
+        )),
+    };
     // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
     if let Some(path) = rotordynamics::ross_model(request.source.model.as_deref()) {
         // A run-up fit on a large rotor takes minutes (each evaluation solves every speed):
@@ -369,6 +382,7 @@ pub fn run(
                 ("--shapes", t.shapes.is_some()),
                 ("--sensor-map", t.sensor_map.is_some()),
                 ("--fix", !t.fix.is_empty()),
+                ("--refit", request.refit.is_some()),
             ],
         )?;
         progress.begin("fitting the run-up", None);
@@ -587,7 +601,7 @@ pub fn run(
         let starts = request.alternative_starts.unwrap_or_else(|| default_alternative_starts(np));
         // Ranking a design alone costs an evaluation per point: skipped with no start.
         if starts > 0 {
-            minima = local_minima(&fit, starts, &mirrors.asymmetric, &budget);
+            minima = local_minima_refit(&fit, starts, &mirrors.asymmetric, &budget, &*refit);
         }
         phases.push(("other_solutions", budget.used()));
         // A regularised estimate is not the least-squares minimum, by design: a deeper one is
@@ -604,15 +618,7 @@ pub fn run(
             ));
         }
         if let Some(better) = better.filter(|_| estimate.regularisation.is_none()) {
-            notes.push(format!(
-                "the search for other solutions found a deeper minimum than the fit reached (Σr² {} → {}): \
-                 it is the estimate reported",
-                shown_number(estimate.last.chi2()),
-                shown_number(better.chi2())
-            ));
-            minima.push(estimate.last.clone());
-            estimate.parameters = better.parameters.clone();
-            estimate.last = better;
+            notes.push(adopt_better_minimum(&mut estimate, better, &mut minima));
             mirrors = mirror_solutions(&fit, &estimate.last, &exchanges, &budget);
         }
         progress.end();
@@ -641,7 +647,7 @@ pub fn run(
     // Profile bounds done / total through the driver's observer mechanism.
     let (unc, scatter) = if converged {
         let mut bounds = StepsObserver::new(progress, "interval bounds");
-        let unc = fit.uncertainty_within(&estimate.last, &budget, &mut [&mut bounds]);
+        let unc = fit.uncertainty_within(&estimate.last, &budget, &mut [&mut bounds], &*refit);
         bounds.finish();
         unc
     } else {

@@ -8,8 +8,8 @@ use crate::outcome::{
     ParameterIdentifiability, ParameterValues, Verdict,
 };
 use eigenfit_core::analysis::alternatives::{
-    better_minimum, like_exchanges, listed_alternatives, mirror_solutions, screened_local_minima,
-    Equivalence, Mirrors,
+    adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, mirror_solutions,
+    screened_local_minima, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, judge};
 use eigenfit_core::analysis::{uncertainty_parallel, Identifiability};
@@ -564,15 +564,7 @@ pub fn estimate_with(
         minima = screened_local_minima(&objective, starts, np + 1, &mirrors.asymmetric, &budget);
         phases.push(("other_solutions", budget.used()));
         if let Some(better) = better_minimum(&objective, &estimate.last, &minima).cloned() {
-            better_note = Some(format!(
-                "the search for other solutions found a deeper minimum than the fit reached (χ² or Σr² {:.6e} → \
-                 {:.6e}): it is the estimate reported",
-                estimate.last.chi2(),
-                better.chi2()
-            ));
-            minima.push(estimate.last.clone());
-            estimate.parameters = better.parameters.clone();
-            estimate.last = better;
+            better_note = Some(adopt_better_minimum(&mut estimate, better, &mut minima));
             mirrors = mirror_solutions(&objective, &estimate.last, &exchanges, &budget);
         }
     } else {

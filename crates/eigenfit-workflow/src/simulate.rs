@@ -456,6 +456,18 @@ pub fn matrices_mode_shapes(
     shapes_report(model, solver, p, count, labels, &|shape| model.expand_shape(p, shape).map_err(failure))
 }
 
+/// The lowest `count` mode shapes of any model at `p` (a registered kind's), mass-normalised,
+/// on the DOFs it solves, labelled by [`StructuralModel::dof_label`].
+pub fn model_mode_shapes(
+    model: &dyn StructuralModel,
+    solver: &dyn EigenSolver,
+    p: &[f64],
+    count: usize,
+) -> Result<ModeShapesReport, WorkflowError> {
+    let labels = (0..model.dofs()).map(|j| model.dof_label(j)).collect();
+    shapes_report(model, solver, p, count, labels, &|shape| Ok(shape.to_vec()))
+}
+
 /// A shape on the solved DOFs to the shape on every DOF of the model as read.
 type ExpandShape<'a> = dyn Fn(&[f64]) -> Result<Vec<f64>, WorkflowError> + 'a;
 

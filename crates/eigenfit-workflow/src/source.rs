@@ -57,6 +57,9 @@ impl ModelSource {
     pub fn load_any(&self) -> Result<(AnyModel, String), WorkflowError> {
         if let Some(path) = &self.model {
             model::check_model_file(path)?;
+            if let Some(registered) = model::load_registered(path) {
+                return registered.map(|m| (m, path.display().to_string()));
+            }
         }
         let Some(path) = self.model.as_ref().filter(|p| model::is_matrices_file(p)) else {
             return self.load().map(|(rotor, label)| (AnyModel::Rotor(rotor), label));

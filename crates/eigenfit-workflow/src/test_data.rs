@@ -14,6 +14,7 @@ use eigenfit_core::measurement::sensors::{self, NodeLayout, SensorSet};
 use eigenfit_core::measurement::{measured_csv, uff, Measurement};
 use eigenfit_core::model::{Fixed, ParameterSet, StructuralModel};
 use eigenfit_core::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
+use eigenfit_core::update::refit::Refit;
 use eigenfit_core::update::{Budget, Estimate, Observer};
 use eigenfit_rotor::Rotor;
 use serde::Serialize;
@@ -247,15 +248,16 @@ impl<'a> Fit<'a> {
         at: &Linearisation,
         budget: &Budget,
         observers: &mut [&mut dyn Observer],
+        refit: &dyn Refit,
     ) -> (Option<Uncertainty>, Option<f64>) {
         match self {
             // Every parameter's profile bounds in parallel: the model and solvers are shared
             // between threads (the solvers' workspaces are per thread).
             Fit::Frequencies(p) => {
-                (eigenfit_core::analysis::uncertainty_parallel(p, at, budget, observers), None)
+                (eigenfit_core::analysis::uncertainty_refit(p, at, budget, observers, refit), None)
             }
             Fit::Shapes(s) => {
-                s.uncertainty_parallel(at, budget).map_or((None, None), |(u, sc)| (Some(u), Some(sc)))
+                s.uncertainty_parallel(at, budget, refit).map_or((None, None), |(u, sc)| (Some(u), Some(sc)))
             }
         }
     }

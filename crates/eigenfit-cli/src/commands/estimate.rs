@@ -59,6 +59,11 @@ pub struct EstimateArgs {
     /// (`refits` in --json; default 6).
     #[arg(long, value_name = "N")]
     pub alternative_starts: Option<usize>,
+    /// The strategy of the local refits behind the intervals (profile likelihood) and the search
+    /// for other solutions, by registered name with settings after colons (as --strategy), run as
+    /// registered; default: damped least squares without restarts. Not for ROSS run-ups.
+    #[arg(long, value_name = "STRATEGY")]
+    pub refit: Option<String>,
     /// Write the plots into this folder: the convergence history (convergence.svg/.png) and,
     /// with shapes, the MAC matrix (mac.svg/.png); for a run-up on a ROSS rotor the run-up fit
     /// (runup-fit.svg/.png: measured and model frequencies against speed) and the estimated
@@ -94,6 +99,7 @@ fn request(args: &EstimateArgs) -> EstimateRequest {
         write_model: args.test_data.write_model.is_some(),
         alternative_starts: args.alternative_starts,
         bearing_parameters: args.parameters.clone(),
+        refit: args.refit.clone(),
     }
 }
 

@@ -123,7 +123,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let (model, label) = args.model.load_any()?;
     let mut rotor = match model {
         AnyModel::Rotor(rotor) => rotor,
-        AnyModel::Matrices(m) => return simulate_matrices(args, &m, &label, args.model.solver()?.as_ref()),
+        AnyModel::Matrices(m) => {
+            return simulate_matrices(args, &m, Some(&m), &label, args.model.solver()?.as_ref())
+        }
+        AnyModel::Registered(m) => {
+            return simulate_matrices(args, m.as_ref(), None, &label, args.model.solver()?.as_ref())
+        }
     };
     for text in &args.effects {
         let effect = EffectSpec::parse(text).map_err(|e| input(format!("--effect {e}")))?;
@@ -222,11 +227,13 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `simulate` on a matrices model: frequencies and their sensitivities at the nominal values
-/// (or `--set`), in the rotor's JSON and table layout.
+/// `simulate` on a matrices model (`matrices`: the same model, for its stored entries and its
+/// massless DOFs' shapes) or a model of a registered kind: frequencies and their sensitivities at
+/// the nominal values (or `--set`), in the rotor's JSON and table layout.
 fn simulate_matrices(
     args: &SimulateArgs,
-    model: &eigenfit_matrices::MatricesModel,
+    model: &dyn StructuralModel,
+    matrices: Option<&eigenfit_matrices::MatricesModel>,
     label: &str,
     solver: &dyn EigenSolver,
 ) -> Result<(), CliError> {
@@ -249,10 +256,14 @@ fn simulate_matrices(
     let mut report = at_point(label, model, solver, &p, args.modes, SweepCheck::None)?;
     report.dofs = Some(model.dofs());
     if args.shapes {
-        report.mode_shapes = Some(matrices_mode_shapes(model, solver, &p, args.modes)?);
+        report.mode_shapes = Some(match matrices {
+            Some(m) => matrices_mode_shapes(m, solver, &p, args.modes)?,
+            None => eigenfit_workflow::simulate::model_mode_shapes(model, solver, &p, args.modes)?,
+        });
     }
     crate::output::report(args.report.json, &report, |report| {
-        println!("{label} ({} DOF, {} stored entries, {} solver)", model.dofs(), model.nnz(), solver.name());
+        let stored = matrices.map_or(String::new(), |m| format!(", {} stored entries", m.nnz()));
+        println!("{label} ({} DOF{stored}, {} solver)", model.dofs(), solver.name());
         print_point(report);
         if let Some(why) = &report.sensitivities_unavailable {
             println!("(no sensitivities: {why})");

@@ -12,7 +12,8 @@
 use crate::analysis::chi2::chi2_quantile_upper;
 use crate::analysis::verdict::SIGNIFICANCE;
 use crate::problem::{Linearisation, Objective};
-use crate::update::{Budget, Driver, LevenbergMarquardt, LevenbergMarquardtSettings};
+use crate::update::refit::{Damped, Refit, RefitRequest};
+use crate::update::{Budget, LevenbergMarquardtSettings};
 
 /// Iterations of one local fit of the search: a local fit from a start of the design converges
 /// in tens of iterations or sits in a valley the budget should not be spent on.
@@ -166,8 +167,20 @@ pub fn local_minima(
     extra: &[Vec<f64>],
     budget: &Budget,
 ) -> Vec<Linearisation> {
+    local_minima_refit(problem, starts, extra, budget, &Damped)
+}
+
+/// [`local_minima`] with the local fits made by `refit` (a registered strategy, say) instead of
+/// damped least squares without restarts.
+pub fn local_minima_refit(
+    problem: &dyn Objective,
+    starts: usize,
+    extra: &[Vec<f64>],
+    budget: &Budget,
+    refit: &dyn Refit,
+) -> Vec<Linearisation> {
     let points = extra.iter().cloned().chain(design(problem, starts)).collect();
-    fitted_minima(problem, points, budget)
+    fitted_minima(problem, points, budget, refit)
 }
 
 /// [`local_minima`] for an objective whose local fits are dear (a run-up solves every speed
@@ -188,7 +201,7 @@ pub fn screened_local_minima(
         .collect();
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
     let points = extra.iter().cloned().chain(ranked.into_iter().take(keep).map(|(_, p)| p)).collect();
-    fitted_minima(problem, points, budget)
+    fitted_minima(problem, points, budget, &Damped)
 }
 
 /// The Halton design of `starts` points over `problem`'s search ranges.
@@ -199,8 +212,13 @@ fn design(problem: &dyn Objective, starts: usize) -> impl Iterator<Item = Vec<f6
     })
 }
 
-/// Local damped fits without restarts from `points`: the distinct converged minima, best first.
-fn fitted_minima(problem: &dyn Objective, points: Vec<Vec<f64>>, budget: &Budget) -> Vec<Linearisation> {
+/// Local fits by `refit` from `points`: the distinct converged minima, best first.
+fn fitted_minima(
+    problem: &dyn Objective,
+    points: Vec<Vec<f64>>,
+    budget: &Budget,
+    refit: &dyn Refit,
+) -> Vec<Linearisation> {
     let params = problem.parameters();
     let mut minima: Vec<Linearisation> = Vec::new();
     for start in points {
@@ -210,9 +228,7 @@ fn fitted_minima(problem: &dyn Objective, points: Vec<Vec<f64>>, budget: &Budget
         if params.check(&start).is_err() {
             continue;
         }
-        let mut local = LevenbergMarquardt::default().with_max_restarts(0);
-        let Ok(est) =
-            (Driver { max_iterations: LOCAL_FIT_ITERATIONS }).run_within(problem, &mut local, &start, budget)
+        let Ok(est) = refit.refit(problem, &start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, budget)
         else {
             continue;
         };
@@ -257,6 +273,25 @@ pub fn better_minimum<'a>(
         .filter(|m| scaled_distance(problem, &m.parameters, &at.parameters) > SAME_MINIMUM)
         .min_by(|a, b| a.cost().total_cmp(&b.cost()))?;
     (best.cost() < own.cost() * (1.0 - 1e-6) && own.cost() - best.cost() > f64::MIN_POSITIVE).then_some(best)
+}
+
+/// Makes `better` (a deeper minimum the search found, [`better_minimum`]) the estimate, keeps
+/// the fit's own end point among `minima` (it is an alternative now), and returns the note that
+/// says so. The caller rechecks the mirrors around the new estimate.
+pub fn adopt_better_minimum(
+    estimate: &mut crate::update::Estimate,
+    better: Linearisation,
+    minima: &mut Vec<Linearisation>,
+) -> String {
+    let note = format!(
+        "the search for other solutions found a deeper minimum than the fit reached (Σr² {} → {}): it is \
+         the estimate reported",
+        crate::measurement::measured_csv::shown_number(estimate.last.chi2()),
+        crate::measurement::measured_csv::shown_number(better.chi2())
+    );
+    minima.push(std::mem::replace(&mut estimate.last, better));
+    estimate.parameters = estimate.last.parameters.clone();
+    note
 }
 
 /// The minima of `minima` other than `at` (more than [`SAME_MINIMUM`] away from it), each judged
@@ -407,6 +442,7 @@ mod tests {
     use crate::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
     use crate::problem::Problem;
     use crate::test_chain::Chain;
+    use crate::update::{Driver, LevenbergMarquardt};
     use nalgebra::{DMatrix, DVector};
 
     /// ground –k₁– m –k_c– m –k₂– ground with equal masses: symmetric under k₁ ↔ k₂ (k_c fixed).

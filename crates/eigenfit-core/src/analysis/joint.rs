@@ -110,7 +110,14 @@ impl<'a> Joint<'a> {
         has_std: bool,
         budget: &Budget,
     ) -> Option<(Uncertainty, f64)> {
-        scatter_uncertainty_parallel(self, |joint| &mut joint.scale, at, has_std, budget)
+        scatter_uncertainty_parallel(
+            self,
+            |joint| &mut joint.scale,
+            at,
+            has_std,
+            budget,
+            &crate::update::refit::Damped,
+        )
     }
 }
 
@@ -132,7 +139,9 @@ impl Objective for Joint<'_> {
                 out
             };
             lin.jacobian = widen(&lin.jacobian) / self.scale;
-            lin.eigenvalue_jacobian = widen(&lin.eigenvalue_jacobian);
+            if let Some(eigen) = lin.eigen.as_mut() {
+                eigen.eigenvalue_jacobian = widen(&eigen.eigenvalue_jacobian);
+            }
             lin.residual /= self.scale;
             lin.parameters = p.to_vec();
             lins.push(lin);

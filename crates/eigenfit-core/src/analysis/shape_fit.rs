@@ -93,11 +93,13 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     }
 
     /// [`ShapeFit::uncertainty_within`] with the parameters' profiles in parallel (a model and
-    /// solver shared between threads): the same intervals and evaluations.
+    /// solver shared between threads): the same intervals and evaluations. The profiles' refits
+    /// are made by `refit` ([`Damped`](crate::update::refit::Damped) unless the user chose).
     pub fn uncertainty_parallel(
         &mut self,
         at: &Linearisation,
         budget: &crate::update::Budget,
+        refit: &dyn crate::update::refit::Refit,
     ) -> Option<(crate::analysis::Uncertainty, f64)>
     where
         M: Sync,
@@ -110,6 +112,7 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
             at,
             has_std,
             budget,
+            refit,
         )
     }
 }

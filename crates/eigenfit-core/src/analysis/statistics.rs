@@ -4,7 +4,8 @@
 use crate::analysis::chi2::Z_95;
 use crate::model::{ParameterSet, Scale};
 use crate::problem::{Linearisation, Objective};
-use crate::update::{scaled_bounds, Budget, Driver, LevenbergMarquardt, Observer};
+use crate::update::refit::{Damped, Refit, RefitRequest};
+use crate::update::{scaled_bounds, Budget, Observer};
 use nalgebra::DMatrix;
 
 /// χ² quantile of one degree of freedom at 95%: the profile-likelihood threshold.
@@ -101,20 +102,21 @@ pub(crate) fn scatter_uncertainty<P: Objective>(
     budget: &Budget,
 ) -> Option<(Uncertainty, f64)> {
     scatter_with(problem, scale, at, has_std, |p, lin| {
-        weighted_uncertainty(Shared::Serial(p), lin, budget, &mut [])
+        weighted_uncertainty(Shared::Serial(p), lin, budget, &mut [], &Damped)
     })
 }
 
-/// [`scatter_uncertainty`] with the parameters' profiles in parallel.
+/// [`scatter_uncertainty`] with the parameters' profiles in parallel, refitted by `refit`.
 pub(crate) fn scatter_uncertainty_parallel<P: Objective + Sync>(
     problem: &mut P,
     scale: fn(&mut P) -> &mut f64,
     at: &Linearisation,
     has_std: bool,
     budget: &Budget,
+    refit: &dyn Refit,
 ) -> Option<(Uncertainty, f64)> {
     scatter_with(problem, scale, at, has_std, |p, lin| {
-        weighted_uncertainty(Shared::Parallel(p), lin, budget, &mut [])
+        weighted_uncertainty(Shared::Parallel(p), lin, budget, &mut [], refit)
     })
 }
 
@@ -158,7 +160,7 @@ pub fn uncertainty_observed(
     if !at.has_std {
         return None;
     }
-    weighted_uncertainty(Shared::Serial(problem), at, budget, observers)
+    weighted_uncertainty(Shared::Serial(problem), at, budget, observers, &Damped)
 }
 
 /// [`uncertainty_observed`] with the parameters' profiles (each bound a job) on rayon's threads:
@@ -172,7 +174,23 @@ pub fn uncertainty_parallel(
     if !at.has_std {
         return None;
     }
-    weighted_uncertainty(Shared::Parallel(problem), at, budget, observers)
+    weighted_uncertainty(Shared::Parallel(problem), at, budget, observers, &Damped)
+}
+
+/// [`uncertainty_parallel`] with the profile likelihood's refits made by `refit` (a registered
+/// strategy, say) instead of the default damped least squares: the intervals a user's own
+/// strategy supports.
+pub fn uncertainty_refit(
+    problem: &(dyn Objective + Sync),
+    at: &Linearisation,
+    budget: &Budget,
+    observers: &mut [&mut dyn Observer],
+    refit: &dyn Refit,
+) -> Option<Uncertainty> {
+    if !at.has_std {
+        return None;
+    }
+    weighted_uncertainty(Shared::Parallel(problem), at, budget, observers, refit)
 }
 
 /// The objective the profile refits run on: one at a time, or (a `Sync` objective) every
@@ -299,6 +317,7 @@ fn weighted_uncertainty(
     at: &Linearisation,
     budget: &Budget,
     observers: &mut [&mut dyn Observer],
+    refit: &dyn Refit,
 ) -> Option<Uncertainty> {
     let problem = shared.objective();
     let params = problem.parameters();
@@ -356,6 +375,7 @@ fn weighted_uncertainty(
         at,
         i,
         budget,
+        refit,
         // σ of the profile's curvature, with the parameters held by their limits left out.
         sigma: conditional_sigma(&js, i, &held),
         held: &held,
@@ -372,8 +392,16 @@ fn weighted_uncertainty(
             .collect(),
         Shared::Parallel(sync) => {
             let job = |i: usize, dir: f64| {
-                Profile { problem: sync, at, i, budget, sigma: conditional_sigma(&js, i, &held), held: &held }
-                    .bound(dir)
+                Profile {
+                    problem: sync,
+                    at,
+                    i,
+                    budget,
+                    refit,
+                    sigma: conditional_sigma(&js, i, &held),
+                    held: &held,
+                }
+                .bound(dir)
             };
             in_parallel(&sides, job, &mut report)
         }
@@ -509,6 +537,8 @@ struct Profile<'a> {
     at: &'a Linearisation,
     i: usize,
     budget: &'a Budget,
+    /// The strategy of the refits.
+    refit: &'a dyn Refit,
     /// σ in scaled units of the profile near the estimate (may be ∞): sets the first step.
     sigma: f64,
     /// The parameters a refit's linear prediction leaves on their limits.
@@ -569,17 +599,12 @@ impl Profile<'_> {
     /// model cannot be evaluated there (counts as beyond the bound).
     fn delta_chi2(&self, s: f64, warm: &Linearisation) -> Result<Option<(f64, Linearisation)>, OutOfBudget> {
         let p = self.start(s, warm);
-        let fixed = (0..p.len()).map(|j| j == self.i).collect();
-        let mut local = LevenbergMarquardt::default()
-            .with_fixed(fixed)
-            .with_max_restarts(0)
-            .with_cost_tolerance(PROFILE_COST_TOLERANCE);
-        let run = Driver { max_iterations: PROFILE_REFIT_ITERATIONS }.run_within(
-            self.problem,
-            &mut local,
-            &p,
-            self.budget,
-        );
+        let request = RefitRequest {
+            fixed: (0..p.len()).map(|j| j == self.i).collect(),
+            cost_tolerance: PROFILE_COST_TOLERANCE,
+            ..RefitRequest::default()
+        };
+        let run = self.refit.refit(self.problem, &p, &request, PROFILE_REFIT_ITERATIONS, self.budget);
         if self.budget.exhausted() {
             return Err(OutOfBudget);
         }

@@ -469,9 +469,6 @@ mod tests {
         Linearisation {
             parameters: vec![1.0],
             paired_modes: (0..n).collect(),
-            model_eigenvalues: DVector::zeros(n),
-            measured_eigenvalues: DVector::zeros(n),
-            eigenvalue_jacobian: DMatrix::zeros(n, 1),
             frequencies_hz: vec![10.0; n],
             measured_hz: vec![10.0; n],
             residual: DVector::from_column_slice(residual),
@@ -479,6 +476,7 @@ mod tests {
             has_std,
             rows_weighted: has_std,
             round_off: Vec::new(),
+            eigen: None,
         }
     }
 

@@ -23,7 +23,8 @@ use crate::measurement::{MeasuredMode, Measurement};
 use crate::model::{Augmented, Candidate, StructuralModel};
 use crate::problem::multi::Stacked;
 use crate::problem::{Linearisation, Objective, Problem};
-use crate::update::{Budget, Driver, LevenbergMarquardt, Termination};
+use crate::update::refit::{RefitChoice, RefitRequest};
+use crate::update::{Budget, Driver, Termination};
 use nalgebra::DVector;
 use thiserror::Error;
 
@@ -80,6 +81,10 @@ pub struct DiscoveryOptions {
     /// ambiguity test and a further effect is needed (default [`BEAM_WIDTH`]; 1: the leader
     /// only, the selection of before).
     pub beam_width: usize,
+    /// The strategy of the calibration and of every candidate's refit (default: damped least
+    /// squares, [`Damped`](crate::update::refit::Damped)); a registered one by
+    /// [`Registered`](crate::update::refit::Registered).
+    pub refit: RefitChoice,
 }
 
 /// Evaluations a discovery run may spend by default: about 1 s of one core on 8 modes of the
@@ -102,6 +107,7 @@ impl Default for DiscoveryOptions {
             max_evaluations: DEFAULT_EVALUATIONS,
             local_calibration: false,
             beam_width: BEAM_WIDTH,
+            refit: RefitChoice::default(),
         }
     }
 }
@@ -604,11 +610,8 @@ pub fn discover_effects<E: EffectSearch>(
     // (a) calibrate
     let est = search
         .with_base(|base| {
-            let mut strategy = LevenbergMarquardt::default();
-            if options.local_calibration {
-                strategy = strategy.with_max_restarts(0);
-            }
-            Some(Driver::default().run_within(base, &mut strategy, initial, &budget))
+            let request = RefitRequest { restarts: !options.local_calibration, ..RefitRequest::default() };
+            Some(options.refit.refit(base, initial, &request, Driver::default().max_iterations, &budget))
         })
         .ok_or_else(|| DiscoveryError::Data("the base problem could not be built".into()))?
         .map_err(|e| match budget.exhausted() {
@@ -1106,7 +1109,16 @@ impl<E: EffectSearch> Selection<'_, E> {
             // it); the confirmation with restarts from its nominal value, the start the local
             // path may have missed — the better of the two is kept.
             let from = screened.iter().find(|(j, _)| *j == i).map(|(_, s)| s.value).filter(|_| !restarts);
-            match refit(self.search, n, &set, &path.current.parameters, budget, (cap, restarts), from) {
+            let fit = refit(
+                self.search,
+                n,
+                &set,
+                &path.current.parameters,
+                budget,
+                (cap, restarts, &self.options.refit),
+                from,
+            );
+            match fit {
                 RefitOutcome::Fit(mut fit) => {
                     fit.place_charge = path.current.place_charge + self.charges[i];
                     RefitOutcome::Fit(fit)
@@ -1317,14 +1329,15 @@ fn screen<E: EffectSearch>(
 /// The refit may spend at most `cap` evaluations of `budget` (it is cut short,
 /// [`RefitOutcome::CutShort`], rather than spend what is kept for later); `restarts`: with the
 /// damped strategy's restarts from a grid of seeds when the local fit does not reach the noise,
-/// else one local fit. The new candidate's value starts at `from` when given (else its nominal).
+/// else one local fit; `strategy`: the options' refit strategy. The new candidate's value
+/// starts at `from` when given (else its nominal).
 fn refit<E: EffectSearch>(
     search: &E,
     n: usize,
     set: &[&Candidate],
     current: &[f64],
     budget: &Budget,
-    (cap, restarts): (usize, bool),
+    (cap, restarts, strategy): (usize, bool, &RefitChoice),
     from: Option<f64>,
 ) -> RefitOutcome {
     let Some(&candidate) = set.last() else { return RefitOutcome::Failed };
@@ -1346,13 +1359,10 @@ fn refit<E: EffectSearch>(
     let fit = search.with_effects(set, |problem| {
         // Bounded work per candidate: a refit that has not converged in 60 steps is not the
         // explanation (the same limit the profile bounds use).
-        let driver = Driver { max_iterations: 60 };
-        let mut strategy = LevenbergMarquardt::default().with_step_units(step_units(base_len, set));
-        if !restarts {
-            strategy = strategy.with_max_restarts(0);
-        }
+        let request =
+            RefitRequest { step_units: step_units(base_len, set), restarts, ..RefitRequest::default() };
         // Every evaluation charged to the run's budget and to the cap.
-        let est = driver.run_within(&budget.wrap(problem), &mut strategy, &start, &capped).ok()?;
+        let est = strategy.refit(&budget.wrap(problem), &start, &request, 60, &capped).ok()?;
         // A fit cut short by the budget is not a fit.
         if matches!(est.termination, Termination::BudgetExhausted { .. }) {
             return None;

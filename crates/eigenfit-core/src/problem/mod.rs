@@ -10,4 +10,4 @@ pub(crate) mod objective;
 pub(crate) mod residual;
 
 pub use objective::Objective;
-pub use residual::{Linearisation, Pairing, Problem, ResidualError, ResidualKind};
+pub use residual::{EigenView, Linearisation, Pairing, Problem, ResidualError, ResidualKind};

@@ -2,7 +2,7 @@
 //! of each configuration are stacked into one least-squares problem.
 
 use crate::model::ParameterSet;
-use crate::problem::{Linearisation, Objective, ResidualError};
+use crate::problem::{EigenView, Linearisation, Objective, ResidualError};
 use nalgebra::{DMatrix, DVector};
 
 /// Stacks problems that share one parameter set (e.g. one rotor measured at several support
@@ -53,9 +53,6 @@ pub fn stack(p: &[f64], parts: &[Linearisation]) -> Linearisation {
     Linearisation {
         parameters: p.to_vec(),
         paired_modes: parts.iter().flat_map(|l| l.paired_modes.iter().copied()).collect(),
-        model_eigenvalues: vec(&|l| &l.model_eigenvalues),
-        measured_eigenvalues: vec(&|l| &l.measured_eigenvalues),
-        eigenvalue_jacobian: mat(&|l| &l.eigenvalue_jacobian),
         frequencies_hz: parts.iter().flat_map(|l| l.frequencies_hz.iter().copied()).collect(),
         measured_hz: parts.iter().flat_map(|l| l.measured_hz.iter().copied()).collect(),
         residual: vec(&|l| &l.residual),
@@ -63,5 +60,27 @@ pub fn stack(p: &[f64], parts: &[Linearisation]) -> Linearisation {
         has_std: parts.iter().all(|l| l.has_std),
         rows_weighted: parts.iter().all(|l| l.rows_weighted),
         round_off: parts.iter().flat_map(|l| l.round_off.iter().copied()).collect(),
+        eigen: stack_eigen(np, parts),
     }
+}
+
+/// The parts' eigenvalue views stacked, when every part has one.
+fn stack_eigen(np: usize, parts: &[Linearisation]) -> Option<EigenView> {
+    let views: Vec<&EigenView> = parts.iter().map(|l| l.eigen.as_ref()).collect::<Option<_>>()?;
+    let rows: usize = views.iter().map(|v| v.model_eigenvalues.len()).sum();
+    let column = |f: &dyn Fn(&EigenView) -> &DVector<f64>| {
+        DVector::from_iterator(rows, views.iter().flat_map(|v| f(v).iter().copied()))
+    };
+    let mut eigenvalue_jacobian = DMatrix::zeros(rows, np);
+    let mut r = 0;
+    for v in &views {
+        let block = &v.eigenvalue_jacobian;
+        eigenvalue_jacobian.rows_mut(r, block.nrows()).copy_from(block);
+        r += block.nrows();
+    }
+    Some(EigenView {
+        model_eigenvalues: column(&|v| &v.model_eigenvalues),
+        measured_eigenvalues: column(&|v| &v.measured_eigenvalues),
+        eigenvalue_jacobian,
+    })
 }

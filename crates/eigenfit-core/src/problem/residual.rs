@@ -64,12 +64,6 @@ pub struct Linearisation {
     pub parameters: Vec<f64>,
     /// Model mode paired with each measured mode.
     pub paired_modes: Vec<usize>,
-    /// Model eigenvalues of the paired modes.
-    pub model_eigenvalues: DVector<f64>,
-    /// Measured eigenvalues (eq. 23).
-    pub measured_eigenvalues: DVector<f64>,
-    /// dλ/dp of the paired modes in physical parameter units (the paper's sensitivity matrix).
-    pub eigenvalue_jacobian: DMatrix<f64>,
     /// Model frequencies of the paired modes, Hz.
     pub frequencies_hz: Vec<f64>,
     /// Measured frequencies, Hz.
@@ -88,6 +82,23 @@ pub struct Linearisation {
     /// Relative accuracy of each model frequency as the matrices define it (half the
     /// eigenvalue's, [`crate::sensitivity::eigenvalue_round_off`]); empty when not known.
     pub round_off: Vec<f64>,
+    /// The eigenvalue view, for the strategies that solve with eigenvalues (the paper's Newton
+    /// and p-step); `None` where the compared frequencies are not eigenvalues of K − λM (a
+    /// run-up's come from a quadratic eigenproblem). Every other strategy works on the residual
+    /// and Jacobian alone.
+    pub eigen: Option<EigenView>,
+}
+
+/// What the paper's eigenvalue strategies solve with (eq. 27–28): model and measured
+/// eigenvalues λ = (2πf)² of the paired modes and their sensitivity matrix ∂λ/∂p.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EigenView {
+    /// Model eigenvalues of the paired modes.
+    pub model_eigenvalues: DVector<f64>,
+    /// Measured eigenvalues (eq. 23).
+    pub measured_eigenvalues: DVector<f64>,
+    /// ∂λ/∂p of the paired modes in physical parameter units (the paper's sensitivity matrix).
+    pub eigenvalue_jacobian: DMatrix<f64>,
 }
 
 impl Linearisation {
@@ -248,12 +259,14 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
         let paired = self.pair(&sens, &rigid)?;
         let m = paired.len();
         let np = self.model.parameters().len();
-        let mut lin = Linearisation {
-            parameters: p.to_vec(),
-            paired_modes: paired.clone(),
+        let mut eigen = EigenView {
             model_eigenvalues: DVector::zeros(m),
             measured_eigenvalues: DVector::zeros(m),
             eigenvalue_jacobian: DMatrix::zeros(m, np),
+        };
+        let mut lin = Linearisation {
+            parameters: p.to_vec(),
+            paired_modes: paired.clone(),
             frequencies_hz: vec![0.0; m],
             measured_hz: vec![0.0; m],
             residual: DVector::zeros(m),
@@ -261,21 +274,23 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             has_std: self.measured.has_std(),
             rows_weighted: self.measured.has_std(),
             round_off: vec![0.0; m],
+            eigen: None,
         };
         for (row, (meas, &k)) in self.measured.modes().iter().zip(&paired).enumerate() {
             let lambda = sens.modes.eigenvalues[k];
             let f = eigenvalue_to_hz(lambda);
             let fm = meas.frequency_hz;
-            lin.model_eigenvalues[row] = lambda;
-            lin.measured_eigenvalues[row] = hz_to_eigenvalue(fm);
+            eigen.model_eigenvalues[row] = lambda;
+            eigen.measured_eigenvalues[row] = hz_to_eigenvalue(fm);
             lin.frequencies_hz[row] = f;
             lin.measured_hz[row] = fm;
             lin.round_off[row] = 0.5 * sens.eigenvalue_round_off[k];
-            lin.eigenvalue_jacobian.row_mut(row).copy_from(&sens.eigenvalues.row(k));
+            eigen.eigenvalue_jacobian.row_mut(row).copy_from(&sens.eigenvalues.row(k));
             let (r, scale, sigma) = self.residual_terms(meas, lambda);
             lin.residual[row] = r / sigma;
             lin.jacobian.row_mut(row).copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));
         }
+        lin.eigen = Some(eigen);
         Ok((lin, sens))
     }
 

@@ -146,16 +146,20 @@ pub struct IterationRecord {
     pub cost: f64,
     /// Largest |f_model − f_measured|, Hz.
     pub max_abs_diff_hz: f64,
+    /// The strategy's own state after this iteration, by name (Levenberg–Marquardt's damping
+    /// `mu`, a trust region's `radius`, …: [`UpdateStrategy::metrics`]); empty at the start.
+    pub metrics: Vec<(&'static str, f64)>,
 }
 
 impl IterationRecord {
-    fn new(iteration: usize, lin: &Linearisation) -> Self {
+    fn new(iteration: usize, lin: &Linearisation, metrics: Vec<(&'static str, f64)>) -> Self {
         Self {
             iteration,
             parameters: lin.parameters.clone(),
             frequencies_hz: lin.frequencies_hz.clone(),
             cost: lin.cost(),
             max_abs_diff_hz: lin.max_abs_diff_hz(),
+            metrics,
         }
     }
 }
@@ -310,13 +314,16 @@ impl ObservedDriver<'_, '_> {
         problem.parameters().check(initial).map_err(|e| UpdateError::Setup(e.to_string()))?;
         let mut current = problem.linearise(initial)?;
         strategy.start(problem, &current)?;
-        let mut history = vec![IterationRecord::new(0, &current)];
+        let mut history = vec![IterationRecord::new(0, &current, Vec::new())];
         observers.iter_mut().for_each(|o| o.observe(&history[0]));
         let mut iterations = 0;
-        let mut accept = |next: Linearisation, current: &mut Linearisation, iterations: &mut usize| {
+        let mut accept = |next: Linearisation,
+                          metrics: Vec<(&'static str, f64)>,
+                          current: &mut Linearisation,
+                          iterations: &mut usize| {
             *iterations += 1;
             *current = next;
-            let record = IterationRecord::new(*iterations, current);
+            let record = IterationRecord::new(*iterations, current, metrics);
             observers.iter_mut().for_each(|o| o.observe(&record));
             history.push(record);
         };
@@ -332,13 +339,13 @@ impl ObservedDriver<'_, '_> {
                 // failed trial as "no better point") meaningless: the run is cut short.
                 if budget.exhausted() {
                     if let Some(step) = step.ok().filter(|s| s.next.cost() < current.cost()) {
-                        accept(step.next, &mut current, &mut iterations);
+                        accept(step.next, strategy.metrics(), &mut current, &mut iterations);
                     }
                     break Termination::BudgetExhausted { limit: budget.limit() };
                 }
                 match step {
                     Ok(step) => {
-                        accept(step.next, &mut current, &mut iterations);
+                        accept(step.next, strategy.metrics(), &mut current, &mut iterations);
                         match step.status {
                             StepStatus::Continue => {}
                             StepStatus::Converged => break Termination::Converged,

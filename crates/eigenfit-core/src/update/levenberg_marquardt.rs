@@ -317,6 +317,9 @@ impl UpdateStrategy for LevenbergMarquardt {
     fn name(&self) -> &'static str {
         "damped"
     }
+    fn metrics(&self) -> Vec<(&'static str, f64)> {
+        vec![("mu", self.mu), ("restarts", self.restarts as f64)]
+    }
 
     fn uses_ranked_starts(&self) -> bool {
         self.settings.max_restarts > 0

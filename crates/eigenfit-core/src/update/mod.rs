@@ -12,6 +12,7 @@ pub(crate) mod grid;
 pub(crate) mod levenberg_marquardt;
 mod newton;
 mod pstep;
+pub mod refit;
 pub mod registry;
 pub mod sampler;
 mod settings;
@@ -39,7 +40,7 @@ pub use tikhonov::{ParameterChoice, Regularisation, TikhonovGaussNewton, Tikhono
 pub use tmcmc::{Tmcmc, TmcmcSettings, MAX_STAGES as TMCMC_MAX_STAGES};
 pub use trust_region_reflective::{trust_region_step, TrustRegionReflective};
 
-use crate::problem::{Linearisation, Objective, ResidualError};
+use crate::problem::{EigenView, Linearisation, Objective, ResidualError};
 use thiserror::Error;
 
 /// Why an update step could not be taken.
@@ -115,6 +116,24 @@ pub trait UpdateStrategy {
     fn regularisation(&self) -> Option<Regularisation> {
         None
     }
+    /// The strategy's own state after its last step, by name, for observers (progress, logs,
+    /// a study of how a strategy behaves): Levenberg–Marquardt's damping `mu`, a trust region's
+    /// `radius`, the regularisation's `lambda`. Default: none.
+    fn metrics(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
+}
+
+/// The eigenvalue view the paper's strategies solve with, or a set-up error naming `who` where
+/// the problem has none (a run-up's frequencies are not eigenvalues of K − λM).
+pub fn eigen_view<'a>(who: &str, lin: &'a Linearisation) -> Result<&'a EigenView, UpdateError> {
+    lin.eigen.as_ref().ok_or_else(|| {
+        UpdateError::Setup(format!(
+            "{who} solves with model eigenvalues and their sensitivities (the paper's eq. 27–28); \
+             this problem compares frequencies that are not eigenvalues of K − λM (not applicable): \
+             use a least-squares strategy such as damped"
+        ))
+    })
 }
 
 /// Solves the paper's eq. 28, S Δk = Δλ, on the first N modes (N = number of parameters, as in
@@ -123,15 +142,16 @@ pub fn newton_point(
     current: &Linearisation,
     target: &nalgebra::DVector<f64>,
 ) -> Result<Vec<f64>, UpdateError> {
-    let n = current.eigenvalue_jacobian.ncols();
-    if current.eigenvalue_jacobian.nrows() < n {
+    let eigen = eigen_view("the paper's Newton step", current)?;
+    let n = eigen.eigenvalue_jacobian.ncols();
+    if eigen.eigenvalue_jacobian.nrows() < n {
         return Err(UpdateError::Setup(format!(
             "the paper's Newton step needs as many modes as parameters (eq. 27); got {} modes for {n} parameters",
-            current.eigenvalue_jacobian.nrows()
+            eigen.eigenvalue_jacobian.nrows()
         )));
     }
-    let s = current.eigenvalue_jacobian.rows(0, n).into_owned();
-    let dlambda = target.rows(0, n) - current.model_eigenvalues.rows(0, n);
+    let s = eigen.eigenvalue_jacobian.rows(0, n).into_owned();
+    let dlambda = target.rows(0, n) - eigen.model_eigenvalues.rows(0, n);
     let dk = s
         .lu()
         .solve(&dlambda)

@@ -2,7 +2,8 @@
 
 use super::settings::{Guard, SettingsError};
 use super::{
-    evaluate_or_diverge, newton_point, square_converged, Step, StepStatus, UpdateError, UpdateStrategy,
+    eigen_view, evaluate_or_diverge, newton_point, square_converged, Step, StepStatus, UpdateError,
+    UpdateStrategy,
 };
 use crate::problem::{Linearisation, Objective};
 
@@ -41,7 +42,7 @@ impl UpdateStrategy for Newton {
     }
 
     fn start(&mut self, _: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
-        newton_point(initial, &initial.measured_eigenvalues).map(|_| ())
+        newton_point(initial, &eigen_view("newton", initial)?.measured_eigenvalues).map(|_| ())
     }
 
     fn converged(&self, lin: &Linearisation) -> bool {
@@ -49,7 +50,7 @@ impl UpdateStrategy for Newton {
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
-        let p = newton_point(current, &current.measured_eigenvalues)?;
+        let p = newton_point(current, &eigen_view("newton", current)?.measured_eigenvalues)?;
         let next = evaluate_or_diverge(problem, &p)?;
         let status = if self.converged(&next) { StepStatus::Converged } else { StepStatus::Continue };
         Ok(Step { next, status })

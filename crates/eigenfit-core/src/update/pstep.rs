@@ -2,8 +2,8 @@
 
 use super::settings::{Guard, SettingsError};
 use super::{
-    evaluate_or_diverge, newton_point, square_converged, square_max_diff_hz, within as frequency_within,
-    Step, StepStatus, UpdateError, UpdateStrategy,
+    eigen_view, evaluate_or_diverge, newton_point, square_converged, square_max_diff_hz,
+    within as frequency_within, Step, StepStatus, UpdateError, UpdateStrategy,
 };
 use crate::problem::{Linearisation, Objective};
 use crate::units::eigenvalue_to_hz;
@@ -24,6 +24,7 @@ pub struct PStep {
     /// p: number of parts.
     parts: usize,
     start_eigenvalues: DVector<f64>,
+    measured_eigenvalues: DVector<f64>,
     stage: usize,
     stages: usize,
 }
@@ -51,6 +52,7 @@ impl PStep {
             split_above_hz,
             parts,
             start_eigenvalues: DVector::zeros(0),
+            measured_eigenvalues: DVector::zeros(0),
             stage: 1,
             stages: 1,
         }
@@ -61,9 +63,9 @@ impl PStep {
         (self.tolerance_hz, self.split_above_hz, self.parts)
     }
 
-    fn target(&self, lin: &Linearisation) -> DVector<f64> {
+    fn target(&self) -> DVector<f64> {
         let t = self.stage as f64 / self.stages as f64;
-        &self.start_eigenvalues + (&lin.measured_eigenvalues - &self.start_eigenvalues) * t
+        &self.start_eigenvalues + (&self.measured_eigenvalues - &self.start_eigenvalues) * t
     }
 
     fn within(&self, lin: &Linearisation, target: &DVector<f64>) -> bool {
@@ -81,8 +83,10 @@ impl UpdateStrategy for PStep {
     }
 
     fn start(&mut self, _: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
-        newton_point(initial, &initial.measured_eigenvalues)?;
-        self.start_eigenvalues = initial.model_eigenvalues.clone();
+        let eigen = eigen_view("p-step", initial)?;
+        newton_point(initial, &eigen.measured_eigenvalues)?;
+        self.start_eigenvalues = eigen.model_eigenvalues.clone();
+        self.measured_eigenvalues = eigen.measured_eigenvalues.clone();
         self.stages = if square_max_diff_hz(initial) > self.split_above_hz { self.parts } else { 1 };
         self.stage = 1;
         Ok(())
@@ -93,10 +97,10 @@ impl UpdateStrategy for PStep {
     }
 
     fn step(&mut self, problem: &dyn Objective, current: &Linearisation) -> Result<Step, UpdateError> {
-        let p = newton_point(current, &self.target(current))?;
+        let p = newton_point(current, &self.target())?;
         let next = evaluate_or_diverge(problem, &p)?;
         // Advance through every stage whose target the new point already meets.
-        while self.stage < self.stages && self.within(&next, &self.target(&next)) {
+        while self.stage < self.stages && self.within(&next, &self.target()) {
             self.stage += 1;
         }
         let status = if self.stage == self.stages && self.converged(&next) {

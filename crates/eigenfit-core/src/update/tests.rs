@@ -91,6 +91,40 @@ fn observers_see_every_iteration() {
         .run(&p, &mut LevenbergMarquardt::default(), &[1e3, 1e3])
         .unwrap();
     assert_eq!(sink.records, est.history);
+    // The channel carries the strategy's own state: LM's damping after every step.
+    assert!(sink.records[0].metrics.is_empty());
+    for r in &sink.records[1..] {
+        let mu = r.metrics.iter().find(|(k, _)| *k == "mu").map(|(_, v)| *v);
+        assert!(mu.is_some_and(|mu| mu > 0.0 && mu.is_finite()), "{:?}", r.metrics);
+    }
+    let mut trf = IterationRecordSink::default();
+    Driver::default().observe(&mut [&mut trf]).run(&p, build("trf").as_mut(), &[1e3, 1e3]).unwrap();
+    assert!(trf.records[1..].iter().all(|r| r.metrics.iter().any(|(k, v)| *k == "radius" && *v > 0.0)));
+}
+
+/// The problem of [`problem`] seen without its eigenvalue view, as a run-up's objective is.
+struct WithoutEigenvalues<'a>(&'a dyn Objective);
+
+impl Objective for WithoutEigenvalues<'_> {
+    fn parameters(&self) -> &ParameterSet {
+        self.0.parameters()
+    }
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        self.0.linearise(p).map(|lin| Linearisation { eigen: None, ..lin })
+    }
+}
+
+#[test]
+fn least_squares_strategies_need_no_eigenvalues_and_the_papers_say_so() {
+    let p = problem(&[3e4, 1e4]);
+    let bare = WithoutEigenvalues(&p);
+    let full = Driver::default().run(&p, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
+    let seen = Driver::default().run(&bare, &mut LevenbergMarquardt::default(), &[1e3, 1e3]).unwrap();
+    assert_eq!(full.parameters, seen.parameters);
+    for name in ["newton", "p-step"] {
+        let err = Driver::default().run(&bare, build(name).as_mut(), &[1e3, 1e3]).unwrap_err();
+        assert!(matches!(&err, UpdateError::Setup(m) if m.contains("not applicable")), "{name}: {err}");
+    }
 }
 
 #[test]
@@ -154,7 +188,7 @@ impl Objective for Tally<'_> {
     fn parameters(&self) -> &ParameterSet {
         self.inner.parameters()
     }
-    fn linearise(&self, p: &[f64]) -> Result<crate::problem::Linearisation, crate::problem::ResidualError> {
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
         self.calls.set(self.calls.get() + 1);
         self.inner.linearise(p)
     }
@@ -537,4 +571,33 @@ fn tikhonov_refuses_data_with_no_residual_beyond_the_parameters() {
     }
     let err = registry::build("tikhonov:choice=aic").unwrap_err().to_string();
     assert!(err.contains("gcv, lcurve"), "{err}");
+}
+
+/// A refit holding a parameter: the default (damped with its fixed set) and a registered
+/// strategy that knows nothing of fixed parameters (trf, on the free ones only) reach the same
+/// conditional minimum, the held value untouched, and the linearisation handed back is the full
+/// problem's.
+#[test]
+fn a_registered_refit_holds_parameters_it_has_no_notion_of() {
+    use crate::update::refit::{Damped, Refit, RefitRequest, Registered};
+    let p = problem(&[3e4, 1e4]);
+    let request = RefitRequest { fixed: vec![true, false], ..RefitRequest::default() };
+    let start = [2.5e4, 2e4];
+    let budget = Budget::unlimited();
+    let damped = Damped.refit(&p, &start, &request, 200, &budget).unwrap();
+    let trf = Registered::new("trf").unwrap().refit(&p, &start, &request, 200, &budget).unwrap();
+    for est in [&damped, &trf] {
+        assert_eq!(est.parameters[0], 2.5e4);
+        assert_eq!(est.last.parameters, est.parameters);
+        assert_eq!(est.last.jacobian.ncols(), 2);
+        assert!(est.history.iter().all(|r| r.parameters.len() == 2 && r.parameters[0] == 2.5e4));
+    }
+    // Each stops at its own tolerance on a conditional minimum that does not fit exactly.
+    assert!(
+        (damped.parameters[1] / trf.parameters[1] - 1.0).abs() < 1e-6,
+        "{:?} {:?}",
+        damped.parameters,
+        trf.parameters
+    );
+    assert!((damped.last.cost() - trf.last.cost()).abs() <= 1e-10 * damped.last.cost().max(1e-30));
 }

@@ -389,6 +389,10 @@ impl UpdateStrategy for TikhonovGaussNewton {
     fn regularisation(&self) -> Option<Regularisation> {
         self.last.clone()
     }
+
+    fn metrics(&self) -> Vec<(&'static str, f64)> {
+        self.last.as_ref().map_or_else(Vec::new, |r| vec![("lambda", r.lambda)])
+    }
 }
 
 #[cfg(test)]

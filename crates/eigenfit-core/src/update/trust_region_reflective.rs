@@ -117,6 +117,9 @@ impl UpdateStrategy for TrustRegionReflective {
     fn name(&self) -> &'static str {
         "trf"
     }
+    fn metrics(&self) -> Vec<(&'static str, f64)> {
+        vec![("radius", self.radius)]
+    }
 
     fn start(&mut self, problem: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
         super::require_enough_residuals("trust-region reflective", problem, initial)?;
