@@ -163,9 +163,10 @@ fn nan_and_inf_in_bearing_tables_are_named_where_they_are() {
 }
 
 /// The work of a Campbell sweep is bounded: on ROSS 3's compressor (732 DOF, 10 modes solved per
-/// speed: 36 eigenvalues wanted) each speed takes at most 80 Krylov steps and 3 convergence
-/// checks on average (measured: 66–78 steps, 2–3 checks); the small eigen-solves of the checks
-/// were most of the time when every 6th step was checked from 48 on.
+/// speed: 36 eigenvalues wanted) each speed takes at most 80 Krylov steps and 1.5 convergence
+/// checks on average (measured: 70.2 steps, 1.20 checks); the small eigen-solves of the checks
+/// were most of the time when every 6th step was checked from 48 on, and half of it when the
+/// first check came at 63 steps, which most speeds do not reach converged.
 #[test]
 fn a_campbell_sweep_of_the_compressor_takes_bounded_krylov_work() {
     use eigenfit_rotordynamics::shift_invert::work;
@@ -183,7 +184,7 @@ fn a_campbell_sweep_of_the_compressor_takes_bounded_krylov_work() {
     let (steps, checks) = (done.0 as f64 / speeds.len() as f64, done.1 as f64 / speeds.len() as f64);
     eprintln!("per speed: {steps:.1} Krylov steps, {checks:.2} checks");
     assert!(steps > 0.0 && steps <= 80.0, "{steps} Krylov steps per speed");
-    assert!(checks <= 3.0, "{checks} convergence checks per speed");
+    assert!(checks <= 1.5, "{checks} convergence checks per speed");
 }
 
 /// The divergence check by Sturm counts on band matrices agrees with the dense symmetric
