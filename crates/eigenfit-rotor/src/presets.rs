@@ -122,7 +122,15 @@ pub fn paper_rotor() -> Rotor {
 /// for the test that checks the coverage (`tests/interval_coverage.rs`) and the `monte_carlo`
 /// benchmark, so the benchmark times the study the test checks.
 pub fn paper_rotor_coverage_study(trials: usize, seed: u64) -> StudySettings {
-    StudySettings { trials, seed, modes: 3, relative_std: 1e-3, initial: vec![1e4, 1e6], max_iterations: 200 }
+    StudySettings {
+        trials,
+        seed,
+        modes: 3,
+        relative_std: 1e-3,
+        initial: vec![1e4, 1e6],
+        max_iterations: 200,
+        refit: Default::default(),
+    }
 }
 
 /// The paper rotor's layout family: 11 nodes, two equal elements up to the heavy disk, six

@@ -18,6 +18,6 @@ pub use chi2::{chi2_quantile_upper, chi2_upper_tail};
 pub use joint::{Joint, JointError};
 pub use shape_fit::{ShapeFit, DEFAULT_FREQUENCY_STD_REL, DEFAULT_SHAPE_STD};
 pub use statistics::{
-    uncertainty, uncertainty_observed, uncertainty_parallel, uncertainty_refit, uncertainty_within,
-    Identifiability, Rank, Uncertainty, RANK_TOLERANCE, UNCERTAINTY_EVALUATIONS,
+    uncertainty, uncertainty_observed, uncertainty_parallel, uncertainty_refit, uncertainty_refit_serial,
+    uncertainty_within, Identifiability, Rank, Uncertainty, RANK_TOLERANCE, UNCERTAINTY_EVALUATIONS,
 };

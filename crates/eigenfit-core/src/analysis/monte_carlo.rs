@@ -5,12 +5,13 @@
 //! Trial i draws its noise from its own generator, seeded from the study's seed and i alone, so
 //! no trial depends on which thread ran it or on the others.
 
-use crate::analysis::uncertainty;
+use crate::analysis::statistics::{uncertainty_refit_serial, UNCERTAINTY_EVALUATIONS};
 use crate::eigen::EigenSolver;
 use crate::measurement::{synthetic::synthesise, synthetic::NoiseRng};
 use crate::model::StructuralModel;
 use crate::problem::Problem;
-use crate::update::{Driver, LevenbergMarquardt};
+use crate::update::refit::{RefitChoice, RefitRequest};
+use crate::update::Budget;
 use rayon::prelude::*;
 
 /// What a study simulates and how each trial is estimated.
@@ -28,6 +29,9 @@ pub struct StudySettings {
     pub initial: Vec<f64>,
     /// Iteration limit of every estimate.
     pub max_iterations: usize,
+    /// The strategy of every trial's fit (with its restarts) and of its intervals' profile
+    /// refits: damped least squares by default, any registered one by name.
+    pub refit: RefitChoice,
 }
 
 /// One trial's estimate.
@@ -115,6 +119,7 @@ impl Study {
 /// # let spring = Spring(ParameterSet::new(vec![Parameter::new("k", "N/m", 4.0)])?);
 /// let settings = StudySettings {
 ///     trials: 200, seed: 1, modes: 1, relative_std: 1e-3, initial: vec![1.0], max_iterations: 100,
+///     refit: Default::default(),
 /// };
 /// let study = run(&spring, &DenseSolver, &[4.0], &settings);
 /// assert_eq!(study.converged(), 200);
@@ -158,11 +163,14 @@ where
         let data = synthesise(model, solver, truth, settings.modes, settings.relative_std, Some(&mut noise))
             .map_err(|e| e.to_string())?;
         let problem = Problem::new(model, solver, data);
-        let driver = Driver { max_iterations: settings.max_iterations };
-        let est = driver
-            .run(&problem, &mut LevenbergMarquardt::default(), &settings.initial)
+        let request = RefitRequest { restarts: true, ..RefitRequest::default() };
+        let est = settings
+            .refit
+            .refit(&problem, &settings.initial, &request, settings.max_iterations, &Budget::unlimited())
             .map_err(|e| e.to_string())?;
-        let intervals = uncertainty(&problem, &est.last).map(|u| u.intervals);
+        let budget = Budget::new(UNCERTAINTY_EVALUATIONS);
+        let intervals =
+            uncertainty_refit_serial(&problem, &est.last, &budget, &*settings.refit).map(|u| u.intervals);
         Ok(TrialEstimate {
             chi2: est.last.chi2(),
             converged: est.termination.is_converged(),
@@ -188,6 +196,7 @@ mod tests {
             relative_std: 1e-3,
             initial: vec![1e4, 1e4],
             max_iterations: 200,
+            refit: RefitChoice::default(),
         }
     }
 
@@ -202,6 +211,25 @@ mod tests {
             assert_eq!(parallel.trials.len(), 64);
             assert_eq!(parallel.converged(), 64);
         }
+    }
+
+    /// The study's estimator chosen by name: the trust-region strategy's trials land where the
+    /// damped ones do (each to its own tolerance), so the coverage is the same.
+    #[test]
+    fn a_study_runs_on_the_refit_strategy_it_is_given() {
+        let model = Chain::new(&[1.0, 2.0]);
+        let truth = [3e3, 8e3];
+        let damped = run(&model, &DenseSolver, &truth, &StudySettings { modes: 2, ..settings(32) });
+        let refit = RefitChoice(std::sync::Arc::new(crate::update::refit::Registered::new("trf").unwrap()));
+        let trf = run(&model, &DenseSolver, &truth, &StudySettings { modes: 2, refit, ..settings(32) });
+        assert_eq!(trf.converged(), 32);
+        for (a, b) in damped.trials.iter().zip(&trf.trials) {
+            let (a, b) = (a.outcome.as_ref().unwrap(), b.outcome.as_ref().unwrap());
+            for (x, y) in a.parameters.iter().zip(&b.parameters) {
+                assert!((x / y - 1.0).abs() < 1e-6, "{:?} against {:?}", a.parameters, b.parameters);
+            }
+        }
+        assert_eq!(damped.coverage(), trf.coverage());
     }
 
     #[test]

@@ -177,6 +177,20 @@ pub fn uncertainty_parallel(
     weighted_uncertainty(Shared::Parallel(problem), at, budget, observers, &Damped)
 }
 
+/// [`uncertainty_within`] with the profile likelihood's refits made by `refit`, one bound after
+/// another (for callers already running in parallel, as a Monte Carlo study's trials).
+pub fn uncertainty_refit_serial(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    budget: &Budget,
+    refit: &dyn Refit,
+) -> Option<Uncertainty> {
+    if !at.has_std {
+        return None;
+    }
+    weighted_uncertainty(Shared::Serial(problem), at, budget, &mut [], refit)
+}
+
 /// [`uncertainty_parallel`] with the profile likelihood's refits made by `refit` (a registered
 /// strategy, say) instead of the default damped least squares: the intervals a user's own
 /// strategy supports.
