@@ -278,7 +278,7 @@ fn runup_shapes(
     };
     let title = format!(
         "{} at the estimate: mode shapes and orbits at {} rpm (the top measured speed)",
-        report.model,
+        plot::rotor_shapes::file_name(&report.model),
         plot::style::trim(shapes.speed_rpm, 1)
     );
     let figure = plot::rotor_shapes::RotorShapesPlot { title, shapes: &shapes };

@@ -115,7 +115,11 @@ fn ross_shapes(
         }
     };
     let title =
-        format!("{}: mode shapes and orbits at {} rpm", report.model, plot::style::trim(report.speed_rpm, 1));
+        format!(
+            "{}: mode shapes and orbits at {} rpm",
+            plot::rotor_shapes::file_name(&report.model),
+            plot::style::trim(report.speed_rpm, 1)
+        );
     let figure = plot::rotor_shapes::RotorShapesPlot { title, shapes: &shapes };
     plot::rotor_shapes::write(&figure, dir, "mode-shapes").unwrap_or_else(|e| {
         crate::output::report_lost(what, &e);

@@ -18,6 +18,10 @@ const LEGEND_W: u32 = 400;
 const ORBIT_STATIONS: usize = 4;
 /// Points per drawn ellipse.
 const ORBIT_POINTS: usize = 145;
+/// Height of the title and the shapes (px).
+const SHAPES_H: u32 = 580;
+/// Height of a row of orbit panels (px).
+const ORBITS_H: u32 = 470;
 
 /// The figure: shapes above, orbits below.
 pub struct RotorShapesPlot<'a> {
@@ -58,12 +62,13 @@ impl RotorShapesPlot<'_> {
 
 /// `mode k: f Hz, whirl, log dec d`.
 fn mode_label(k: usize, m: &ModeShape) -> String {
+    // An undamped rotor's log dec is round-off (±1e-13): no `-0.0000`.
+    let log_dec = if m.log_dec.abs() < 5e-5 { 0.0 } else { m.log_dec };
     format!(
-        "mode {}: {} Hz, {}, log dec {:.4}",
+        "mode {}: {} Hz, {}, log dec {log_dec:.4}",
         k + 1,
         super::mode_shapes::format_hz(m.frequency_hz),
         m.whirl.name(),
-        m.log_dec
     )
 }
 
@@ -74,7 +79,7 @@ fn station_colour(i: usize) -> RGBColor {
 
 impl Figure for RotorShapesPlot<'_> {
     fn size(&self) -> (u32, u32) {
-        (1300, 1150)
+        (1400, SHAPES_H + ORBITS_H * self.grid().0 as u32)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
@@ -83,8 +88,7 @@ impl Figure for RotorShapesPlot<'_> {
         let (x0, x1) = (z[0], z[z.len() - 1].max(z[0] + 1e-9));
         let pad = (x1 - x0) * 0.04;
         let body = style::title(root, &self.title, 50)?;
-        let split = (body.dim_in_pixel().1 as f64 * 0.5) as u32;
-        let (top, bottom) = body.split_vertically(split);
+        let (top, bottom) = body.split_vertically(px(SHAPES_H - 50));
         let (plot, legend) = top.split_horizontally(top.dim_in_pixel().0 - px(LEGEND_W));
         let y_ticks = vec![-1.0, -0.5, 0.0, 0.5, 1.0];
         let mut chart = ChartBuilder::on(&plot)
@@ -156,16 +160,21 @@ impl Figure for RotorShapesPlot<'_> {
 impl RotorShapesPlot<'_> {
     /// One panel per mode: each chosen station's ellipse (normalised as the shapes), a dot where
     /// it is at t = 0 and an arrowhead a quarter period later, pointing the way it turns.
+    /// Rows and columns of orbit panels: one row up to 4 modes, else rows of 3.
+    fn grid(&self) -> (usize, usize) {
+        let n = self.modes().len().max(1);
+        let cols = if n <= 4 { n } else { 3 };
+        (n.div_ceil(cols), cols)
+    }
+
     fn draw_orbits<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
         let modes = self.modes();
-        let cols = if modes.len() <= 3 { modes.len() } else { modes.len().div_ceil(2) };
-        let rows = modes.len().div_ceil(cols.max(1));
-        let panels = area.split_evenly((rows, cols.max(1)));
+        let panels = area.split_evenly(self.grid());
         for (k, (m, panel)) in modes.iter().zip(&panels).enumerate() {
             let (w, h) = panel.dim_in_pixel();
             let (margin, caption) = (px(12), px(style::CAPTION + 14));
             // Equal scales across and up: a circle stays a circle.
-            let legend_h = px(22) * ORBIT_STATIONS as u32;
+            let legend_h = px(26) * ORBIT_STATIONS as u32 + px(10);
             let plot_h = h.saturating_sub(2 * margin + caption + legend_h).max(1) as f64;
             let plot_w = w.saturating_sub(2 * margin).max(1) as f64;
             let (upper, lower) = panel.split_vertically(h.saturating_sub(legend_h));
@@ -218,6 +227,11 @@ fn arrowhead(o: &Orbit) -> Vec<(f64, f64)> {
     let (tx, ty) = (x + ux * size, y + uy * size);
     let (bx, by) = (x - ux * size * 0.6, y - uy * size * 0.6);
     vec![(tx, ty), (bx - uy * size * 0.6, by + ux * size * 0.6), (bx + uy * size * 0.6, by - ux * size * 0.6)]
+}
+
+/// The file name of a model path, for a title that must fit (the folders are in the JSON).
+pub fn file_name(model: &str) -> String {
+    Path::new(model).file_name().map_or_else(|| model.to_string(), |n| n.to_string_lossy().into_owned())
 }
 
 /// The numbers drawn, one row per mode and shaft node: the mode's frequency, whirl and log
