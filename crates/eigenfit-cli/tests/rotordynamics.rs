@@ -461,11 +461,9 @@ fn simulate_set_on_a_ross_rotor_sets_what_it_says() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("kxx_Nowhere") && err.contains("kxx_DE") && err.contains("cyy_NDE"), "{err}");
-    for extra in [
-        &["--stiffness", "1e6,1e6"][..],
-        &["--sweep", "1e5:1e8:5"],
-        &["--effect", "support-mass@1=2"],
-    ] {
+    for extra in
+        [&["--stiffness", "1e6,1e6"][..], &["--sweep", "1e5:1e8:5"], &["--effect", "support-mass@1=2"]]
+    {
         let mut args = vec!["simulate", "--model", &model, "--speed", "3000"];
         args.extend_from_slice(extra);
         let out = run(&args);
@@ -681,16 +679,16 @@ fn estimate_on_a_ross_rotor_plots_the_runup_fit() {
     }
     // The shapes are the solver's modes of the estimated rotor (the start file's bearings times
     // the reported factors) at the top measured speed, as many as measured.
-    let start = eigenfit_rotordynamics::ross_file::read(std::path::Path::new(&data(
-        "ross3/pchip_speed_start.toml",
-    )))
-    .unwrap();
+    let start =
+        eigenfit_rotordynamics::ross_file::read(std::path::Path::new(&data("ross3/pchip_speed_start.toml")))
+            .unwrap();
     let scales = v["scales"].as_object().unwrap();
     let names: Vec<&str> = scales.keys().map(String::as_str).collect();
     let params = eigenfit_rotordynamics::identify::bearing_parameters(&start, &names).unwrap();
     let factors: Vec<f64> = params.iter().map(|p| scales[&p.name].as_f64().unwrap()).collect();
     let estimated = eigenfit_rotordynamics::identify::scaled_rotor(&start, &params, &factors);
-    let top = v["points"].as_array().unwrap().iter().map(|p| p["speed_rpm"].as_f64().unwrap()).fold(0.0, f64::max);
+    let top =
+        v["points"].as_array().unwrap().iter().map(|p| p["speed_rpm"].as_f64().unwrap()).fold(0.0, f64::max);
     let shapes = read_shapes(&dir.join("mode-shapes-estimate.csv"));
     assert_eq!(shapes.len(), 4, "modes drawn");
     check_shapes(&shapes, &estimated, top);
@@ -874,7 +872,10 @@ fn swept_area(o: &[f64; 4]) -> f64 {
     let n = 720;
     (0..n)
         .map(|j| {
-            let (a, b) = (at(j as f64 * std::f64::consts::TAU / n as f64), at((j + 1) as f64 * std::f64::consts::TAU / n as f64));
+            let (a, b) = (
+                at(j as f64 * std::f64::consts::TAU / n as f64),
+                at((j + 1) as f64 * std::f64::consts::TAU / n as f64),
+            );
             0.5 * (a.0 * b.1 - a.1 * b.0)
         })
         .sum()
@@ -893,8 +894,10 @@ fn check_shapes(shapes: &[CsvMode], rotor: &eigenfit_rotordynamics::Rotor, rpm: 
         assert_eq!(m.whirl, s.whirl.name(), "mode {}", k + 1);
         // c = α s in least squares: α = sᴴc / sᴴs, and the rest must be round-off.
         let c: Vec<(f64, f64)> = m.xy.iter().flat_map(|v| [(v[0], v[1]), (v[2], v[3])]).collect();
-        let sv: Vec<(f64, f64)> =
-            (0..m.xy.len()).flat_map(|n| [4 * n, 4 * n + 1]).map(|i| (s.right[i].re, s.right[i].im)).collect();
+        let sv: Vec<(f64, f64)> = (0..m.xy.len())
+            .flat_map(|n| [4 * n, 4 * n + 1])
+            .map(|i| (s.right[i].re, s.right[i].im))
+            .collect();
         let (mut dot, mut ss) = ((0.0, 0.0), 0.0);
         for (a, b) in sv.iter().zip(&c) {
             // conj(a)·b
@@ -909,7 +912,12 @@ fn check_shapes(shapes: &[CsvMode], rotor: &eigenfit_rotordynamics::Rotor, rpm: 
             rest += (b.0 - fit.0).powi(2) + (b.1 - fit.1).powi(2);
             cc += b.0 * b.0 + b.1 * b.1;
         }
-        assert!(rest.sqrt() <= 1e-10 * cc.sqrt(), "mode {}: the shape is not the solver's ({:e})", k + 1, rest.sqrt());
+        assert!(
+            rest.sqrt() <= 1e-10 * cc.sqrt(),
+            "mode {}: the shape is not the solver's ({:e})",
+            k + 1,
+            rest.sqrt()
+        );
         let largest = m.major.iter().copied().fold(0.0, f64::max);
         assert!((largest - 1.0).abs() < 1e-12, "mode {}: largest semi-major axis {largest}", k + 1);
         for (n, o) in m.xy.iter().enumerate() {

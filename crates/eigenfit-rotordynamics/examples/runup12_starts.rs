@@ -6,7 +6,9 @@
 //! each factor the truth's × (1 ± u), u in 0.3…0.5 (`tests/support/starts.rs`).
 //!
 //! `cargo run --release -p eigenfit-rotordynamics --example runup12_starts -- [CSV] [STARTS]`
-//! (CSV in tests/data, default runup_truth6.csv; STARTS default 24, the first 3 are the test's).
+//! (CSV in tests/data, default runup_truth6.csv; STARTS default 24; the test takes starts 0, 1, 2,
+//! 17 and 20). A fit that ends elsewhere but passes the χ² test with the truth as good by core's
+//! test of alternatives is counted `not unique`: the run-up does not fix that point.
 use eigenfit_core::analysis::alternatives::Equivalence;
 use eigenfit_core::analysis::verdict::{judge, FitVerdict};
 use eigenfit_core::problem::Objective;
@@ -54,7 +56,10 @@ fn main() {
             "returned".to_string()
         } else if passes && truth_as_good.equally_good {
             not_unique += 1;
-            format!("not unique: the truth is as good (Δχ² {:.2})", truth_as_good.delta_chi2.unwrap_or(f64::NAN))
+            format!(
+                "not unique: the truth is as good (Δχ² {:.2})",
+                truth_as_good.delta_chi2.unwrap_or(f64::NAN)
+            )
         } else {
             "not returned".to_string()
         };

@@ -219,10 +219,7 @@ mod tests {
         let e = c64::new((-p).cos(), (-p).sin());
         let u = e * a;
         let v = e * c64::new(0.0, -b);
-        let o = Orbit {
-            x: u * th.cos() - v * th.sin(),
-            y: u * th.sin() + v * th.cos(),
-        };
+        let o = Orbit { x: u * th.cos() - v * th.sin(), y: u * th.sin() + v * th.cos() };
         assert!((o.major() - a).abs() < 1e-12, "{}", o.major());
         assert!((o.minor() - b).abs() < 1e-12, "{}", o.minor());
         let d = (o.angle() - th).rem_euclid(std::f64::consts::PI);

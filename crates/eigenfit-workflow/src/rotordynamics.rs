@@ -670,7 +670,11 @@ pub fn estimate_with(
     };
     Ok(RunupEstimateReport {
         updated_model,
-        estimated_rotor: eigenfit_rotordynamics::identify::scaled_rotor(&rotor, &params, &estimate.parameters),
+        estimated_rotor: eigenfit_rotordynamics::identify::scaled_rotor(
+            &rotor,
+            &params,
+            &estimate.parameters,
+        ),
         history: estimate.history.clone(),
         model: path.display().to_string(),
         outcome: Outcome::of(&estimate, converged),

@@ -298,7 +298,11 @@ fn runup_convergence(report: &eigenfit_workflow::rotordynamics::RunupEstimateRep
         runs: vec![Run {
             strategy: "damped".to_string(),
             outcome: format!("{}, {} it.", report.outcome.termination.status, report.outcome.iterations),
-            history: report.history.iter().map(|r| (r.iteration, r.parameters.clone(), r.max_abs_diff_hz)).collect(),
+            history: report
+                .history
+                .iter()
+                .map(|r| (r.iteration, r.parameters.clone(), r.max_abs_diff_hz))
+                .collect(),
         }],
         target: None,
         tolerance: None,

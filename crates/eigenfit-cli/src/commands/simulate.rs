@@ -114,12 +114,11 @@ fn ross_shapes(
             return Vec::new();
         }
     };
-    let title =
-        format!(
-            "{}: mode shapes and orbits at {} rpm",
-            plot::rotor_shapes::file_name(&report.model),
-            plot::style::trim(report.speed_rpm, 1)
-        );
+    let title = format!(
+        "{}: mode shapes and orbits at {} rpm",
+        plot::rotor_shapes::file_name(&report.model),
+        plot::style::trim(report.speed_rpm, 1)
+    );
     let figure = plot::rotor_shapes::RotorShapesPlot { title, shapes: &shapes };
     plot::rotor_shapes::write(&figure, dir, "mode-shapes").unwrap_or_else(|e| {
         crate::output::report_lost(what, &e);

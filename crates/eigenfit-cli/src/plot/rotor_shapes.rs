@@ -112,7 +112,10 @@ impl Figure for RotorShapesPlot<'_> {
         for d in &s.disks {
             let x = z[d.node];
             chart
-                .draw_series([Rectangle::new([(x - pad * 0.15, -0.14), (x + pad * 0.15, 0.14)], INK.filled())])
+                .draw_series([Rectangle::new(
+                    [(x - pad * 0.15, -0.14), (x + pad * 0.15, 0.14)],
+                    INK.filled(),
+                )])
                 .map_err(err)?;
             chart
                 .draw_series([Text::new(
@@ -144,7 +147,11 @@ impl Figure for RotorShapesPlot<'_> {
         if s.modes.len() > self.modes().len() {
             entries.push((
                 Swatch::None,
-                format!("(the lowest {} of {} modes: more would not be told apart)", self.modes().len(), s.modes.len()),
+                format!(
+                    "(the lowest {} of {} modes: more would not be told apart)",
+                    self.modes().len(),
+                    s.modes.len()
+                ),
             ));
         }
         entries.push((Swatch::None, "▲ bearing or seal, ■ disk".to_string()));
@@ -178,7 +185,8 @@ impl RotorShapesPlot<'_> {
             let plot_h = h.saturating_sub(2 * margin + caption + legend_h).max(1) as f64;
             let plot_w = w.saturating_sub(2 * margin).max(1) as f64;
             let (upper, lower) = panel.split_vertically(h.saturating_sub(legend_h));
-            let (rx, ry) = if plot_w > plot_h { (1.15 * plot_w / plot_h, 1.15) } else { (1.15, 1.15 * plot_h / plot_w) };
+            let (rx, ry) =
+                if plot_w > plot_h { (1.15 * plot_w / plot_h, 1.15) } else { (1.15, 1.15 * plot_h / plot_w) };
             let mut chart = ChartBuilder::on(&upper)
                 .margin(margin)
                 .caption(format!("mode {} ({})", k + 1, m.whirl.name()), style::font(style::CAPTION))
@@ -200,10 +208,7 @@ impl RotorShapesPlot<'_> {
                 if !head.is_empty() {
                     chart.draw_series([Polygon::new(head, c.filled())]).map_err(err)?;
                 }
-                entries.push((
-                    Swatch::Line(c),
-                    format!("node {node} ({what}): {}", o.direction().name()),
-                ));
+                entries.push((Swatch::Line(c), format!("node {node} ({what}): {}", o.direction().name())));
             }
             style::legend_column(&lower, (pxi(12), 0), &entries)?;
         }
