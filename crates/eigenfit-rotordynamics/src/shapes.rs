@@ -210,11 +210,11 @@ mod tests {
         assert!((back.minor() + 1.0).abs() < 1e-15);
     }
 
-    /// An ellipse of semi-axes 2 (along 30°) and 0.5, at its extreme at phase 0.4: major,
+    /// An ellipse of semi-axes 2 (along 0.6 rad) and 0.5, at its extreme at phase 0.4: major,
     /// minor and angle come back, and the largest distance over a fine sweep is the major.
     #[test]
     fn an_ellipse_gives_back_its_axes_and_angle() {
-        let (a, b, th, p) = (2.0f64, 0.5f64, 0.5236f64, 0.4f64);
+        let (a, b, th, p) = (2.0f64, 0.5f64, 0.6f64, 0.4f64);
         // Position u(t) = a cos(ωt − p) along the axis, v(t) = b sin(ωt − p) across it.
         let e = c64::new((-p).cos(), (-p).sin());
         let u = e * a;
