@@ -461,12 +461,9 @@ fn simulate_set_on_a_ross_rotor_sets_what_it_says() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("kxx_Nowhere") && err.contains("kxx_DE") && err.contains("cyy_NDE"), "{err}");
-    for extra in [
-        &["--plot", scratch.path().to_str().unwrap()][..],
-        &["--stiffness", "1e6,1e6"],
-        &["--sweep", "1e5:1e8:5"],
-        &["--effect", "support-mass@1=2"],
-    ] {
+    for extra in
+        [&["--stiffness", "1e6,1e6"][..], &["--sweep", "1e5:1e8:5"], &["--effect", "support-mass@1=2"]]
+    {
         let mut args = vec!["simulate", "--model", &model, "--speed", "3000"];
         args.extend_from_slice(extra);
         let out = run(&args);
@@ -673,7 +670,35 @@ fn estimate_on_a_ross_rotor_plots_the_runup_fit() {
         "--json",
     ]));
     let plots: Vec<&str> = v["plots"].as_array().unwrap().iter().map(|p| p.as_str().unwrap()).collect();
-    assert_eq!(plots.len(), 4, "{plots:?}");
+    // The run-up fit, the Campbell diagram, the mode shapes and orbits (with their numbers as
+    // CSV) and the convergence, each as SVG and PNG.
+    assert_eq!(plots.len(), 9, "{plots:?}");
+    for stem in ["runup-fit", "campbell-estimate", "mode-shapes-estimate", "convergence"] {
+        valid_figure(&dir, stem);
+        assert!(plots.iter().any(|p| p.ends_with(&format!("{stem}.svg"))), "{stem} not in {plots:?}");
+    }
+    // The shapes are the solver's modes of the estimated rotor (the start file's bearings times
+    // the reported factors) at the top measured speed, as many as measured.
+    let start =
+        eigenfit_rotordynamics::ross_file::read(std::path::Path::new(&data("ross3/pchip_speed_start.toml")))
+            .unwrap();
+    let scales = v["scales"].as_object().unwrap();
+    let names: Vec<&str> = scales.keys().map(String::as_str).collect();
+    let params = eigenfit_rotordynamics::identify::bearing_parameters(&start, &names).unwrap();
+    let factors: Vec<f64> = params.iter().map(|p| scales[&p.name].as_f64().unwrap()).collect();
+    let estimated = eigenfit_rotordynamics::identify::scaled_rotor(&start, &params, &factors);
+    let top =
+        v["points"].as_array().unwrap().iter().map(|p| p["speed_rpm"].as_f64().unwrap()).fold(0.0, f64::max);
+    let shapes = read_shapes(&dir.join("mode-shapes-estimate.csv"));
+    assert_eq!(shapes.len(), 4, "modes drawn");
+    check_shapes(&shapes, &estimated, top);
+    let svg = std::fs::read_to_string(dir.join("mode-shapes-estimate.svg")).unwrap();
+    assert!(svg.contains(&format!("at {top} rpm (the top measured speed)")), "the caption names the speed");
+    // The convergence plot draws every fitted factor.
+    let svg = std::fs::read_to_string(dir.join("convergence.svg")).unwrap();
+    for name in &names {
+        assert!(svg.contains(name), "{name} not on the convergence plot");
+    }
     // The estimated rotor's Campbell diagram (0 to 1.2 × the top measured speed, as many modes as
     // measured): the fit reaches the truth, so it is the truth file's diagram drawn by `campbell
     // --plot` over the same speeds, line for line but the title.
@@ -787,5 +812,165 @@ fn ross2_reads_the_written_model_as_eigenfit_does() {
             );
         }
         assert_eq!(ours.len(), 4, "{speed} rpm: {s}");
+    }
+}
+
+/// An SVG document and a PNG image that decodes, both written.
+fn valid_figure(dir: &std::path::Path, stem: &str) {
+    let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "{stem}.svg is no SVG document");
+    let png = image::open(dir.join(format!("{stem}.png"))).unwrap_or_else(|e| panic!("{stem}.png: {e}"));
+    let (w, h) = image::GenericImageView::dimensions(&png);
+    assert!(w >= 800 && h >= 600, "{stem}.png is {w}×{h}");
+}
+
+/// One mode of a shapes CSV: frequency, whirl, log dec, and per shaft node its complex x and y,
+/// orbit direction and signed semi-major axis.
+#[derive(Debug)]
+struct CsvMode {
+    frequency_hz: f64,
+    whirl: String,
+    log_dec: f64,
+    xy: Vec<[f64; 4]>,
+    major: Vec<f64>,
+    direction: Vec<String>,
+}
+
+fn read_shapes(path: &std::path::Path) -> Vec<CsvMode> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no {name}"));
+    let mut modes: Vec<CsvMode> = Vec::new();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let num = |name: &str| f[col(name)].parse::<f64>().unwrap();
+        let k: usize = f[col("mode")].parse().unwrap();
+        if modes.len() < k {
+            modes.push(CsvMode {
+                frequency_hz: num("frequency_hz"),
+                whirl: f[col("whirl")].to_string(),
+                log_dec: num("log_dec"),
+                xy: Vec::new(),
+                major: Vec::new(),
+                direction: Vec::new(),
+            });
+        }
+        let m = &mut modes[k - 1];
+        assert_eq!(f[col("node")].parse::<usize>().unwrap(), m.xy.len(), "nodes in order");
+        m.xy.push([num("x_re"), num("x_im"), num("y_re"), num("y_im")]);
+        m.major.push(num("major"));
+        m.direction.push(f[col("direction")].to_string());
+    }
+    modes
+}
+
+/// The sense of an orbit from its motion: the signed area it sweeps, ½∮(x dy − y dx), sampled
+/// over one period (x(φ) = x_re cos φ − x_im sin φ) — positive turning from x towards y.
+fn swept_area(o: &[f64; 4]) -> f64 {
+    let at = |p: f64| (o[0] * p.cos() - o[1] * p.sin(), o[2] * p.cos() - o[3] * p.sin());
+    let n = 720;
+    (0..n)
+        .map(|j| {
+            let (a, b) = (
+                at(j as f64 * std::f64::consts::TAU / n as f64),
+                at((j + 1) as f64 * std::f64::consts::TAU / n as f64),
+            );
+            0.5 * (a.0 * b.1 - a.1 * b.0)
+        })
+        .sum()
+}
+
+/// `shapes` are the modal solver's lowest modes of `rotor` at `rpm`: frequency, whirl and log
+/// dec equal, each shape the solver's eigenvector (x, y of every shaft node) to a complex
+/// factor, normalised to a largest semi-major axis of 1; every orbit turns the way its
+/// direction column says, and in a forward (backward) mode every moving node turns forward
+/// (backward).
+fn check_shapes(shapes: &[CsvMode], rotor: &eigenfit_rotordynamics::Rotor, rpm: f64) {
+    let solved = rotor.lowest_modes(eigenfit_rotordynamics::rpm_to_rad(rpm), shapes.len()).unwrap();
+    for (k, (m, s)) in shapes.iter().zip(&solved).enumerate() {
+        assert!((m.frequency_hz - s.frequency_hz()).abs() <= 1e-12 * s.frequency_hz(), "mode {}", k + 1);
+        assert!((m.log_dec - s.log_dec()).abs() <= 1e-12 * s.log_dec().abs().max(1e-9), "mode {}", k + 1);
+        assert_eq!(m.whirl, s.whirl.name(), "mode {}", k + 1);
+        // c = α s in least squares: α = sᴴc / sᴴs, and the rest must be round-off.
+        let c: Vec<(f64, f64)> = m.xy.iter().flat_map(|v| [(v[0], v[1]), (v[2], v[3])]).collect();
+        let sv: Vec<(f64, f64)> = (0..m.xy.len())
+            .flat_map(|n| [4 * n, 4 * n + 1])
+            .map(|i| (s.right[i].re, s.right[i].im))
+            .collect();
+        let (mut dot, mut ss) = ((0.0, 0.0), 0.0);
+        for (a, b) in sv.iter().zip(&c) {
+            // conj(a)·b
+            dot.0 += a.0 * b.0 + a.1 * b.1;
+            dot.1 += a.0 * b.1 - a.1 * b.0;
+            ss += a.0 * a.0 + a.1 * a.1;
+        }
+        let alpha = (dot.0 / ss, dot.1 / ss);
+        let (mut rest, mut cc) = (0.0, 0.0);
+        for (a, b) in sv.iter().zip(&c) {
+            let fit = (alpha.0 * a.0 - alpha.1 * a.1, alpha.0 * a.1 + alpha.1 * a.0);
+            rest += (b.0 - fit.0).powi(2) + (b.1 - fit.1).powi(2);
+            cc += b.0 * b.0 + b.1 * b.1;
+        }
+        assert!(
+            rest.sqrt() <= 1e-10 * cc.sqrt(),
+            "mode {}: the shape is not the solver's ({:e})",
+            k + 1,
+            rest.sqrt()
+        );
+        let largest = m.major.iter().copied().fold(0.0, f64::max);
+        assert!((largest - 1.0).abs() < 1e-12, "mode {}: largest semi-major axis {largest}", k + 1);
+        for (n, o) in m.xy.iter().enumerate() {
+            if m.major[n] < 1e-6 {
+                continue;
+            }
+            let area = swept_area(o);
+            let sense = if area > 0.0 { "forward" } else { "backward" };
+            // A line sweeps no area: its direction is `mixed`.
+            if area.abs() > 1e-9 {
+                assert_eq!(m.direction[n], sense, "mode {} node {n}: area {area:e}", k + 1);
+                if m.whirl != "mixed" {
+                    assert_eq!(sense, m.whirl, "mode {} node {n} turns against its whirl", k + 1);
+                }
+            }
+        }
+    }
+}
+
+/// `simulate --plot DIR` on a ROSS rotor draws its modes' shapes and orbits at the speed
+/// (mode-shapes.svg/.png), the numbers drawn in mode-shapes.csv: the solver's modes, each
+/// labelled with frequency, whirl and log decrement.
+#[test]
+fn simulate_plot_on_a_ross_rotor_draws_the_solvers_shapes_and_orbits() {
+    let scratch = common::scratch();
+    let dir = scratch.path().join("plots");
+    let model = data("rotor_example.toml");
+    let v = json(&run(&[
+        "simulate",
+        "--model",
+        &model,
+        "--speed",
+        "3000",
+        "--modes",
+        "4",
+        "--plot",
+        dir.to_str().unwrap(),
+        "--json",
+    ]));
+    let plots: Vec<&str> = v["plots"].as_array().unwrap().iter().map(|p| p.as_str().unwrap()).collect();
+    assert_eq!(plots.len(), 3, "{plots:?}");
+    valid_figure(&dir, "mode-shapes");
+    let shapes = read_shapes(&dir.join("mode-shapes.csv"));
+    assert_eq!(shapes.len(), 4);
+    let rotor = eigenfit_rotordynamics::ross_file::read(std::path::Path::new(&model)).unwrap();
+    check_shapes(&shapes, &rotor, 3000.0);
+    // The JSON's modes are the ones drawn, and the legend names each.
+    let svg = std::fs::read_to_string(dir.join("mode-shapes.svg")).unwrap();
+    for (k, m) in shapes.iter().enumerate() {
+        assert_eq!(v["whirl"][k].as_str().unwrap(), m.whirl);
+        assert_eq!(v["frequencies_hz"][k].as_f64().unwrap(), m.frequency_hz);
+        let label = format!("mode {}: ", k + 1);
+        let line = svg.lines().find(|l| l.starts_with(&label)).unwrap_or_else(|| panic!("no {label}"));
+        assert!(line.contains(&m.whirl) && line.contains("log dec") && line.contains(" Hz"), "{line}");
     }
 }

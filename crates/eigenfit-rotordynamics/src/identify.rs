@@ -239,9 +239,14 @@ impl Parameter {
     }
 
     /// Whether it scales a direct stiffness (kxx or kyy): the coefficients that move the
-    /// frequencies most, fitted first and screened by the search from other starts.
+    /// frequencies most, fitted first.
     pub fn is_direct_stiffness(&self) -> bool {
         matches!(self.coefficient, 0 | 3)
+    }
+
+    /// Whether it scales a stiffness, direct or cross-coupled (kxx … kyy).
+    pub fn is_stiffness(&self) -> bool {
+        self.coefficient < 4
     }
 
     /// Whether it scales a damping coefficient (cxx … cyy).

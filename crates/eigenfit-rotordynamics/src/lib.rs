@@ -20,6 +20,7 @@ pub mod objective;
 pub mod ross_file;
 pub mod rotor;
 pub mod sensitivity;
+pub mod shapes;
 pub mod shift_invert;
 
 pub use campbell::{campbell, Campbell};

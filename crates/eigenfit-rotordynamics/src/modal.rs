@@ -453,7 +453,7 @@ pub fn whirl_of(x: &[c64], pairs: &[(usize, usize)]) -> Whirl {
 }
 
 /// Orbits flatter than this (|minor/major| below about 10⁻¹⁰) are lines.
-const WHIRL_TOLERANCE: f64 = 2e-10;
+pub const WHIRL_TOLERANCE: f64 = 2e-10;
 
 /// Modal assurance criterion of two complex shapes.
 pub fn mac(a: &[c64], b: &[c64]) -> f64 {

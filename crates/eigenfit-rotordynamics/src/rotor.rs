@@ -8,7 +8,7 @@ use crate::modal::{self, Mode, Quadratic};
 use faer::Mat;
 
 /// A rotor model.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Rotor {
     /// Shaft elements, in node order.
     pub shafts: Vec<ShaftElement>,

@@ -338,7 +338,11 @@ fn every_bearing_means_the_bearings_and_seals_are_named_one_by_one() {
 /// scripts/ross_realistic_runups.py). Each start as `estimate` runs it (6 restarts), within a
 /// budget of evaluations; each must end converged, pass the χ² test and give every factor to
 /// 1e-5. The starts are the first 3 of the study's design (every factor 40 % up, 40 % down, one
-/// mixed); the study over 24 starts, where 2 do not come back, is `examples/runup12_starts.rs`.
+/// mixed) and its start 17, which came back only once the screened restarts also spread the
+/// cross-coupled stiffnesses (before: best-found at χ² 1.9e5). Start 20 ends at another fit the
+/// χ² test accepts (the cross-coupled stiffnesses traded) and the truth is as good by core's test
+/// of alternatives: the run-up does not fix a unique point there, which `estimate` reports as not
+/// unique. The study over 24 starts is `examples/runup12_starts.rs`.
 #[test]
 fn twelve_coefficients_come_back_from_starts_thirty_to_fifty_percent_off() {
     use eigenfit_core::analysis::verdict::{judge, FitVerdict};
@@ -350,8 +354,10 @@ fn twelve_coefficients_come_back_from_starts_thirty_to_fifty_percent_off() {
     let params = bearing_parameters(&r, &["kxx", "kyy", "kxy", "kyx", "cxx", "cyy"]).unwrap();
     let t: Vec<f64> = params.iter().map(|p| truth["factors"][&p.name].as_f64().unwrap()).collect();
     const BUDGET: usize = 1000;
-    for (k, start) in starts::starts_off(&t, 3).into_iter().enumerate() {
-        let id = fit(&r, &params, &points, &start, 200, 6, BUDGET).unwrap();
+    let design = starts::starts_off(&t, 21);
+    for k in [0, 1, 2, 17] {
+        let start = &design[k];
+        let id = fit(&r, &params, &points, start, 200, 6, BUDGET).unwrap();
         let worst = id.scales.iter().zip(&t).map(|(s, t)| (s / t - 1.0).abs()).fold(0.0, f64::max);
         eprintln!(
             "start {k}: {}, χ² {:.2e}, worst factor error {worst:.1e}, {} restarts, {} evaluations",
@@ -362,4 +368,13 @@ fn twelve_coefficients_come_back_from_starts_thirty_to_fifty_percent_off() {
         assert!(worst < 1e-5, "start {k}: worst relative factor error {worst:.2e}: {:?}", id.scales);
         assert!(id.estimate.evaluations < BUDGET, "start {k}: {} evaluations", id.estimate.evaluations);
     }
+    let id = fit(&r, &params, &points, &design[20], 200, 6, BUDGET).unwrap();
+    assert_eq!(judge(&id.estimate.last, params.len()).verdict, FitVerdict::Acceptable);
+    let worst = id.scales.iter().zip(&t).map(|(s, t)| (s / t - 1.0).abs()).fold(0.0, f64::max);
+    assert!(worst > 0.1, "start 20 came back ({worst:.1e}): the note above is out of date");
+    let objective = RunupObjective::new(&r, params.clone(), &points, None).unwrap();
+    let at_truth = eigenfit_core::problem::Objective::linearise(&objective, &t).unwrap();
+    let judged = eigenfit_core::analysis::alternatives::Equivalence::at(&id.estimate.last, params.len())
+        .judge(&at_truth);
+    assert!(judged.equally_good, "start 20: the truth is told apart from the fit: {judged:?}");
 }

@@ -20,6 +20,7 @@ use eigenfit_rotordynamics::identify::{
 };
 use eigenfit_rotordynamics::interpolation::Coefficient;
 use eigenfit_rotordynamics::objective::RunupObjective;
+use eigenfit_rotordynamics::shapes::RotorShapes;
 use eigenfit_rotordynamics::{campbell, ross_file, rpm_to_rad, Campbell, Rotor, RotorDynError};
 use serde::Serialize;
 use std::path::Path;
@@ -109,6 +110,9 @@ pub struct SpeedReport {
     /// The rotor's DOFs.
     #[serde(skip)]
     pub dofs: usize,
+    /// Plot files written (`simulate --plot`: the mode shapes and orbits).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plots: Option<Vec<String>>,
     /// What the numbers rest on that a reader should know: bearing tables extrapolated,
     /// unstable modes.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -244,6 +248,7 @@ pub fn simulate_with(
         log_dec: shown.iter().map(|m| m.log_dec()).collect(),
         rigid_body_modes_left_out: (rigid > 0).then_some(rigid),
         dofs: rotor.dofs(),
+        plots: None,
         notes,
     })
 }
@@ -363,6 +368,14 @@ pub struct RunupEstimateReport {
     /// coefficients (each table multiplied by its estimated factor).
     #[serde(skip)]
     pub updated_model: Option<String>,
+    /// The rotor at the estimate: the file's, each estimated coefficient's table multiplied by
+    /// its factor (what `--plot` draws at the estimate).
+    #[serde(skip)]
+    pub estimated_rotor: Rotor,
+    /// The fit's iterations (parameters as factors on the file's coefficients), for the
+    /// convergence plot.
+    #[serde(skip)]
+    pub history: Vec<eigenfit_core::update::IterationRecord>,
 }
 
 /// Refits from screened other starts a run-up estimate runs at most, when not given.
@@ -649,6 +662,12 @@ pub fn estimate_with(
     };
     Ok(RunupEstimateReport {
         updated_model,
+        estimated_rotor: eigenfit_rotordynamics::identify::scaled_rotor(
+            &rotor,
+            &params,
+            &estimate.parameters,
+        ),
+        history: estimate.history.clone(),
         model: path.display().to_string(),
         outcome: Outcome::of(&estimate, converged),
         verdict,
@@ -1045,24 +1064,48 @@ pub fn campbell_diagram_with(
 /// measured speed, so the critical speeds just above the run-up show.
 const ESTIMATE_CAMPBELL_SPEEDS: usize = 41;
 
-/// The Campbell diagram of the rotor at a run-up estimate (`report`: its model file and its
-/// estimated factors), from 0 to 1.2 × the highest measured speed, with as many modes as the
-/// run-up measured: what `estimate --plot` draws beside the run-up fit.
+/// The Campbell diagram of the rotor at a run-up estimate (its estimated rotor), from 0 to 1.2 ×
+/// the highest measured speed, with as many modes as the run-up measured: what `estimate --plot`
+/// draws beside the run-up fit.
 pub fn campbell_at_estimate(report: &RunupEstimateReport) -> Result<Campbell, WorkflowError> {
-    let rotor = load(Path::new(&report.model))?;
-    let names: Vec<&str> = report.scales.iter().map(|(n, _)| n.as_str()).collect();
-    let params = bearing_parameters(&rotor, &names).map_err(to_workflow)?;
-    let scales: Vec<f64> = params
-        .iter()
-        .map(|p| report.scales.iter().find(|(n, _)| *n == p.name).map_or(1.0, |(_, s)| *s))
-        .collect();
-    let estimated = eigenfit_rotordynamics::identify::scaled_rotor(&rotor, &params, &scales);
-    let top = report.points.iter().map(|p| p.speed_rpm).fold(0.0, f64::max) * 1.2;
+    let rotor = &report.estimated_rotor;
+    let top = top_measured_rpm(report) * 1.2;
     let speeds: Vec<f64> = (0..ESTIMATE_CAMPBELL_SPEEDS)
         .map(|i| top * i as f64 / (ESTIMATE_CAMPBELL_SPEEDS - 1) as f64)
         .collect();
-    let modes = report.points.iter().map(|p| p.mode).max().unwrap_or(1).min(rotor.dofs());
-    campbell(&estimated, &speeds, modes).map_err(to_workflow)
+    campbell(rotor, &speeds, measured_modes(report)).map_err(to_workflow)
+}
+
+/// The highest speed of the run-up (rpm).
+pub fn top_measured_rpm(report: &RunupEstimateReport) -> f64 {
+    report.points.iter().map(|p| p.speed_rpm).fold(0.0, f64::max)
+}
+
+/// How many modes the run-up measured (its highest mode number), at most the rotor's DOFs.
+fn measured_modes(report: &RunupEstimateReport) -> usize {
+    report.points.iter().map(|p| p.mode).max().unwrap_or(1).min(report.estimated_rotor.dofs())
+}
+
+/// The mode shapes and orbits of the rotor at a run-up estimate, at the top measured speed, of
+/// the modes the run-up measured: what `estimate --plot` draws beside the Campbell diagram.
+pub fn shapes_at_estimate(report: &RunupEstimateReport) -> Result<RotorShapes, WorkflowError> {
+    let rpm = top_measured_rpm(report);
+    RotorShapes::of(&report.estimated_rotor, rpm, measured_modes(report)).map_err(to_workflow)
+}
+
+/// The mode shapes and orbits of `simulate --model ROSS-FILE --speed RPM --modes N [--set …]`
+/// (what `simulate --plot` draws), `sets` applied as [`simulate_with`] applies them.
+pub fn shapes_at(
+    path: &Path,
+    speed_rpm: Option<f64>,
+    modes: usize,
+    sets: &[String],
+) -> Result<RotorShapes, WorkflowError> {
+    let mut rotor = load(path)?;
+    apply_sets(&mut rotor, sets)?;
+    let rpm = speed_rpm.unwrap_or(0.0);
+    check_speed("--speed", rpm)?;
+    RotorShapes::of(&rotor, rpm, modes).map_err(to_workflow)
 }
 
 #[cfg(test)]

@@ -67,7 +67,9 @@ pub struct EstimateArgs {
     /// Write the plots into this folder: the convergence history (convergence.svg/.png) and,
     /// with shapes, the MAC matrix (mac.svg/.png); for a run-up on a ROSS rotor the run-up fit
     /// (runup-fit.svg/.png: measured and model frequencies against speed) and the estimated
-    /// rotor's Campbell diagram with its critical speeds (campbell-estimate.svg/.png).
+    /// rotor's Campbell diagram with its critical speeds (campbell-estimate.svg/.png), its mode
+    /// shapes and orbits at the top measured speed (mode-shapes-estimate.svg/.png, the numbers
+    /// drawn in mode-shapes-estimate.csv) and the fit's convergence (convergence.svg/.png).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
     /// `--quiet`, `--json`.
@@ -157,6 +159,12 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                         }
                         Err(e) => crate::output::report_lost("the Campbell plot at the estimate", &e.into()),
                     }
+                    written.extend(runup_shapes(&report, dir));
+                    let figure = runup_convergence(&report);
+                    written.extend(plot::write(&figure, dir, "convergence").unwrap_or_else(|e| {
+                        crate::output::report_lost("the convergence plot", &e);
+                        Vec::new()
+                    }));
                     written
                 }
                 None => Vec::new(),
@@ -257,6 +265,54 @@ fn declared_units(model: &ModelArgs) -> Vec<(String, String)> {
     match model.load_any() {
         Ok((m, _)) => m.parameters().iter().map(|p| (p.name.clone(), p.unit.clone())).collect(),
         Err(_) => Vec::new(),
+    }
+}
+
+/// The estimated rotor's mode shapes and orbits at the top measured speed, of the modes the
+/// run-up measured (mode-shapes-estimate.svg/.png/.csv); a failure is said and nothing written.
+fn runup_shapes(
+    report: &eigenfit_workflow::rotordynamics::RunupEstimateReport,
+    dir: &std::path::Path,
+) -> Vec<PathBuf> {
+    let what = "the mode shapes and orbits at the estimate";
+    let shapes = match eigenfit_workflow::rotordynamics::shapes_at_estimate(report) {
+        Ok(s) => s,
+        Err(e) => {
+            crate::output::report_lost(what, &e.into());
+            return Vec::new();
+        }
+    };
+    let title = format!(
+        "{} at the estimate: mode shapes and orbits at {} rpm (the top measured speed)",
+        plot::rotor_shapes::file_name(&report.model),
+        plot::style::trim(shapes.speed_rpm, 1)
+    );
+    let figure = plot::rotor_shapes::RotorShapesPlot { title, shapes: &shapes };
+    plot::rotor_shapes::write(&figure, dir, "mode-shapes-estimate").unwrap_or_else(|e| {
+        crate::output::report_lost(what, &e);
+        Vec::new()
+    })
+}
+
+/// The convergence plot of a run-up fit: the factors on the file's coefficients and the largest
+/// frequency difference per iteration, of the run that gave the estimate (its stages chained).
+fn runup_convergence(report: &eigenfit_workflow::rotordynamics::RunupEstimateReport) -> Convergence {
+    Convergence {
+        title: format!("{}: convergence of the run-up fit", report.model),
+        parameter_names: report.scales.iter().map(|(n, _)| n.clone()).collect(),
+        unit: "factor on the file's value".to_string(),
+        runs: vec![Run {
+            strategy: "damped".to_string(),
+            outcome: format!("{}, {} it.", report.outcome.termination.status, report.outcome.iterations),
+            history: report
+                .history
+                .iter()
+                .map(|r| (r.iteration, r.parameters.clone(), r.max_abs_diff_hz))
+                .collect(),
+        }],
+        target: None,
+        tolerance: None,
+        sigma_hz: None,
     }
 }
 

@@ -51,7 +51,9 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "FROM:TO:COUNT")]
     pub sweep: Option<String>,
     /// Write the critical speed map (critical-speed-map.svg/.png, over the --sweep range or
-    /// 1e2–1e9 N/m) and the mode shapes (mode-shapes.svg/.png) into this folder.
+    /// 1e2–1e9 N/m) and the mode shapes (mode-shapes.svg/.png) into this folder. ROSS rotors:
+    /// the modes' shapes along the shaft and their orbits at --speed (mode-shapes.svg/.png, the
+    /// numbers drawn in mode-shapes.csv).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
     /// Write the modes and node coordinates as a universal file (datasets 164, 15, 55;
@@ -78,7 +80,6 @@ fn refuse_for_ross(args: &SimulateArgs) -> Result<(), CliError> {
         ),
         (!args.effects.is_empty(), "--effect", "the what-if effects are defined on planar rotors"),
         (args.sweep.is_some(), "--sweep", "draw the modes over speed with `eigenfit campbell`"),
-        (args.plot.is_some(), "--plot", "draw the Campbell diagram with `eigenfit campbell --plot DIR`"),
         (args.uff.is_some(), "--uff", "the universal-file export is written for planar rotors"),
         (args.model.solver != "auto", "--solver", "a ROSS rotor has its own damped gyroscopic solver"),
         (
@@ -96,17 +97,55 @@ fn refuse_for_ross(args: &SimulateArgs) -> Result<(), CliError> {
     }
 }
 
+/// `simulate --plot DIR` on a ROSS rotor: the mode shapes and orbits of the modes listed, at the
+/// speed (mode-shapes.svg/.png, the numbers drawn in mode-shapes.csv). Drawn after the modes are
+/// reported: a failure is said and nothing written.
+fn ross_shapes(
+    path: &std::path::Path,
+    args: &SimulateArgs,
+    report: &eigenfit_workflow::rotordynamics::SpeedReport,
+    dir: &std::path::Path,
+) -> Vec<PathBuf> {
+    let what = "the mode shapes and orbits";
+    let shapes = match eigenfit_workflow::rotordynamics::shapes_at(path, args.speed, args.modes, &args.sets) {
+        Ok(s) => s,
+        Err(e) => {
+            crate::output::report_lost(what, &e.into());
+            return Vec::new();
+        }
+    };
+    let title = format!(
+        "{}: mode shapes and orbits at {} rpm",
+        plot::rotor_shapes::file_name(&report.model),
+        plot::style::trim(report.speed_rpm, 1)
+    );
+    let figure = plot::rotor_shapes::RotorShapesPlot { title, shapes: &shapes };
+    plot::rotor_shapes::write(&figure, dir, "mode-shapes").unwrap_or_else(|e| {
+        crate::output::report_lost(what, &e);
+        Vec::new()
+    })
+}
+
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     // Two-plane rotors saved by ROSS are solved at speed by the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
         // Outputs this path does not write are refused, never silently dropped.
         refuse_for_ross(args)?;
-        let report =
+        if let Some(dir) = &args.plot {
+            crate::output::check_writable_dir(dir, "--plot")?;
+        }
+        let mut report =
             eigenfit_workflow::rotordynamics::simulate_with(path, args.speed, args.modes, &args.sets)?;
         print_notes(&report.notes);
+        let plots = match &args.plot {
+            Some(dir) => ross_shapes(path, args, &report, dir),
+            None => Vec::new(),
+        };
+        report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
         crate::output::report(args.report.json, &report, |report| {
             crate::rotordynamics::print_speed(report);
+            plots.iter().for_each(|w| println!("wrote {}", w.display()));
         });
         return Ok(());
     }

@@ -18,6 +18,7 @@ pub mod critical_speed;
 pub mod discovery;
 pub mod mac_matrix;
 pub mod mode_shapes;
+pub mod rotor_shapes;
 pub mod runup;
 pub mod style;
 pub mod text;
