@@ -38,10 +38,12 @@ pub fn relative_roundoff(system: &System, modes: &Modes) -> Vec<f64> {
 /// How far below zero, in units of its round-off bound ε (‖K‖∞ + |λ| ‖M‖∞) ‖φ‖², an eigenvalue
 /// must lie to be a divergent mode (K not positive semi-definite) rather than a zero computed
 /// with round-off. The bound uses row-sum norms (≥ the 2-norms); the margin covers the solvers'
-/// own constants (a backward-stable solve moves λ by a small multiple of ε‖K‖‖φ‖²). Measured on
-/// free–free chains, rotors and matrices models (dense, banded, sparse): a rigid-body mode's
-/// computed λ lies within 1e-1 of its bound, so 10 leaves a decade to spare; a ground spring of
-/// −1e-9 N/m on a 1000 N/m chain lies 375× below zero by this measure.
+/// own constants (a backward-stable solve moves λ by a small multiple of ε‖K‖‖φ‖²); the free
+/// chains of this module's tests (dense and banded, at scales 10⁹ apart) and the free–free
+/// models of core's and the CLI corpus's tests keep their rigid-body modes with it. A ground
+/// spring of −1e-9 N/m on a free 1000 N/m, 1 kg chain of 3 gives λ ≈ −3.3e-10 against a bound
+/// of ε·4000 ≈ 8.9e-13, 375× below zero: unstable (it was called rigid-body under the 1e3
+/// margin on the largest entry used before).
 pub const UNSTABLE_ROUNDOFF_MARGIN: f64 = 10.0;
 
 /// The first mode of `modes` whose eigenvalue is negative beyond round-off
