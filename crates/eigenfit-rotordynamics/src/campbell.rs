@@ -184,7 +184,7 @@ pub fn refine_critical_speed(
             .iter()
             .max_by(|a, z| {
                 let s = |m: &Mode| mac(&lo.2.right, &m.right).max(mac(&hi.2.right, &m.right));
-                s(*a).total_cmp(&s(*z))
+                s(a).total_cmp(&s(z))
             })
             .cloned()
         else {
