@@ -44,9 +44,10 @@ pub(crate) struct Partition {
     place: Vec<Place>,
 }
 
-/// K_ss singular: the massless DOF (full index, from 0) at which the factorisation broke down.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct SingularAt(pub usize);
+/// K_ss singular: the massless DOF (full index, from 0) at which the factorisation broke down,
+/// and its pivot there (negative: a negative stiffness, not a missing one).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SingularAt(pub usize, pub f64);
 
 impl Partition {
     /// The DOFs of an n-DOF model that no entry of any of `masses` touches (every value of their
@@ -142,7 +143,7 @@ impl Partition {
                 }
             }
         }
-        let chol = factor(&kss).map_err(|a| SingularAt(self.massless[a]))?;
+        let chol = factor(&kss).map_err(|(a, pivot)| SingularAt(self.massless[a], pivot))?;
         let x = chol.solve(&ksm);
         // K_c = K_mm − K_smᵀ X, symmetrised against round-off.
         kmm.gemm_tr(-1.0, &ksm, &x, 1.0);
@@ -241,13 +242,13 @@ impl Partition {
 }
 
 /// Cholesky factor of K_ss, or the index of the first pivot at which it is (numerically) singular.
-fn factor(kss: &DMatrix<f64>) -> Result<Cholesky<f64, Dyn>, usize> {
+fn factor(kss: &DMatrix<f64>) -> Result<Cholesky<f64, Dyn>, (usize, f64)> {
     let singular = |j: usize, pivot: f64| pivot <= 0.0 || pivot <= SINGULAR_PIVOT_RATIO * kss[(j, j)].abs();
     match Cholesky::new(kss.clone()) {
         Some(chol) => {
             let l = chol.l_dirty();
             match (0..kss.nrows()).find(|&j| singular(j, l[(j, j)] * l[(j, j)])) {
-                Some(j) => Err(j),
+                Some(j) => Err((j, l[(j, j)] * l[(j, j)])),
                 None => Ok(chol),
             }
         }
@@ -256,14 +257,14 @@ fn factor(kss: &DMatrix<f64>) -> Result<Cholesky<f64, Dyn>, usize> {
 }
 
 /// The first pivot of an unpivoted LDLᵀ of `a` that `singular(j, pivot)` refuses (a failed
-/// Cholesky has one). O(n³), only on the failure path.
-fn first_bad_pivot(a: &DMatrix<f64>, singular: impl Fn(usize, f64) -> bool) -> usize {
+/// Cholesky has one), with its value. O(n³), only on the failure path.
+fn first_bad_pivot(a: &DMatrix<f64>, singular: impl Fn(usize, f64) -> bool) -> (usize, f64) {
     let n = a.nrows();
     let mut w = a.clone();
     for j in 0..n {
         let pivot = w[(j, j)];
         if singular(j, pivot) {
-            return j;
+            return (j, pivot);
         }
         for i in j + 1..n {
             let f = w[(i, j)] / pivot;
@@ -274,7 +275,10 @@ fn first_bad_pivot(a: &DMatrix<f64>, singular: impl Fn(usize, f64) -> bool) -> u
             }
         }
     }
-    n.saturating_sub(1)
+    match n {
+        0 => (0, 0.0),
+        _ => (n - 1, w[(n - 1, n - 1)]),
+    }
 }
 
 #[cfg(test)]
@@ -350,6 +354,14 @@ mod tests {
         let k = CscSymmetric::from_triplets(3, [(0, 0, 2.0), (1, 1, 1.0), (1, 0, -1.0)]);
         let m = CscSymmetric::from_triplets(3, [(0, 0, 1.0), (1, 1, 1.0)]);
         let part = Partition::of(3, &[&m]).unwrap();
-        assert_eq!(part.condense(&k).unwrap_err(), SingularAt(2));
+        assert_eq!(part.condense(&k).unwrap_err(), SingularAt(2, 0.0));
+    }
+
+    #[test]
+    fn a_massless_dof_with_negative_stiffness_gives_its_negative_pivot() {
+        let k = CscSymmetric::from_triplets(3, [(0, 0, 2.0), (1, 1, 1.0), (1, 0, -1.0), (2, 2, -5.0)]);
+        let m = CscSymmetric::from_triplets(3, [(0, 0, 1.0), (1, 1, 1.0)]);
+        let part = Partition::of(3, &[&m]).unwrap();
+        assert_eq!(part.condense(&k).unwrap_err(), SingularAt(2, -5.0));
     }
 }

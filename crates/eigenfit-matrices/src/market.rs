@@ -76,6 +76,8 @@ pub fn parse_symmetric(text: &str, expected: Option<usize>) -> Result<CscSymmetr
 }
 
 fn parse(text: &str, expected: Option<usize>) -> Result<CscSymmetric, String> {
+    // A UTF-8 byte-order mark (Windows editors write one) is no part of the header.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let header = text.lines().next().unwrap_or_default().to_ascii_lowercase();
     if !header.starts_with("%%matrixmarket") {
         return Err("not a Matrix Market file: the first line must start with `%%MatrixMarket`".into());
@@ -99,7 +101,8 @@ fn parse(text: &str, expected: Option<usize>) -> Result<CscSymmetric, String> {
         Some(other) => return Err(format!("header `{}`: `{other}` matrices cannot be stiffness or mass matrices; use `symmetric` or `general`", header.trim())),
         None => return Err(format!("header `{}`: the symmetry field is missing", header.trim())),
     };
-    let (n, entries) = read_entries(text, expected, symmetric)?;
+    let integer = words.get(3) == Some(&"integer");
+    let (n, entries) = read_entries(text, expected, symmetric, integer)?;
     symmetric_from_entries(n, entries, &|r, c| line_of(text, r, c))
 }
 
@@ -184,11 +187,23 @@ fn line_of(text: &str, r: usize, c: usize) -> Option<usize> {
     })
 }
 
+/// Whether a value is written as a whole number (`-12`, `+3`): what an `integer` file holds.
+fn is_whole(v: &str) -> bool {
+    let digits = v.strip_prefix(['+', '-']).unwrap_or(v);
+    !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+}
+
 /// Entries (row, column, value), 0-based, as stored.
 type Entries = Vec<(usize, usize, f64)>;
 
-/// The size n and the entries (0-based, as stored), every check of [`parse_symmetric`] made.
-fn read_entries(text: &str, expected: Option<usize>, symmetric: bool) -> Result<(usize, Entries), String> {
+/// The size n and the entries (0-based, as stored), every check of [`parse_symmetric`] made;
+/// with `integer` (the header's field) every value must be a whole number as written.
+fn read_entries(
+    text: &str,
+    expected: Option<usize>,
+    symmetric: bool,
+    integer: bool,
+) -> Result<(usize, Entries), String> {
     let mut lines = data_lines(text);
     let (size_line, size) = lines.next().ok_or("the size line (rows columns entries) is missing")?;
     let fields: Vec<&str> = size.split_ascii_whitespace().collect();
@@ -242,10 +257,17 @@ fn read_entries(text: &str, expected: Option<usize>, symmetric: bool) -> Result<
         if r == 0 || r > rows || c == 0 || c > cols {
             return Err(format!("line {line}: entry ({r}, {c}) lies outside the {rows}×{cols} matrix"));
         }
+        let text_value = v;
         let v: f64 =
             v.parse().map_err(|_| format!("line {line}: entry ({r}, {c}): `{v}` is not a number"))?;
         if !v.is_finite() {
             return Err(format!("line {line}: entry ({r}, {c}) is {v}: every entry must be finite"));
+        }
+        if integer && !is_whole(text_value) {
+            return Err(format!(
+                "line {line}: entry ({r}, {c}) is `{text_value}`, not a whole number, but the header says \
+                 `integer` (make the header `real` if the values are)"
+            ));
         }
         if entries.len() == nnz {
             return Err(format!("line {line}: more entries than the {nnz} the size line declares"));
@@ -385,6 +407,23 @@ mod tests {
         let text = "%%MatrixMarket matrix coordinate real general\n2 2 3\n1 1 4\n1 2 -1\n2 1 -2\n";
         let e = parse(text, None).unwrap_err();
         assert!(e.contains("entry (2, 1) = -2 (line 5) but (1, 2) = -1 (line 4)"), "{e}");
+    }
+
+    #[test]
+    fn an_integer_file_holds_whole_numbers_and_a_byte_order_mark_is_skipped() {
+        let fraction = "%%MatrixMarket matrix coordinate integer symmetric\n2 2 2\n1 1 4\n2 2 2000.5\n";
+        let e = parse(fraction, None).unwrap_err();
+        assert!(e.contains("line 4: entry (2, 2) is `2000.5`, not a whole number"), "{e}");
+        for whole in ["-12", "+3", "0"] {
+            let text = format!("%%MatrixMarket matrix coordinate integer symmetric\n1 1 1\n1 1 {whole}\n");
+            assert!(parse(&text, None).is_ok(), "{whole}");
+        }
+        let plain = "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 4\n2 2 3\n";
+        let bom = format!("\u{feff}{plain}");
+        assert_eq!(parse(&bom, None).unwrap(), parse(plain, None).unwrap());
+        // Lines keep their numbers after the mark.
+        let e = parse(&bom.replace("2 2 3", "2 2 x"), None).unwrap_err();
+        assert!(e.contains("line 4"), "{e}");
     }
 
     #[test]

@@ -384,14 +384,26 @@ impl MatricesModel {
         let k =
             self.combine(&self.stiffness, p.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.0.as_ref())));
         let (kc, x) = c.partition.condense(&k).map_err(|at| {
-            ModelError::Invalid(format!(
-                "massless {} is held by no stiffness once the massless DOFs before it are (K_ss, the stiffness \
-                 among the {} massless DOFs, is singular there) at {}: its static condensation does not exist; \
-                 give it a mass or a stiffness",
-                self.full_dof_label(at.0),
-                c.partition.massless().len(),
-                self.values_text(p)
-            ))
+            // A negative pivot is a negative stiffness (an unstable massless DOF), not a missing one.
+            let held = if at.1 < 0.0 {
+                format!(
+                    "has a negative stiffness ({:e} once the massless DOFs before it are held; K_ss, the \
+                     stiffness among the {} massless DOFs, is not positive definite there) at {}: a massless \
+                     DOF on a negative spring has no static equilibrium; check the stiffness's sign",
+                    at.1,
+                    c.partition.massless().len(),
+                    self.values_text(p)
+                )
+            } else {
+                format!(
+                    "is held by no stiffness once the massless DOFs before it are (K_ss, the stiffness among \
+                     the {} massless DOFs, is singular there) at {}: its static condensation does not exist; \
+                     give it a mass or a stiffness",
+                    c.partition.massless().len(),
+                    self.values_text(p)
+                )
+            };
+            ModelError::Invalid(format!("massless {} {held}", self.full_dof_label(at.0)))
         })?;
         let x = Arc::new(x);
         *c.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((p.to_vec(), Arc::clone(&x)));
@@ -731,11 +743,17 @@ fn parameter(
 /// Reads the DOF map: CSV with header `dof,node,direction,x,y,z`, DOFs counted from 1, one row
 /// per DOF of the model.
 fn read_dof_map(path: &Path, n: usize) -> Result<Vec<Dof>, MatricesError> {
+    // Every field spelled out, no `#[serde(flatten)]`: through a flattened struct the csv crate
+    // infers each field's type, so a direction written `1` (the universal file's number, which
+    // the docs accept) arrived as an integer and was refused as "expected a string".
     #[derive(Deserialize)]
     struct Row {
         dof: usize,
-        #[serde(flatten)]
-        info: Dof,
+        node: u64,
+        direction: String,
+        x: f64,
+        y: f64,
+        z: f64,
     }
     let bytes =
         eigenfit_core::measurement::measured_csv::read_checked_file(path, MAX_DOF_MAP_BYTES, "a DOF map")
@@ -751,7 +769,8 @@ fn read_dof_map(path: &Path, n: usize) -> Result<Vec<Dof>, MatricesError> {
         if out[row.dof - 1].is_some() {
             return Err(MatricesError::invalid(path, format!("line {line}: dof {} given twice", row.dof)));
         }
-        out[row.dof - 1] = Some(row.info);
+        out[row.dof - 1] =
+            Some(Dof { node: row.node, direction: row.direction, x: row.x, y: row.y, z: row.z });
     }
     if let Some(missing) = out.iter().position(Option::is_none) {
         return Err(MatricesError::invalid(

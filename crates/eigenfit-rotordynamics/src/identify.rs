@@ -119,6 +119,7 @@ pub fn parse_runup(text: &str) -> Result<Vec<RunupPoint>, RunupError> {
         if speed_rpm < 0.0 {
             return Err(line_error(at, format!("speed_rpm {speed_rpm} must be ≥ 0")));
         }
+        crate::check_speed_rpm(speed_rpm).map_err(|e| line_error(at, format!("speed_rpm: {e}")))?;
         let mode: usize = f[cm]
             .parse()
             .map_err(|_| line_error(at, format!("mode `{}` is not a whole number ≥ 1", f[cm])))?;

@@ -28,6 +28,30 @@ pub use error::RotorDynError;
 pub use modal::{Mode, Whirl};
 pub use rotor::Rotor;
 
+/// The highest rotor speed accepted anywhere (rpm: `simulate --speed`, `campbell --speeds`,
+/// run-up CSVs, the speed and frequency lists of a ROSS file's bearing tables). No rotor can
+/// turn faster: a rim bursts when its speed Ω·r exceeds about √(σ/ρ) ≈ 500 m/s (steel, σ ≈ 2
+/// GPa), which at 1e7 rpm (1.05e6 rad/s) is a radius of half a millimetre; the fastest machines
+/// built (micro turbines, ultracentrifuges) run below 2e6 rpm. A larger number is a slip (an
+/// exponent, a unit), which would otherwise give frequencies of 1e278 Hz.
+pub const MAX_SPEED_RPM: f64 = 1e7;
+
+/// Refuses a speed beyond [`MAX_SPEED_RPM`] (or not finite, or negative), saying the bound and
+/// why; callers add where the speed came from.
+pub fn check_speed_rpm(rpm: f64) -> Result<(), String> {
+    if !rpm.is_finite() || rpm < 0.0 {
+        return Err(format!("speed {rpm} rpm: a speed is a finite number of rpm ≥ 0"));
+    }
+    if rpm > MAX_SPEED_RPM {
+        return Err(format!(
+            "speed {rpm:e} rpm is beyond {MAX_SPEED_RPM:e} rpm, faster than any rotor can turn (its rim would \
+             burst: at 1e7 rpm even a steel rim of 0.5 mm radius moves at the ~500 m/s that tears it apart); a \
+             slip in the exponent or the unit?"
+        ));
+    }
+    Ok(())
+}
+
 /// rpm → rad/s.
 pub fn rpm_to_rad(rpm: f64) -> f64 {
     rpm * std::f64::consts::PI / 30.0

@@ -376,6 +376,17 @@ impl Entry<'_> {
     }
 
     fn axis(&self, name: &str) -> Result<Option<Vec<f64>>, RotorDynError> {
+        let axis = self.axis_values(name)?;
+        // The lists are in rad/s (ROSS's unit): a speed or whirl frequency no rotor reaches is
+        // a slip, refused rather than evaluated at 1e300 rpm.
+        for (i, &v) in axis.iter().flatten().enumerate() {
+            crate::check_speed_rpm(crate::rad_to_rpm(v.abs()))
+                .map_err(|e| self.err(format!("`{name}`[{i}] = {v:e} rad/s: {e}")))?;
+        }
+        Ok(axis)
+    }
+
+    fn axis_values(&self, name: &str) -> Result<Option<Vec<f64>>, RotorDynError> {
         match self.table.get(name) {
             None | Some(Value::Null) => Ok(None),
             Some(Value::Array(a)) => Ok(Some(

@@ -233,6 +233,15 @@ pub fn is_matrices_file(path: &Path) -> bool {
 /// Said as such rather than as the rotor reader's "unknown field `kind`".
 pub fn other_kind(path: &Path, what: &str) -> Option<WorkflowError> {
     let text = std::fs::read_to_string(path).ok()?;
+    if let Some(data) = data_file_kind(&text) {
+        return Some(input(format!(
+            "{}: {data}, not a model: {what} takes a model file (TOML): a planar rotor \
+             (docs/rotor-model.md), a `kind = \"matrices\"` model naming its matrix files \
+             (`stiffness = \"K.mtx\"`, docs/matrices.md) or a ROSS rotor (docs/rotordynamics.md); \
+             measured data go to --measured",
+            path.display()
+        )));
+    }
     if eigenfit_rotordynamics::ross_file::looks_like_ross(&text) {
         return Some(input(format!(
             "{}: a ROSS rotor file (two-plane, saved by ROSS), but {what} takes a planar rotor \
@@ -276,6 +285,30 @@ pub fn other_kind(path: &Path, what: &str) -> Option<WorkflowError> {
             i + 1,
             value.chars().take(40).collect::<String>()
         )));
+    }
+    None
+}
+
+/// What a data file given where a model file belongs looks like, from its first line that is
+/// not blank or a `#` comment: a Matrix Market matrix, a universal file (a dataset's `-1` delimiter) or a CSV
+/// table (a header of comma-separated names, no TOML `=` or `[table]`). `None` for anything else
+/// (left to the TOML reader, whose errors name line and column).
+fn data_file_kind(text: &str) -> Option<String> {
+    let first = text
+        .trim_start_matches('\u{feff}')
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'))?;
+    if first.starts_with("%%MatrixMarket") {
+        return Some("a Matrix Market matrix file (its first line is `%%MatrixMarket …`)".into());
+    }
+    if first == "-1" {
+        return Some("a universal file (UFF/UNV: it opens with a dataset's `-1` delimiter)".into());
+    }
+    let toml_like = first.contains('=') || first.starts_with('[');
+    if !toml_like && first.contains(',') {
+        let shown: String = first.chars().take(60).collect();
+        return Some(format!("a CSV table (its first line is `{shown}`)"));
     }
     None
 }

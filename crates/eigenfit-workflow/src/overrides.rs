@@ -83,7 +83,18 @@ pub fn fixed<M: StructuralModel>(model: M, fixes: &[String]) -> Result<Fixed<M>,
         }
         pairs.push((name.trim().to_string(), v));
     }
-    Fixed::new(model, &pairs).map_err(|e| input(format!("--fix: {e}")))
+    let held = Fixed::new(model, &pairs).map_err(|e| input(format!("--fix: {e}")))?;
+    // Every parameter held leaves an empty fit, which would otherwise fail later as "no
+    // stiffness can produce mode 1 … a typing slip?".
+    if !pairs.is_empty() && held.parameters().is_empty() {
+        let names: Vec<&str> = pairs.iter().map(|(n, _)| n.as_str()).collect();
+        return Err(input(format!(
+            "--fix holds every parameter ({}): nothing is left to fit; leave at least one free (to see the \
+             model at given values, use `simulate --set NAME=VALUE`)",
+            names.join(", ")
+        )));
+    }
+    Ok(held)
 }
 
 /// Points `K1:K2` separated by commas, each of `np` positive values (`--targets`, `--initials`).

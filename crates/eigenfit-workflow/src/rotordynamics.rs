@@ -14,6 +14,7 @@ use eigenfit_core::analysis::alternatives::{
 use eigenfit_core::analysis::verdict::{at_limits, judge};
 use eigenfit_core::analysis::{uncertainty_parallel, Identifiability};
 use eigenfit_core::update::Budget;
+use eigenfit_rotordynamics::campbell::refine_critical_speed;
 use eigenfit_rotordynamics::fit::fit_runup;
 use eigenfit_rotordynamics::identify::{
     bearing_parameters, check_selection, evaluate, read_runup, RunupPoint, DEFAULT_COEFFICIENTS,
@@ -80,10 +81,7 @@ pub fn load(path: &Path) -> Result<Rotor, WorkflowError> {
 }
 
 fn check_speed(flag: &str, rpm: f64) -> Result<(), WorkflowError> {
-    if !rpm.is_finite() || rpm < 0.0 {
-        return Err(input(format!("{flag} {rpm}: speed must be a finite number of rpm ≥ 0")));
-    }
-    Ok(())
+    eigenfit_rotordynamics::check_speed_rpm(rpm).map_err(|e| input(format!("{flag}: {e}")))
 }
 
 /// Damped modes of a two-plane rotor at one speed.
@@ -491,6 +489,128 @@ fn initial_factors(
     Ok(factors)
 }
 
+/// Units a run-up's frequencies are mistyped in, each with the factor that turns its number
+/// into Hz (rpm here: cycles per minute).
+const RUNUP_UNIT_SLIPS: [(&str, f64); 3] =
+    [("kHz", 1e3), ("MHz", 1e6), ("rpm (cycles per minute)", 1.0 / 60.0)];
+
+/// How far (a ratio) every measured frequency must lie from the starting rotor's frequency of
+/// its mode number before a unit slip is considered. A bearing factor within 1e-3…1e3 moves a
+/// frequency by at most its square root, √1000 ≈ 32 (a mode held by the bearings alone; the
+/// shaft's own flexibility holds it closer), so no real run-up lies 40× from the rotor at every
+/// point; a slip of kHz (×1e-3) or rpm (×60) does.
+const RUNUP_SLIP_RATIO: f64 = 40.0;
+
+/// Refuses a run-up whose frequencies one unit slip explains, as the modal-test paths refuse
+/// one: every point lies more than [`RUNUP_SLIP_RATIO`] from the starting rotor's frequency of
+/// its mode number at its speed, and converted from one unit ([`RUNUP_UNIT_SLIPS`]) every one
+/// lies within a factor of 2 of it. Compared by mode number (the fit pairs by frequency, and
+/// would pair a run-up in rpm with the rotor's high modes); one eigen-solve per measured speed,
+/// not charged to the fit's budget. Without such a slip nothing is refused here.
+fn refuse_unit_slip(
+    rotor: &Rotor,
+    params: &[eigenfit_rotordynamics::identify::Parameter],
+    initial: &[f64],
+    points: &[RunupPoint],
+    measured: &Path,
+) -> Result<(), WorkflowError> {
+    let start = eigenfit_rotordynamics::identify::scaled_rotor(rotor, params, initial);
+    let mut ratios = Vec::with_capacity(points.len());
+    let mut solved: Vec<(f64, Vec<f64>)> = Vec::new();
+    for p in points {
+        if !solved.iter().any(|(rpm, _)| *rpm == p.speed_rpm) {
+            let highest =
+                points.iter().filter(|q| q.speed_rpm == p.speed_rpm).map(|q| q.mode).max().unwrap_or(1);
+            let Ok(modes) = start.lowest_modes(rpm_to_rad(p.speed_rpm), highest) else { return Ok(()) };
+            solved.push((p.speed_rpm, modes.iter().map(|m| m.frequency_hz()).collect()));
+        }
+        let at = &solved.iter().find(|(rpm, _)| *rpm == p.speed_rpm).expect("solved above").1;
+        let Some(model) = at.get(p.mode - 1).copied().filter(|f| *f > 0.0) else { return Ok(()) };
+        ratios.push((p.frequency_hz / model, model));
+    }
+    let far = ratios.iter().all(|(r, _)| !(1.0 / RUNUP_SLIP_RATIO..=RUNUP_SLIP_RATIO).contains(r));
+    let Some((unit, factor)) = RUNUP_UNIT_SLIPS
+        .iter()
+        .copied()
+        .find(|(_, f)| far && ratios.iter().all(|(r, _)| (0.5..=2.0).contains(&(r * f))))
+    else {
+        return Ok(());
+    };
+    let (p, (_, model)) = (&points[0], ratios[0]);
+    Err(input(format!(
+        "{}: every measured frequency is {}× or more off the rotor's frequency of its mode (mode {} at {} rpm: \
+         {} measured, the rotor at its starting bearings {:.4} Hz), more than bearing factors within \
+         1e-3…1e3 can move it (√1000 ≈ 32×): the frequencies look entered in {unit}, not Hz; converted \
+         (×{}) every one lies within a factor of 2 of the rotor's; give them in Hz",
+        measured.display(),
+        RUNUP_SLIP_RATIO,
+        p.mode,
+        p.speed_rpm,
+        eigenfit_core::measurement::measured_csv::shown_number(p.frequency_hz),
+        model,
+        eigenfit_core::measurement::measured_csv::shown_number(factor)
+    )))
+}
+
+/// Refuses whirl labels every one of which contradicts the rotor: each point labelled forward
+/// or backward (at least two such) has, at the starting coefficients, a model mode of its
+/// number whirling the other way (a model mode whirling mixed judges nothing) — swapped labels or a reversed sense of rotation. The fit's pairing
+/// only weighs a mismatch, so it would pair such labels with the wrong modes of a close
+/// forward/backward pair and end in a poor fit; compared by mode number (as the unit-slip check)
+/// with one eigen-solve per labelled speed, not charged to the budget. Points labelled mixed,
+/// or not at all, are not judged.
+fn refuse_reversed_whirl(
+    rotor: &Rotor,
+    params: &[eigenfit_rotordynamics::identify::Parameter],
+    initial: &[f64],
+    points: &[RunupPoint],
+    measured: &Path,
+) -> Result<(), WorkflowError> {
+    use eigenfit_rotordynamics::Whirl;
+    let labelled: Vec<&RunupPoint> =
+        points.iter().filter(|p| matches!(p.whirl, Some(Whirl::Forward | Whirl::Backward))).collect();
+    if labelled.len() < 2 {
+        return Ok(());
+    }
+    let start = eigenfit_rotordynamics::identify::scaled_rotor(rotor, params, initial);
+    let mut solved: Vec<(f64, Vec<Whirl>)> = Vec::new();
+    let mut contradicting = 0;
+    for p in &labelled {
+        if !solved.iter().any(|(rpm, _)| *rpm == p.speed_rpm) {
+            let highest =
+                labelled.iter().filter(|q| q.speed_rpm == p.speed_rpm).map(|q| q.mode).max().unwrap_or(1);
+            let Ok(modes) = start.lowest_modes(rpm_to_rad(p.speed_rpm), highest) else { return Ok(()) };
+            solved.push((p.speed_rpm, modes.iter().map(|m| m.whirl).collect()));
+        }
+        let at = &solved.iter().find(|(rpm, _)| *rpm == p.speed_rpm).expect("solved above").1;
+        // A model mode that whirls mixed (or is missing) neither agrees nor contradicts.
+        match (p.whirl, at.get(p.mode - 1)) {
+            (Some(Whirl::Forward), Some(Whirl::Backward)) | (Some(Whirl::Backward), Some(Whirl::Forward)) => {
+                contradicting += 1
+            }
+            (Some(w), Some(m)) if w == *m => return Ok(()),
+            _ => {}
+        }
+    }
+    if contradicting < 2 {
+        return Ok(());
+    }
+    let p = labelled[0];
+    Err(input(format!(
+        "{}: every whirl label contradicts the rotor ({} of {} labelled points; none agrees): at its starting \
+         bearings the rotor's mode of each number whirls the other way (e.g. mode {} at {} rpm, {} Hz, is labelled {}); are forward and \
+         backward swapped, or the sense of rotation reversed? Correct the labels, or leave the whirl column \
+         empty to pair by frequency alone",
+        measured.display(),
+        contradicting,
+        labelled.len(),
+        p.mode,
+        p.speed_rpm,
+        p.frequency_hz,
+        p.whirl.map_or("", |w| w.name())
+    )))
+}
+
 /// [`estimate`] with `--initial` and `--write-model` (see [`RunupOptions`]).
 pub fn estimate_with(
     path: &Path,
@@ -545,6 +665,8 @@ pub fn estimate_with(
         return Err(input("--budget 0: at least one model evaluation is needed"));
     }
     let objective = RunupObjective::new(&rotor, params.clone(), &points, None).map_err(to_workflow)?;
+    refuse_unit_slip(&rotor, &params, &initial, &points, measured)?;
+    refuse_reversed_whirl(&rotor, &params, &initial, &points, measured)?;
     let np = params.len();
     let budget = Budget::new(budget);
     let mut phases: Vec<(&str, usize)> = Vec::new();
@@ -864,6 +986,7 @@ pub fn parse_speeds(text: &str) -> Result<Vec<f64>, WorkflowError> {
     if count == 0 || count > 100_000 || (count == 1 && to != from) {
         return Err(bad("COUNT must be 1 … 100000 (1 only when FROM = TO)"));
     }
+    eigenfit_rotordynamics::check_speed_rpm(to).map_err(|e| bad(&format!("TO: {e}")))?;
     Ok((0..count)
         .map(|i| if count == 1 { from } else { from + (to - from) * i as f64 / (count - 1) as f64 })
         .collect())
@@ -1054,6 +1177,26 @@ pub fn campbell_diagram_with(
                 hi * 1.27
             ));
         }
+        // The amplification factor 1/(2ζ) needs ζ at the crossing itself: each critical speed is
+        // refined on the rotor (a coarse sweep's interpolated ζ can be off by half).
+        let rotor = load(path)?;
+        let refined = report
+            .campbell
+            .critical_speeds
+            .iter()
+            .map(|k| refine_critical_speed(&rotor, &report.campbell, k, modes))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(to_workflow)?;
+        if !refined.is_empty() {
+            report.notes.push(format!(
+                "--operating: the {} critical speed(s) were refined on the rotor (the 1× crossing solved to 1e-10, \
+                 each within its two swept speeds): their speeds, damping ratios and amplification factors are at \
+                 the crossing, not interpolated between swept speeds",
+                refined.len()
+            ));
+        }
+        report.critical_speeds_rpm = refined.iter().map(|k| k.rpm).collect();
+        report.campbell.critical_speeds = refined;
         report.separation_margins = Some(separation_margins(&report.campbell.critical_speeds, lo, hi));
         report.operating_range_rpm = Some([lo, hi]);
     }

@@ -5,7 +5,8 @@ use crate::error::{failure, input, WorkflowError};
 use crate::named::Named;
 use crate::progress::Progress;
 use eigenfit_core::eigen::roundoff::{
-    relative_roundoff, rigid_body_modes, trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF, NOTE_RELATIVE_ROUNDOFF,
+    first_unstable, relative_roundoff, rigid_body_modes, trial_vector_roundoff, MAX_RELATIVE_ROUNDOFF,
+    NOTE_RELATIVE_ROUNDOFF,
 };
 use eigenfit_core::eigen::{EigenSolver, Modes, SolveError};
 use eigenfit_core::matrix::System;
@@ -84,15 +85,8 @@ pub fn check_roundoff_except(
     }
 }
 
-/// How far below zero, in units of its round-off bound ε·(max|Kᵢⱼ| + |λ| max|Mᵢⱼ|)·‖φ‖², an
-/// eigenvalue must lie to be a divergent mode rather than a zero computed with round-off. A
-/// backward-stable solver moves an eigenvalue by up to ε‖K‖‖φ‖² (see `eigen::roundoff`); the
-/// margin absorbs the row count between the largest entry and the norm, so a rigid-body mode or
-/// an extreme value drowned in round-off (a support of 1e50 N·m/rad) is never called unstable.
-const UNSTABLE_MARGIN: f64 = 1e3;
-
-/// Refuses an unstable model: a negative eigenvalue beyond round-off means K(p) is not positive
-/// semi-definite, a divergent mode, not a vibration at 0 Hz (a rigid-body mode is zero to
+/// Refuses an unstable model: a negative eigenvalue beyond round-off (core's [`first_unstable`])
+/// means K(p) is not positive semi-definite, a divergent mode, not a vibration at 0 Hz (a rigid-body mode is zero to
 /// round-off). The message names the mode, its eigenvalue and the parameter values.
 pub fn check_stable(
     model: &dyn StructuralModel,
@@ -100,29 +94,20 @@ pub fn check_stable(
     modes: &Modes,
     p: &[f64],
 ) -> Result<(), WorkflowError> {
-    let (k_max, m_max) = system.amax();
-    for j in 0..modes.count() {
-        let lambda = modes.eigenvalues[j];
-        if lambda.is_nan() {
-            return Err(failure(format!("mode {}: the eigen-solver returned NaN", j + 1)));
-        }
-        if lambda >= 0.0 {
-            continue;
-        }
-        let phi2 = if modes.shapes.ncols() > j { modes.shapes.column(j).norm_squared() } else { 1.0 };
-        let bound = f64::EPSILON * (k_max + lambda.abs() * m_max) * phi2;
-        if -lambda > UNSTABLE_MARGIN * bound {
-            return Err(input(format!(
-                "the model is unstable at {}: mode {} has a negative eigenvalue λ = {} (rad/s)², \
-                 so K(p) is not positive semi-definite — a divergent mode, not a vibration (a \
-                 rigid-body mode is zero to round-off); no natural frequency exists there",
-                values_at(model, p),
-                j + 1,
-                readable(lambda)
-            )));
-        }
+    if let Some(j) = modes.eigenvalues.iter().position(|l| l.is_nan()) {
+        return Err(failure(format!("mode {}: the eigen-solver returned NaN", j + 1)));
     }
-    Ok(())
+    match first_unstable(system, modes) {
+        Some(j) => Err(input(format!(
+            "the model is unstable at {}: mode {} has a negative eigenvalue λ = {} (rad/s)², \
+             so K(p) is not positive semi-definite — a divergent mode, not a vibration (a \
+             rigid-body mode is zero to round-off); no natural frequency exists there",
+            values_at(model, p),
+            j + 1,
+            readable(modes.eigenvalues[j])
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// `name = value, …` of `p`, for messages ("its nominal values" for a model without parameters).
@@ -188,7 +173,7 @@ const MOST_EXTRA_MODES_FOR_RIGID: usize = 64;
 /// them is zero to round-off, more modes are solved until one is resolved. A system none of whose
 /// modes is resolved has a zero K: every mode is rigid-body. When the extra modes cannot be
 /// solved, none is called rigid-body (the round-off check then refuses them, naming both
-/// causes). More than core's `MAX_RIGID_BODY_MODES` zeros are taken for round-off, not motion.
+/// causes). More than core's `MAX_RIGID_BODY_MODES` zeros per separate body are round-off, not motion.
 pub fn rigid_body_flags(
     solver: &dyn EigenSolver,
     system: &System,

@@ -58,3 +58,7 @@ def in_khz(block):
 
 # Every frequency in kHz: a unit slip, refused as the CSV path refuses it.
 write("uff_in_khz.unv", head + in_khz(m1) + in_khz(m2) + in_khz(m3))
+# Mode 2's dataset numbered 1 (record 7), as mode 1's is: which mode did the test mean?
+write("uff_mode_number_twice.unv", head + m1 + m2[:8] + ["         2         4         1         1\n"] + m2[9:] + m3)
+# Mode 3 numbered -2 (record 7).
+write("uff_mode_number_negative.unv", head + m1 + m2 + m3[:8] + ["         2         4         1        -2\n"] + m3[9:])

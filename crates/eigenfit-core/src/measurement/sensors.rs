@@ -303,8 +303,8 @@ fn build(
 }
 
 /// The measured modes of `file` at `sensors`: frequencies and shapes (value × sign; a node a
-/// mode does not list counts as an error naming both). Modes keep the file's numbers when they
-/// are distinct and ≥ 1, else they are numbered 1, 2, … in file order (with a note).
+/// mode does not list counts as an error naming both). Modes keep the file's numbers, which
+/// must be distinct and ≥ 1 (refused naming the dataset's line otherwise).
 ///
 /// A mode that moves (almost) only in directions the model lacks — an x-plane mode of a rotor
 /// exported from a 3-D model, for the planar rotor — is left out, with a note (the second
@@ -334,21 +334,28 @@ pub fn measurement(file: &UffFile, sensors: &SensorSet) -> Result<(Measurement, 
         }
         first.entry((m.number, m.frequency_hz.to_bits())).or_insert(k);
     }
-    let mut numbers: Vec<i64> = file.modes.iter().map(|m| m.number).collect();
-    let distinct = {
-        let mut s = numbers.clone();
-        s.sort_unstable();
-        s.dedup();
-        s.len() == numbers.len() && s[0] >= 1
-    };
-    let mut notes = Vec::new();
-    if !distinct {
-        numbers = (1..=file.modes.len() as i64).collect();
-        notes.push(
-            "the mode numbers of the datasets 55 are not distinct numbers ≥ 1: modes numbered 1, 2, … in file order"
-                .to_string(),
-        );
+    // The file's mode numbers are the pairing's order hint: one that is not ≥ 1, or that two
+    // datasets share, is a slip in the export (which mode did the test mean?), refused.
+    let mut seen: HashMap<i64, usize> = HashMap::new();
+    for m in &file.modes {
+        if m.number < 1 {
+            return Err(SensorError::Measurement(format!(
+                "dataset 55 at line {} gives mode number {} (record 7): mode numbers count from 1",
+                m.line, m.number
+            )));
+        }
+        if let Some(first) = seen.insert(m.number, m.line) {
+            return Err(SensorError::Measurement(format!(
+                "dataset 55 at line {} gives mode number {} (record 7), as does the one at line {first}                  ({} Hz and {} Hz): each measured mode has its own number",
+                m.line,
+                m.number,
+                file.modes.iter().find(|o| o.line == first).map_or(f64::NAN, |o| o.frequency_hz),
+                m.frequency_hz
+            )));
+        }
     }
+    let numbers: Vec<i64> = file.modes.iter().map(|m| m.number).collect();
+    let mut notes = Vec::new();
     let mut modes = Vec::with_capacity(file.modes.len());
     for (m, &number) in file.modes.iter().zip(&numbers) {
         let shape = sensors
