@@ -15,8 +15,8 @@ use crate::simulate::check_roundoff_of;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
-    better_minimum, like_exchanges, listed_alternatives, local_minima, mirror_solutions, search_starts,
-    Equivalence, Mirrors,
+    better_minimum, like_exchanges, listed_alternatives, local_minima, mirror_solutions, screened_fits,
+    screened_local_minima, search_starts, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};
@@ -585,9 +585,12 @@ pub fn run(
         mirrors = mirror_solutions(&fit, &estimate.last, &exchanges, &budget);
         phases.push(("mirror_solutions", budget.used()));
         let starts = request.alternative_starts.unwrap_or_else(|| default_alternative_starts(np));
-        // Ranking a design alone costs an evaluation per point: skipped with no start.
-        if starts > 0 {
-            minima = local_minima(&fit, starts, &mirrors.asymmetric, &budget);
+        // The default design of a problem with many parameters is screened by misfit; starts
+        // given on the command line are each fitted. Skipped with no start.
+        match screened_fits(np).filter(|_| request.alternative_starts.is_none()) {
+            _ if starts == 0 => {}
+            Some(keep) => minima = screened_local_minima(&fit, starts, keep, &mirrors.asymmetric, &budget),
+            None => minima = local_minima(&fit, starts, &mirrors.asymmetric, &budget),
         }
         phases.push(("other_solutions", budget.used()));
         // A regularised estimate is not the least-squares minimum, by design: a deeper one is
