@@ -112,9 +112,8 @@ def main():
     if args.eigenfit:
         with open(args.eigenfit) as f:
             out = json.load(f)
-        params = out.get("parameters") or out.get("estimate", {}).get("parameters")
-        theirs = {p["name"]: p["value"] for p in params}
-        print(f"eigenfit chi2 {out.get('chi2', out.get('quality', {}).get('chi2'))}")
+        theirs = out["parameters"]  # name → value
+        print(f"eigenfit chi2 {out['chi2']} on {out['dof']} dof")
     for name, v, nom, truth in zip(names, factors * nominal, nominal, fb.TRUTH):
         line = f"  {name:10s} {v / nom:10.6f}  (true {truth:.2f})"
         if theirs is not None:
