@@ -10,9 +10,10 @@
 //! an individual mode is not defined, and any number returned would be silently wrong.
 
 use crate::eigen::{EigenSolver, Modes, SolveError};
-use crate::matrix::{System, SystemDerivative};
+use crate::matrix::{Expansion, System, SystemDerivative};
 use crate::model::{ModelError, StructuralModel};
 use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 use thiserror::Error;
 
 /// Relative gap below which two eigenvalues count as repeated.
@@ -120,6 +121,36 @@ pub fn eigenvalue_derivative(modes: &Modes, k: usize, d: &SystemDerivative) -> f
     d.shifted_bilinear(modes.eigenvalues[k], phi, phi)
 }
 
+/// Tφ of one mode under the expansion T that derivatives of a condensed model are held through,
+/// computed for the first derivative that has one and reused while the next ones share it.
+#[derive(Default)]
+struct ExpandedShape(Option<(Arc<Expansion>, Vec<f64>)>);
+
+impl ExpandedShape {
+    /// Tφ for `d`'s T, `None` when `d`'s stiffness is plain (no expansion).
+    fn of(&mut self, d: &SystemDerivative, phi: &[f64]) -> Option<&[f64]> {
+        let t = d.stiffness.expansion()?;
+        if !matches!(&self.0, Some((held, _)) if Arc::ptr_eq(held, t)) {
+            self.0 = Some((Arc::clone(t), t.expand(phi)));
+        }
+        self.0.as_ref().map(|(_, full)| full.as_slice())
+    }
+}
+
+/// [`eigenvalue_derivative`] with φₖ's expansion shared across derivatives (see [`ExpandedShape`]).
+fn eigenvalue_derivative_shared(
+    modes: &Modes,
+    k: usize,
+    d: &SystemDerivative,
+    full: &mut ExpandedShape,
+) -> f64 {
+    let phi = modes.shape(k);
+    match full.of(d, phi) {
+        Some(tphi) => d.shifted_bilinear_expanded(modes.eigenvalues[k], phi, phi, tphi, tphi),
+        None => d.shifted_bilinear(modes.eigenvalues[k], phi, phi),
+    }
+}
+
 /// Eigenvalue and frequency sensitivities of the lowest modes to every parameter.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sensitivities {
@@ -185,10 +216,11 @@ impl Sensitivities {
             }
         }
         let mut derivatives = Vec::with_capacity(np);
+        let mut full: Vec<ExpandedShape> = (0..count).map(|_| ExpandedShape::default()).collect();
         for i in 0..np {
             let d = model.derivative(p, i)?;
             for &k in wanted {
-                dl[(k, i)] = eigenvalue_derivative(&modes, k, &d);
+                dl[(k, i)] = eigenvalue_derivative_shared(&modes, k, &d, &mut full[k]);
             }
             derivatives.push(d);
         }
@@ -281,12 +313,16 @@ pub fn eigenvector_derivatives_nelson(
     let mut m_phi = vec![0.0; n];
     system.mass_mul_add(1.0, phi, &mut m_phi);
     let pivot = modes.shapes.column(k).iamax();
+    let mut full = ExpandedShape::default();
     let mut solutions: Vec<Vec<f64>> = derivatives
         .iter()
         .map(|d| {
-            let dlk = eigenvalue_derivative(modes, k, d);
+            let dlk = eigenvalue_derivative_shared(modes, k, d, &mut full);
             let mut rhs: Vec<f64> = m_phi.iter().map(|v| v * dlk).collect();
-            d.stiffness.mul_add(-1.0, phi, &mut rhs);
+            match full.of(d, phi) {
+                Some(tphi) => d.stiffness.mul_add_expanded(-1.0, phi, tphi, &mut rhs),
+                None => d.stiffness.mul_add(-1.0, phi, &mut rhs),
+            }
             d.mass.mul_add(lk, phi, &mut rhs);
             rhs[pivot] = 0.0;
             rhs

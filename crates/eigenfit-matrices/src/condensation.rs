@@ -15,7 +15,9 @@
 //! K_ss and X are dense here (K_c fills in wherever massless DOFs connect massed ones), so the
 //! reduction is for models of up to [`MAX_CONDENSED_DOFS`] massed and as many massless DOFs.
 
-use eigenfit_core::matrix::{CscSymmetric, SparseSymmetric};
+#[cfg(doc)]
+use eigenfit_core::matrix::SparseSymmetric;
+use eigenfit_core::matrix::{CscSymmetric, Expansion};
 use nalgebra::{Cholesky, DMatrix, Dyn};
 
 /// Largest number of massed DOFs, and of massless ones, condensed (dense K_ss, X and K_c).
@@ -151,93 +153,11 @@ impl Partition {
         Ok((CscSymmetric::from_dense(&kc), x))
     }
 
-    /// Tᵀ D T for a derivative D = ∂K/∂p of the full model, T = [I; −X]: the exact derivative of
-    /// K_c. With G = D T on the t rows D touches (n_m wide), Tᵀ G is G's kept rows scattered
-    /// plus one product −X_Sᵀ G_S over its massless rows S (a GEMM): O(nnz(D)·n_m + |S|·n_m²).
-    pub fn project(&self, d: &CscSymmetric, x: &DMatrix<f64>) -> SparseSymmetric {
-        let nm = self.kept.len();
-        if d.values().iter().all(|&v| v == 0.0) {
-            return SparseSymmetric::zeros(nm);
-        }
-        // Row r of X as a contiguous column of Xᵀ.
-        let xt = x.transpose();
-        // The touched rows, each given a column of G (stored transposed: n_m × t).
-        let mut slot = vec![usize::MAX; d.dim()];
-        let mut touched = Vec::new();
-        for c in 0..d.dim() {
-            let (rs, values) = d.column(c);
-            for (&r, &v) in rs.iter().zip(values) {
-                if v != 0.0 {
-                    for row in [r, c] {
-                        if slot[row] == usize::MAX {
-                            slot[row] = touched.len();
-                            touched.push(row);
-                        }
-                    }
-                }
-            }
-        }
-        let mut g = DMatrix::<f64>::zeros(nm, touched.len());
-        let mut add = |r: usize, c: usize, v: f64| {
-            let mut column = g.column_mut(slot[r]);
-            match self.place[c] {
-                Place::Kept(j) => column[j] += v,
-                Place::Massless(a) => column.axpy(-v, &xt.column(a), 1.0),
-            }
-        };
-        for c in 0..d.dim() {
-            let (rs, values) = d.column(c);
-            for (&r, &v) in rs.iter().zip(values) {
-                if v == 0.0 {
-                    continue;
-                }
-                add(r, c, v);
-                if r != c {
-                    add(c, r, v);
-                }
-            }
-        }
-        // (Tᵀ G)ᵀ = Gᵀ-columns: kept rows scattered into their column, massless rows through X.
-        let mut out = DMatrix::<f64>::zeros(nm, nm);
-        let mut massless_columns = Vec::new();
-        let mut massless_rows = Vec::new();
-        for (t, &r) in touched.iter().enumerate() {
-            match self.place[r] {
-                Place::Kept(i) => out.column_mut(i).axpy(1.0, &g.column(t), 1.0),
-                Place::Massless(a) => {
-                    massless_columns.push(t);
-                    massless_rows.push(a);
-                }
-            }
-        }
-        if !massless_columns.is_empty() {
-            let gs = g.select_columns(&massless_columns);
-            let xs = xt.select_columns(&massless_rows);
-            // out[:, i] −= Σ_a G[:, a] X[a, i]: out −= G_S X_S.
-            out.gemm(-1.0, &gs, &xs.transpose(), 1.0);
-        }
-        let mut s = SparseSymmetric::zeros(nm);
-        for j in 0..nm {
-            for i in 0..=j {
-                let v = 0.5 * (out[(i, j)] + out[(j, i)]);
-                if v != 0.0 {
-                    s.add(i, j, v);
-                }
-            }
-        }
-        s
-    }
-
-    /// The full-model vector of a condensed one: φ_m at the massed DOFs, −X φ_m at the massless.
-    pub fn expand(&self, shape: &[f64], x: &DMatrix<f64>) -> Vec<f64> {
-        let mut full = vec![0.0; self.place.len()];
-        for (&j, &v) in self.kept.iter().zip(shape) {
-            full[j] = v;
-        }
-        for (a, &j) in self.massless.iter().enumerate() {
-            full[j] = -x.row(a).iter().zip(shape).map(|(xa, v)| xa * v).sum::<f64>();
-        }
-        full
+    /// T = [I; −X] for the X of [`condense`](Self::condense): the full vector of a condensed one
+    /// (φ_m at the massed DOFs, −X φ_m at the massless), and derivatives of K_c = TᵀKT as Tᵀ(∂K)T
+    /// kept in product form ([`SparseSymmetric::congruent`]).
+    pub fn expansion(&self, x: &DMatrix<f64>) -> Expansion {
+        Expansion::new(self.place.len(), self.kept.clone(), self.massless.clone(), x)
     }
 }
 
@@ -309,11 +229,13 @@ mod tests {
         let (kf, mf) = (k.to_dense(), m.to_dense());
         for (i, &lambda) in eig.eigenvalues.iter().enumerate() {
             let phi_m = &scale * eig.eigenvectors.column(i);
-            let full = nalgebra::DVector::from_vec(part.expand(phi_m.as_slice(), &x));
+            let full = nalgebra::DVector::from_vec(part.expansion(&x).expand(phi_m.as_slice()));
             let residual = (&kf - &mf * lambda) * &full;
             assert!(residual.amax() < 1e-12, "mode {i}: {residual}");
         }
     }
+
+    use eigenfit_core::matrix::SparseSymmetric;
 
     #[test]
     fn the_projected_derivative_is_t_transposed_d_t() {
@@ -345,7 +267,8 @@ mod tests {
         }
         assert_eq!(ns, 4);
         let reference = t.transpose() * d.to_dense() * &t;
-        let projected = part.project(&d, &x).to_dense();
+        let t_op = std::sync::Arc::new(part.expansion(&x));
+        let projected = SparseSymmetric::congruent(d.to_sparse_symmetric(), t_op).to_dense();
         assert!((&projected - &reference).amax() < 1e-14 * reference.amax(), "{projected} vs {reference}");
     }
 

@@ -5,10 +5,9 @@ use crate::condensation::{Partition, MAX_CONDENSED_DOFS};
 use crate::error::MatricesError;
 use crate::layout::{Dof, DofLayout};
 use crate::market::read_symmetric;
-use eigenfit_core::matrix::{CscSymmetric, SparseSymmetric, System, SystemDerivative};
+use eigenfit_core::matrix::{CscSymmetric, Expansion, SparseSymmetric, System, SystemDerivative};
 use eigenfit_core::measurement::measured_csv::shown_number;
 use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
-use nalgebra::DMatrix;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -70,14 +69,14 @@ impl Files {
     }
 }
 
-/// A parameter vector p and X(p) = K_ss(p)⁻¹K_sm(p) there.
-type LastCondensation = (Vec<f64>, Arc<DMatrix<f64>>);
+/// A parameter vector p and T(p) = [I; −X(p)], X = K_ss(p)⁻¹K_sm(p), there.
+type LastCondensation = (Vec<f64>, Arc<Expansion>);
 
-/// The static condensation of a model's massless DOFs and the last X = K_ss⁻¹K_sm computed.
+/// The static condensation of a model's massless DOFs and the last T = [I; −K_ss⁻¹K_sm] computed.
 #[derive(Debug)]
 struct Condensation {
     partition: Partition,
-    /// (p, X(p)) of the last assembly: the derivatives at p reuse it.
+    /// (p, T(p)) of the last assembly: the derivatives at p reuse it.
     last: Mutex<Option<LastCondensation>>,
 }
 
@@ -367,7 +366,7 @@ impl MatricesModel {
             ));
         }
         self.condensation = Some(Condensation { partition, last: Mutex::new(None) });
-        self.condensed_x(&nominal).map(|_| ()).map_err(|e| e.to_string())
+        self.condensed_t(&nominal).map(|_| ()).map_err(|e| e.to_string())
     }
 
     /// `DOF j (node N direction D)` with the DOF map, `DOF j` without (j from 1).
@@ -378,8 +377,8 @@ impl MatricesModel {
         }
     }
 
-    /// X(p) = K_ss(p)⁻¹K_sm(p) and K_c(p), remembered for the derivatives at `p`.
-    fn condense_at(&self, p: &[f64]) -> Result<(CscSymmetric, Arc<DMatrix<f64>>), ModelError> {
+    /// K_c(p) and T(p) = [I; −X(p)], X = K_ss(p)⁻¹K_sm(p), remembered for the derivatives at `p`.
+    fn condense_at(&self, p: &[f64]) -> Result<(CscSymmetric, Arc<Expansion>), ModelError> {
         let c = self.condensation.as_ref().expect("a condensed model");
         let k =
             self.combine(&self.stiffness, p.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.0.as_ref())));
@@ -405,20 +404,20 @@ impl MatricesModel {
             };
             ModelError::Invalid(format!("massless {} {held}", self.full_dof_label(at.0)))
         })?;
-        let x = Arc::new(x);
-        *c.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((p.to_vec(), Arc::clone(&x)));
-        Ok((kc, x))
+        let t = Arc::new(c.partition.expansion(&x));
+        *c.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((p.to_vec(), Arc::clone(&t)));
+        Ok((kc, t))
     }
 
-    /// X(p), from the last assembly when it was at `p`.
-    fn condensed_x(&self, p: &[f64]) -> Result<Arc<DMatrix<f64>>, ModelError> {
+    /// T(p), from the last assembly when it was at `p`.
+    fn condensed_t(&self, p: &[f64]) -> Result<Arc<Expansion>, ModelError> {
         let c = self.condensation.as_ref().expect("a condensed model");
         if let Some((q, x)) = c.last.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
             if q.as_slice() == p {
                 return Ok(Arc::clone(x));
             }
         }
-        self.condense_at(p).map(|(_, x)| x)
+        self.condense_at(p).map(|(_, t)| t)
     }
 
     /// `name = value, …` of the parameter vector `p`, for messages.
@@ -464,8 +463,8 @@ impl MatricesModel {
                 };
                 let stiffness = match stiffness {
                     Some(k) => {
-                        let x = self.condensed_x(&self.params.nominal_values()).map_err(|e| e.to_string())?;
-                        c.partition.project(&k, &x)
+                        let t = self.condensed_t(&self.params.nominal_values()).map_err(|e| e.to_string())?;
+                        SparseSymmetric::congruent(k.to_sparse_symmetric(), t)
                     }
                     None => SparseSymmetric::zeros(n),
                 };
@@ -554,9 +553,9 @@ impl MatricesModel {
         }
         match &self.condensation {
             None => Ok(shape.to_vec()),
-            Some(c) => {
+            Some(_) => {
                 self.params.check(p)?;
-                Ok(c.partition.expand(shape, &*self.condensed_x(p)?))
+                Ok(self.condensed_t(p)?.expand(shape))
             }
         }
     }
@@ -821,7 +820,7 @@ impl StructuralModel for MatricesModel {
     }
 
     /// Exact: K and M are linear in every parameter; with massless DOFs ∂K_c/∂pᵢ = Tᵀ(∂K/∂pᵢ)T
-    /// (the `condensation` module), exact too.
+    /// (the `condensation` module), exact too, held as ∂K/∂pᵢ and T (it would fill in densely).
     fn derivative(&self, p: &[f64], i: usize) -> Result<SystemDerivative, ModelError> {
         let (dk, dm) = self
             .derivatives
@@ -831,7 +830,7 @@ impl StructuralModel for MatricesModel {
         let n = self.dofs();
         if let Some(c) = &self.condensation {
             let stiffness = match dk {
-                Some(t) => c.partition.project(&t.matrix, &*self.condensed_x(p)?),
+                Some(t) => SparseSymmetric::congruent(t.matrix.to_sparse_symmetric(), self.condensed_t(p)?),
                 None => SparseSymmetric::zeros(n),
             };
             let mass = dm.as_ref().map_or_else(

@@ -16,7 +16,7 @@ use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
     adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, local_minima_refit,
-    mirror_solutions, search_starts, Equivalence, Mirrors,
+    mirror_solutions, screened_fits, screened_local_minima_refit, search_starts, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};
@@ -599,9 +599,13 @@ pub fn run(
         mirrors = mirror_solutions(&fit, &estimate.last, &exchanges, &budget);
         phases.push(("mirror_solutions", budget.used()));
         let starts = request.alternative_starts.unwrap_or_else(|| default_alternative_starts(np));
-        // Ranking a design alone costs an evaluation per point: skipped with no start.
-        if starts > 0 {
-            minima = local_minima_refit(&fit, starts, &mirrors.asymmetric, &budget, &*refit);
+        // The default design of a problem with many parameters is screened by misfit; starts
+        // given on the command line are each fitted. Skipped with no start.
+        let (extra, refit) = (&mirrors.asymmetric, &*refit);
+        match screened_fits(np).filter(|_| request.alternative_starts.is_none()) {
+            _ if starts == 0 => {}
+            Some(keep) => minima = screened_local_minima_refit(&fit, starts, keep, extra, &budget, refit),
+            None => minima = local_minima_refit(&fit, starts, extra, &budget, refit),
         }
         phases.push(("other_solutions", budget.used()));
         // A regularised estimate is not the least-squares minimum, by design: a deeper one is

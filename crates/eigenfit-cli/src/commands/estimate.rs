@@ -52,8 +52,9 @@ pub struct EstimateArgs {
     #[arg(long, value_name = "N")]
     pub budget: Option<usize>,
     /// Starts of the space-filling design refitted locally when searching for other minima
-    /// (default: 4 per free parameter and 8 more; 0: no such search; the exchange of like
-    /// parameters is still checked). Each is a local fit of several model evaluations: on a
+    /// (default: 4 per free parameter and 8 more — above 8 free parameters ranked by misfit and
+    /// only the best free + 1 fitted; 0: no such search; the exchange of like parameters is
+    /// still checked). Each is a local fit of several model evaluations: on a
     /// large model most of a run's time (`evaluations_by_phase` in --json). ROSS rotors: the
     /// most refits from screened starts when the fit from the file's bearings fails the χ² test
     /// (`refits` in --json; default 6).

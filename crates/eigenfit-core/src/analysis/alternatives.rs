@@ -35,6 +35,19 @@ pub fn search_starts(free: usize) -> usize {
     4 * free + 8
 }
 
+/// Free parameters above which the default search screens its design by misfit.
+pub const SCREEN_ABOVE_FREE: usize = 8;
+
+/// How many of the default design's starts are fitted locally with `free` free parameters:
+/// all of them (`None`) up to [`SCREEN_ABOVE_FREE`]; above, the best `free + 1` by misfit
+/// ([`screened_local_minima`], as for run-ups). A local fit from a far start in many dimensions
+/// costs dozens of evaluations, each a linearisation of the model: fitting every one of the
+/// 4·free + 8 starts was most of a large model's run (issue 29), while ranking a start costs
+/// one eigen-solve without derivatives.
+pub fn screened_fits(free: usize) -> Option<usize> {
+    (free > SCREEN_ABOVE_FREE).then_some(free + 1)
+}
+
 /// The test of one point against the estimate: whether the data can tell them apart.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Equivalence {
@@ -194,6 +207,18 @@ pub fn screened_local_minima(
     extra: &[Vec<f64>],
     budget: &Budget,
 ) -> Vec<Linearisation> {
+    screened_local_minima_refit(problem, starts, keep, extra, budget, &Damped)
+}
+
+/// [`screened_local_minima`] with the local fits made by `refit`.
+pub fn screened_local_minima_refit(
+    problem: &dyn Objective,
+    starts: usize,
+    keep: usize,
+    extra: &[Vec<f64>],
+    budget: &Budget,
+    refit: &dyn Refit,
+) -> Vec<Linearisation> {
     let budgeted = budget.wrap(problem);
     let mut ranked: Vec<(f64, Vec<f64>)> = design(problem, starts)
         .filter(|p| problem.parameters().check(p).is_ok())
@@ -201,7 +226,7 @@ pub fn screened_local_minima(
         .collect();
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
     let points = extra.iter().cloned().chain(ranked.into_iter().take(keep).map(|(_, p)| p)).collect();
-    fitted_minima(problem, points, budget, &Damped)
+    fitted_minima(problem, points, budget, refit)
 }
 
 /// The Halton design of `starts` points over `problem`'s search ranges.

@@ -1,14 +1,17 @@
 //! Matrix layer: the stiffness–mass pair [`System`] and its storage — dense, [`SparseSymmetric`]
-//! (triplets), [`BandedSymmetric`] with its [`BandCholesky`] factor, and [`CscSymmetric`].
+//! (triplets), [`BandedSymmetric`] with its [`BandCholesky`] factor, and [`CscSymmetric`]; the
+//! [`Expansion`] T of a static condensation, through which condensed derivatives are applied.
 //!
 //! Depends only on [`units`](crate::units). Files are named after their main type.
 
 pub(crate) mod banded;
 pub(crate) mod csc;
+pub(crate) mod expansion;
 pub(crate) mod sparse;
 pub(crate) mod system;
 
 pub use banded::{BandCholesky, BandedSymmetric};
 pub use csc::CscSymmetric;
+pub use expansion::Expansion;
 pub use sparse::SparseSymmetric;
 pub use system::{System, SystemDerivative, SystemError, MAX_BAND_ENTRIES_FOR_PIVOT};

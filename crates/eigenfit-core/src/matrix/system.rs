@@ -291,6 +291,25 @@ impl SystemDerivative {
             k - lambda * self.mass.bilinear(phi, psi)
         }
     }
+
+    /// [`shifted_bilinear`](Self::shifted_bilinear) with Tφ and Tψ given, T the
+    /// [`expansion`](SparseSymmetric::expansion) ∂K is held through (a condensed model's): the
+    /// expansions, the costly part, are shared by every parameter's derivative.
+    pub fn shifted_bilinear_expanded(
+        &self,
+        lambda: f64,
+        phi: &[f64],
+        psi: &[f64],
+        tphi: &[f64],
+        tpsi: &[f64],
+    ) -> f64 {
+        let k = self.stiffness.bilinear_expanded(phi, psi, tphi, tpsi);
+        if self.mass.is_empty() {
+            k
+        } else {
+            k - lambda * self.mass.bilinear(phi, psi)
+        }
+    }
 }
 
 #[cfg(test)]
