@@ -274,6 +274,10 @@ impl ShiftInvert for FactorSolve<'_> {
     }
 }
 
+/// Bisection steps of [`SparseSolver::shift_below_lowest`]: the shift lands within 2⁻¹² of the
+/// upper bound of λ₁ below it, so the inverted spectrum's lowest gaps are of order one.
+const SHIFT_BISECTIONS: usize = 12;
+
 /// Converged modes of one shift: eigenvalues ascending, vectors column-major n×count.
 struct Found {
     eigenvalues: Vec<f64>,
@@ -348,7 +352,17 @@ impl SparseSolver {
             ws.checked_mass = Some(m.clone());
         }
         let (sigma, mut found) = if ws.cholesky(k, true)? {
-            (0.0, self.iterate(m, 0.0, count, None, ws)?)
+            match self.iterate(m, 0.0, count, None, ws) {
+                Ok(found) => (0.0, found),
+                // A spectrum spread far above zero (λᵢ = 1001, 1002, …): inverted at zero its
+                // relative gaps are 1e-3 and Lanczos runs out of steps. Shifted to just below
+                // the lowest eigenvalue they become 1, 2, 3, …
+                Err(e @ SolveError::NotConverged { .. }) => match self.shift_below_lowest(k, m, ws)? {
+                    Some(s) => (-s, self.iterate(m, -s, count, None, ws)?),
+                    None => return Err(e),
+                },
+                Err(e) => return Err(e),
+            }
         } else {
             // Rigid-body modes or a nearly singular K: the dense solver's two shifts.
             let scale = k.diagonal_max() / m.diagonal_max();
@@ -414,6 +428,42 @@ impl SparseSolver {
             found = merge(found, extra, n);
         }
         Ok(None)
+    }
+
+    /// A shift s below the lowest eigenvalue λ₁ and close to it, with K − sM factored in the
+    /// workspace; `None` (and K factored again) when none better than zero is found. K is
+    /// positive definite (s = 0 works) and λ₁ ≤ minᵢ Kᵢᵢ/Mᵢᵢ (the Rayleigh quotient of a unit
+    /// vector): bisection on whether K − sM has a Cholesky factor brackets λ₁ within 2⁻¹² of that
+    /// bound — no eigenvalue lies below s, so none is missed, and the Sturm count that follows
+    /// checks the modes found as for any shift.
+    fn shift_below_lowest(
+        &self,
+        k: &CscSymmetric,
+        m: &CscSymmetric,
+        ws: &mut Workspace,
+    ) -> Result<Option<f64>, SolveError> {
+        let upper = (0..k.dim())
+            .filter(|&i| m.get(i, i) > 0.0)
+            .map(|i| k.get(i, i) / m.get(i, i))
+            .fold(f64::INFINITY, f64::min);
+        if !(upper.is_finite() && upper > 0.0) {
+            return Ok(None);
+        }
+        let (mut lo, mut hi) = (0.0, upper);
+        for _ in 0..SHIFT_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if ws.cholesky(&CscSymmetric::combination(1.0, k, -mid, m), false)? {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        if lo == 0.0 || !ws.cholesky(&CscSymmetric::combination(1.0, k, -lo, m), true)? {
+            // Put back the factor the caller's later steps assume.
+            ws.cholesky(k, true)?;
+            return Ok(None);
+        }
+        Ok(Some(lo))
     }
 
     /// The `count` lowest modes (outside the locked ones) from the factor of K + σM held in
