@@ -514,18 +514,14 @@ fn refuse_unit_slip(
     points: &[RunupPoint],
     measured: &Path,
 ) -> Result<(), WorkflowError> {
-    let start = eigenfit_rotordynamics::identify::scaled_rotor(rotor, params, initial);
+    let all: Vec<&RunupPoint> = points.iter().collect();
+    let Some(solved) = start_modes_at_speeds(rotor, params, initial, &all) else { return Ok(()) };
     let mut ratios = Vec::with_capacity(points.len());
-    let mut solved: Vec<(f64, Vec<f64>)> = Vec::new();
     for p in points {
-        if !solved.iter().any(|(rpm, _)| *rpm == p.speed_rpm) {
-            let highest =
-                points.iter().filter(|q| q.speed_rpm == p.speed_rpm).map(|q| q.mode).max().unwrap_or(1);
-            let Ok(modes) = start.lowest_modes(rpm_to_rad(p.speed_rpm), highest) else { return Ok(()) };
-            solved.push((p.speed_rpm, modes.iter().map(|m| m.frequency_hz()).collect()));
-        }
-        let at = &solved.iter().find(|(rpm, _)| *rpm == p.speed_rpm).expect("solved above").1;
-        let Some(model) = at.get(p.mode - 1).copied().filter(|f| *f > 0.0) else { return Ok(()) };
+        let at = &solved.iter().find(|(rpm, _)| *rpm == p.speed_rpm).expect("solved").1;
+        let Some(model) = at.get(p.mode - 1).map(|m| m.frequency_hz()).filter(|f| *f > 0.0) else {
+            return Ok(());
+        };
         ratios.push((p.frequency_hz / model, model));
     }
     let far = ratios.iter().all(|(r, _)| !(1.0 / RUNUP_SLIP_RATIO..=RUNUP_SLIP_RATIO).contains(r));
@@ -552,6 +548,28 @@ fn refuse_unit_slip(
     )))
 }
 
+/// The rotor at its starting coefficients, solved at each speed of `points` for its modes up to
+/// the highest number measured there: what the up-front checks compare a run-up with, mode by
+/// mode number (one eigen-solve per speed, not charged to the fit's budget). `None` when a speed
+/// cannot be solved: the checks then judge nothing, and the fit says what is wrong.
+fn start_modes_at_speeds(
+    rotor: &Rotor,
+    params: &[eigenfit_rotordynamics::identify::Parameter],
+    initial: &[f64],
+    points: &[&RunupPoint],
+) -> Option<Vec<(f64, Vec<eigenfit_rotordynamics::Mode>)>> {
+    let start = eigenfit_rotordynamics::identify::scaled_rotor(rotor, params, initial);
+    let mut solved: Vec<(f64, Vec<eigenfit_rotordynamics::Mode>)> = Vec::new();
+    for p in points {
+        if !solved.iter().any(|(rpm, _)| *rpm == p.speed_rpm) {
+            let highest =
+                points.iter().filter(|q| q.speed_rpm == p.speed_rpm).map(|q| q.mode).max().unwrap_or(1);
+            solved.push((p.speed_rpm, start.lowest_modes(rpm_to_rad(p.speed_rpm), highest).ok()?));
+        }
+    }
+    Some(solved)
+}
+
 /// Refuses whirl labels every one of which contradicts the rotor: each point labelled forward
 /// or backward (at least two such) has, at the starting coefficients, a model mode of its
 /// number whirling the other way (a model mode whirling mixed judges nothing) — swapped labels or a reversed sense of rotation. The fit's pairing
@@ -572,19 +590,12 @@ fn refuse_reversed_whirl(
     if labelled.len() < 2 {
         return Ok(());
     }
-    let start = eigenfit_rotordynamics::identify::scaled_rotor(rotor, params, initial);
-    let mut solved: Vec<(f64, Vec<Whirl>)> = Vec::new();
+    let Some(solved) = start_modes_at_speeds(rotor, params, initial, &labelled) else { return Ok(()) };
     let mut contradicting = 0;
     for p in &labelled {
-        if !solved.iter().any(|(rpm, _)| *rpm == p.speed_rpm) {
-            let highest =
-                labelled.iter().filter(|q| q.speed_rpm == p.speed_rpm).map(|q| q.mode).max().unwrap_or(1);
-            let Ok(modes) = start.lowest_modes(rpm_to_rad(p.speed_rpm), highest) else { return Ok(()) };
-            solved.push((p.speed_rpm, modes.iter().map(|m| m.whirl).collect()));
-        }
-        let at = &solved.iter().find(|(rpm, _)| *rpm == p.speed_rpm).expect("solved above").1;
+        let at = &solved.iter().find(|(rpm, _)| *rpm == p.speed_rpm).expect("solved").1;
         // A model mode that whirls mixed (or is missing) neither agrees nor contradicts.
-        match (p.whirl, at.get(p.mode - 1)) {
+        match (p.whirl, at.get(p.mode - 1).map(|m| &m.whirl)) {
             (Some(Whirl::Forward), Some(Whirl::Backward)) | (Some(Whirl::Backward), Some(Whirl::Forward)) => {
                 contradicting += 1
             }
