@@ -324,6 +324,30 @@ fn intervals_are_profiled_by_a_refit_strategy_of_the_users_choice() {
     }
 }
 
+/// Discovery's calibration and candidate refits by another registered strategy (`discover
+/// --refit`, issue 27 item 6): on the paper rotor's hidden-effect data the trust-region strategy
+/// names the effect the default names, at the same place, and explains the data as it does.
+#[test]
+fn discover_runs_on_a_refit_strategy_of_the_users_choice() {
+    let hidden = common::data_file("../../examples", "measured_hidden_effect.csv");
+    let run = |more: &[&str]| {
+        let mut args = vec!["discover", "--preset", "paper-rotor", "--measured", hidden.as_str(), "--json"];
+        args.extend_from_slice(more);
+        json(&eigenfit(&args))
+    };
+    let (damped, trf) = (run(&[]), run(&["--refit", "trf"]));
+    let first = |v: &Value| v["missing_effects"][0].clone();
+    assert!(first(&damped).is_object(), "the default names an effect: {damped}");
+    assert_eq!(first(&trf)["kind"], first(&damped)["kind"], "{trf}");
+    assert_eq!(first(&trf)["location"], first(&damped)["location"], "{trf}");
+    assert_eq!(trf["explained"], damped["explained"]);
+    // The refits really are the trust region's: they spend their own evaluations.
+    assert_ne!(trf["evaluations"], damped["evaluations"]);
+    let refused =
+        eigenfit(&["discover", "--preset", "paper-rotor", "--measured", &hidden, "--refit", "tmcmc"]);
+    assert_eq!(refused.status.code(), Some(2));
+}
+
 /// Contract: `estimate --json` carries the same verdict keys for every model kind.
 fn assert_contract_keys(v: &Value) {
     for k in [

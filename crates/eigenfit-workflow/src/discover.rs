@@ -13,6 +13,7 @@ use eigenfit_core::discovery::{
 use eigenfit_core::eigen::EigenSolver;
 use eigenfit_core::model::StructuralModel;
 use eigenfit_core::problem::Problem;
+use eigenfit_core::update::refit::RefitChoice;
 use eigenfit_core::update::Budget;
 use eigenfit_rotor::discovery::{discover_rotor, RotorDiscovery};
 use serde::Serialize;
@@ -133,8 +134,8 @@ pub struct Discovery {
 
 /// Runs the discovery on `model` against the measured CSV at `measured`, assuming a relative
 /// standard deviation `assumed_std` where the file gives none, spending at most `budget` model
-/// evaluations (eigen-solves) on the data check and the whole search together. Notes on the file
-/// go to `notes`.
+/// evaluations (eigen-solves) on the data check and the whole search together, calibrating and
+/// refitting with `refit`. Notes on the file go to `notes`.
 #[allow(clippy::too_many_arguments)]
 pub fn run(
     label: &str,
@@ -143,6 +144,7 @@ pub fn run(
     measured: &Path,
     assumed_std: f64,
     budget: usize,
+    refit: RefitChoice,
     notes: &mut Vec<String>,
     progress: &mut dyn Progress,
 ) -> Result<Discovery, WorkflowError> {
@@ -174,6 +176,7 @@ pub fn run(
     let options = DiscoveryOptions {
         assumed_relative_std: assumed_std,
         max_evaluations: check.remaining(),
+        refit,
         ..Default::default()
     };
     progress.begin("discovering: calibrate, detect, screen and refit candidates", None);

@@ -47,6 +47,17 @@ pub fn refuse_unit_slip(
     }
 }
 
+/// The refit strategy `--refit SPEC` names (damped least squares without it), checked before
+/// anything is read: an unknown name, a bad setting or a sampler is bad input.
+pub fn refit_choice(spec: Option<&str>) -> Result<RefitChoice, WorkflowError> {
+    match spec {
+        None => Ok(RefitChoice::default()),
+        Some(spec) => Registered::new(spec)
+            .map(|r| RefitChoice(std::sync::Arc::new(r)))
+            .map_err(|e| input(format!("--refit {}: {e}", shown(spec)))),
+    }
+}
+
 /// Starts of the search for other solutions when not given: a space-filling design sized to the
 /// free parameters ([`search_starts`]: 4 per parameter and 8 more).
 pub fn default_alternative_starts(free: usize) -> usize {
@@ -364,12 +375,7 @@ pub fn run(
         )));
     }
     // The refit strategy by name, checked before anything is read.
-    let refit = match &request.refit {
-        None => RefitChoice::default(),
-        Some(spec) => RefitChoice(std::sync::Arc::new(
-            Registered::new(spec).map_err(|e| input(format!("--refit {}: {e}", shown(spec))))?,
-        )),
-    };
+    let refit = refit_choice(request.refit.as_deref())?;
     // Two-plane rotors saved by ROSS: bearing kxx/kyy from run-up whirl frequencies.
     if let Some(path) = rotordynamics::ross_model(request.source.model.as_deref()) {
         // A run-up fit on a large rotor takes minutes (each evaluation solves every speed):

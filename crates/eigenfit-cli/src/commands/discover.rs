@@ -30,6 +30,11 @@ pub struct DiscoverArgs {
     /// code 3 (as `estimate`'s `--budget`).
     #[arg(long, value_name = "N", default_value_t = eigenfit_core::discovery::DEFAULT_EVALUATIONS)]
     pub budget: usize,
+    /// The strategy of the calibration and of every candidate's refit, by registered name with
+    /// settings after colons (as `estimate --strategy`); default: damped least squares. Not for
+    /// ROSS run-ups.
+    #[arg(long, value_name = "STRATEGY")]
+    pub refit: Option<String>,
     /// Write the augmented model (calibrated stiffnesses + the named effect) to this TOML file.
     #[arg(long, value_name = "FILE.toml")]
     pub write_model: Option<PathBuf>,
@@ -47,11 +52,13 @@ pub struct DiscoverArgs {
 /// Runs `discover`; returns the exit code: 0 when the data are explained (by the noise, or after
 /// the named effects), 3 when a significant disagreement stays unexplained or the budget ran out.
 pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
+    // Checked before anything is read.
+    let refit = eigenfit_workflow::estimate::refit_choice(args.refit.as_deref())?;
     // Two-plane rotors saved by ROSS, against a run-up CSV: the rotordynamics workflow.
     if let Some(path) = eigenfit_workflow::rotordynamics::ross_model(args.model.model.as_deref()) {
-        if args.write_model.is_some() || args.plot.is_some() {
+        if args.write_model.is_some() || args.plot.is_some() || args.refit.is_some() {
             return Err(crate::error::input(
-                "--write-model and --plot are not available for ROSS rotors (the report names the effects)",
+                "--write-model, --plot and --refit are not available for ROSS rotors (the report names the effects)",
             ));
         }
         args.html.check()?;
@@ -95,6 +102,7 @@ pub fn run(args: &DiscoverArgs) -> Result<u8, CliError> {
         &args.measured,
         args.assumed_std,
         args.budget,
+        refit,
         &mut notes,
         &mut Bars::new(args.report.quiet),
     );
