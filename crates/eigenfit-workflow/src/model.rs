@@ -192,6 +192,10 @@ pub fn registered_model_kinds() -> Vec<String> {
 
 /// The file's top-level `kind = "…"`, when it names a registered kind, with the file's text.
 fn registered_kind_of(path: &Path) -> Option<(Arc<dyn ModelKind>, String)> {
+    // Nothing registered (every run of the CLI): no file read and parsed for nothing.
+    if kinds().read().ok()?.is_empty() {
+        return None;
+    }
     let text = std::fs::read_to_string(path).ok()?;
     let table: toml::Table = toml::from_str(&text).ok()?;
     let name = table.get("kind")?.as_str()?;
