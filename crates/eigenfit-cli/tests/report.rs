@@ -516,7 +516,8 @@ fn campaign_writes_a_report_listing_every_file_the_campaign_names() {
 }
 
 /// A ROSS run-up fit's page: each bearing coefficient in its unit (stiffnesses N/m, damping
-/// N·s/m), each run-up point, the verdict.
+/// N·s/m), each run-up point, the verdict, and the figures `--plot` draws: the run-up fit, the
+/// estimated rotor's Campbell diagram, its mode shapes and orbits, the convergence.
 #[test]
 fn a_runup_estimate_report_gives_each_coefficient_its_unit() {
     let data = |name: &str| common::data_file("../eigenfit-rotordynamics/tests/data", name);
@@ -540,6 +541,15 @@ fn a_runup_estimate_report_gives_each_coefficient_its_unit() {
     let v = json(&out);
     let html = std::fs::read_to_string(&page).unwrap();
     self_contained(&html);
+    let captions: Vec<&str> =
+        html.split("<figcaption>").skip(1).map(|c| c.split("</figcaption>").next().unwrap()).collect();
+    assert_eq!(captions.len(), 4, "{captions:?}");
+    for (caption, starts) in
+        captions.iter().zip(["Run-up fit", "Campbell diagram", "Mode shapes", "Convergence"])
+    {
+        assert!(caption.starts_with(starts), "{caption}");
+    }
+    assert!(!html.contains("could not be computed"));
     let Some(browser) = chromium() else { return };
     let r = render(&browser, &page);
     assert!(r.requests.is_empty(), "{:?}", r.requests);

@@ -50,8 +50,7 @@ fn compare(file: &str, reference: &Value) -> (f64, f64, usize) {
             assert!((ours.frequency_hz - f).abs() < 1e-6 * f, "{file} {rpm} rpm mode {}", k + 1);
             let nodes = ross["nodes"].as_array().unwrap();
             assert_eq!(nodes.len(), ours.orbits.len(), "{file}: shaft nodes");
-            let theirs: Vec<c64> =
-                nodes.iter().flat_map(|n| [complex(&n["x"]), complex(&n["y"])]).collect();
+            let theirs: Vec<c64> = nodes.iter().flat_map(|n| [complex(&n["x"]), complex(&n["y"])]).collect();
             let mine: Vec<c64> = ours.orbits.iter().flat_map(|o| [o.x, o.y]).collect();
             let d = distance(&mine, &theirs);
             let ross_max = nodes.iter().map(|n| n["major"].as_f64().unwrap()).fold(0.0, f64::max);
@@ -85,10 +84,8 @@ fn compare(file: &str, reference: &Value) -> (f64, f64, usize) {
 
 #[test]
 fn mode_shapes_and_orbits_agree_with_ross3() {
-    let reference: Value = serde_json::from_str(
-        &std::fs::read_to_string(data("ross3_mode_shapes.json")).unwrap(),
-    )
-    .unwrap();
+    let reference: Value =
+        serde_json::from_str(&std::fs::read_to_string(data("ross3_mode_shapes.json")).unwrap()).unwrap();
     assert!(reference["ross_version"].as_str().unwrap().starts_with('3'));
     for file in ["compressor.toml", "pchip_speed.toml"] {
         let (shape, axis, n) = compare(file, &reference);

@@ -119,6 +119,10 @@ pub struct HistoryRecord {
     pub frequencies_hz: Vec<f64>,
     /// Largest |model − measured| (Hz).
     pub max_abs_diff_hz: f64,
+    /// `true` on the last record when it is not an iteration of the fit but the deeper minimum
+    /// the search for other solutions found, which the estimate took (absent otherwise).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub from_search: bool,
 }
 
 /// The intervals part of an estimate report: every key present, `null` when not computed (a
@@ -729,6 +733,7 @@ pub fn run(
                 parameters: r.parameters.clone(),
                 frequencies_hz: r.frequencies_hz.clone(),
                 max_abs_diff_hz: r.max_abs_diff_hz,
+                from_search: r.is_from_search(),
             })
             .collect(),
         uncertainty: IntervalsReport::new(&names, unc.as_ref()),

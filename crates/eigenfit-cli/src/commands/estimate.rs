@@ -10,6 +10,7 @@ use clap::Args;
 use eigenfit_core::analysis::verdict::FitVerdict;
 use eigenfit_core::update::DEFAULT_EVALUATIONS;
 use eigenfit_workflow::estimate::{self, EstimateOutcome, EstimateRequest, Estimation};
+use eigenfit_workflow::rotordynamics::RunupEstimateReport;
 use std::path::PathBuf;
 
 /// Arguments of `estimate`.
@@ -137,38 +138,14 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
         EstimateOutcome::Runup(mut report) => {
             print_notes(&report.notes);
             let code = if report.verdict.is_answer() { EXIT_OK } else { EXIT_NOT_CONVERGED };
-            let plots = match &args.plot {
+            // The estimated rotor's Campbell diagram and its shapes at the top measured speed,
+            // computed once for the plots and the report.
+            let figures =
+                (args.plot.is_some() || args.html.html.is_some()).then(|| RunupFigures::of(&report));
+            let plots = match (&args.plot, &figures) {
                 // A plot that fails after the fit is lost, said so; the fit's exit code stands.
-                Some(dir) => {
-                    let figure =
-                        plot::runup::RunupFit { title: report.model.clone(), points: &report.points };
-                    let mut written = plot::write(&figure, dir, "runup-fit").unwrap_or_else(|e| {
-                        crate::output::report_lost("the run-up fit plot", &e);
-                        Vec::new()
-                    });
-                    // The estimated rotor's Campbell diagram, critical speeds on the 1× line.
-                    match eigenfit_workflow::rotordynamics::campbell_at_estimate(&report) {
-                        Ok(campbell) => {
-                            let title = format!("{} at the estimate", report.model);
-                            let figure = plot::campbell::CampbellPlot { title, campbell: &campbell };
-                            written.extend(plot::write(&figure, dir, "campbell-estimate").unwrap_or_else(
-                                |e| {
-                                    crate::output::report_lost("the Campbell plot at the estimate", &e);
-                                    Vec::new()
-                                },
-                            ));
-                        }
-                        Err(e) => crate::output::report_lost("the Campbell plot at the estimate", &e.into()),
-                    }
-                    written.extend(runup_shapes(&report, dir));
-                    let figure = runup_convergence(&report);
-                    written.extend(plot::write(&figure, dir, "convergence").unwrap_or_else(|e| {
-                        crate::output::report_lost("the convergence plot", &e);
-                        Vec::new()
-                    }));
-                    written
-                }
-                None => Vec::new(),
+                (Some(dir), Some(figures)) => figures.write(&report, dir),
+                _ => Vec::new(),
             };
             report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
             crate::error::set_exit_on_closed_pipe(code);
@@ -184,7 +161,8 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                 }
             }
             if let (Some(path), Some(mut html)) = (&args.html.html, html) {
-                crate::report::estimate::fill_runup(&mut html, &report);
+                let figures = figures.as_ref().expect("computed for the report");
+                crate::report::estimate::fill_runup(&mut html, &report, &figures.for_report(&report));
                 html.write_after(path, args.report.json);
             }
             return Ok(code);
@@ -269,48 +247,109 @@ fn declared_units(model: &ModelArgs) -> Vec<(String, String)> {
     }
 }
 
-/// The estimated rotor's mode shapes and orbits at the top measured speed, of the modes the
-/// run-up measured (mode-shapes-estimate.svg/.png/.csv); a failure is said and nothing written.
-fn runup_shapes(
-    report: &eigenfit_workflow::rotordynamics::RunupEstimateReport,
-    dir: &std::path::Path,
-) -> Vec<PathBuf> {
-    let what = "the mode shapes and orbits at the estimate";
-    let shapes = match eigenfit_workflow::rotordynamics::shapes_at_estimate(report) {
-        Ok(s) => s,
-        Err(e) => {
-            crate::output::report_lost(what, &e.into());
-            return Vec::new();
+/// The figures of a run-up estimate beyond the run-up fit itself, each computed once: the
+/// estimated rotor's Campbell diagram (critical speeds on the 1× line) and its mode shapes and
+/// orbits at the top measured speed (an error kept as what to say in its place).
+struct RunupFigures {
+    campbell: Result<eigenfit_rotordynamics::Campbell, CliError>,
+    shapes: Result<eigenfit_rotordynamics::shapes::RotorShapes, CliError>,
+}
+
+impl RunupFigures {
+    fn of(report: &RunupEstimateReport) -> Self {
+        use eigenfit_workflow::rotordynamics::{campbell_at_estimate, shapes_at_estimate};
+        Self {
+            campbell: campbell_at_estimate(report).map_err(CliError::from),
+            shapes: shapes_at_estimate(report).map_err(CliError::from),
         }
-    };
-    let title = format!(
-        "{} at the estimate: mode shapes and orbits at {} rpm (the top measured speed)",
-        plot::rotor_shapes::file_name(&report.model),
-        plot::style::trim(shapes.speed_rpm, 1)
-    );
-    let figure = plot::rotor_shapes::RotorShapesPlot { title, shapes: &shapes };
-    plot::rotor_shapes::write(&figure, dir, "mode-shapes-estimate").unwrap_or_else(|e| {
-        crate::output::report_lost(what, &e);
-        Vec::new()
-    })
+    }
+
+    fn campbell_title(report: &RunupEstimateReport) -> String {
+        format!("{} at the estimate", report.model)
+    }
+
+    fn shapes_title(
+        report: &RunupEstimateReport,
+        shapes: &eigenfit_rotordynamics::shapes::RotorShapes,
+    ) -> String {
+        format!(
+            "{} at the estimate: mode shapes and orbits at {} rpm (the top measured speed)",
+            plot::rotor_shapes::file_name(&report.model),
+            plot::style::trim(shapes.speed_rpm, 1)
+        )
+    }
+
+    /// Writes every run-up figure into `dir`; a figure that fails is lost, said so.
+    fn write(&self, report: &RunupEstimateReport, dir: &std::path::Path) -> Vec<PathBuf> {
+        let lost = |what: &str, e: &CliError| {
+            crate::output::report_lost(what, e);
+            Vec::new()
+        };
+        let figure = plot::runup::RunupFit { title: report.model.clone(), points: &report.points };
+        let mut written =
+            plot::write(&figure, dir, "runup-fit").unwrap_or_else(|e| lost("the run-up fit plot", &e));
+        let what = "the Campbell plot at the estimate";
+        match &self.campbell {
+            Ok(campbell) => {
+                let figure = plot::campbell::CampbellPlot { title: Self::campbell_title(report), campbell };
+                written.extend(
+                    plot::write(&figure, dir, "campbell-estimate").unwrap_or_else(|e| lost(what, &e)),
+                );
+            }
+            Err(e) => crate::output::report_lost(what, e),
+        }
+        let what = "the mode shapes and orbits at the estimate";
+        match &self.shapes {
+            Ok(shapes) => {
+                let figure =
+                    plot::rotor_shapes::RotorShapesPlot { title: Self::shapes_title(report, shapes), shapes };
+                written.extend(
+                    plot::rotor_shapes::write(&figure, dir, "mode-shapes-estimate")
+                        .unwrap_or_else(|e| lost(what, &e)),
+                );
+            }
+            Err(e) => crate::output::report_lost(what, e),
+        }
+        let figure = runup_convergence(report);
+        written.extend(
+            plot::write(&figure, dir, "convergence").unwrap_or_else(|e| lost("the convergence plot", &e)),
+        );
+        written
+    }
+
+    /// The figures as the HTML report draws them.
+    fn for_report<'a>(
+        &'a self,
+        report: &RunupEstimateReport,
+    ) -> crate::report::estimate::RunupReportFigures<'a> {
+        crate::report::estimate::RunupReportFigures {
+            campbell: self
+                .campbell
+                .as_ref()
+                .map(|c| (Self::campbell_title(report), c))
+                .map_err(|e| e.to_string()),
+            shapes: self
+                .shapes
+                .as_ref()
+                .map(|s| (Self::shapes_title(report, s), s))
+                .map_err(|e| e.to_string()),
+            convergence: runup_convergence(report),
+        }
+    }
 }
 
 /// The convergence plot of a run-up fit: the factors on the file's coefficients and the largest
 /// frequency difference per iteration, of the run that gave the estimate (its stages chained).
-fn runup_convergence(report: &eigenfit_workflow::rotordynamics::RunupEstimateReport) -> Convergence {
+fn runup_convergence(report: &RunupEstimateReport) -> Convergence {
     Convergence {
         title: format!("{}: convergence of the run-up fit", report.model),
         parameter_names: report.scales.iter().map(|(n, _)| n.clone()).collect(),
         unit: "factor on the file's value".to_string(),
-        runs: vec![Run {
-            strategy: "damped".to_string(),
-            outcome: format!("{}, {} it.", report.outcome.termination.status, report.outcome.iterations),
-            history: report
-                .history
-                .iter()
-                .map(|r| (r.iteration, r.parameters.clone(), r.max_abs_diff_hz))
-                .collect(),
-        }],
+        runs: vec![Run::of(
+            "damped",
+            &format!("{}, {} it.", report.outcome.termination.status, report.outcome.iterations),
+            &report.history,
+        )],
         target: None,
         tolerance: None,
         sigma_hz: None,

@@ -3,7 +3,7 @@
 
 use super::style::{self, log_bounds, log_tick, px, pxi, series_style, strategy_colour, Swatch, INK};
 use super::{err, DrawResult, Figure};
-use eigenfit_core::update::Estimate;
+use eigenfit_core::update::{Estimate, IterationRecord};
 use plotters::coord::combinators::WithKeyPoints;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -77,14 +77,25 @@ pub struct Run {
 impl Run {
     /// From a finished estimate.
     pub fn from_estimate(e: &Estimate) -> Self {
+        Self::of(
+            &e.strategy.to_string(),
+            &format!("{}, {} it.", e.termination.label(), e.iterations),
+            &e.history,
+        )
+    }
+
+    /// From a fit's history, `outcome` saying how it ended; a last record that is the search's
+    /// deeper minimum (taken as the estimate after the fit) is said so in the legend.
+    pub fn of(strategy: &str, outcome: &str, history: &[IterationRecord]) -> Self {
+        let adopted = history.last().is_some_and(IterationRecord::is_from_search);
         Self {
-            strategy: e.strategy.to_string(),
-            outcome: format!("{}, {} it.", e.termination.label(), e.iterations),
-            history: e
-                .history
-                .iter()
-                .map(|r| (r.iteration, r.parameters.clone(), r.max_abs_diff_hz))
-                .collect(),
+            strategy: strategy.to_string(),
+            outcome: if adopted {
+                format!("{outcome}; last point: the search's deeper minimum")
+            } else {
+                outcome.to_string()
+            },
+            history: history.iter().map(|r| (r.iteration, r.parameters.clone(), r.max_abs_diff_hz)).collect(),
         }
     }
 }

@@ -341,8 +341,19 @@ pub fn ross_coefficient_unit(name: &str) -> String {
     }
 }
 
+/// The figures of a run-up report beside the run-up fit: each with its title, or why it could
+/// not be computed.
+pub struct RunupReportFigures<'a> {
+    /// The estimated rotor's Campbell diagram.
+    pub campbell: Result<(String, &'a eigenfit_rotordynamics::Campbell), String>,
+    /// The estimated rotor's mode shapes and orbits at the top measured speed.
+    pub shapes: Result<(String, &'a eigenfit_rotordynamics::shapes::RotorShapes), String>,
+    /// The fit's convergence.
+    pub convergence: Convergence,
+}
+
 /// Fills `html` with the report of a ROSS run-up estimate.
-pub fn fill_runup(html: &mut Report, r: &RunupEstimateReport) {
+pub fn fill_runup(html: &mut Report, r: &RunupEstimateReport, figures: &RunupReportFigures<'_>) {
     let names: Vec<String> = r.values.parameters.iter().map(|(n, _)| n.clone()).collect();
     let units = units(r, &names, ross_coefficient_unit);
     html.title = format!("{}: bearing coefficients from a run-up", r.model);
@@ -413,9 +424,32 @@ pub fn fill_runup(html: &mut Report, r: &RunupEstimateReport) {
     s.list(r.notes.clone());
     let s = html.section("Other solutions");
     alternatives(s, &r.alternative_solutions, &units, r.alternatives_sigma);
-    html.section("Plots").figure(
+    let plots = html.section("Plots");
+    plots.figure(
         "Run-up fit: each mode's measured frequencies (marks) and the model's at the estimate (line) against \
-         rotor speed, with the synchronous 1× line. `eigenfit campbell --report` draws the rotor's Campbell diagram.",
+         rotor speed, with the synchronous 1× line.",
         &crate::plot::runup::RunupFit { title: r.model.clone(), points: &r.points },
+    );
+    match &figures.campbell {
+        Ok((title, campbell)) => plots.figure(
+            "Campbell diagram of the estimated rotor, 0 to 1.2× the top measured speed: each mode's damped \
+             frequency against rotor speed, critical speeds where a mode crosses the 1× line.",
+            &crate::plot::campbell::CampbellPlot { title: title.clone(), campbell },
+        ),
+        Err(e) => plots.text(format!("The Campbell diagram at the estimate could not be computed: {e}")),
+    };
+    match &figures.shapes {
+        Ok((title, shapes)) => plots.figure(
+            "Mode shapes of the estimated rotor at the top measured speed: each mode's whirl-ellipse semi-major \
+             axis along the shaft (largest 1; bearings and disks marked) and its orbits with their sense of whirl.",
+            &crate::plot::rotor_shapes::RotorShapesPlot { title: title.clone(), shapes },
+        ),
+        Err(e) => plots.text(format!("The mode shapes at the estimate could not be computed: {e}")),
+    };
+    plots.figure(
+        "Convergence: the factors on the file's coefficients and the largest frequency difference per iteration \
+         of the fit that gave the estimate (a last point from the search for other solutions is said so in the \
+         legend).",
+        &figures.convergence,
     );
 }

@@ -301,8 +301,10 @@ pub fn better_minimum<'a>(
 }
 
 /// Makes `better` (a deeper minimum the search found, [`better_minimum`]) the estimate, keeps
-/// the fit's own end point among `minima` (it is an alternative now), and returns the note that
-/// says so. The caller rechecks the mirrors around the new estimate.
+/// the fit's own end point among `minima` (it is an alternative now), closes the estimate's
+/// history with the adopted point (marked [`crate::update::FROM_SEARCH`], so a convergence plot
+/// ends where the estimate is and says how it got there), and returns the note that says so. The
+/// caller rechecks the mirrors around the new estimate.
 pub fn adopt_better_minimum(
     estimate: &mut crate::update::Estimate,
     better: Linearisation,
@@ -316,6 +318,9 @@ pub fn adopt_better_minimum(
     );
     minima.push(std::mem::replace(&mut estimate.last, better));
     estimate.parameters = estimate.last.parameters.clone();
+    let next = estimate.history.last().map_or(0, |r| r.iteration + 1);
+    let marked = vec![(crate::update::FROM_SEARCH, 1.0)];
+    estimate.history.push(crate::update::IterationRecord::new(next, &estimate.last, marked));
     note
 }
 
@@ -467,7 +472,7 @@ mod tests {
     use crate::model::{ModelError, Parameter, ParameterSet, Scale, StructuralModel};
     use crate::problem::Problem;
     use crate::test_chain::Chain;
-    use crate::update::{Driver, LevenbergMarquardt};
+    use crate::update::{Driver, IterationRecord, LevenbergMarquardt};
     use nalgebra::{DMatrix, DVector};
 
     /// ground –k₁– m –k_c– m –k₂– ground with equal masses: symmetric under k₁ ↔ k₂ (k_c fixed).
@@ -556,6 +561,37 @@ mod tests {
         let at = fit(&problem, &[4e4, 1e4]);
         let mirrors = mirror_solutions(&problem, &at, &like_exchanges(&problem), &Budget::new(100));
         assert!(mirrors.symmetric.is_empty() && mirrors.asymmetric.len() == 1, "{mirrors:?}");
+    }
+
+    /// A fit stopped short of the minimum, and the search's deeper minimum taken as the estimate:
+    /// the estimate, its last linearisation and the end of its history are that minimum, the
+    /// fit's own end point is kept as an alternative, and the history says where its last point
+    /// came from — a convergence plot ends at the reported estimate.
+    #[test]
+    fn an_adopted_deeper_minimum_ends_the_history_of_the_estimate() {
+        let chain = Chain::new(&[1.0, 2.0]);
+        let truth = [4e4, 1e4];
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let mut lm = LevenbergMarquardt::default().with_max_restarts(0);
+        let mut estimate = Driver { max_iterations: 1 }.run(&problem, &mut lm, &[2e4, 2e4]).unwrap();
+        let fit_end = estimate.last.parameters.clone();
+        let (iterations, records) = (estimate.iterations, estimate.history.len());
+        assert!(!estimate.history.iter().any(IterationRecord::is_from_search));
+        let deeper = problem.linearise(&truth).unwrap();
+        let mut minima = Vec::new();
+        let note = adopt_better_minimum(&mut estimate, deeper, &mut minima);
+        assert!(note.contains("deeper minimum"), "{note}");
+        assert_eq!(estimate.parameters, truth.to_vec());
+        assert_eq!(estimate.last.parameters, truth.to_vec());
+        assert_eq!(minima.len(), 1);
+        assert_eq!(minima[0].parameters, fit_end);
+        assert_eq!(estimate.history.len(), records + 1);
+        let last = estimate.history.last().unwrap();
+        assert!(last.is_from_search() && last.parameters == truth.to_vec());
+        assert_eq!(last.iteration, estimate.history[records - 1].iteration + 1);
+        assert!(last.cost < estimate.history[records - 1].cost);
+        // The fit's own count is not changed: the adopted point is no iteration of it.
+        assert_eq!(estimate.iterations, iterations);
     }
 
     #[test]

@@ -151,8 +151,12 @@ pub struct IterationRecord {
     pub metrics: Vec<(&'static str, f64)>,
 }
 
+/// The metric that marks a history's last record as the search's deeper minimum, adopted as the
+/// estimate after the fit ended ([`crate::analysis::alternatives::adopt_better_minimum`]).
+pub const FROM_SEARCH: &str = "from_search";
+
 impl IterationRecord {
-    fn new(iteration: usize, lin: &Linearisation, metrics: Vec<(&'static str, f64)>) -> Self {
+    pub(crate) fn new(iteration: usize, lin: &Linearisation, metrics: Vec<(&'static str, f64)>) -> Self {
         Self {
             iteration,
             parameters: lin.parameters.clone(),
@@ -161,6 +165,12 @@ impl IterationRecord {
             max_abs_diff_hz: lin.max_abs_diff_hz(),
             metrics,
         }
+    }
+
+    /// Whether this record is not an iteration of the fit but the deeper minimum the search for
+    /// other solutions found and the estimate took ([`FROM_SEARCH`]).
+    pub fn is_from_search(&self) -> bool {
+        self.metrics.iter().any(|(name, _)| *name == FROM_SEARCH)
     }
 }
 

@@ -26,7 +26,7 @@ pub use budget::{Budget, Budgeted, DEFAULT_EVALUATIONS};
 pub use counted::Counted;
 pub use driver::{
     Driver, Estimate, IterationRecord, IterationRecordSink, ObservedDriver, Observer, Outcome, Termination,
-    TerminationReport,
+    TerminationReport, FROM_SEARCH,
 };
 pub use gauss_newton::GaussNewtonLineSearch;
 pub use grid::halton;
