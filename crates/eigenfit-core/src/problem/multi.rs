@@ -34,53 +34,44 @@ impl Objective for Stacked<'_> {
 /// own length: with shapes a part has more residual rows (a frequency and the sensors of every
 /// mode) than eigenvalues (one per mode), so one row count for all would not fit.
 pub fn stack(p: &[f64], parts: &[Linearisation]) -> Linearisation {
-    let np = p.len();
-    let vec = |f: &dyn Fn(&Linearisation) -> &DVector<f64>| {
-        let rows: usize = parts.iter().map(|l| f(l).len()).sum();
-        DVector::from_iterator(rows, parts.iter().flat_map(|l| f(l).iter().copied()))
-    };
-    let mat = |f: &dyn Fn(&Linearisation) -> &DMatrix<f64>| {
-        let rows: usize = parts.iter().map(|l| f(l).nrows()).sum();
-        let mut m = DMatrix::zeros(rows, np);
-        let mut r = 0;
-        for l in parts {
-            let block = f(l);
-            m.rows_mut(r, block.nrows()).copy_from(block);
-            r += block.nrows();
-        }
-        m
-    };
     Linearisation {
         parameters: p.to_vec(),
         paired_modes: parts.iter().flat_map(|l| l.paired_modes.iter().copied()).collect(),
         frequencies_hz: parts.iter().flat_map(|l| l.frequencies_hz.iter().copied()).collect(),
         measured_hz: parts.iter().flat_map(|l| l.measured_hz.iter().copied()).collect(),
-        residual: vec(&|l| &l.residual),
-        jacobian: mat(&|l| &l.jacobian),
+        residual: stack_rows(parts.iter().map(|l| &l.residual)),
+        jacobian: stack_blocks(p.len(), parts.iter().map(|l| &l.jacobian)),
         has_std: parts.iter().all(|l| l.has_std),
         rows_weighted: parts.iter().all(|l| l.rows_weighted),
         round_off: parts.iter().flat_map(|l| l.round_off.iter().copied()).collect(),
-        eigen: stack_eigen(np, parts),
+        eigen: stack_eigen(p.len(), parts),
     }
 }
 
 /// The parts' eigenvalue views stacked, when every part has one.
 fn stack_eigen(np: usize, parts: &[Linearisation]) -> Option<EigenView> {
     let views: Vec<&EigenView> = parts.iter().map(|l| l.eigen.as_ref()).collect::<Option<_>>()?;
-    let rows: usize = views.iter().map(|v| v.model_eigenvalues.len()).sum();
-    let column = |f: &dyn Fn(&EigenView) -> &DVector<f64>| {
-        DVector::from_iterator(rows, views.iter().flat_map(|v| f(v).iter().copied()))
-    };
-    let mut eigenvalue_jacobian = DMatrix::zeros(rows, np);
+    Some(EigenView {
+        model_eigenvalues: stack_rows(views.iter().map(|v| &v.model_eigenvalues)),
+        measured_eigenvalues: stack_rows(views.iter().map(|v| &v.measured_eigenvalues)),
+        eigenvalue_jacobian: stack_blocks(np, views.iter().map(|v| &v.eigenvalue_jacobian)),
+    })
+}
+
+/// Vectors one below the other.
+fn stack_rows<'a>(parts: impl Iterator<Item = &'a DVector<f64>> + Clone) -> DVector<f64> {
+    let rows: usize = parts.clone().map(|v| v.len()).sum();
+    DVector::from_iterator(rows, parts.flat_map(|v| v.iter().copied()))
+}
+
+/// Blocks of `columns` columns one below the other.
+fn stack_blocks<'a>(columns: usize, parts: impl Iterator<Item = &'a DMatrix<f64>> + Clone) -> DMatrix<f64> {
+    let rows: usize = parts.clone().map(|m| m.nrows()).sum();
+    let mut out = DMatrix::zeros(rows, columns);
     let mut r = 0;
-    for v in &views {
-        let block = &v.eigenvalue_jacobian;
-        eigenvalue_jacobian.rows_mut(r, block.nrows()).copy_from(block);
+    for block in parts {
+        out.rows_mut(r, block.nrows()).copy_from(block);
         r += block.nrows();
     }
-    Some(EigenView {
-        model_eigenvalues: column(&|v| &v.model_eigenvalues),
-        measured_eigenvalues: column(&|v| &v.measured_eigenvalues),
-        eigenvalue_jacobian,
-    })
+    out
 }

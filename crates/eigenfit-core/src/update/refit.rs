@@ -181,12 +181,24 @@ impl Objective for Held<'_> {
 
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
         let full = self.inner.linearise(&self.widen(p))?;
-        let mut reduced = full.clone();
-        reduced.parameters = p.to_vec();
-        reduced.jacobian = full.jacobian.select_columns(&self.free);
-        if let Some(eigen) = reduced.eigen.as_mut() {
-            eigen.eigenvalue_jacobian = eigen.eigenvalue_jacobian.select_columns(&self.free);
-        }
+        // The full one is kept for the expansion back: the reduced one copies its rows and only
+        // the free parameters' columns (no copy of the full Jacobians).
+        let reduced = Linearisation {
+            parameters: p.to_vec(),
+            paired_modes: full.paired_modes.clone(),
+            frequencies_hz: full.frequencies_hz.clone(),
+            measured_hz: full.measured_hz.clone(),
+            residual: full.residual.clone(),
+            jacobian: full.jacobian.select_columns(&self.free),
+            has_std: full.has_std,
+            rows_weighted: full.rows_weighted,
+            round_off: full.round_off.clone(),
+            eigen: full.eigen.as_ref().map(|e| crate::problem::EigenView {
+                model_eigenvalues: e.model_eigenvalues.clone(),
+                measured_eigenvalues: e.measured_eigenvalues.clone(),
+                eigenvalue_jacobian: e.eigenvalue_jacobian.select_columns(&self.free),
+            }),
+        };
         let mut seen = self.seen.borrow_mut();
         if seen.len() == HELD_KEPT {
             seen.remove(0);
