@@ -121,26 +121,12 @@ impl Figure for ModeShapes {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let (x0, x1) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
-        let pad = (x1 - x0) * 0.04;
         let body = style::title(root, &self.title, 50)?;
         // Ticks only where they carry a number: the axis reaches past ±1 to make room for the
         // disk and bearing labels, which are not displacements.
-        let y_ticks = vec![-1.0, -0.5, 0.0, 0.5, 1.0];
-        let mut chart = ChartBuilder::on(&body)
-            .margin(px(20))
-            .margin_top(px(5))
-            .x_label_area_size(px(60))
-            .y_label_area_size(px(80))
-            .build_cartesian_2d(x0 - pad..x1 + pad, style::FixedTicks { lo: -1.75, hi: 2.15, ticks: y_ticks })
-            .map_err(err)?;
-        let mut mesh = chart.configure_mesh();
         let x = "position along the shaft x [m]";
-        style::grid(style::axes(&mut mesh, x, "displacement (normalised to the largest) [–]"), 0.4)
-            .x_label_formatter(&|v: &f64| style::trim(*v, 3))
-            .y_label_formatter(&|v: &f64| style::trim(*v, 1))
-            .draw()
-            .map_err(err)?;
-        drop(mesh);
+        let (mut chart, pad) =
+            style::shaft_chart(&body, x0..x1, 2.15, x, "displacement (normalised to the largest) [–]")?;
         // The shaft axis and the nodes.
         chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], INK.stroke_width(px(2)))).map_err(err)?;
         chart

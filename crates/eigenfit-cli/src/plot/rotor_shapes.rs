@@ -86,28 +86,11 @@ impl Figure for RotorShapesPlot<'_> {
         let s = self.shapes;
         let z = &s.positions_m;
         let (x0, x1) = (z[0], z[z.len() - 1].max(z[0] + 1e-9));
-        let pad = (x1 - x0) * 0.04;
         let body = style::title(root, &self.title, 50)?;
         let (top, bottom) = body.split_vertically(px(SHAPES_H - 50));
         let (plot, legend) = top.split_horizontally(top.dim_in_pixel().0 - px(LEGEND_W));
-        let y_ticks = vec![-1.0, -0.5, 0.0, 0.5, 1.0];
-        let mut chart = ChartBuilder::on(&plot)
-            .margin(px(20))
-            .margin_top(px(5))
-            .x_label_area_size(px(60))
-            .y_label_area_size(px(80))
-            .build_cartesian_2d(x0 - pad..x1 + pad, style::FixedTicks { lo: -1.75, hi: 1.5, ticks: y_ticks })
-            .map_err(err)?;
-        let mut mesh = chart.configure_mesh();
-        style::grid(
-            style::axes(&mut mesh, "axial position z [m]", "semi-major axis (largest = 1), signed [–]"),
-            0.4,
-        )
-        .x_label_formatter(&|v: &f64| style::trim(*v, 3))
-        .y_label_formatter(&|v: &f64| style::trim(*v, 1))
-        .draw()
-        .map_err(err)?;
-        drop(mesh);
+        let y = "semi-major axis (largest = 1), signed [–]";
+        let (mut chart, pad) = style::shaft_chart(&plot, x0..x1, 1.5, "axial position z [m]", y)?;
         chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], INK.stroke_width(px(2)))).map_err(err)?;
         for d in &s.disks {
             let x = z[d.node];

@@ -382,6 +382,38 @@ impl Ranged for SymLog {
     }
 }
 
+/// A chart along a shaft, its grid drawn: x the position `x` (m) with 4 % room at each end, y a
+/// normalised displacement ticked at −1, −0.5, 0, 0.5, 1 only, from −1.75 (room for the bearing
+/// labels under the shaft) to `top` (room for the disk labels over it). Returns the chart and the
+/// room added at each end (the unit the markers of disks are sized in).
+pub fn shaft_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    x: Range<f64>,
+    top: f64,
+    x_label: &str,
+    y_label: &str,
+) -> Result<
+    (ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, FixedTicks>>, f64),
+    String,
+> {
+    let pad = (x.end - x.start) * 0.04;
+    let y_ticks = vec![-1.0, -0.5, 0.0, 0.5, 1.0];
+    let mut chart = ChartBuilder::on(area)
+        .margin(px(20))
+        .margin_top(px(5))
+        .x_label_area_size(px(60))
+        .y_label_area_size(px(80))
+        .build_cartesian_2d(x.start - pad..x.end + pad, FixedTicks { lo: -1.75, hi: top, ticks: y_ticks })
+        .map_err(super::err)?;
+    let mut mesh = chart.configure_mesh();
+    grid(axes(&mut mesh, x_label, y_label), 0.4)
+        .x_label_formatter(&|v: &f64| trim(*v, 3))
+        .y_label_formatter(&|v: &f64| trim(*v, 1))
+        .draw()
+        .map_err(super::err)?;
+    Ok((chart, pad))
+}
+
 /// A linear axis over `lo..hi` with ticks only at `ticks`: every tick drawn is one the chart
 /// labels (plotters' own choice spreads ticks over the whole range, also where the axis holds
 /// no values to read).
