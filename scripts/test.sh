@@ -34,7 +34,13 @@ fi
 py_venv="$(mktemp -d)/venv"
 trap 'rm -rf "$(dirname "$py_venv")"' EXIT
 python3 -m venv "$py_venv"
-"$py_venv/bin/python" -m pip install --quiet --disable-pip-version-check ./python pytest numpy scipy dask distributed
+# The wheel is built in cargo's dev profile into the target directory the tests above just built
+# (MATURIN_PEP517_ARGS, maturin's pass-through to its PEP 517 build): most of it is already
+# compiled there (the workspace crates and a few dependencies whose features differ are rebuilt:
+# 262 CPU-s here), where the default release build compiles every crate again, dependencies
+# included, at opt-level 3. `pip install ./python` for users is unchanged (release).
+CARGO_TARGET_DIR="$PWD/target" MATURIN_PEP517_ARGS="--profile dev" \
+  "$py_venv/bin/python" -m pip install --quiet --disable-pip-version-check ./python pytest numpy scipy dask distributed
 py_status=0
 EIGENFIT_BIN="$PWD/target/debug/eigenfit" "$py_venv/bin/python" -m pytest python/tests -p no:cacheprovider -q \
   || py_status=$?
