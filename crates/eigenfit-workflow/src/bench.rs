@@ -24,8 +24,9 @@
 //!
 //! A problem file whose `model` is a ROSS rotor takes a run-up CSV as `measured` (required) and
 //! its `truth` as factors on the file's coefficient curves by parameter name (`kxx_DE = 1.2`,
-//! `estimate`'s `scales`): the truth's names are the parameters fitted. On a run-up the paper's
-//! eigenvalue strategies ([`crate::bench_runup::EIGENVALUE_STRATEGIES`]) are recorded `refused`.
+//! `estimate`'s `scales`): the truth's names are the parameters fitted. On a run-up a strategy
+//! that solves with the model's eigenvalues (the paper's newton and p-step, or a user's that says
+//! so, `UpdateStrategy::needs_eigenvalues`) is recorded `refused`.
 //!
 //! Start `i` of a problem is drawn uniformly in each parameter's scaled coordinate (ln p for a
 //! log parameter) within the start range, from the seed and `i` only: every strategy starts from
@@ -606,13 +607,15 @@ impl BenchProblem {
         }
     }
 
-    /// Why `strategy` (a registry name, settings after colons) does not apply, if it does not.
-    fn refuses(&self, strategy: &str) -> Option<String> {
-        let base = strategy.split(':').next().unwrap_or(strategy).trim();
-        match &self.data {
-            ProblemData::Runup(_) if crate::bench_runup::EIGENVALUE_STRATEGIES.contains(&base) => Some(format!(
-                "not applicable: {base} solves the paper's square eigenvalue system (the first N modes of one \
-                 configuration); a run-up's rows are whirl frequencies at many speeds"
+    /// Why `method` does not apply to this problem, if it does not: a strategy that solves with
+    /// the model's eigenvalues ([`UpdateStrategy::needs_eigenvalues`], built-in or registered)
+    /// on a run-up, whose rows are whirl frequencies at many speeds.
+    fn refuses(&self, method: &Method) -> Option<String> {
+        match (&self.data, method) {
+            (ProblemData::Runup(_), Method::Local(s)) if s.needs_eigenvalues() => Some(format!(
+                "not applicable: {} solves with the model's eigenvalues and their sensitivities (the paper's \
+                 eq. 27–28); a run-up's rows are whirl frequencies at many speeds, not eigenvalues of K − λM",
+                s.name()
             )),
             _ => None,
         }
@@ -652,7 +655,7 @@ fn run_one(
                 regularisation: None,
             }
         };
-    if let Some(why) = problem.refuses(spec) {
+    if let Some(why) = problem.refuses(&method) {
         return Ok(record("refused", Some(why), 0, 0, &initial, None));
     }
     match method {

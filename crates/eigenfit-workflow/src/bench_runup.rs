@@ -24,11 +24,6 @@ const RUNUP_CSV: &str = include_str!("../../eigenfit-rotordynamics/tests/data/ru
 /// The factors ROSS's truth rotor has on the file's coefficient curves.
 const TRUTH_JSON: &str = include_str!("../../eigenfit-rotordynamics/tests/data/runup_truth.json");
 
-/// Strategies that solve the paper's square eigenvalue system (the first N modes of one
-/// configuration, λ and ∂λ/∂p): a run-up's rows are whirl frequencies at many speeds, so they are
-/// recorded as refused on it rather than run on a square slice of it.
-pub const EIGENVALUE_STRATEGIES: [&str; 2] = ["newton", "p-step"];
-
 /// A ROSS rotor, the factors fitted on it and the measured run-up.
 pub struct RunupCase {
     rotor: Rotor,

@@ -122,6 +122,13 @@ pub trait UpdateStrategy {
     fn metrics(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
     }
+    /// Whether the strategy solves with the model's eigenvalues and their sensitivities
+    /// ([`Linearisation::eigen`], through [`eigen_view`]) and so does not apply to a problem
+    /// whose frequencies are not eigenvalues of K − λM (a run-up). Default: it works on the
+    /// residual alone.
+    fn needs_eigenvalues(&self) -> bool {
+        false
+    }
 }
 
 /// The eigenvalue view the paper's strategies solve with, or a set-up error naming `who` where

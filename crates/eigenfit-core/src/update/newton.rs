@@ -41,6 +41,10 @@ impl UpdateStrategy for Newton {
         "newton"
     }
 
+    fn needs_eigenvalues(&self) -> bool {
+        true
+    }
+
     fn start(&mut self, _: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
         newton_point(initial, &eigen_view("newton", initial)?.measured_eigenvalues).map(|_| ())
     }

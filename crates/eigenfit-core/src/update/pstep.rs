@@ -82,6 +82,10 @@ impl UpdateStrategy for PStep {
         "p-step"
     }
 
+    fn needs_eigenvalues(&self) -> bool {
+        true
+    }
+
     fn start(&mut self, _: &dyn Objective, initial: &Linearisation) -> Result<(), UpdateError> {
         let eigen = eigen_view("p-step", initial)?;
         newton_point(initial, &eigen.measured_eigenvalues)?;
