@@ -738,4 +738,38 @@ mod tests {
         assert!(test.sigma_estimated());
         assert!(test.judge(&at).equally_good && test.judge(&at).delta_chi2.unwrap().abs() < 1e-9);
     }
+
+    #[test]
+    fn a_local_fit_that_does_not_come_within_reach_is_abandoned_after_its_evaluations() {
+        let chain = Chain::new(&[1.0, 2.0]);
+        let truth = [4e4, 1e4];
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let at = fit(&problem, &truth);
+        // A negative cost no fit can reach: every fit still running after its probe is
+        // abandoned, having cost exactly the probe; one that ends sooner ends by itself.
+        let mut abandoned_seen = 0;
+        for start in design(&problem, 12) {
+            let budget = Budget::new(1_000);
+            let (minima, fitted, abandoned) =
+                fitted_minima_within(&problem, vec![start.clone()], &budget, &Damped, Some(-1.0));
+            assert_eq!(fitted, 1);
+            if abandoned == 1 {
+                abandoned_seen += 1;
+                assert!(minima.is_empty(), "{start:?}: an abandoned fit yields no minimum");
+                assert_eq!(
+                    budget.used(),
+                    REACH_EVALUATIONS,
+                    "{start:?}: an abandoned fit costs its probe only"
+                );
+            } else {
+                assert!(budget.used() <= REACH_EVALUATIONS, "{start:?}: {} evaluations", budget.used());
+            }
+        }
+        assert!(abandoned_seen > 0, "no start of the design needed more than the probe");
+        // The screened search counts what it fitted and abandoned, and gives the reach in Δχ².
+        let search = screened_search(&problem, 8, 3, &[], &Budget::new(1_000), &Damped, &at);
+        assert_eq!(search.fitted, 3);
+        let threshold = Equivalence::at(&at, 2).threshold();
+        assert!((search.reach_delta_chi2.unwrap() / (REACH_THRESHOLDS * threshold) - 1.0).abs() < 1e-9);
+    }
 }
