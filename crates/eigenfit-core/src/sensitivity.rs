@@ -350,7 +350,7 @@ fn solve_pinned(
     rhs: &mut [Vec<f64>],
     k: usize,
 ) -> Result<(), SensitivityError> {
-    if system.band().is_some() || system.sparse_pair().is_some() {
+    if system.band().is_some() || system.sparse_pair().is_some() || system.condensed_pencil().is_some() {
         return match crate::eigen::sparse_solver::solve_pinned(system, lk, pivot, rhs)? {
             true => Ok(()),
             false => Err(SensitivityError::Singular { mode: k }),

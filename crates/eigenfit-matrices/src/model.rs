@@ -5,7 +5,7 @@ use crate::condensation::{Partition, MAX_CONDENSED_DOFS};
 use crate::error::MatricesError;
 use crate::layout::{Dof, DofLayout};
 use crate::market::read_symmetric;
-use eigenfit_core::matrix::{CscSymmetric, Expansion, SparseSymmetric, System, SystemDerivative};
+use eigenfit_core::matrix::{Condensed, CscSymmetric, Expansion, SparseSymmetric, System, SystemDerivative};
 use eigenfit_core::measurement::measured_csv::shown_number;
 use eigenfit_core::model::{Candidate, ModelError, Parameter, ParameterSet, Scale, StructuralModel};
 use serde::Deserialize;
@@ -377,12 +377,21 @@ impl MatricesModel {
         }
     }
 
-    /// K_c(p) and T(p) = [I; −X(p)], X = K_ss(p)⁻¹K_sm(p), remembered for the derivatives at `p`.
+    /// The full K(p) and T(p) = [I; −X(p)], X = K_ss(p)⁻¹K_sm(p) held as K_sm and a sparse factor
+    /// of K_ss (never formed densely), remembered for the derivatives at `p`.
     fn condense_at(&self, p: &[f64]) -> Result<(CscSymmetric, Arc<Expansion>), ModelError> {
         let c = self.condensation.as_ref().expect("a condensed model");
         let k =
             self.combine(&self.stiffness, p.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.0.as_ref())));
-        let (kc, x) = c.partition.condense(&k).map_err(|at| {
+        let partition = &c.partition;
+        if let Some(t) = Expansion::factored(&k, partition.kept().to_vec(), partition.massless().to_vec()) {
+            let t = Arc::new(t);
+            *c.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((p.to_vec(), Arc::clone(&t)));
+            return Ok((k, t));
+        }
+        // K_ss is singular: the dense condensation finds the massless DOF, pivot by pivot in the
+        // model's order, for the message.
+        let (_, x) = c.partition.condense(&k).map_err(|at| {
             // A negative pivot is a negative stiffness (an unstable massless DOF), not a missing one.
             let held = if at.1 < 0.0 {
                 format!(
@@ -404,9 +413,11 @@ impl MatricesModel {
             };
             ModelError::Invalid(format!("massless {} {held}", self.full_dof_label(at.0)))
         })?;
+        // The sparse factor refused a K_ss the dense one accepts (a pivot near the 1e-12 limit in
+        // another order): the dense X serves.
         let t = Arc::new(c.partition.expansion(&x));
         *c.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((p.to_vec(), Arc::clone(&t)));
-        Ok((kc, t))
+        Ok((k, t))
     }
 
     /// T(p), from the last assembly when it was at `p`.
@@ -810,9 +821,11 @@ impl StructuralModel for MatricesModel {
     fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
         self.params.check(p)?;
         let m = self.combine(&self.mass, p.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.1.as_ref())));
-        if let Some(c) = &self.condensation {
-            let (kc, _) = self.condense_at(p)?;
-            return Ok(System::sparse(kc, c.partition.restrict(&m))?);
+        if self.condensation.is_some() {
+            // Kept as the full sparse pencil: the solvers factor K − σM (sparse, narrow), not
+            // the dense K_c.
+            let (k, t) = self.condense_at(p)?;
+            return Ok(System::condensed(Condensed::new(k, m, t))?);
         }
         let k =
             self.combine(&self.stiffness, p.iter().zip(&self.derivatives).map(|(&v, d)| (v, d.0.as_ref())));

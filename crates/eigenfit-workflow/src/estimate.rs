@@ -15,8 +15,8 @@ use crate::simulate::check_roundoff_of;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
-    adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, local_minima_refit,
-    mirror_solutions, screened_fits, screened_local_minima_refit, search_starts, Equivalence, Mirrors,
+    self, adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, local_minima_refit,
+    mirror_solutions, screened_fits, screened_search, search_starts, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};
@@ -159,6 +159,20 @@ impl IntervalsReport {
     }
 }
 
+/// What the screened search for other solutions did with its starts (`search` in the report).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SearchReport {
+    /// Starts ranked by misfit: the design's and the exchanged points of asymmetric exchanges.
+    pub ranked: usize,
+    /// Starts fitted locally (the best by misfit).
+    pub fitted: usize,
+    /// Local fits abandoned: not within `reach_delta_chi2` of the estimate after a few
+    /// evaluations. They tested nothing: no claim rests on them.
+    pub abandoned: usize,
+    /// Δχ² above the estimate within which a local fit had to come (`null` when σ is unknown).
+    pub reach_delta_chi2: Option<f64>,
+}
+
 /// `estimate`'s report (the `--json` object).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EstimateReport {
@@ -200,6 +214,10 @@ pub struct EstimateReport {
     pub covariances: Covariances,
     /// Other minima found and mirror points, each with its χ², Δχ² and the test's outcome.
     pub alternative_solutions: Vec<AlternativeSolution>,
+    /// What the screened search for other solutions (above 8 free parameters) did with its
+    /// starts; absent when the search was not screened.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub search: Option<SearchReport>,
     /// How σ was taken for the alternatives' test: `std` (given), `residuals` (estimated from the
     /// estimate's residuals), or `exact` (no σ: only fits at least as good as the estimate are
     /// equally good).
@@ -596,6 +614,7 @@ pub fn run(
     // the fit, that one is the estimate, and the intervals are drawn around it.
     let mut mirrors = Mirrors::default();
     let mut minima = Vec::new();
+    let mut search = None;
     if estimate.termination.is_converged() {
         progress.begin("searching for other solutions", None);
         // Exchanges of like parameters, and a structure's symmetries exchanging more than one pair
@@ -614,7 +633,27 @@ pub fn run(
         let (extra, refit) = (&mirrors.asymmetric, &*refit);
         match screened_fits(np).filter(|_| request.alternative_starts.is_none()) {
             _ if starts == 0 => {}
-            Some(keep) => minima = screened_local_minima_refit(&fit, starts, keep, extra, &budget, refit),
+            Some(keep) => {
+                let found = screened_search(&fit, starts, keep, extra, &budget, refit, &estimate.last);
+                if found.abandoned > 0 {
+                    notes.push(format!(
+                        "the search for other solutions abandoned {} of its {} local fits: after {} evaluations \
+                         each was still more than Δχ² {} above the estimate; they tested nothing, so the \
+                         search supports no claim about the regions they started from",
+                        found.abandoned,
+                        found.fitted,
+                        alternatives::REACH_EVALUATIONS,
+                        found.reach_delta_chi2.map_or_else(|| "?".into(), shown_number),
+                    ));
+                }
+                minima = found.minima.clone();
+                search = Some(SearchReport {
+                    ranked: starts + extra.len(),
+                    fitted: found.fitted,
+                    abandoned: found.abandoned,
+                    reach_delta_chi2: found.reach_delta_chi2,
+                });
+            }
             None => minima = local_minima_refit(&fit, starts, extra, &budget, refit),
         }
         phases.push(("other_solutions", budget.used()));
@@ -721,6 +760,7 @@ pub fn run(
         values: ParameterValues::new(&names, &initial, &estimate.parameters, status),
         at_limit: pinned,
         alternative_solutions: AlternativeSolution::list(&names, &alternatives),
+        search,
         alternatives_sigma,
         regularisation: estimate.regularisation.clone(),
         posterior: posterior.map(|(_, report, _)| report),

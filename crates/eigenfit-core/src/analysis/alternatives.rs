@@ -20,6 +20,13 @@ use crate::update::{Budget, LevenbergMarquardtSettings};
 const LOCAL_FIT_ITERATIONS: usize = 100;
 /// Largest scaled difference (1 % of a log parameter) within which two minima are the same.
 pub const SAME_MINIMUM: f64 = 0.01;
+/// Evaluations a local fit of the screened search gets to come within reach of the estimate
+/// ([`REACH_THRESHOLDS`]) before it is abandoned: a far start in many dimensions otherwise
+/// wanders for hundreds (issue 29: 18 fits × ~260 evaluations were 97 % of a 17-parameter run).
+pub const REACH_EVALUATIONS: usize = 6;
+/// Δχ² above the estimate, in units of the equivalence test's threshold, within which a local
+/// fit of the screened search must have come after [`REACH_EVALUATIONS`] evaluations.
+pub const REACH_THRESHOLDS: f64 = 10.0;
 /// Scaled distance (10 % of a log parameter) below which an exchanged pair is the same point.
 const MIRROR_DISTANCE: f64 = 0.1;
 /// Relative difference of the model frequencies below which an exchange leaves them unchanged
@@ -229,6 +236,117 @@ pub fn screened_local_minima_refit(
     fitted_minima(problem, points, budget, refit)
 }
 
+/// What a screened search did ([`screened_search`]): the minima it reached and what became of
+/// its starts.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Search {
+    /// Distinct converged minima, best first.
+    pub minima: Vec<Linearisation>,
+    /// Starts fitted locally (after screening).
+    pub fitted: usize,
+    /// Local fits abandoned because they had not come within reach of the estimate: they
+    /// tested nothing, and no claim (a unique estimate included) rests on them.
+    pub abandoned: usize,
+    /// The reach, as Δχ² above the estimate; `None` when σ is unknown (no rule applied).
+    pub reach_delta_chi2: Option<f64>,
+}
+
+/// [`screened_local_minima_refit`] with a budget per local fit: the design's `starts` points
+/// and the `extra` starts are ranked by misfit (one evaluation each, no derivatives), each
+/// group apart; the best `keep` of the design and the best ⌈`keep`/2⌉ extra starts are fitted
+/// locally (all extra starts were before: 17 like parameters give up to 136), and a local fit that after [`REACH_EVALUATIONS`]
+/// evaluations has not come within [`REACH_THRESHOLDS`] × the equivalence threshold (Δχ²) of
+/// the estimate `at` is abandoned and counted as such — it can no longer end equally good
+/// cheaply, and a far start in many dimensions would wander for hundreds of evaluations.
+pub fn screened_search(
+    problem: &dyn Objective,
+    starts: usize,
+    keep: usize,
+    extra: &[Vec<f64>],
+    budget: &Budget,
+    refit: &dyn Refit,
+    at: &Linearisation,
+) -> Search {
+    let budgeted = budget.wrap(problem);
+    let best = |points: Vec<Vec<f64>>, keep: usize| {
+        let mut ranked: Vec<(f64, Vec<f64>)> = points
+            .into_iter()
+            .filter(|p| problem.parameters().check(p).is_ok())
+            .filter_map(|p| budgeted.cost(&p).filter(|c| c.is_finite()).map(|c| (c, p)))
+            .collect();
+        ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
+        ranked.into_iter().take(keep).map(|(_, p)| p).collect::<Vec<_>>()
+    };
+    // Ranked apart: the exchanged points lie next to the estimate and would crowd out the
+    // design's far starts, which are what searches the rest of the space.
+    let mut points = best(extra.to_vec(), keep.div_ceil(2));
+    points.extend(best(design(problem, starts).collect(), keep));
+    let test = Equivalence::at(at, problem.parameters().len());
+    // In cost units (½Σr²): Δχ² = 2Δcost/σ².
+    let reach = test.sigma2.map(|s2| (test.best_cost + 0.5 * REACH_THRESHOLDS * test.threshold * s2, s2));
+    let (minima, fitted, abandoned) =
+        fitted_minima_within(problem, points, budget, refit, reach.map(|r| r.0));
+    Search {
+        minima,
+        fitted,
+        abandoned,
+        reach_delta_chi2: reach.map(|(cost, s2)| 2.0 * (cost - test.best_cost) / s2),
+    }
+}
+
+/// `inner` for one local fit of the search, abandoned (its own budget refused) once it has had
+/// [`REACH_EVALUATIONS`] evaluations and the lowest cost seen is still above `within`.
+struct Reach<'a> {
+    inner: &'a dyn Objective,
+    local: &'a Budget,
+    within: f64,
+    seen: std::cell::Cell<usize>,
+    best: std::cell::Cell<f64>,
+    abandoned: std::cell::Cell<bool>,
+}
+
+impl Reach<'_> {
+    fn admit(&self) -> bool {
+        if self.seen.get() >= REACH_EVALUATIONS && self.best.get() > self.within {
+            self.abandoned.set(true);
+            self.local.refuse();
+            return false;
+        }
+        self.seen.set(self.seen.get() + 1);
+        true
+    }
+
+    fn saw(&self, cost: f64) {
+        if cost < self.best.get() {
+            self.best.set(cost);
+        }
+    }
+}
+
+impl Objective for Reach<'_> {
+    fn parameters(&self) -> &crate::model::ParameterSet {
+        self.inner.parameters()
+    }
+
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, crate::problem::ResidualError> {
+        if !self.admit() {
+            return Err(crate::problem::ResidualError::BudgetExhausted { limit: self.seen.get() });
+        }
+        let lin = self.inner.linearise(p)?;
+        self.saw(lin.cost());
+        Ok(lin)
+    }
+
+    fn cost(&self, p: &[f64]) -> Option<f64> {
+        if !self.admit() {
+            return None;
+        }
+        let cost = self.inner.cost(p)?;
+        self.saw(cost);
+        Some(cost)
+    }
+}
+
 /// The Halton design of `starts` points over `problem`'s search ranges.
 fn design(problem: &dyn Objective, starts: usize) -> impl Iterator<Item = Vec<f64>> + '_ {
     let params = problem.parameters();
@@ -244,8 +362,22 @@ fn fitted_minima(
     budget: &Budget,
     refit: &dyn Refit,
 ) -> Vec<Linearisation> {
+    fitted_minima_within(problem, points, budget, refit, None).0
+}
+
+/// [`fitted_minima`], each local fit abandoned when it has not come below the cost `reach`
+/// within [`REACH_EVALUATIONS`] evaluations (no rule for `None`); also the starts fitted and
+/// the fits abandoned.
+fn fitted_minima_within(
+    problem: &dyn Objective,
+    points: Vec<Vec<f64>>,
+    budget: &Budget,
+    refit: &dyn Refit,
+    reach: Option<f64>,
+) -> (Vec<Linearisation>, usize, usize) {
     let params = problem.parameters();
     let mut minima: Vec<Linearisation> = Vec::new();
+    let (mut fitted, mut abandoned) = (0, 0);
     for start in points {
         if budget.exhausted() {
             break;
@@ -253,10 +385,30 @@ fn fitted_minima(
         if params.check(&start).is_err() {
             continue;
         }
-        let Ok(est) = refit.refit(problem, &start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, budget)
-        else {
-            continue;
+        fitted += 1;
+        let est = match reach {
+            None => refit.refit(problem, &start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, budget),
+            Some(within) => {
+                // The search's budget is charged through `charged`; the fit's own budget is
+                // refused when the fit is abandoned, which ends it as a spent budget would.
+                let (charged, local) = (budget.wrap(problem), Budget::unlimited());
+                let reach = Reach {
+                    inner: &charged,
+                    local: &local,
+                    within,
+                    seen: 0.into(),
+                    best: f64::INFINITY.into(),
+                    abandoned: false.into(),
+                };
+                let est = refit.refit(&reach, &start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, &local);
+                if reach.abandoned.get() {
+                    abandoned += 1;
+                    continue;
+                }
+                est
+            }
         };
+        let Ok(est) = est else { continue };
         if !est.termination.is_converged() || !est.last.cost().is_finite() {
             continue;
         }
@@ -270,7 +422,7 @@ fn fitted_minima(
         }
     }
     minima.sort_by(|a, b| a.cost().total_cmp(&b.cost()));
-    minima
+    (minima, fitted, abandoned)
 }
 
 /// The minimum of `minima` that fits better than `at`'s own minimum and lies elsewhere (more
@@ -621,5 +773,39 @@ mod tests {
         let test = Equivalence::at(&at, 2);
         assert!(test.sigma_estimated());
         assert!(test.judge(&at).equally_good && test.judge(&at).delta_chi2.unwrap().abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_local_fit_that_does_not_come_within_reach_is_abandoned_after_its_evaluations() {
+        let chain = Chain::new(&[1.0, 2.0]);
+        let truth = [4e4, 1e4];
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let at = fit(&problem, &truth);
+        // A negative cost no fit can reach: every fit still running after its probe is
+        // abandoned, having cost exactly the probe; one that ends sooner ends by itself.
+        let mut abandoned_seen = 0;
+        for start in design(&problem, 12) {
+            let budget = Budget::new(1_000);
+            let (minima, fitted, abandoned) =
+                fitted_minima_within(&problem, vec![start.clone()], &budget, &Damped, Some(-1.0));
+            assert_eq!(fitted, 1);
+            if abandoned == 1 {
+                abandoned_seen += 1;
+                assert!(minima.is_empty(), "{start:?}: an abandoned fit yields no minimum");
+                assert_eq!(
+                    budget.used(),
+                    REACH_EVALUATIONS,
+                    "{start:?}: an abandoned fit costs its probe only"
+                );
+            } else {
+                assert!(budget.used() <= REACH_EVALUATIONS, "{start:?}: {} evaluations", budget.used());
+            }
+        }
+        assert!(abandoned_seen > 0, "no start of the design needed more than the probe");
+        // The screened search counts what it fitted and abandoned, and gives the reach in Δχ².
+        let search = screened_search(&problem, 8, 3, &[], &Budget::new(1_000), &Damped, &at);
+        assert_eq!(search.fitted, 3);
+        let threshold = Equivalence::at(&at, 2).threshold();
+        assert!((search.reach_delta_chi2.unwrap() / (REACH_THRESHOLDS * threshold) - 1.0).abs() < 1e-9);
     }
 }

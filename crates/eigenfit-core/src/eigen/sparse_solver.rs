@@ -308,15 +308,30 @@ impl SparseSolver {
     ) -> Result<(Modes, f64), SolveError> {
         check_count(system, count)?;
         let n = system.dofs();
-        let pair = csc_pair(system);
-        let (k, m): (&CscSymmetric, &CscSymmetric) = (&pair.0, &pair.1);
         // More than half the spectrum: Lanczos has no advantage, the dense solver is exact.
         if 2 * count > n && n <= MAX_DENSE_FALLBACK {
             return DenseSolver.lowest_with_next(system, count);
         }
+        // A condensed system is solved on its full sparse pencil (M semi-definite): its massed
+        // DOFs' M_mm is checked here instead of the full M's Cholesky factor.
+        let condensed = system.condensed_pencil();
+        if let Some(c) = condensed {
+            let checked = WORKSPACE.with(|ws| ws.borrow().checked_mass.as_ref() == Some(c.restricted_mass()));
+            if !checked {
+                if system.mass_failure_dof().is_some() {
+                    return Err(SolveError::MassNotPositiveDefinite { detail: None, dof: None });
+                }
+                WORKSPACE.with(|ws| ws.borrow_mut().checked_mass = Some(c.restricted_mass().clone()));
+            }
+        }
+        let pair = match condensed {
+            Some(c) => (Cow::Borrowed(c.full_stiffness()), Cow::Borrowed(c.full_mass())),
+            None => csc_pair(system),
+        };
+        let (k, m): (&CscSymmetric, &CscSymmetric) = (&pair.0, &pair.1);
         let found = WORKSPACE.with(|ws| {
             let ws = &mut *ws.try_borrow_mut().map_err(|_| backend("workspace in use (re-entrant solve)"))?;
-            Self { tolerance }.solve_sparse(k, m, count, ws)
+            Self { tolerance }.solve_sparse(k, m, count, condensed.map(|c| c.kept()), ws)
         });
         match found {
             Ok(Some(found)) => Ok(found),
@@ -338,6 +353,7 @@ impl SparseSolver {
         k: &CscSymmetric,
         m: &CscSymmetric,
         count: usize,
+        kept: Option<&[usize]>,
         ws: &mut Workspace,
     ) -> Result<Option<(Modes, f64)>, SolveError> {
         let n = k.dim();
@@ -345,7 +361,11 @@ impl SparseSolver {
         let pattern = CscSymmetric::combination(0.0, k, 0.0, m);
         let k = &with_pattern(&pattern, k);
         let m = &with_pattern(&pattern, m);
-        if ws.checked_mass.as_ref() != Some(m) {
+        // The full pencil of a condensed system: M is semi-definite by design (its massed part
+        // was checked by the caller). Lanczos in the M inner product sees only the massed
+        // entries of its vectors — (K + σM)⁻¹M and the M products read nothing else, and their
+        // massed parts are the condensed problem's — so the shapes kept are those entries.
+        if kept.is_none() && ws.checked_mass.as_ref() != Some(m) {
             if !ws.cholesky(m, false)? {
                 return Err(SolveError::MassNotPositiveDefinite { detail: None, dof: None });
             }
@@ -400,7 +420,7 @@ impl SparseSolver {
                 // Every eigenvalue below σ′ is among those found. A repeated eigenvalue cut in
                 // two by `count` puts its other copy below σ′ too: that copy is the next one.
                 let next = if known > count { found.eigenvalues[count] } else { bound };
-                let modes = finish(to_modes(&found, n, count))?;
+                let modes = finish(restricted(to_modes(&found, n, count), kept))?;
                 return Ok(Some((modes, next)));
             }
             if below < known || found.eigenvalues.len() >= n {
@@ -413,7 +433,7 @@ impl SparseSolver {
             let low = top - (1e-6 * top.abs()).max(floor);
             let known_low = found.eigenvalues.iter().filter(|&&l| l < low).count();
             if known_low < count && ws.count_below(k, m, low)? == Some(known_low) {
-                let modes = finish(to_modes(&found, n, count))?;
+                let modes = finish(restricted(to_modes(&found, n, count), kept))?;
                 return Ok(Some((modes, found.eigenvalues.get(count).copied().unwrap_or(top))));
             }
             // Missed modes: rerun M-orthogonally to the modes found, on the same factor of
@@ -528,7 +548,31 @@ pub(crate) fn solve_pinned(
     pinned: usize,
     rhs: &mut [Vec<f64>],
 ) -> Result<bool, SolveError> {
-    let pair = csc_pair(system);
+    // A condensed system: the full K − σM with [b; 0], the massed DOF pinned — its massed part
+    // is the condensed solution exactly (block elimination of the non-singular K_ss; pinning a
+    // massed DOF leaves K_ss whole).
+    if let Some(c) = system.condensed_pencil() {
+        rhs.iter_mut().for_each(|b| b[pinned] = 0.0);
+        let mut full: Vec<Vec<f64>> = rhs.iter().map(|b| c.lift(b)).collect();
+        let pair = (Cow::Borrowed(c.full_stiffness()), Cow::Borrowed(c.full_mass()));
+        if !solve_pinned_pair(pair, sigma, c.kept()[pinned], &mut full)? {
+            return Ok(false);
+        }
+        for (b, f) in rhs.iter_mut().zip(&full) {
+            b.copy_from_slice(&c.restrict(f));
+        }
+        return Ok(true);
+    }
+    solve_pinned_pair(csc_pair(system), sigma, pinned, rhs)
+}
+
+/// [`solve_pinned`] on (K, M) given as sparse matrices.
+fn solve_pinned_pair(
+    pair: (Cow<'_, CscSymmetric>, Cow<'_, CscSymmetric>),
+    sigma: f64,
+    pinned: usize,
+    rhs: &mut [Vec<f64>],
+) -> Result<bool, SolveError> {
     let pattern = CscSymmetric::combination(0.0, &pair.0, 0.0, &pair.1);
     let mut a = CscSymmetric::combination(
         1.0,
@@ -608,6 +652,18 @@ fn to_modes(found: &Found, n: usize, count: usize) -> Modes {
         // After a rerun `found` may hold more modes than asked for (10⁶-DOF plate: 11 of 10).
         eigenvalues: DVector::from_column_slice(&found.eigenvalues[..count]),
         shapes: DMatrix::from_column_slice(n, count, &found.vectors[..n * count]),
+    }
+}
+
+/// `modes` with their shapes' rows `kept` only (all rows for `None`): a condensed system's
+/// modes from its full pencil's.
+fn restricted(modes: Modes, kept: Option<&[usize]>) -> Modes {
+    match kept {
+        None => modes,
+        Some(kept) => Modes {
+            shapes: DMatrix::from_fn(kept.len(), modes.shapes.ncols(), |i, c| modes.shapes[(kept[i], c)]),
+            eigenvalues: modes.eigenvalues,
+        },
     }
 }
 

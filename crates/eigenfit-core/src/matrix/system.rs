@@ -1,6 +1,6 @@
 //! Assembled matrices K, M of a structure at one parameter vector, and their parameter derivatives.
 
-use crate::matrix::{BandedSymmetric, CscSymmetric, SparseSymmetric};
+use crate::matrix::{BandedSymmetric, Condensed, CscSymmetric, SparseSymmetric};
 use nalgebra::DMatrix;
 use std::sync::OnceLock;
 use thiserror::Error;
@@ -56,6 +56,11 @@ enum Storage {
         mass: CscSymmetric,
         dense: OnceLock<(DMatrix<f64>, DMatrix<f64>)>,
     },
+    /// K_c = TᵀKT, M_mm held as the full sparse pencil (K_c is dense; built only on demand).
+    Condensed {
+        pencil: Condensed,
+        dense: OnceLock<(DMatrix<f64>, DMatrix<f64>)>,
+    },
 }
 
 impl PartialEq for System {
@@ -108,12 +113,32 @@ impl System {
         Ok(Self { storage: Storage::Sparse { stiffness, mass, dense: OnceLock::new() } })
     }
 
+    /// A statically condensed system (K_c = TᵀKT, M_mm on the massed DOFs) kept as its full
+    /// sparse pencil ([`Condensed`]): checks size and finiteness of the full K and M, O(nnz).
+    pub fn condensed(pencil: Condensed) -> Result<Self, SystemError> {
+        let (k, m) = (pencil.full_stiffness(), pencil.full_mass());
+        check_pair((k.dim(), k.first_non_finite()), (m.dim(), m.first_non_finite()))?;
+        if pencil.dim() == 0 {
+            return Err(SystemError::Empty);
+        }
+        Ok(Self { storage: Storage::Condensed { pencil, dense: OnceLock::new() } })
+    }
+
+    /// The full pencil of a condensed system ([`System::condensed`]).
+    pub fn condensed_pencil(&self) -> Option<&Condensed> {
+        match &self.storage {
+            Storage::Condensed { pencil, .. } => Some(pencil),
+            _ => None,
+        }
+    }
+
     /// Number of degrees of freedom n.
     pub fn dofs(&self) -> usize {
         match &self.storage {
             Storage::Dense { stiffness, .. } => stiffness.nrows(),
             Storage::Banded { stiffness, .. } => stiffness.dim(),
             Storage::Sparse { stiffness, .. } => stiffness.dim(),
+            Storage::Condensed { pencil, .. } => pencil.dim(),
         }
     }
 
@@ -144,6 +169,11 @@ impl System {
                 let (k, m) = dense.get_or_init(|| (stiffness.to_dense(), mass.to_dense()));
                 (k, m)
             }
+            Storage::Condensed { pencil, dense } => {
+                let (k, m) =
+                    dense.get_or_init(|| (pencil.dense_stiffness(), pencil.restricted_mass().to_dense()));
+                (k, m)
+            }
         }
     }
 
@@ -160,6 +190,10 @@ impl System {
             Storage::Sparse { mass, .. } => {
                 mass.to_banded_within(MAX_BAND_ENTRIES_FOR_PIVOT).and_then(|m| m.first_failed_pivot())
             }
+            Storage::Condensed { pencil, .. } => pencil
+                .restricted_mass()
+                .to_banded_within(MAX_BAND_ENTRIES_FOR_PIVOT)
+                .and_then(|m| m.first_failed_pivot()),
         }
     }
 
@@ -179,6 +213,11 @@ impl System {
             Storage::Dense { stiffness, mass } => (stiffness.amax(), mass.amax()),
             Storage::Banded { stiffness, mass, .. } => (stiffness.amax(), mass.amax()),
             Storage::Sparse { stiffness, mass, .. } => (stiffness.amax(), mass.amax()),
+            // The full K's largest entry: K_c's are no larger (its diagonal is K_mm's less a
+            // positive part), and the full entries are the ones given.
+            Storage::Condensed { pencil, .. } => {
+                (pencil.full_stiffness().amax(), pencil.restricted_mass().amax())
+            }
         }
     }
 
@@ -195,6 +234,11 @@ impl System {
             Storage::Dense { stiffness, mass } => (dense(stiffness), dense(mass)),
             Storage::Banded { stiffness, mass, .. } => (stiffness.abs_quadratic(x), mass.abs_quadratic(x)),
             Storage::Sparse { stiffness, mass, .. } => (stiffness.abs_quadratic(x), mass.abs_quadratic(x)),
+            // On the full K with Tx: the entries known to one rounding are the full matrix's.
+            Storage::Condensed { pencil, .. } => (
+                pencil.full_stiffness().abs_quadratic(&pencil.expansion().expand(x)),
+                pencil.restricted_mass().abs_quadratic(x),
+            ),
         }
     }
 
@@ -211,6 +255,7 @@ impl System {
             }
             Storage::Banded { mass, .. } => mass.mul_add(alpha, x, out),
             Storage::Sparse { mass, .. } => mass.mul_add(alpha, x, out),
+            Storage::Condensed { pencil, .. } => pencil.restricted_mass().mul_add(alpha, x, out),
         }
     }
 
@@ -224,6 +269,9 @@ impl System {
             Storage::Sparse { stiffness, mass, dense } => {
                 dense.into_inner().unwrap_or_else(|| (stiffness.to_dense(), mass.to_dense()))
             }
+            Storage::Condensed { pencil, dense } => dense
+                .into_inner()
+                .unwrap_or_else(|| (pencil.dense_stiffness(), pencil.restricted_mass().to_dense())),
         }
     }
 }

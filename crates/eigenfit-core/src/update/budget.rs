@@ -66,6 +66,12 @@ impl Budget {
         }
     }
 
+    /// Marks the budget exhausted now: a caller that ends a run early for its own reason (a
+    /// local fit of the search abandoned) stops the driver as a spent budget would.
+    pub fn refuse(&self) {
+        self.refused.store(true, Ordering::Relaxed);
+    }
+
     /// `problem` with every evaluation charged to this budget.
     pub fn wrap<'a>(&'a self, problem: &'a dyn Objective) -> Budgeted<'a> {
         Budgeted { inner: problem, budget: self }
