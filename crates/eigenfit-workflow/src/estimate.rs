@@ -173,6 +173,33 @@ pub struct SearchReport {
     pub reach_delta_chi2: Option<f64>,
 }
 
+impl SearchReport {
+    /// What `found` did with `ranked` starts.
+    pub fn of(found: &alternatives::Search, ranked: usize) -> Self {
+        Self {
+            ranked,
+            fitted: found.fitted,
+            abandoned: found.abandoned,
+            reach_delta_chi2: found.reach_delta_chi2,
+        }
+    }
+
+    /// The note that says local fits were abandoned and what that means, if any were.
+    pub fn note(&self) -> Option<String> {
+        (self.abandoned > 0).then(|| {
+            format!(
+                "the search for other solutions abandoned {} of its {} local fits: after {} evaluations each was \
+                 still more than Δχ² {} above the estimate; they tested nothing, so the search supports no claim \
+                 about the regions they started from",
+                self.abandoned,
+                self.fitted,
+                alternatives::REACH_EVALUATIONS,
+                self.reach_delta_chi2.map_or_else(|| "?".into(), |d| format!("{d:.1}")),
+            )
+        })
+    }
+}
+
 /// `estimate`'s report (the `--json` object).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EstimateReport {
@@ -635,24 +662,10 @@ pub fn run(
             _ if starts == 0 => {}
             Some(keep) => {
                 let found = screened_search(&fit, starts, keep, extra, &budget, refit, &estimate.last);
-                if found.abandoned > 0 {
-                    notes.push(format!(
-                        "the search for other solutions abandoned {} of its {} local fits: after {} evaluations \
-                         each was still more than Δχ² {} above the estimate; they tested nothing, so the \
-                         search supports no claim about the regions they started from",
-                        found.abandoned,
-                        found.fitted,
-                        alternatives::REACH_EVALUATIONS,
-                        found.reach_delta_chi2.map_or_else(|| "?".into(), shown_number),
-                    ));
-                }
-                minima = found.minima.clone();
-                search = Some(SearchReport {
-                    ranked: starts + extra.len(),
-                    fitted: found.fitted,
-                    abandoned: found.abandoned,
-                    reach_delta_chi2: found.reach_delta_chi2,
-                });
+                let report = SearchReport::of(&found, starts + extra.len());
+                notes.extend(report.note());
+                minima = found.minima;
+                search = Some(report);
             }
             None => minima = local_minima_refit(&fit, starts, extra, &budget, refit),
         }

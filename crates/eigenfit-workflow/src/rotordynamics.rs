@@ -2,6 +2,7 @@
 //! stiffnesses from run-up frequencies, and the Campbell diagram.
 
 use crate::error::{input, WorkflowError};
+use crate::estimate::SearchReport;
 use crate::named::Named;
 use crate::outcome::{
     phase_counts, AlternativeSolution, BudgetReport, Covariances, FitQualityReport, Outcome,
@@ -9,10 +10,11 @@ use crate::outcome::{
 };
 use eigenfit_core::analysis::alternatives::{
     adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, mirror_solutions,
-    screened_local_minima, Equivalence, Mirrors,
+    screened_fits, screened_local_minima, screened_search, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, judge};
 use eigenfit_core::analysis::{uncertainty_parallel, Identifiability};
+use eigenfit_core::update::refit::Damped;
 use eigenfit_core::update::Budget;
 use eigenfit_rotordynamics::campbell::refine_critical_speed;
 use eigenfit_rotordynamics::fit::fit_runup;
@@ -352,6 +354,10 @@ pub struct RunupEstimateReport {
     /// Mirror points of a symmetric rotor (exchanged bearings), each with its χ², Δχ² and the
     /// test's outcome.
     pub alternative_solutions: Vec<AlternativeSolution>,
+    /// What the search for other solutions did with its starts when each local fit was
+    /// budgeted (above 8 coefficients; absent otherwise), as in every model kind's estimate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub search: Option<SearchReport>,
     /// How σ was taken for the alternatives' test: `std`, `residuals` or `exact`.
     pub alternatives_sigma: &'static str,
     /// The run-up points at the estimate.
@@ -699,15 +705,26 @@ pub fn estimate_with(
     // then the search for other minima from a space-filling design, as for every model kind: a
     // run-up at one speed fits as many factors as frequencies, and another exact fit may exist.
     let (mut mirrors, mut minima) = (Mirrors::default(), Vec::new());
-    let mut better_note = None;
+    let (mut better_note, mut search_note, mut search) = (None, None, None);
     if converged {
         let exchanges = like_exchanges(&objective);
         mirrors = mirror_solutions(&objective, &estimate.last, &exchanges, &budget);
         phases.push(("mirror_solutions", budget.used()));
         // Screened: a run-up evaluation solves every speed, so the design is ranked by misfit and
-        // only its best np + 1 points are fitted locally (fitting all cost ~300× the fit itself).
+        // only its best np + 1 points are fitted locally (fitting all cost ~300× the fit itself);
+        // above 8 coefficients each local fit is budgeted as every model kind's is (a far start
+        // in 12 dimensions wandered for ~400 evaluations).
         let starts = eigenfit_core::analysis::alternatives::search_starts(np);
-        minima = screened_local_minima(&objective, starts, np + 1, &mirrors.asymmetric, &budget);
+        let extra = &mirrors.asymmetric;
+        if screened_fits(np).is_some() {
+            let found = screened_search(&objective, starts, np + 1, extra, &budget, &Damped, &estimate.last);
+            let report = SearchReport::of(&found, starts + extra.len());
+            search_note = report.note();
+            minima = found.minima;
+            search = Some(report);
+        } else {
+            minima = screened_local_minima(&objective, starts, np + 1, extra, &budget);
+        }
         phases.push(("other_solutions", budget.used()));
         if let Some(better) = better_minimum(&objective, &estimate.last, &minima).cloned() {
             better_note = Some(adopt_better_minimum(&mut estimate, better, &mut minima));
@@ -801,6 +818,7 @@ pub fn estimate_with(
             &estimate.parameters,
         ),
         history: estimate.history.clone(),
+        search,
         model: path.display().to_string(),
         outcome: Outcome::of(&estimate, converged),
         verdict,
@@ -852,6 +870,7 @@ pub fn estimate_with(
                 notes.push(format!("the fit started from --initial: {}", start.join(", ")));
             }
             notes.extend(rotor.extrapolation_notes(&points.iter().map(|p| p.speed_rpm).collect::<Vec<_>>()));
+            notes.extend(search_note);
             notes.extend(better_note);
             notes
         },
