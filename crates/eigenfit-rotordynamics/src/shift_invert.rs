@@ -216,7 +216,7 @@ pub fn generic_start(size: usize) -> Vec<f64> {
 /// Ritz vector); `None` while any wanted pair has not converged (the `exact` to [`RESIDUAL`], the
 /// others to [`RANKING_RESIDUAL`] or [`RANKING_MARGIN`]).
 ///
-/// The Ritz values come from an eigenvalues-only Hessenberg QR and the wanted pairs' vectors
+/// The Ritz values come from an eigenvalues-only Hessenberg QR ([`crate::hessenberg`]) and the wanted pairs' vectors
 /// from inverse iteration ([`crate::hessenberg`]): O(m²) each instead of the Schur vectors'
 /// O(m³). When two wanted Ritz values lie closer than [`CLUSTER`] (inverse iteration would give
 /// both nearly the same vector) the full eigendecomposition gives them instead.
@@ -233,7 +233,12 @@ fn ritz(
     }
     let hm = h.as_ref().submatrix(0, 0, steps, steps).to_owned();
     let beta_last = h[(steps, steps - 1)];
-    let values = hessenberg_eigen(&hm, false)?.0;
+    // EISPACK's QR on the Hessenberg matrix as it is; faer's (which reduces it again) if that
+    // does not converge.
+    let values = match crate::hessenberg::eigenvalues(hm.as_ref()) {
+        Some(values) => values,
+        None => hessenberg_eigen(&hm, false)?.0,
+    };
     let chosen = largest(&values, wanted);
     let thetas: Vec<c64> = chosen.iter().map(|&i| values[i]).collect();
     let scale = thetas.iter().map(|t| t.norm()).fold(0.0, f64::max);
