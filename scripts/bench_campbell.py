@@ -1,5 +1,7 @@
 """Campbell diagram timing: ROSS `run_campbell` against `eigenfit campbell`, same rotor file,
-same speeds (50, linear 0-12000 rpm), 6 modes, same machine, one run each after a warm-up.
+same speeds (50, linear 0-12000 rpm), 6 modes, same machine, after a warm-up; BENCH_REPEATS=N
+runs N pairs (ROSS then eigenfit, back to back) and prints each pair's wall and CPU times and the
+median of the pairs' wall-clock ratios.
 
     /work/venvs/rotordyn/bin/python scripts/bench_campbell.py [path/to/eigenfit]
     # ROSS 3 on the compressor ROSS 3 saved:
@@ -30,21 +32,40 @@ FILE = ROOT / os.environ.get("BENCH_FILE", "crates/eigenfit-rotordynamics/tests/
 EIGENFIT = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "target/release/eigenfit")
 RPM = np.linspace(0.0, 12000.0, 50)
 
-rotor = rs.Rotor.load(FILE)
-speeds = RPM * np.pi / 30
-rotor.run_campbell(speeds[:2], frequencies=6)  # warm-up (imports, caches)
-t0 = time.perf_counter()
-camp = rotor.run_campbell(speeds, frequencies=6)
-t_ross = time.perf_counter() - t0
+REPEATS = int(os.environ.get("BENCH_REPEATS", "1"))
 
+speeds = RPM * np.pi / 30
+# Warm-up (imports, compiled code) on a rotor of its own: ROSS caches `run_modal` per rotor and
+# speed (methodtools' lru_cache), so every timed run below loads a fresh rotor, with nothing cached.
+rs.Rotor.load(FILE).run_campbell(speeds[:2], frequencies=6)
 cmd = [EIGENFIT, "campbell", "--model", str(FILE), "--speeds", "0:12000:50", "--modes", "6", "--json"]
 subprocess.run(cmd, check=True, capture_output=True)  # warm-up (page cache)
-t0 = time.perf_counter()
-out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-t_eig = time.perf_counter() - t0
+
+
+def children_cpu():
+    t = os.times()
+    return t.children_user + t.children_system
+
+
+ratios = []
+for rep in range(REPEATS):
+    # One pair: ROSS then eigenfit, back to back, wall and CPU time of each.
+    rotor = rs.Rotor.load(FILE)
+    c0, t0 = time.process_time(), time.perf_counter()
+    camp = rotor.run_campbell(speeds, frequencies=6)
+    t_ross, c_ross = time.perf_counter() - t0, time.process_time() - c0
+    k0, t0 = children_cpu(), time.perf_counter()
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    t_eig, c_eig = time.perf_counter() - t0, children_cpu() - k0
+    ratios.append(t_ross / t_eig)
+    print(
+        f"ROSS run_campbell: {t_ross:.3f} s ({c_ross:.3f} s CPU); eigenfit campbell: {t_eig:.3f} s "
+        f"({c_eig:.3f} s CPU); ratio {t_ross / t_eig:.1f}x (CPU {c_ross / max(c_eig, 1e-9):.1f}x)"
+    )
+if REPEATS > 1:
+    print(f"median ratio of {REPEATS} pairs: {np.median(ratios):.1f}x (min {min(ratios):.1f}x, max {max(ratios):.1f}x)")
 ours = np.array(json.loads(out)["frequencies_hz"])
 
-print(f"ROSS run_campbell: {t_ross:.3f} s; eigenfit campbell: {t_eig:.3f} s; ratio {t_ross / t_eig:.1f}x")
 wd = camp.wd / (2 * np.pi)  # (speeds, modes), tracked order
 diffs = []
 for k in range(len(RPM)):

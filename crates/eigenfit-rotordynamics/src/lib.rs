@@ -13,6 +13,7 @@ pub mod effects;
 pub mod elements;
 pub mod error;
 pub mod fit;
+pub mod hessenberg;
 pub mod identify;
 pub mod interpolation;
 pub mod modal;

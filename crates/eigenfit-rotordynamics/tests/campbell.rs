@@ -163,10 +163,12 @@ fn nan_and_inf_in_bearing_tables_are_named_where_they_are() {
 }
 
 /// The work of a Campbell sweep is bounded: on ROSS 3's compressor (732 DOF, 10 modes solved per
-/// speed: 36 eigenvalues wanted) each speed takes at most 80 Krylov steps and 1.5 convergence
-/// checks on average (measured: 70.2 steps, 1.20 checks); the small eigen-solves of the checks
-/// were most of the time when every 6th step was checked from 48 on, and half of it when the
-/// first check came at 63 steps, which most speeds do not reach converged.
+/// speed: 36 eigenvalues wanted) each speed takes at most 53 Krylov steps and 1.9 convergence
+/// checks on average (measured: 52.1 steps, 1.85 checks). Before the spares were ranked by
+/// their margin above the modes returned it took 70.2 steps (bound 80) and 1.20 checks (bound
+/// 1.5): the spares at the far end of the wanted set needed 1.9 steps per wanted eigenvalue to
+/// reach 1e-8, the modes returned 1.3. A check now costs an eigenvalues-only Hessenberg QR and
+/// one inverse iteration per wanted pair, not every Schur vector, so it checks from 47 steps on.
 #[test]
 fn a_campbell_sweep_of_the_compressor_takes_bounded_krylov_work() {
     use eigenfit_rotordynamics::shift_invert::work;
@@ -183,8 +185,8 @@ fn a_campbell_sweep_of_the_compressor_takes_bounded_krylov_work() {
     assert_eq!(diagram.frequencies_hz.len(), speeds.len());
     let (steps, checks) = (done.0 as f64 / speeds.len() as f64, done.1 as f64 / speeds.len() as f64);
     eprintln!("per speed: {steps:.1} Krylov steps, {checks:.2} checks");
-    assert!(steps > 0.0 && steps <= 80.0, "{steps} Krylov steps per speed");
-    assert!(checks <= 1.5, "{checks} convergence checks per speed");
+    assert!(steps > 0.0 && steps <= 53.0, "{steps} Krylov steps per speed");
+    assert!(checks <= 1.9, "{checks} convergence checks per speed");
 }
 
 /// The divergence check by Sturm counts on band matrices agrees with the dense symmetric
