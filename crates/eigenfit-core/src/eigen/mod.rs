@@ -7,6 +7,7 @@
 //! Depends on [`matrix`](crate::matrix) and below.
 
 pub(crate) mod banded_solver;
+pub(crate) mod complement;
 pub(crate) mod dense_solver;
 pub(crate) mod lanczos;
 pub(crate) mod modes;
