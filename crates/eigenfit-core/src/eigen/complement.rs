@@ -12,7 +12,8 @@
 
 use crate::eigen::sparse_solver::with_held_factor;
 use crate::eigen::{Modes, SolveError};
-use crate::matrix::System;
+use crate::matrix::{CscSymmetric, System};
+use nalgebra::{DMatrixView, DMatrixViewMut};
 
 /// Relative residual, in the preconditioner's norm (‖r‖_{B⁻¹}/‖b‖_{B⁻¹}), at which a column stops.
 pub(crate) const COMPLEMENT_TOLERANCE: f64 = 1e-10;
@@ -53,13 +54,23 @@ pub(crate) fn solve_on_complement(
             m.mul_add(1.0, &phi[l * n..(l + 1) * n], &mut m_phi[l * n..(l + 1) * n]);
         }
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-        // y −= Φ Φᵀ M y: back onto the complement (B⁻¹ maps there exactly; this removes round-off).
-        let project = |y: &mut [f64]| {
-            for l in 0..nm {
-                let c = dot(&m_phi[l * n..(l + 1) * n], y);
-                y.iter_mut().zip(&phi[l * n..(l + 1) * n]).for_each(|(yi, p)| *yi -= c * p);
-            }
+        let phi_mat = DMatrixView::from_slice(phi, n, nm);
+        let m_phi_mat = DMatrixView::from_slice(&m_phi, n, nm);
+        // Y −= Φ(ΦᵀMY) for an n × c block: back onto the complement (B⁻¹ maps there exactly;
+        // this removes round-off), as two matrix products.
+        let project = |y: &mut [f64], c: usize| {
+            let mut y = DMatrixViewMut::from_slice(y, n, c);
+            let coefficients = m_phi_mat.tr_mul(&y);
+            y.gemm(-1.0, &phi_mat, &coefficients, 1.0);
         };
+        // K − λₖM once per mode, so each CG step is one product.
+        let mut shifted: Vec<(usize, CscSymmetric)> = Vec::new();
+        for (kk, _) in columns.iter() {
+            if !shifted.iter().any(|(j, _)| j == kk) {
+                shifted.push((*kk, CscSymmetric::combination(1.0, k, -lam[*kk], m)));
+            }
+        }
+        let operator_of = |kk: usize| &shifted.iter().find(|(j, _)| *j == kk).expect("built above").1;
         let cols = columns.len();
         let mut counts = ComplementCounts::default();
         // Modal part: v = Σₗ≠ₖ φₗ(φₗᵀb)/(λₗ − λₖ) + w; the complement's right-hand side is
@@ -86,11 +97,10 @@ pub(crate) fn solve_on_complement(
                 block.extend_from_slice(&z[j * n..(j + 1) * n]);
             }
             solve(&mut block, active.len());
+            project(&mut block, active.len());
             counts.block_solves += 1;
             for (i, &j) in active.iter().enumerate() {
-                let zj = &mut z[j * n..(j + 1) * n];
-                zj.copy_from_slice(&block[i * n..(i + 1) * n]);
-                project(zj);
+                z[j * n..(j + 1) * n].copy_from_slice(&block[i * n..(i + 1) * n]);
             }
         };
         let all: Vec<usize> = (0..cols).collect();
@@ -118,8 +128,7 @@ pub(crate) fn solve_on_complement(
             for &j in &active {
                 let pj = &p[j * n..(j + 1) * n];
                 q.fill(0.0);
-                k.mul_add(1.0, pj, &mut q);
-                m.mul_add(-lam[columns[j].0], pj, &mut q);
+                operator_of(columns[j].0).mul_add(1.0, pj, &mut q);
                 let pq = dot(pj, &q);
                 if !(pq > 0.0 && pq.is_finite()) {
                     // Not positive definite on the complement: a mode below λₖ was not computed.
