@@ -338,6 +338,9 @@ pub fn eigenvector_derivatives_nelson_modes(
     nelson_modes(system, modes, ks, derivatives, iterative).map(|(v, _)| v)
 }
 
+/// dφₖ/dpᵢ: one list per mode, one vector per parameter.
+type PerMode = Vec<Vec<DVector<f64>>>;
+
 /// [`eigenvector_derivatives_nelson_modes`] with the route chosen by the caller (`iterative`),
 /// and the CG counts when it was taken.
 pub(crate) fn nelson_modes(
@@ -346,7 +349,7 @@ pub(crate) fn nelson_modes(
     ks: &[usize],
     derivatives: &[SystemDerivative],
     iterative: bool,
-) -> Result<(Vec<Vec<DVector<f64>>>, Option<ComplementCounts>), SensitivityError> {
+) -> Result<(PerMode, Option<ComplementCounts>), SensitivityError> {
     let floor = rigid_body_tolerance(system);
     let n = modes.shapes.nrows();
     let np = derivatives.len();
