@@ -326,15 +326,27 @@ fn a_symmetric_structure_reports_the_mirror_that_exchanges_two_pairs_of_zones() 
 
 #[test]
 fn measured_shapes_update_a_model_beyond_the_dense_solvers_size() {
-    // A fixed–fixed chain of 2,100 unit masses on springs, in three zones (thirds of the springs)
-    // each scaled by a parameter: beyond what a dense n×n factorisation per mode and iteration
-    // would do in a test, so the shapes' derivatives (Nelson's method) go through the sparse
-    // LDLᵀ. At zone factors (1, 1, 1) the chain is uniform and its modes are known in closed
-    // form (independent of any solver): λⱼ = 4k sin²(jπ/2(n+1)), φⱼ(i) ∝ sin(ijπ/(n+1)). Two
-    // modes measured at 14 sensors determine three parameters only with the shapes counted.
+    // Beyond what a dense n×n factorisation per mode and iteration would do in a test, so the
+    // shapes' derivatives (Nelson's method) go through the sparse LDLᵀ.
+    shapes_update_a_uniform_chain(2100, &[]);
+}
+
+#[test]
+fn measured_shapes_update_a_model_above_the_iterative_nelson_threshold() {
+    // At 20,000 DOFs and more Nelson's systems are solved by CG on the eigen-solve's factor
+    // (eigenfit_core::sensitivity::NELSON_ITERATIVE_MIN_DOFS): the same update, end to end
+    // (without the search for other solutions, which the case above covers, to keep it short).
+    shapes_update_a_uniform_chain(21_000, &["--alternative-starts", "0"]);
+}
+
+/// A fixed–fixed chain of `n` unit masses on springs, in three zones (thirds of the springs)
+/// each scaled by a parameter, updated from (0.7, 1.4, 1.2) with two modes' frequencies and
+/// shapes at 14 sensors. At zone factors (1, 1, 1) the chain is uniform and its modes are known
+/// in closed form (independent of any solver): λⱼ = 4k sin²(jπ/2(n+1)), φⱼ(i) ∝ sin(ijπ/(n+1)).
+/// Two modes determine three parameters only with the shapes counted. `extra`: further options.
+fn shapes_update_a_uniform_chain(n: usize, extra: &[&str]) {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let n = 2100;
     let stiffness = 1e6;
     let zone = |spring: usize| 3 * spring / (n + 1);
     // Spring s (0..=n) joins masses s − 1 and s (1-based: s and s + 1); 0 and n hold the ends.
@@ -386,7 +398,8 @@ fn measured_shapes_update_a_model_beyond_the_dense_solvers_size() {
         format!("mode,frequency_hz\n1,{:.15e}\n2,{:.15e}\n", frequency(1), frequency(2)),
     )
     .unwrap();
-    let sensors: Vec<usize> = (1..=14).map(|s| 150 * s - 75).collect();
+    let spacing = n / 14;
+    let sensors: Vec<usize> = (1..=14).map(|s| spacing * s - spacing / 2).collect();
     // The CSV's node is counted from 0 in the DOF map's order: mass i is node i − 1.
     let shapes: String = (1..=2)
         .flat_map(|j| {
@@ -395,18 +408,21 @@ fn measured_shapes_update_a_model_beyond_the_dense_solvers_size() {
         .collect();
     std::fs::write(dir.join("s.csv"), format!("mode,node,direction,value\n{shapes}")).unwrap();
     let path = |f: &str| dir.join(f).to_str().unwrap().to_string();
-    let (code, v, err) = eigenfit(&[
+    let (model, measured, shapes) = (path("model.toml"), path("f.csv"), path("s.csv"));
+    let mut args = vec![
         "estimate",
         "--model",
-        &path("model.toml"),
+        &model,
         "--measured",
-        &path("f.csv"),
+        &measured,
         "--shapes",
-        &path("s.csv"),
+        &shapes,
         "--initial",
         "0.7,1.4,1.2",
         "--json",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let (code, v, err) = eigenfit(&args);
     assert_eq!(code, 0, "{err}\n{v}");
     for z in 0..3 {
         let value = v["parameters"][format!("zone{z}")].as_f64().unwrap();

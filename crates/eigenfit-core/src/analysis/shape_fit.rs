@@ -4,13 +4,13 @@
 //! s = Pφₖ and the measured shape d are both scaled to unit length, the measured one turned to
 //! point the model's way (dᵀs ≥ 0); the residual rows are (d/‖d‖ − s/‖s‖)/σ_shape, one per
 //! sensor. Unit length makes the residual independent of how the test system scaled its shapes
-//! (mass-normalised, unit maximum, …). Their derivatives follow from Nelson's method:
+//! (mass-normalised, unit maximum, …). Their derivatives follow from Nelson's method (all paired modes at once):
 //! d(s/‖s‖)/dp = (I − uuᵀ) P dφₖ/dp / ‖s‖.
 
 use crate::eigen::EigenSolver;
 use crate::model::{ParameterSet, StructuralModel};
 use crate::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
-use crate::sensitivity::eigenvector_derivatives_nelson;
+use crate::sensitivity::eigenvector_derivatives_nelson_modes;
 use nalgebra::{DMatrix, DVector};
 
 /// Default standard deviation of a unit-length measured shape's entries.
@@ -140,6 +140,8 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
         residual.rows_mut(0, m).copy_from(&(&lin.residual * w));
         jacobian.rows_mut(0, m).copy_from(&(&lin.jacobian * w));
         let ws = 1.0 / (self.shape_std * self.scale);
+        // (u, ‖s‖) of each paired mode, the residual rows filled on the way.
+        let mut units = Vec::with_capacity(lin.paired_modes.len());
         for (j, (meas, &k)) in self.problem.measured.modes().iter().zip(&lin.paired_modes).enumerate() {
             let d = meas
                 .shape
@@ -165,14 +167,18 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
             let u = &s / sn;
             let sign = if d.dot(&s) < 0.0 { -1.0 } else { 1.0 };
             let ud = &d * (sign / dn);
-            let row0 = m + j * ns;
-            residual.rows_mut(row0, ns).copy_from(&((ud - &u) * ws));
-            // One factorisation of K − λₖM for every parameter.
-            for (i, dphi) in eigenvector_derivatives_nelson(system, modes, k, derivatives)?.iter().enumerate()
-            {
+            residual.rows_mut(m + j * ns, ns).copy_from(&((ud - &u) * ws));
+            units.push((u, sn));
+        }
+        // Every paired mode and parameter in one call: at large sizes their systems share the
+        // eigen-solve's factor (no factorisation per mode).
+        let ks = &lin.paired_modes[..units.len()];
+        let dphis = eigenvector_derivatives_nelson_modes(system, modes, ks, derivatives)?;
+        for (j, ((u, sn), dphi_k)) in units.iter().zip(&dphis).enumerate() {
+            for (i, dphi) in dphi_k.iter().enumerate() {
                 let ds = DVector::from_iterator(ns, sensor_dofs.iter().map(|&dof| dphi[dof]));
-                let du = (&ds - &u * u.dot(&ds)) / sn;
-                jacobian.view_mut((row0, i), (ns, 1)).copy_from(&(du * ws));
+                let du = (&ds - u * u.dot(&ds)) / *sn;
+                jacobian.view_mut((m + j * ns, i), (ns, 1)).copy_from(&(du * ws));
             }
         }
         lin.residual = residual;

@@ -2,11 +2,12 @@
 //! named after its type: [`DenseSolver`] (nalgebra), [`BandedSolver`] (band Cholesky + subspace
 //! iteration / Lanczos), [`SparseSolver`] (faer sparse Cholesky + shift-invert Lanczos). The
 //! Lanczos and small dense eigen kernels they share are private; [`roundoff`] bounds the error
-//! of a computed mode.
+//! of a computed mode; `complement` solves Nelson's systems on the sparse solve's held factor.
 //!
 //! Depends on [`matrix`](crate::matrix) and below.
 
 pub(crate) mod banded_solver;
+pub(crate) mod complement;
 pub(crate) mod dense_solver;
 pub(crate) mod lanczos;
 pub(crate) mod modes;

@@ -108,6 +108,16 @@ struct Workspace {
     checked_mass: Option<CscSymmetric>,
     lanczos: LanczosWork,
     diagonal: Vec<f64>,
+    /// What `llt` is the factor of, after a successful eigen-solve (cleared by any other
+    /// Cholesky): Nelson's iterative solves precondition with it instead of factoring again.
+    held: Option<Held>,
+}
+
+/// K and M (on the union pattern) and σ of the factor of K + σM held in [`Workspace::llt`].
+struct Held {
+    k: CscSymmetric,
+    m: CscSymmetric,
+    sigma: f64,
 }
 
 thread_local! {
@@ -121,6 +131,7 @@ impl Workspace {
         if same && self.symbolic.is_some() {
             return Ok(());
         }
+        self.held = None;
         let n = a.dim();
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
         let symbolic = factorize_symbolic_cholesky(
@@ -150,6 +161,7 @@ impl Workspace {
     /// whose inverse would drown the lowest modes in round-off).
     fn cholesky(&mut self, a: &CscSymmetric, well_conditioned: bool) -> Result<bool, SolveError> {
         self.prepare(a)?;
+        self.held = None;
         let (symbolic, buffer) =
             (self.symbolic.as_ref().expect("prepared"), self.buffer.as_mut().expect("prepared"));
         let n = a.dim();
@@ -421,6 +433,10 @@ impl SparseSolver {
                 // two by `count` puts its other copy below σ′ too: that copy is the next one.
                 let next = if known > count { found.eigenvalues[count] } else { bound };
                 let modes = finish(restricted(to_modes(&found, n, count), kept))?;
+                if kept.is_none() {
+                    // A condensed system's factor is of its full pencil, not of the system.
+                    ws.held = Some(Held { k: k.clone(), m: m.clone(), sigma });
+                }
                 return Ok(Some((modes, next)));
             }
             if below < known || found.eigenvalues.len() >= n {
@@ -434,6 +450,10 @@ impl SparseSolver {
             let known_low = found.eigenvalues.iter().filter(|&&l| l < low).count();
             if known_low < count && ws.count_below(k, m, low)? == Some(known_low) {
                 let modes = finish(restricted(to_modes(&found, n, count), kept))?;
+                if kept.is_none() {
+                    // A condensed system's factor is of its full pencil, not of the system.
+                    ws.held = Some(Held { k: k.clone(), m: m.clone(), sigma });
+                }
                 return Ok(Some((modes, found.eigenvalues.get(count).copied().unwrap_or(top))));
             }
             // Missed modes: rerun M-orthogonally to the modes found, on the same factor of
@@ -599,6 +619,60 @@ fn solve_pinned_pair(
             b.iter_mut().zip(&residual).for_each(|(x, dx)| *x += dx);
         }
         Ok(true)
+    })
+}
+
+/// Runs `f` on the factor of K + σM that the thread's last sparse eigen-solve left behind, when
+/// that solve was of `system` (same K and M); `None` otherwise (another system solved since, or
+/// a banded or dense solver used). `f` gets K and M on the factor's pattern, σ, and the solve
+/// (K + σM)⁻¹ applied in place to an n × c column-major block (one pass over the factor for
+/// all c columns).
+pub(crate) fn with_held_factor<R>(
+    system: &System,
+    f: impl FnOnce(&CscSymmetric, &CscSymmetric, f64, &mut dyn FnMut(&mut [f64], usize)) -> R,
+) -> Result<Option<R>, SolveError> {
+    if system.condensed_pencil().is_some() {
+        // Solved on its full pencil: no factor of the system's own K + σM is held.
+        return Ok(None);
+    }
+    let pair = csc_pair(system);
+    let pattern = CscSymmetric::combination(0.0, &pair.0, 0.0, &pair.1);
+    WORKSPACE.with(|ws| {
+        let ws = &mut *ws.try_borrow_mut().map_err(|_| backend("workspace in use (re-entrant solve)"))?;
+        let Workspace { held: Some(held), symbolic: Some(symbolic), llt, .. } = ws else { return Ok(None) };
+        if !held.k.same_pattern(&pattern)
+            || held.k != with_pattern(&pattern, &pair.0)
+            || held.m != with_pattern(&pattern, &pair.1)
+        {
+            return Ok(None);
+        }
+        let mut scratch: Option<(usize, MemBuffer)> = None;
+        let mut failed = false;
+        let mut solve = |x: &mut [f64], cols: usize| {
+            let n = symbolic.nrows();
+            if scratch.as_ref().is_none_or(|(c, _)| *c < cols) {
+                match MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq)) {
+                    Ok(b) => scratch = Some((cols, b)),
+                    Err(_) => {
+                        failed = true;
+                        x.fill(f64::NAN);
+                        return;
+                    }
+                }
+            }
+            let (_, buffer) = scratch.as_mut().expect("allocated");
+            LltRef::new(symbolic, llt).solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(x, n, cols),
+                Par::Seq,
+                MemStack::new(buffer),
+            );
+        };
+        let out = f(&held.k, &held.m, held.sigma, &mut solve);
+        if failed {
+            return Err(backend("out of memory for a block solve"));
+        }
+        Ok(Some(out))
     })
 }
 
