@@ -6,7 +6,7 @@ use crate::named::Named;
 use crate::outcome::{
     cycles, phase_counts, Covariances, FitQualityReport, Outcome, PairedFrequencies, ParameterValues, Verdict,
 };
-pub use crate::outcome::{AlternativeSolution, ParameterIdentifiability};
+pub use crate::outcome::{AlternativeSolution, ParameterIdentifiability, SearchReport};
 use crate::overrides::{fixed, parameter_vector};
 use crate::posterior::{PosteriorReport, SamplingError};
 use crate::progress::{Progress, StepsObserver};
@@ -15,7 +15,7 @@ use crate::simulate::check_roundoff_of;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
-    self, adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, local_minima_refit,
+    adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, local_minima_refit,
     mirror_solutions, screened_fits, screened_search, search_starts, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
@@ -156,47 +156,6 @@ impl IntervalsReport {
                 .map(|u| Named::new(names, (0..names.len()).map(|i| u.covariance[(i, i)].sqrt()))),
             poorly_determined_directions: u.map(|u| Rank::said(&u.poorly_determined, names)),
         }
-    }
-}
-
-/// What the screened search for other solutions did with its starts (`search` in the report).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SearchReport {
-    /// Starts ranked by misfit: the design's and the exchanged points of asymmetric exchanges.
-    pub ranked: usize,
-    /// Starts fitted locally (the best by misfit).
-    pub fitted: usize,
-    /// Local fits abandoned: not within `reach_delta_chi2` of the estimate after a few
-    /// evaluations. They tested nothing: no claim rests on them.
-    pub abandoned: usize,
-    /// Δχ² above the estimate within which a local fit had to come (`null` when σ is unknown).
-    pub reach_delta_chi2: Option<f64>,
-}
-
-impl SearchReport {
-    /// What `found` did with `ranked` starts.
-    pub fn of(found: &alternatives::Search, ranked: usize) -> Self {
-        Self {
-            ranked,
-            fitted: found.fitted,
-            abandoned: found.abandoned,
-            reach_delta_chi2: found.reach_delta_chi2,
-        }
-    }
-
-    /// The note that says local fits were abandoned and what that means, if any were.
-    pub fn note(&self) -> Option<String> {
-        (self.abandoned > 0).then(|| {
-            format!(
-                "the search for other solutions abandoned {} of its {} local fits: after {} evaluations each was \
-                 still more than Δχ² {} above the estimate; they tested nothing, so the search supports no claim \
-                 about the regions they started from",
-                self.abandoned,
-                self.fitted,
-                alternatives::REACH_EVALUATIONS,
-                self.reach_delta_chi2.map_or_else(|| "?".into(), |d| format!("{d:.1}")),
-            )
-        })
     }
 }
 

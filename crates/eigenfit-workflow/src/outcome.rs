@@ -365,3 +365,44 @@ impl Covariances {
         }
     }
 }
+
+/// What the screened search for other solutions did with its starts (`search` in the report).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SearchReport {
+    /// Starts ranked by misfit: the design's and the exchanged points of asymmetric exchanges.
+    pub ranked: usize,
+    /// Starts fitted locally (the best by misfit).
+    pub fitted: usize,
+    /// Local fits abandoned: not within `reach_delta_chi2` of the estimate after a few
+    /// evaluations. They tested nothing: no claim rests on them.
+    pub abandoned: usize,
+    /// Δχ² above the estimate within which a local fit had to come (`null` when σ is unknown).
+    pub reach_delta_chi2: Option<f64>,
+}
+
+impl SearchReport {
+    /// What `found` did with `ranked` starts.
+    pub fn of(found: &eigenfit_core::analysis::alternatives::Search, ranked: usize) -> Self {
+        Self {
+            ranked,
+            fitted: found.fitted,
+            abandoned: found.abandoned,
+            reach_delta_chi2: found.reach_delta_chi2,
+        }
+    }
+
+    /// The note that says local fits were abandoned and what that means, if any were.
+    pub fn note(&self) -> Option<String> {
+        (self.abandoned > 0).then(|| {
+            format!(
+                "the search for other solutions abandoned {} of its {} local fits: after {} evaluations each was \
+                 still more than Δχ² {} above the estimate; they tested nothing, so the search supports no claim \
+                 about the regions they started from",
+                self.abandoned,
+                self.fitted,
+                eigenfit_core::analysis::alternatives::REACH_EVALUATIONS,
+                self.reach_delta_chi2.map_or_else(|| "?".into(), |d| format!("{d:.1}")),
+            )
+        })
+    }
+}

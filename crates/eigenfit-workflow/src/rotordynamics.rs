@@ -2,8 +2,8 @@
 //! stiffnesses from run-up frequencies, and the Campbell diagram.
 
 use crate::error::{input, WorkflowError};
-use crate::estimate::SearchReport;
 use crate::named::Named;
+use crate::outcome::SearchReport;
 use crate::outcome::{
     phase_counts, AlternativeSolution, BudgetReport, Covariances, FitQualityReport, Outcome,
     ParameterIdentifiability, ParameterValues, Verdict,

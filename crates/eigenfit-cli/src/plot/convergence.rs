@@ -77,11 +77,7 @@ pub struct Run {
 impl Run {
     /// From a finished estimate.
     pub fn from_estimate(e: &Estimate) -> Self {
-        Self::of(
-            &e.strategy.to_string(),
-            &format!("{}, {} it.", e.termination.label(), e.iterations),
-            &e.history,
-        )
+        Self::of(e.strategy, &format!("{}, {} it.", e.termination.label(), e.iterations), &e.history)
     }
 
     /// From a fit's history, `outcome` saying how it ended; a last record that is the search's

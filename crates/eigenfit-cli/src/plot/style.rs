@@ -382,6 +382,10 @@ impl Ranged for SymLog {
     }
 }
 
+/// A chart over x (m) and a normalised displacement on fixed ticks: what [`shaft_chart`] builds.
+pub type ShaftChart<'a, DB> =
+    ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, FixedTicks>>;
+
 /// A chart along a shaft, its grid drawn: x the position `x` (m) with 4 % room at each end, y a
 /// normalised displacement ticked at −1, −0.5, 0, 0.5, 1 only, from −1.75 (room for the bearing
 /// labels under the shaft) to `top` (room for the disk labels over it). Returns the chart and the
@@ -392,10 +396,7 @@ pub fn shaft_chart<'a, DB: DrawingBackend>(
     top: f64,
     x_label: &str,
     y_label: &str,
-) -> Result<
-    (ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, FixedTicks>>, f64),
-    String,
-> {
+) -> Result<(ShaftChart<'a, DB>, f64), String> {
     let pad = (x.end - x.start) * 0.04;
     let y_ticks = vec![-1.0, -0.5, 0.0, 0.5, 1.0];
     let mut chart = ChartBuilder::on(area)
