@@ -226,14 +226,26 @@ pub fn screened_local_minima_refit(
     budget: &Budget,
     refit: &dyn Refit,
 ) -> Vec<Linearisation> {
+    let best = best_by_misfit(problem, design(problem, starts), keep, budget);
+    let points = extra.iter().cloned().chain(best).collect();
+    fitted_minima(problem, points, budget, refit)
+}
+
+/// The `keep` points of `points` with the lowest misfit (one evaluation each, charged to
+/// `budget`; points outside the limits or that cannot be evaluated are dropped), best first.
+fn best_by_misfit(
+    problem: &dyn Objective,
+    points: impl Iterator<Item = Vec<f64>>,
+    keep: usize,
+    budget: &Budget,
+) -> Vec<Vec<f64>> {
     let budgeted = budget.wrap(problem);
-    let mut ranked: Vec<(f64, Vec<f64>)> = design(problem, starts)
+    let mut ranked: Vec<(f64, Vec<f64>)> = points
         .filter(|p| problem.parameters().check(p).is_ok())
         .filter_map(|p| budgeted.cost(&p).filter(|c| c.is_finite()).map(|c| (c, p)))
         .collect();
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let points = extra.iter().cloned().chain(ranked.into_iter().take(keep).map(|(_, p)| p)).collect();
-    fitted_minima(problem, points, budget, refit)
+    ranked.into_iter().take(keep).map(|(_, p)| p).collect()
 }
 
 /// What a screened search did ([`screened_search`]): the minima it reached and what became of
@@ -254,8 +266,8 @@ pub struct Search {
 /// [`screened_local_minima_refit`] with a budget per local fit: the design's `starts` points
 /// and the `extra` starts are ranked by misfit (one evaluation each, no derivatives), each
 /// group apart; the best `keep` of the design and the best ⌈`keep`/2⌉ extra starts are fitted
-/// locally (all extra starts were before: 17 like parameters give up to 136), and a local fit that after [`REACH_EVALUATIONS`]
-/// evaluations has not come within [`REACH_THRESHOLDS`] × the equivalence threshold (Δχ²) of
+/// locally (all extra starts were before: 17 like parameters give up to 136), and a local fit
+/// that after [`REACH_EVALUATIONS`] evaluations has not come within [`REACH_THRESHOLDS`] × the equivalence threshold (Δχ²) of
 /// the estimate `at` is abandoned and counted as such — it can no longer end equally good
 /// cheaply, and a far start in many dimensions would wander for hundreds of evaluations.
 pub fn screened_search(
@@ -267,20 +279,10 @@ pub fn screened_search(
     refit: &dyn Refit,
     at: &Linearisation,
 ) -> Search {
-    let budgeted = budget.wrap(problem);
-    let best = |points: Vec<Vec<f64>>, keep: usize| {
-        let mut ranked: Vec<(f64, Vec<f64>)> = points
-            .into_iter()
-            .filter(|p| problem.parameters().check(p).is_ok())
-            .filter_map(|p| budgeted.cost(&p).filter(|c| c.is_finite()).map(|c| (c, p)))
-            .collect();
-        ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
-        ranked.into_iter().take(keep).map(|(_, p)| p).collect::<Vec<_>>()
-    };
     // Ranked apart: the exchanged points lie next to the estimate and would crowd out the
     // design's far starts, which are what searches the rest of the space.
-    let mut points = best(extra.to_vec(), keep.div_ceil(2));
-    points.extend(best(design(problem, starts).collect(), keep));
+    let mut points = best_by_misfit(problem, extra.iter().cloned(), keep.div_ceil(2), budget);
+    points.extend(best_by_misfit(problem, design(problem, starts), keep, budget));
     let test = Equivalence::at(at, problem.parameters().len());
     // In cost units (½Σr²): Δχ² = 2Δcost/σ².
     let reach = test.sigma2.map(|s2| (test.best_cost + 0.5 * REACH_THRESHOLDS * test.threshold * s2, s2));
