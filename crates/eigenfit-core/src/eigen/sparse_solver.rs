@@ -13,10 +13,7 @@ use crate::matrix::{CscSymmetric, System};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
-    SymbolicCholeskyRaw, SymmetricOrdering,
-};
+use faer::sparse::linalg::cholesky::{LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use nalgebra::{DMatrix, DVector};
@@ -132,15 +129,8 @@ impl Workspace {
             return Ok(());
         }
         self.held = None;
-        let n = a.dim();
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
-        let symbolic = factorize_symbolic_cholesky(
-            pattern,
-            Side::Upper,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| backend(format!("symbolic factorisation: {e:?}")))?;
+        let symbolic =
+            a.symbolic_cholesky().map_err(|e| backend(format!("symbolic factorisation: {e:?}")))?;
         let par = Par::Seq;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
@@ -753,6 +743,9 @@ fn finish(mut modes: Modes) -> Result<Modes, SolveError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::sparse::linalg::cholesky::{
+        factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+    };
     use faer::sparse::linalg::SupernodalThreshold;
 
     /// A rectangular grid of masses with springs to neighbours and to ground: a 2-D pattern

@@ -146,6 +146,25 @@ impl CscSymmetric {
         &self.row_idx
     }
 
+    /// faer's symbolic Cholesky of this pattern (upper triangle, AMD fill-reducing ordering):
+    /// the analysis every sparse factorisation of the matrix starts from.
+    pub(crate) fn symbolic_cholesky(
+        &self,
+    ) -> Result<faer::sparse::linalg::cholesky::SymbolicCholesky<usize>, faer::sparse::FaerError> {
+        use faer::sparse::linalg::cholesky::{
+            factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+        };
+        let n = self.dim();
+        let pattern =
+            faer::sparse::SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
+        factorize_symbolic_cholesky(
+            pattern,
+            faer::Side::Upper,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+    }
+
     /// Value of every stored entry.
     pub fn values(&self) -> &[f64] {
         &self.values

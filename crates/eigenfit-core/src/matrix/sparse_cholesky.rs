@@ -4,10 +4,7 @@
 use super::CscSymmetric;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
-};
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use std::sync::Arc;
@@ -30,13 +27,7 @@ impl SparseCholesky {
     pub(crate) fn factor(a: &CscSymmetric) -> Option<Self> {
         let n = a.dim();
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
-        let symbolic = factorize_symbolic_cholesky(
-            pattern,
-            Side::Upper,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .ok()?;
+        let symbolic = a.symbolic_cholesky().ok()?;
         let mut values = vec![0.0; symbolic.len_val()];
         let req = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         let mut buffer = MemBuffer::try_new(req).ok()?;
