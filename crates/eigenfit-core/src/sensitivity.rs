@@ -460,7 +460,7 @@ fn solve_pinned(
 mod tests {
     use super::*;
     use crate::eigen::DenseSolver;
-    use crate::matrix::SparseSymmetric;
+    use crate::matrix::{BandedSymmetric, CscSymmetric, SparseSymmetric};
 
     fn chain() -> (System, Modes) {
         let k = DMatrix::from_row_slice(3, 3, &[3.0, -1.0, 0.0, -1.0, 2.0, -1.0, 0.0, -1.0, 1.5]);
@@ -547,28 +547,40 @@ mod tests {
         (k, m, SystemDerivative { stiffness: dk, mass: dm })
     }
 
-    #[test]
-    fn nelson_on_sparse_and_banded_storage_matches_dense_and_finite_differences() {
-        use crate::eigen::SparseSolver;
-        use crate::matrix::{BandedSymmetric, CscSymmetric};
-        let (nx, ny, p) = (18, 13, 1.7);
+    /// [`grid`] in sparse storage.
+    fn sparse_grid(nx: usize, ny: usize, p: f64) -> System {
+        let (k, m, _) = grid(nx, ny, p);
+        System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap()
+    }
+
+    /// [`grid`] in dense, sparse and band storage, with its derivative.
+    fn grid_storages(nx: usize, ny: usize, p: f64) -> (System, System, System, SystemDerivative) {
         let (k, m, d) = grid(nx, ny, p);
-        let dense = System::new(k.clone(), m.clone()).unwrap();
         let sparse = System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap();
         let banded =
             System::banded(BandedSymmetric::from_dense(&k), BandedSymmetric::from_dense(&m)).unwrap();
+        (System::new(k, m).unwrap(), sparse, banded, d)
+    }
+
+    /// Mode `kk` of the [`grid`] at parameter `q` as the sparse solver returns it (of `count`),
+    /// its sign aligned with `like`'s: what finite differences of a shape are taken of.
+    fn grid_shape(nx: usize, ny: usize, q: f64, count: usize, kk: usize, like: &Modes) -> DVector<f64> {
+        let modes = crate::eigen::SparseSolver::default().lowest(&sparse_grid(nx, ny, q), count).unwrap();
+        let phi = modes.shapes.column(kk).into_owned();
+        if phi.dot(&like.shapes.column(kk)) < 0.0 {
+            -phi
+        } else {
+            phi
+        }
+    }
+
+    #[test]
+    fn nelson_on_sparse_and_banded_storage_matches_dense_and_finite_differences() {
+        use crate::eigen::SparseSolver;
+        let (nx, ny, p) = (18, 13, 1.7);
+        let (dense, sparse, banded, d) = grid_storages(nx, ny, p);
         let count = 6;
         let modes = SparseSolver::default().lowest(&sparse, count).unwrap();
-        // The mode as the sparse solver returns it, sign-aligned with `modes`, at parameter q.
-        let shape_at = |q: f64, kk: usize| {
-            let (k, m, _) = grid(nx, ny, q);
-            let s = System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap();
-            let mut phi = SparseSolver::default().lowest(&s, count).unwrap().shapes.column(kk).into_owned();
-            if phi.dot(&modes.shapes.column(kk)) < 0.0 {
-                phi = -phi;
-            }
-            phi
-        };
         for kk in 0..count {
             let reference = eigenvector_derivative_nelson(&dense, &modes, kk, &d).unwrap();
             let scale = reference.amax();
@@ -578,7 +590,8 @@ mod tests {
                 let err = (&v - &reference).amax() / scale;
                 assert!(err < 1e-9, "{name} mode {kk}: {err:e} from the dense LU");
             }
-            let fd = crate::testing::richardson(&[p], 0, 1e-3, |q| shape_at(q[0], kk));
+            let fd =
+                crate::testing::richardson(&[p], 0, 1e-3, |q| grid_shape(nx, ny, q[0], count, kk, &modes));
             let v = eigenvector_derivative_nelson(&sparse, &modes, kk, &d).unwrap();
             let err = (&v - &fd).amax() / scale;
             assert!(err < 1e-6, "mode {kk}: {err:e} from the finite difference");
@@ -591,13 +604,8 @@ mod tests {
     #[test]
     fn nelson_on_the_eigen_solves_factor_matches_the_direct_solve_and_finite_differences() {
         use crate::eigen::SparseSolver;
-        use crate::matrix::{BandedSymmetric, CscSymmetric};
         let (nx, ny, p) = (18, 13, 1.7);
-        let (k, m, d) = grid(nx, ny, p);
-        let dense = System::new(k.clone(), m.clone()).unwrap();
-        let sparse = System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap();
-        let banded =
-            System::banded(BandedSymmetric::from_dense(&k), BandedSymmetric::from_dense(&m)).unwrap();
+        let (dense, sparse, banded, d) = grid_storages(nx, ny, p);
         // As a MAC-paired fit solves: 2·6 + 2 modes for 6 measured ones.
         let (measured, count) = (6, 14);
         let ks: Vec<usize> = (0..measured).collect();
@@ -621,16 +629,8 @@ mod tests {
         let modes = SparseSolver::default().lowest(&sparse, count).unwrap();
         let (v, _) = nelson_modes(&sparse, &modes, &ks, std::slice::from_ref(&d), true).unwrap();
         for &kk in &ks {
-            let fd = crate::testing::richardson(&[p], 0, 1e-3, |q| {
-                let (k, m, _) = grid(nx, ny, q[0]);
-                let s = System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap();
-                let mut phi =
-                    SparseSolver::default().lowest(&s, count).unwrap().shapes.column(kk).into_owned();
-                if phi.dot(&modes.shapes.column(kk)) < 0.0 {
-                    phi = -phi;
-                }
-                phi
-            });
+            let fd =
+                crate::testing::richardson(&[p], 0, 1e-3, |q| grid_shape(nx, ny, q[0], count, kk, &modes));
             let err = (&v[kk][0] - &fd).amax() / fd.amax();
             assert!(err < 1e-6, "mode {kk}: {err:e} from the finite difference");
         }
@@ -641,16 +641,11 @@ mod tests {
     #[test]
     fn nelson_without_a_held_factor_solves_directly() {
         use crate::eigen::SparseSolver;
-        use crate::matrix::CscSymmetric;
-        let (k, m, d) = grid(18, 13, 1.7);
-        let sparse = System::sparse(CscSymmetric::from_dense(&k), CscSymmetric::from_dense(&m)).unwrap();
+        let (dense, sparse, _, d) = grid_storages(18, 13, 1.7);
         let modes = SparseSolver::default().lowest(&sparse, 14).unwrap();
-        let (k2, m2, _) = grid(18, 13, 1.9);
-        let other = System::sparse(CscSymmetric::from_dense(&k2), CscSymmetric::from_dense(&m2)).unwrap();
-        SparseSolver::default().lowest(&other, 14).unwrap();
+        SparseSolver::default().lowest(&sparse_grid(18, 13, 1.9), 14).unwrap();
         let (v, counts) = nelson_modes(&sparse, &modes, &[0, 3], std::slice::from_ref(&d), true).unwrap();
         assert_eq!(counts, None);
-        let dense = System::new(k, m).unwrap();
         for (j, kk) in [0, 3].into_iter().enumerate() {
             let reference = eigenvector_derivative_nelson(&dense, &modes, kk, &d).unwrap();
             assert!((&v[j][0] - &reference).amax() < 1e-9 * reference.amax());
