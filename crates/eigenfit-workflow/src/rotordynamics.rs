@@ -716,8 +716,8 @@ pub fn estimate_with(
         // in 12 dimensions wandered for ~400 evaluations).
         let starts = eigenfit_core::analysis::alternatives::search_starts(np);
         let extra = &mirrors.asymmetric;
-        if screened_fits(np).is_some() {
-            let found = screened_search(&objective, starts, np + 1, extra, &budget, &Damped, &estimate.last);
+        if let Some(keep) = screened_fits(np) {
+            let found = screened_search(&objective, starts, keep, extra, &budget, &Damped, &estimate.last);
             let report = SearchReport::of(&found, starts + extra.len());
             search_note = report.note();
             minima = found.minima;

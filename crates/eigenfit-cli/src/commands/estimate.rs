@@ -160,8 +160,7 @@ pub fn run(args: &EstimateArgs) -> Result<u8, CliError> {
                     println!("wrote {}", path.display());
                 }
             }
-            if let (Some(path), Some(mut html)) = (&args.html.html, html) {
-                let figures = figures.as_ref().expect("computed for the report");
+            if let (Some(path), Some(mut html), Some(figures)) = (&args.html.html, html, &figures) {
                 crate::report::estimate::fill_runup(&mut html, &report, &figures.for_report(&report));
                 html.write_after(path, args.report.json);
             }

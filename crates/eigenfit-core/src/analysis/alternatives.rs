@@ -267,9 +267,10 @@ pub struct Search {
 /// and the `extra` starts are ranked by misfit (one evaluation each, no derivatives), each
 /// group apart; the best `keep` of the design and the best ⌈`keep`/2⌉ extra starts are fitted
 /// locally (all extra starts were before: 17 like parameters give up to 136), and a local fit
-/// that after [`REACH_EVALUATIONS`] evaluations has not come within [`REACH_THRESHOLDS`] × the equivalence threshold (Δχ²) of
-/// the estimate `at` is abandoned and counted as such — it can no longer end equally good
-/// cheaply, and a far start in many dimensions would wander for hundreds of evaluations.
+/// that after [`REACH_EVALUATIONS`] evaluations has not come within [`REACH_THRESHOLDS`] × the
+/// equivalence threshold (Δχ²) of the estimate `at` is abandoned and counted as such — it can
+/// no longer end equally good cheaply, and a far start in many dimensions would wander for
+/// hundreds of evaluations.
 pub fn screened_search(
     problem: &dyn Objective,
     starts: usize,
