@@ -117,6 +117,9 @@ pub struct SpeedReport {
     /// unstable modes.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// The rotor solved (the file's, `--set` applied): what `--plot` draws the shapes of.
+    #[serde(skip)]
+    pub rotor: Rotor,
 }
 
 /// Damping ratio below which a mode is called unstable: an undamped rotor's come out of the
@@ -250,6 +253,7 @@ pub fn simulate_with(
         dofs: rotor.dofs(),
         plots: None,
         notes,
+        rotor,
     })
 }
 
@@ -1266,19 +1270,10 @@ pub fn shapes_at_estimate(report: &RunupEstimateReport) -> Result<RotorShapes, W
     RotorShapes::of(&report.estimated_rotor, rpm, measured_modes(report)).map_err(to_workflow)
 }
 
-/// The mode shapes and orbits of `simulate --model ROSS-FILE --speed RPM --modes N [--set …]`
-/// (what `simulate --plot` draws), `sets` applied as [`simulate_with`] applies them.
-pub fn shapes_at(
-    path: &Path,
-    speed_rpm: Option<f64>,
-    modes: usize,
-    sets: &[String],
-) -> Result<RotorShapes, WorkflowError> {
-    let mut rotor = load(path)?;
-    apply_sets(&mut rotor, sets)?;
-    let rpm = speed_rpm.unwrap_or(0.0);
-    check_speed("--speed", rpm)?;
-    RotorShapes::of(&rotor, rpm, modes).map_err(to_workflow)
+/// The mode shapes and orbits of the modes `simulate --model ROSS-FILE --speed RPM --modes N
+/// [--set …]` listed (what `simulate --plot` draws), on the rotor it solved.
+pub fn shapes_of(report: &SpeedReport) -> Result<RotorShapes, WorkflowError> {
+    RotorShapes::of(&report.rotor, report.speed_rpm, report.frequencies_hz.len()).map_err(to_workflow)
 }
 
 #[cfg(test)]

@@ -101,13 +101,11 @@ fn refuse_for_ross(args: &SimulateArgs) -> Result<(), CliError> {
 /// speed (mode-shapes.svg/.png, the numbers drawn in mode-shapes.csv). Drawn after the modes are
 /// reported: a failure is said and nothing written.
 fn ross_shapes(
-    path: &std::path::Path,
-    args: &SimulateArgs,
     report: &eigenfit_workflow::rotordynamics::SpeedReport,
     dir: &std::path::Path,
 ) -> Vec<PathBuf> {
     let what = "the mode shapes and orbits";
-    let shapes = match eigenfit_workflow::rotordynamics::shapes_at(path, args.speed, args.modes, &args.sets) {
+    let shapes = match eigenfit_workflow::rotordynamics::shapes_of(report) {
         Ok(s) => s,
         Err(e) => {
             crate::output::report_lost(what, &e.into());
@@ -139,7 +137,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             eigenfit_workflow::rotordynamics::simulate_with(path, args.speed, args.modes, &args.sets)?;
         print_notes(&report.notes);
         let plots = match &args.plot {
-            Some(dir) => ross_shapes(path, args, &report, dir),
+            Some(dir) => ross_shapes(&report, dir),
             None => Vec::new(),
         };
         report.plots = args.plot.as_ref().map(|_| plot::names(&plots));
