@@ -334,9 +334,28 @@ fn measured_shapes_update_a_model_beyond_the_dense_solvers_size() {
 #[test]
 fn measured_shapes_update_a_model_above_the_iterative_nelson_threshold() {
     // At 20,000 DOFs and more Nelson's systems are solved by CG on the eigen-solve's factor
-    // (eigenfit_core::sensitivity::NELSON_ITERATIVE_MIN_DOFS): the same update, end to end
-    // (without the search for other solutions, which the case above covers, to keep it short).
-    shapes_update_a_uniform_chain(21_000, &["--alternative-starts", "0"]);
+    // (eigenfit_core::sensitivity::NELSON_ITERATIVE_MIN_DOFS): the same update, end to end.
+    // The default search for other solutions is proportioned to the fit on a model this size
+    // (alternatives::DEAR_MODEL_DOFS): it spends at most the fit's evaluations, and says so.
+    let (v, err) = shapes_update_a_uniform_chain(21_000, &[]);
+    let phases = &v["evaluations_by_phase"];
+    let fit = phases["fit"].as_u64().unwrap();
+    let search = &v["search"];
+    assert_eq!(search["most_evaluations"].as_u64(), Some(fit), "{search}");
+    // The design of free + 1 = 4 points is ranked; the exchanged points are ranked without
+    // evaluation (here there are none: the estimate's zones are equal).
+    assert_eq!(search["ranked"].as_u64(), Some(4), "{search}");
+    let (fitted, not_fitted) = (search["fitted"].as_u64().unwrap(), search["not_fitted"].as_u64().unwrap());
+    assert!(fitted >= 2 && fitted + not_fitted == 4, "{search}");
+    // No batch of local fits starts once the search has spent the fit's evaluations: the search
+    // ends within one batch's fits of that.
+    eprintln!("evaluations by phase {phases}; search {search}");
+    let spent = phases["other_solutions"].as_u64().unwrap();
+    assert!(spent >= 4, "{phases}");
+    if not_fitted > 0 {
+        assert!(spent >= fit, "starts left unfitted before the cap was spent: {phases} {search}");
+    }
+    assert!(err.contains("at most as many evaluations as the fit"), "{err}");
 }
 
 /// A fixed–fixed chain of `n` unit masses on springs, in three zones (thirds of the springs)
@@ -344,7 +363,7 @@ fn measured_shapes_update_a_model_above_the_iterative_nelson_threshold() {
 /// shapes at 14 sensors. At zone factors (1, 1, 1) the chain is uniform and its modes are known
 /// in closed form (independent of any solver): λⱼ = 4k sin²(jπ/2(n+1)), φⱼ(i) ∝ sin(ijπ/(n+1)).
 /// Two modes determine three parameters only with the shapes counted. `extra`: further options.
-fn shapes_update_a_uniform_chain(n: usize, extra: &[&str]) {
+fn shapes_update_a_uniform_chain(n: usize, extra: &[&str]) -> (serde_json::Value, String) {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let stiffness = 1e6;
@@ -432,6 +451,7 @@ fn shapes_update_a_uniform_chain(n: usize, extra: &[&str]) {
     for (k, row) in mac.iter().enumerate() {
         assert!(row[k].as_f64().unwrap() > 0.999_999, "MAC of mode {}: {row}", k + 1);
     }
+    (v, err)
 }
 
 /// A four-mass chain (4 DOFs, masses 1): springs to ground at mass 1 (`a`), between masses 1–2

@@ -144,6 +144,11 @@ fn frequencies_alone_admit_the_mirror_solution_and_shapes_exclude_it() {
     let (at, at_mirror) =
         (Objective::cost(&fit, &est.parameters).unwrap(), Objective::cost(&fit, &mirror).unwrap());
     assert!(at_mirror > 100.0 * at, "{at} vs mirror {at_mirror}");
+    // The cost skips the shapes' derivatives, not any row: it is the linearisation's.
+    for p in [&est.parameters[..], &mirror[..], &start[..]] {
+        let (cost, lin) = (Objective::cost(&fit, p).unwrap(), fit.linearise(p).unwrap());
+        assert!((cost / lin.cost() - 1.0).abs() < 1e-12, "{p:?}: {cost} vs {}", lin.cost());
+    }
 }
 
 /// One sensor gives every MAC = 1 (to round-off): the mode nearest in frequency is taken.

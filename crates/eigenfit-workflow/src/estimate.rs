@@ -16,7 +16,7 @@ use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
     adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, local_minima_refit,
-    mirror_solutions, screened_fits, screened_search, search_starts, Equivalence, Mirrors,
+    default_screening, mirror_solutions, screened_search, search_starts, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};
@@ -614,14 +614,17 @@ pub fn run(
         mirrors = mirror_solutions(&fit, &estimate.last, &exchanges, &budget);
         phases.push(("mirror_solutions", budget.used()));
         let starts = request.alternative_starts.unwrap_or_else(|| default_alternative_starts(np));
-        // The default design of a problem with many parameters is screened by misfit; starts
-        // given on the command line are each fitted. Skipped with no start.
+        // The default design of a problem with many parameters, or of a model whose evaluation
+        // takes seconds, is screened by misfit; starts given on the command line are each
+        // fitted. Skipped with no start.
         let (extra, refit) = (&mirrors.asymmetric, &*refit);
-        match screened_fits(np).filter(|_| request.alternative_starts.is_none()) {
+        let fit_evaluations = phases.iter().find(|(name, _)| *name == "fit").map_or(0, |(_, used)| *used);
+        let screening = default_screening(np, model.dofs(), fit_evaluations);
+        match screening.filter(|_| request.alternative_starts.is_none()) {
             _ if starts == 0 => {}
-            Some(keep) => {
-                let found = screened_search(&fit, starts, keep, extra, &budget, refit, &estimate.last);
-                let report = SearchReport::of(&found, starts + extra.len());
+            Some(screening) => {
+                let found = screened_search(&fit, &screening, extra, &budget, refit, &estimate.last);
+                let report = SearchReport::of(&found, &screening, extra.len());
                 notes.extend(report.note());
                 minima = found.minima;
                 search = Some(report);

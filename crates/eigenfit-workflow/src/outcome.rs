@@ -378,23 +378,45 @@ pub struct SearchReport {
     pub abandoned: usize,
     /// Δχ² above the estimate within which a local fit had to come (`null` when σ is unknown).
     pub reach_delta_chi2: Option<f64>,
+    /// Most evaluations the search could spend (`null`: no cap but the task's budget): on a
+    /// model whose evaluation takes seconds, as many as the fit took.
+    pub most_evaluations: Option<usize>,
+    /// Starts kept by the ranking but not fitted because `most_evaluations` were spent.
+    pub not_fitted: usize,
 }
 
 impl SearchReport {
-    /// What `found` did with `ranked` starts.
-    pub fn of(found: &eigenfit_core::analysis::alternatives::Search, ranked: usize) -> Self {
+    /// What `found` did with the starts `screening` ranked and `extra` exchanged points.
+    pub fn of(
+        found: &eigenfit_core::analysis::alternatives::Search,
+        screening: &eigenfit_core::analysis::alternatives::Screening,
+        extra: usize,
+    ) -> Self {
         Self {
-            ranked,
+            ranked: screening.starts + extra,
             fitted: found.fitted,
             abandoned: found.abandoned,
             reach_delta_chi2: found.reach_delta_chi2,
+            most_evaluations: screening.most_evaluations,
+            not_fitted: found.not_fitted,
         }
     }
 
-    /// The note that says local fits were abandoned and what that means, if any were.
-    pub fn note(&self) -> Option<String> {
-        (self.abandoned > 0).then(|| {
-            format!(
+    /// The notes that say local fits were abandoned or not made, and what that means.
+    pub fn note(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        if let Some(most) = self.most_evaluations {
+            notes.push(format!(
+                "one evaluation of this model takes seconds, so the search for other solutions spent at most as many \
+                 evaluations as the fit ({most}): it ranked {} starts and fitted {} of them locally{}; --alternative-starts N \
+                 fits N starts in full",
+                self.ranked,
+                self.fitted,
+                if self.not_fitted > 0 { format!(" ({} more left unfitted)", self.not_fitted) } else { String::new() },
+            ));
+        }
+        if self.abandoned > 0 {
+            notes.push(format!(
                 "the search for other solutions abandoned {} of its {} local fits: after {} evaluations each was \
                  still more than Δχ² {} above the estimate; they tested nothing, so the search supports no claim \
                  about the regions they started from",
@@ -402,7 +424,8 @@ impl SearchReport {
                 self.fitted,
                 eigenfit_core::analysis::alternatives::REACH_EVALUATIONS,
                 self.reach_delta_chi2.map_or_else(|| "?".into(), |d| format!("{d:.1}")),
-            )
-        })
+            ));
+        }
+        notes
     }
 }

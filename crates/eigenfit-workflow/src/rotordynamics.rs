@@ -10,7 +10,7 @@ use crate::outcome::{
 };
 use eigenfit_core::analysis::alternatives::{
     adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, mirror_solutions,
-    screened_fits, screened_local_minima, screened_search, Equivalence, Mirrors,
+    screened_fits, screened_local_minima, screened_search, Equivalence, Mirrors, Screening,
 };
 use eigenfit_core::analysis::verdict::{at_limits, judge};
 use eigenfit_core::analysis::{uncertainty_parallel, Identifiability};
@@ -709,7 +709,7 @@ pub fn estimate_with(
     // then the search for other minima from a space-filling design, as for every model kind: a
     // run-up at one speed fits as many factors as frequencies, and another exact fit may exist.
     let (mut mirrors, mut minima) = (Mirrors::default(), Vec::new());
-    let (mut better_note, mut search_note, mut search) = (None, None, None);
+    let (mut better_note, mut search_note, mut search) = (None, Vec::new(), None);
     if converged {
         let exchanges = like_exchanges(&objective);
         mirrors = mirror_solutions(&objective, &estimate.last, &exchanges, &budget);
@@ -721,8 +721,9 @@ pub fn estimate_with(
         let starts = eigenfit_core::analysis::alternatives::search_starts(np);
         let extra = &mirrors.asymmetric;
         if let Some(keep) = screened_fits(np) {
-            let found = screened_search(&objective, starts, keep, extra, &budget, &Damped, &estimate.last);
-            let report = SearchReport::of(&found, starts + extra.len());
+            let screening = Screening { starts, keep, most_evaluations: None, predict_extra: false };
+            let found = screened_search(&objective, &screening, extra, &budget, &Damped, &estimate.last);
+            let report = SearchReport::of(&found, &screening, extra.len());
             search_note = report.note();
             minima = found.minima;
             search = Some(report);

@@ -182,7 +182,7 @@ impl OtherSolution {
 /// restarts; every evaluation is charged to `budget` (a spent budget ends the search with what
 /// was found). Distinct minima only, best first.
 pub fn local_minima(
-    problem: &dyn Objective,
+    problem: &(dyn Objective + Sync),
     starts: usize,
     extra: &[Vec<f64>],
     budget: &Budget,
@@ -193,7 +193,7 @@ pub fn local_minima(
 /// [`local_minima`] with the local fits made by `refit` (a registered strategy, say) instead of
 /// damped least squares without restarts.
 pub fn local_minima_refit(
-    problem: &dyn Objective,
+    problem: &(dyn Objective + Sync),
     starts: usize,
     extra: &[Vec<f64>],
     budget: &Budget,
@@ -208,7 +208,7 @@ pub fn local_minima_refit(
 /// are ranked by their misfit (one evaluation each) and only the best `keep`, with `extra`, are
 /// fitted locally. Charged to `budget`.
 pub fn screened_local_minima(
-    problem: &dyn Objective,
+    problem: &(dyn Objective + Sync),
     starts: usize,
     keep: usize,
     extra: &[Vec<f64>],
@@ -219,7 +219,7 @@ pub fn screened_local_minima(
 
 /// [`screened_local_minima`] with the local fits made by `refit`.
 pub fn screened_local_minima_refit(
-    problem: &dyn Objective,
+    problem: &(dyn Objective + Sync),
     starts: usize,
     keep: usize,
     extra: &[Vec<f64>],
@@ -234,15 +234,17 @@ pub fn screened_local_minima_refit(
 /// The `keep` points of `points` with the lowest misfit (one evaluation each, charged to
 /// `budget`; points outside the limits or that cannot be evaluated are dropped), best first.
 fn best_by_misfit(
-    problem: &dyn Objective,
+    problem: &(dyn Objective + Sync),
     points: impl Iterator<Item = Vec<f64>>,
     keep: usize,
     budget: &Budget,
 ) -> Vec<Vec<f64>> {
-    let budgeted = budget.wrap(problem);
+    use rayon::prelude::*;
+    let points: Vec<Vec<f64>> = points.filter(|p| problem.parameters().check(p).is_ok()).collect();
+    // Each point on rayon's threads, collected in the points' order (the ranking's ties too).
     let mut ranked: Vec<(f64, Vec<f64>)> = points
-        .filter(|p| problem.parameters().check(p).is_ok())
-        .filter_map(|p| budgeted.cost(&p).filter(|c| c.is_finite()).map(|c| (c, p)))
+        .into_par_iter()
+        .filter_map(|p| budget.wrap(problem).cost(&p).filter(|c| c.is_finite()).map(|c| (c, p)))
         .collect();
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
     ranked.into_iter().take(keep).map(|(_, p)| p).collect()
@@ -261,40 +263,118 @@ pub struct Search {
     pub abandoned: usize,
     /// The reach, as Δχ² above the estimate; `None` when σ is unknown (no rule applied).
     pub reach_delta_chi2: Option<f64>,
+    /// Starts kept by the screening but not fitted: the search's evaluations
+    /// ([`Screening::most_evaluations`]) were spent.
+    pub not_fitted: usize,
 }
 
-/// [`screened_local_minima_refit`] with a budget per local fit: the design's `starts` points
-/// and the `extra` starts are ranked by misfit (one evaluation each, no derivatives), each
-/// group apart; the best `keep` of the design and the best ⌈`keep`/2⌉ extra starts are fitted
-/// locally (all extra starts were before: 17 like parameters give up to 136), and a local fit
-/// that after [`REACH_EVALUATIONS`] evaluations has not come within [`REACH_THRESHOLDS`] × the
+/// How a screened search ([`screened_search`]) treats its starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Screening {
+    /// Points of the space-filling design, ranked by misfit (one evaluation each).
+    pub starts: usize,
+    /// How many of the design are fitted (the best by misfit); of the extra starts, ⌈keep/2⌉.
+    pub keep: usize,
+    /// Most evaluations the search spends, its ranking included: once spent, no further local
+    /// fit starts (`None`: no cap but the task's budget).
+    pub most_evaluations: Option<usize>,
+    /// Rank the extra starts by the misfit the estimate's linearisation predicts for them,
+    /// ½‖r − JΔp‖², instead of by an evaluation each.
+    pub predict_extra: bool,
+}
+
+/// Degrees of freedom from which one evaluation of a model takes seconds (an eigen-solve of a
+/// 10⁵-DOF plate with its shapes' derivatives, ~3–6 s here) and the default search is
+/// proportioned to the fit ([`default_screening`]): fitting 4·free + 8 starts in full took over
+/// 15 minutes on that plate (issue 29, item 7b).
+pub const DEAR_MODEL_DOFS: usize = 20_000;
+
+/// The default search's screening for a model of `dofs` degrees of freedom with `free` free
+/// parameters whose fit took `fit_evaluations`: `None` (every start fitted) up to
+/// [`SCREEN_ABOVE_FREE`] parameters on a model below [`DEAR_MODEL_DOFS`]; above
+/// [`SCREEN_ABOVE_FREE`] the best `free + 1` of the 4·free + 8 design points and ⌈(free + 1)/2⌉
+/// exchanged points ([`screened_fits`]). On a dear model the search costs at most what the fit
+/// cost: `free + 1` design points ranked, the exchanged points ranked by the linearised misfit
+/// (no evaluation), and local fits from the best, [`FITS_AT_ONCE`] at a time, until the search
+/// has spent `fit_evaluations`.
+pub fn default_screening(free: usize, dofs: usize, fit_evaluations: usize) -> Option<Screening> {
+    if dofs >= DEAR_MODEL_DOFS {
+        return Some(Screening {
+            starts: free + 1,
+            keep: free + 1,
+            most_evaluations: Some(fit_evaluations.max(1)),
+            predict_extra: true,
+        });
+    }
+    screened_fits(free).map(|keep| Screening {
+        starts: search_starts(free),
+        keep,
+        most_evaluations: None,
+        predict_extra: false,
+    })
+}
+
+/// [`screened_local_minima_refit`] with a budget per local fit: the design's points and the
+/// `extra` starts are ranked by misfit, each group apart; the best `keep` of the design and
+/// the best ⌈`keep`/2⌉ extra starts are fitted locally, alternately (all extra starts were
+/// before: 17 like parameters give up to 136), and a local fit that after
+/// [`REACH_EVALUATIONS`] evaluations has not come within [`REACH_THRESHOLDS`] × the
 /// equivalence threshold (Δχ²) of the estimate `at` is abandoned and counted as such — it can
 /// no longer end equally good cheaply, and a far start in many dimensions would wander for
-/// hundreds of evaluations.
+/// hundreds of evaluations. See [`Screening`] for the rest.
 pub fn screened_search(
-    problem: &dyn Objective,
-    starts: usize,
-    keep: usize,
+    problem: &(dyn Objective + Sync),
+    screening: &Screening,
     extra: &[Vec<f64>],
     budget: &Budget,
     refit: &dyn Refit,
     at: &Linearisation,
 ) -> Search {
+    let since = budget.used();
+    let keep = screening.keep;
     // Ranked apart: the exchanged points lie next to the estimate and would crowd out the
     // design's far starts, which are what searches the rest of the space.
-    let mut points = best_by_misfit(problem, extra.iter().cloned(), keep.div_ceil(2), budget);
-    points.extend(best_by_misfit(problem, design(problem, starts), keep, budget));
+    let extra = if screening.predict_extra {
+        best_by_prediction(at, extra, keep.div_ceil(2))
+    } else {
+        best_by_misfit(problem, extra.iter().cloned(), keep.div_ceil(2), budget)
+    };
+    let design = best_by_misfit(problem, design(problem, screening.starts), keep, budget);
+    // Alternately, so that a capped search fits both kinds.
+    let mut points = Vec::with_capacity(extra.len() + design.len());
+    let (mut e, mut d) = (extra.into_iter(), design.into_iter());
+    loop {
+        match (e.next(), d.next()) {
+            (None, None) => break,
+            (a, b) => points.extend(a.into_iter().chain(b)),
+        }
+    }
     let test = Equivalence::at(at, problem.parameters().len());
     // In cost units (½Σr²): Δχ² = 2Δcost/σ².
     let reach = test.sigma2.map(|s2| (test.best_cost + 0.5 * REACH_THRESHOLDS * test.threshold * s2, s2));
-    let (minima, fitted, abandoned) =
-        fitted_minima_within(problem, points, budget, refit, reach.map(|r| r.0));
+    let cap = screening.most_evaluations.map(|most| (since, most));
+    let found = fitted_minima_within(problem, points, budget, refit, reach.map(|r| r.0), cap);
     Search {
-        minima,
-        fitted,
-        abandoned,
+        minima: found.minima,
+        fitted: found.fitted,
+        abandoned: found.abandoned,
         reach_delta_chi2: reach.map(|(cost, s2)| 2.0 * (cost - test.best_cost) / s2),
+        not_fitted: found.not_fitted,
     }
+}
+
+/// The `keep` of `points` with the lowest misfit that `at`'s linearisation predicts for them,
+/// ½‖r − JΔp‖² (no evaluation), best first.
+fn best_by_prediction(at: &Linearisation, points: &[Vec<f64>], keep: usize) -> Vec<Vec<f64>> {
+    let mut ranked: Vec<(f64, &Vec<f64>)> = points
+        .iter()
+        .map(|p| {
+            let step = nalgebra::DVector::from_iterator(p.len(), p.iter().zip(&at.parameters).map(|(a, b)| a - b));
+            (0.5 * (&at.residual - &at.jacobian * step).norm_squared(), p)
+        })
+        .collect();
+    ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
+    ranked.into_iter().take(keep).map(|(_, p)| p.clone()).collect()
 }
 
 /// `inner` for one local fit of the search, abandoned (its own budget refused) once it has had
@@ -360,72 +440,123 @@ fn design(problem: &dyn Objective, starts: usize) -> impl Iterator<Item = Vec<f6
 
 /// Local fits by `refit` from `points`: the distinct converged minima, best first.
 fn fitted_minima(
-    problem: &dyn Objective,
+    problem: &(dyn Objective + Sync),
     points: Vec<Vec<f64>>,
     budget: &Budget,
     refit: &dyn Refit,
 ) -> Vec<Linearisation> {
-    fitted_minima_within(problem, points, budget, refit, None).0
+    fitted_minima_within(problem, points, budget, refit, None, None).minima
 }
 
 /// [`fitted_minima`], each local fit abandoned when it has not come below the cost `reach`
 /// within [`REACH_EVALUATIONS`] evaluations (no rule for `None`); also the starts fitted and
 /// the fits abandoned.
+///
+/// The local fits are independent: they run on rayon's threads, and their minima are merged in
+/// the starts' order, so the result does not depend on the threads. With `most_evaluations`
+/// they run [`FITS_AT_ONCE`] at a time and no further batch starts once the search (ranking
+/// included: `budget.used()` since `since`) has spent that many.
 fn fitted_minima_within(
-    problem: &dyn Objective,
+    problem: &(dyn Objective + Sync),
     points: Vec<Vec<f64>>,
     budget: &Budget,
     refit: &dyn Refit,
     reach: Option<f64>,
-) -> (Vec<Linearisation>, usize, usize) {
+    cap: Option<(usize, usize)>,
+) -> Fitted {
+    use rayon::prelude::*;
     let params = problem.parameters();
-    let mut minima: Vec<Linearisation> = Vec::new();
-    let (mut fitted, mut abandoned) = (0, 0);
-    for start in points {
-        if budget.exhausted() {
-            break;
-        }
-        if params.check(&start).is_err() {
+    let points: Vec<Vec<f64>> = points.into_iter().filter(|p| params.check(p).is_ok()).collect();
+    let batch = if cap.is_some() { FITS_AT_ONCE } else { points.len().max(1) };
+    let mut out = Fitted::default();
+    let mut ends: Vec<Linearisation> = Vec::new();
+    for chunk in points.chunks(batch) {
+        let spent = cap.is_some_and(|(since, most)| budget.used() - since >= most);
+        if budget.exhausted() || spent {
+            out.not_fitted += chunk.len();
             continue;
         }
-        fitted += 1;
-        let est = match reach {
-            None => refit.refit(problem, &start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, budget),
-            Some(within) => {
-                // The search's budget is charged through `charged`; the fit's own budget is
-                // refused when the fit is abandoned, which ends it as a spent budget would.
-                let (charged, local) = (budget.wrap(problem), Budget::unlimited());
-                let reach = Reach {
-                    inner: &charged,
-                    local: &local,
-                    within,
-                    seen: 0.into(),
-                    best: f64::INFINITY.into(),
-                    abandoned: false.into(),
-                };
-                let est = refit.refit(&reach, &start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, &local);
-                if reach.abandoned.get() {
-                    abandoned += 1;
-                    continue;
-                }
-                est
+        let results: Vec<LocalFit> =
+            chunk.par_iter().map(|start| local_fit(problem, start, budget, refit, reach)).collect();
+        for r in results {
+            out.fitted += 1;
+            match r {
+                LocalFit::Abandoned => out.abandoned += 1,
+                LocalFit::Converged(lin) => ends.push(*lin),
+                LocalFit::Failed => {}
             }
-        };
-        let Ok(est) = est else { continue };
-        if !est.termination.is_converged() || !est.last.cost().is_finite() {
-            continue;
-        }
-        match minima
-            .iter_mut()
-            .find(|m| scaled_distance(problem, &m.parameters, &est.last.parameters) <= SAME_MINIMUM)
-        {
-            Some(m) if est.last.cost() < m.cost() => *m = est.last,
-            Some(_) => {}
-            None => minima.push(est.last),
         }
     }
-    minima.sort_by(|a, b| a.cost().total_cmp(&b.cost()));
-    (minima, fitted, abandoned)
+    for end in ends {
+        match out.minima.iter_mut().find(|m| scaled_distance(problem, &m.parameters, &end.parameters) <= SAME_MINIMUM) {
+            Some(m) if end.cost() < m.cost() => *m = end,
+            Some(_) => {}
+            None => out.minima.push(end),
+        }
+    }
+    out.minima.sort_by(|a, b| a.cost().total_cmp(&b.cost()));
+    out
+}
+
+/// Local fits at once when the search's evaluations are capped: as many as this machine's two
+/// cores run, fixed so that where the cap stops the search does not depend on the machine.
+pub const FITS_AT_ONCE: usize = 2;
+
+/// What [`fitted_minima_within`] found.
+#[derive(Default)]
+struct Fitted {
+    minima: Vec<Linearisation>,
+    fitted: usize,
+    abandoned: usize,
+    /// Starts left unfitted because the search's evaluations were spent.
+    not_fitted: usize,
+}
+
+/// How one local fit ended.
+enum LocalFit {
+    Converged(Box<Linearisation>),
+    Abandoned,
+    Failed,
+}
+
+/// One local fit of the search from `start` (see [`fitted_minima_within`]).
+fn local_fit(
+    problem: &(dyn Objective + Sync),
+    start: &[f64],
+    budget: &Budget,
+    refit: &dyn Refit,
+    reach: Option<f64>,
+) -> LocalFit {
+    if budget.exhausted() {
+        return LocalFit::Failed;
+    }
+    let est = match reach {
+        None => refit.refit(problem, start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, budget),
+        Some(within) => {
+            // The search's budget is charged through `charged`; the fit's own budget is
+            // refused when the fit is abandoned, which ends it as a spent budget would.
+            let (charged, local) = (budget.wrap(problem), Budget::unlimited());
+            let reach = Reach {
+                inner: &charged,
+                local: &local,
+                within,
+                seen: 0.into(),
+                best: f64::INFINITY.into(),
+                abandoned: false.into(),
+            };
+            let est = refit.refit(&reach, start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, &local);
+            if reach.abandoned.get() {
+                return LocalFit::Abandoned;
+            }
+            est
+        }
+    };
+    match est {
+        Ok(est) if est.termination.is_converged() && est.last.cost().is_finite() => {
+            LocalFit::Converged(Box::new(est.last))
+        }
+        _ => LocalFit::Failed,
+    }
 }
 
 /// The minimum of `minima` that fits better than `at`'s own minimum and lies elsewhere (more
@@ -585,10 +716,17 @@ pub fn mirror_solutions(
         .collect();
     let mut probe_lin: Option<Option<Linearisation>> = None;
     let mut out = Mirrors::default();
-    for perm in permutations {
+    let candidates: Vec<&Vec<usize>> = permutations
+        .iter()
+        // (Nearly) equal values: the exchange is the same point.
+        .filter(|perm| scaled_distance(problem, &permuted(&at.parameters, perm), &at.parameters) > MIRROR_DISTANCE)
+        .collect();
+    let broken = broken_symmetries(problem, at, &candidates, &budgeted);
+    for (perm, broken) in candidates.into_iter().zip(broken) {
         let p = permuted(&at.parameters, perm);
-        if scaled_distance(problem, &p, &at.parameters) <= MIRROR_DISTANCE {
-            continue; // (nearly) equal values: the exchange is the same point
+        if broken {
+            out.asymmetric.push(p);
+            continue;
         }
         let Ok(lin) = budgeted.linearise(&p) else { continue };
         let symmetric = same(&lin, at) && {
@@ -605,6 +743,82 @@ pub fn mirror_solutions(
         }
     }
     out
+}
+
+/// Relative difference of two columns of ∂λ/∂p, at a point an exchange leaves in place, above
+/// which the model is not symmetric under that exchange: far above the sensitivities' round-off
+/// (modes converged to 1e-10 or better), far below the difference an asymmetric zone makes.
+const BROKEN_SYMMETRY: f64 = 1e-5;
+/// Relative gap to the nearest other eigenvalue below which a mode's row of ∂λ/∂p is not used
+/// to test an exchange: a repeated eigenvalue's row is that of one vector of its eigenspace,
+/// which a symmetric model's exchange need not leave unchanged.
+const ISOLATED_EIGENVALUE: f64 = 1e-6;
+
+/// For each exchange of `permutations`, whether one linearisation shows that the model is not
+/// symmetric under it, so its exchanged point needs no evaluation of its own.
+///
+/// If the model is symmetric under π — its eigenvalues equal at q and πq for every q — then at a
+/// point q̄ that π leaves in place the derivatives along parameter i and along π(i) are equal:
+/// ∂λₖ/∂pᵢ(q̄) = ∂λₖ/∂p_π(i)(q̄) for every simple λₖ. One linearisation at the point where every
+/// set of exchanged parameters takes its mean (scaled) value tests every exchange at once; a
+/// column pair that differs proves the symmetry absent. Without the eigenvalue view, with fewer
+/// than two exchanges (the test would cost as much as the evaluation it saves), or where the
+/// exchanged parameters are not alike, nothing is decided here (all `false`).
+fn broken_symmetries(
+    problem: &dyn Objective,
+    at: &Linearisation,
+    permutations: &[&Vec<usize>],
+    budgeted: &dyn Objective,
+) -> Vec<bool> {
+    let mut broken = vec![false; permutations.len()];
+    if permutations.len() < 2 || at.eigen.is_none() {
+        return broken;
+    }
+    let params = problem.parameters().as_slice();
+    let n = params.len();
+    // Classes of parameters joined by some exchange (i ~ π(i)): the mean point of each class is
+    // left in place by every exchange.
+    let mut class: Vec<usize> = (0..n).collect();
+    fn root(class: &mut [usize], mut i: usize) -> usize {
+        while class[i] != i {
+            class[i] = class[class[i]];
+            i = class[i];
+        }
+        i
+    }
+    for perm in permutations {
+        for (i, &j) in perm.iter().enumerate() {
+            let (a, b) = (root(&mut class, i), root(&mut class, j));
+            class[a.max(b)] = a.min(b);
+        }
+    }
+    let roots: Vec<usize> = (0..n).map(|i| root(&mut class, i)).collect();
+    let alike = |i: usize, j: usize| {
+        let (a, b) = (&params[i], &params[j]);
+        a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper
+    };
+    if (0..n).any(|i| !alike(i, roots[i])) {
+        return broken;
+    }
+    let centre: Vec<f64> = (0..n)
+        .map(|i| {
+            let members: Vec<usize> = (0..n).filter(|&j| roots[j] == roots[i]).collect();
+            let mean = members.iter().map(|&j| params[j].to_scaled(at.parameters[j])).sum::<f64>()
+                / members.len() as f64;
+            params[i].from_scaled(mean).clamp(params[i].lower, params[i].upper)
+        })
+        .collect();
+    let Some(view) = budgeted.linearise(&centre).ok().and_then(|l| l.eigen) else { return broken };
+    let jac = &view.eigenvalue_jacobian;
+    for (perm, broken) in permutations.iter().zip(&mut broken) {
+        *broken = (0..jac.nrows()).filter(|&k| view.isolation[k] >= ISOLATED_EIGENVALUE).any(|k| {
+            let row = jac.row(k);
+            let scale = row.amax();
+            scale > 0.0
+                && perm.iter().enumerate().any(|(i, &j)| (row[i] - row[j]).abs() > BROKEN_SYMMETRY * scale)
+        });
+    }
+    broken
 }
 
 /// Largest scaled difference between two parameter vectors of `problem` (two points are the same
@@ -718,6 +932,101 @@ mod tests {
         assert!(mirrors.symmetric.is_empty() && mirrors.asymmetric.len() == 1, "{mirrors:?}");
     }
 
+    /// A search capped at some evaluations (a dear model's) ranks its design by one evaluation
+    /// each and its extra starts by the linearised misfit (none), fits two at a time and starts
+    /// no batch once the cap is spent — the same result every run, whatever the threads.
+    #[test]
+    fn a_capped_search_starts_no_local_fit_once_its_evaluations_are_spent() {
+        let chain = Chain::new(&[1.0, 2.0]);
+        let truth = [4e4, 1e4];
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let at = fit(&problem, &truth);
+        let extra = vec![vec![1e4, 4e4], vec![2e4, 2e4], vec![3e4, 1.5e4]];
+        let screening = Screening { starts: 6, keep: 6, most_evaluations: Some(12), predict_extra: true };
+        let run = || {
+            let budget = Budget::new(1_000);
+            let search = screened_search(&problem, &screening, &extra, &budget, &Damped, &at);
+            (search, budget.used())
+        };
+        let (search, used) = run();
+        // 6 design points and ⌈6/2⌉ = 3 extra starts kept; the ranking cost the design's 6.
+        assert_eq!(search.fitted + search.not_fitted, 9, "{search:?}");
+        assert!(search.not_fitted > 0 && search.fitted % FITS_AT_ONCE == 0, "{search:?}");
+        // A batch starts only below the cap: what was spent before the last batch was under it.
+        assert!(used >= 12, "{used}");
+        let (again, used_again) = run();
+        assert_eq!((again, used_again), (search, used));
+        // Uncapped, every kept start is fitted.
+        let all = Screening { most_evaluations: None, ..screening };
+        let search = screened_search(&problem, &all, &extra, &Budget::new(1_000), &Damped, &at);
+        assert_eq!((search.fitted, search.not_fitted), (9, 0), "{search:?}");
+    }
+
+    #[test]
+    fn extra_starts_are_ranked_by_the_misfit_the_linearisation_predicts() {
+        let chain = Chain::new(&[1.0, 2.0]);
+        let truth = [4e4, 1e4];
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let at = fit(&problem, &truth);
+        let near = vec![4.1e4, 1.01e4];
+        let far = vec![1e4, 4e4];
+        let ranked = best_by_prediction(&at, &[far.clone(), near.clone()], 1);
+        assert_eq!(ranked, vec![near]);
+        assert_eq!(best_by_prediction(&at, &[far.clone()], 3), vec![far]);
+    }
+
+    /// ground –k₁– m –k₂– m –k₃– ground with equal masses: symmetric under k₁ ↔ k₃ only.
+    struct Clamped {
+        params: ParameterSet,
+    }
+
+    impl StructuralModel for Clamped {
+        fn parameters(&self) -> &ParameterSet {
+            &self.params
+        }
+        fn dofs(&self) -> usize {
+            2
+        }
+        fn assemble(&self, p: &[f64]) -> Result<System, ModelError> {
+            self.params.check(p)?;
+            let k = DMatrix::from_row_slice(2, 2, &[p[0] + p[1], -p[1], -p[1], p[1] + p[2]]);
+            Ok(System::new(k, DMatrix::from_diagonal(&DVector::from_element(2, 1.0)))?)
+        }
+    }
+
+    /// One linearisation where the like parameters are equal shows which exchanges the model is
+    /// not symmetric under: their exchanged points need no evaluation, and the one exchange the
+    /// model is symmetric under is still tested in full and found.
+    #[test]
+    fn one_linearisation_rules_out_the_exchanges_a_model_is_not_symmetric_under() {
+        let k = |n: &str| Parameter::new(n, "N/m", 1e4).with_bounds(1e-3, 1e9).with_scale(Scale::Log);
+        let model = Clamped { params: ParameterSet::new(vec![k("k1"), k("k2"), k("k3")]).unwrap() };
+        let truth = [2e4, 5e3, 8e3];
+        let problem = Problem::new(&model, DenseSolver, measured(&model, &truth, Some(1e-3)));
+        let at = problem.linearise(&truth).unwrap();
+        let exchanges = like_exchanges(&problem);
+        assert_eq!(exchanges.len(), 3);
+        let budget = Budget::new(100);
+        let mirrors = mirror_solutions(&problem, &at, &exchanges, &budget);
+        // k₁ ↔ k₃ is a symmetry: its exchanged point fits as well as the estimate.
+        assert_eq!(mirrors.symmetric.len(), 1, "{mirrors:?}");
+        let m = &mirrors.symmetric[0];
+        assert_eq!(m.permutation, Some(vec![2, 1, 0]), "{m:?}");
+        assert!(m.is_mirror() && m.judged.delta_chi2.unwrap().abs() < 1e-6, "{m:?}");
+        // k₁ ↔ k₂ and k₂ ↔ k₃ are not: their exchanged points are starts.
+        assert_eq!(mirrors.asymmetric.len(), 2, "{mirrors:?}");
+        // The screen (1) and the full test of k₁ ↔ k₃ (its point, the probe and its exchange):
+        // 4 evaluations where every exchange tested in full took 5.
+        assert_eq!(budget.used(), 4);
+        // Where the eigenvalue view is missing the screen decides nothing: all three in full.
+        let mut bare = at.clone();
+        bare.eigen = None;
+        let budget = Budget::new(100);
+        let full = mirror_solutions(&problem, &bare, &exchanges, &budget);
+        assert_eq!((full.symmetric.len(), full.asymmetric.len()), (1, 2), "{full:?}");
+        assert_eq!(budget.used(), 5);
+    }
+
     /// A fit stopped short of the minimum, and the search's deeper minimum taken as the estimate:
     /// the estimate, its last linearisation and the end of its history are that minimum, the
     /// fit's own end point is kept as an alternative, and the history says where its last point
@@ -789,8 +1098,8 @@ mod tests {
         let mut abandoned_seen = 0;
         for start in design(&problem, 12) {
             let budget = Budget::new(1_000);
-            let (minima, fitted, abandoned) =
-                fitted_minima_within(&problem, vec![start.clone()], &budget, &Damped, Some(-1.0));
+            let Fitted { minima, fitted, abandoned, .. } =
+                fitted_minima_within(&problem, vec![start.clone()], &budget, &Damped, Some(-1.0), None);
             assert_eq!(fitted, 1);
             if abandoned == 1 {
                 abandoned_seen += 1;
@@ -806,8 +1115,10 @@ mod tests {
         }
         assert!(abandoned_seen > 0, "no start of the design needed more than the probe");
         // The screened search counts what it fitted and abandoned, and gives the reach in Δχ².
-        let search = screened_search(&problem, 8, 3, &[], &Budget::new(1_000), &Damped, &at);
+        let screening = Screening { starts: 8, keep: 3, most_evaluations: None, predict_extra: false };
+        let search = screened_search(&problem, &screening, &[], &Budget::new(1_000), &Damped, &at);
         assert_eq!(search.fitted, 3);
+        assert_eq!(search.not_fitted, 0);
         let threshold = Equivalence::at(&at, 2).threshold();
         assert!((search.reach_delta_chi2.unwrap() / (REACH_THRESHOLDS * threshold) - 1.0).abs() < 1e-9);
     }

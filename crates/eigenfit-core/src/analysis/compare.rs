@@ -152,7 +152,7 @@ pub struct SharedData {
 impl SharedData {
     /// Finds the local solutions of `problem`'s data and, when `rank_seeds`, ranks the
     /// restart seeds.
-    pub fn new(problem: &dyn Objective, rank_seeds: bool) -> Self {
+    pub fn new(problem: &(dyn Objective + Sync), rank_seeds: bool) -> Self {
         Self {
             seeds: if rank_seeds { LevenbergMarquardt::rank_seeds(problem) } else { Arc::new(Vec::new()) },
             solutions: local_minima(
@@ -167,7 +167,7 @@ impl SharedData {
     /// What runs of `strategies` (registry names) on `problem` share: the local solutions, and
     /// the ranked seeds when one of them restarts from ranked starts.
     pub fn for_runs(
-        problem: &dyn Objective,
+        problem: &(dyn Objective + Sync),
         registry: &Registry,
         strategies: &[String],
     ) -> Result<Self, StrategyError> {
@@ -337,7 +337,7 @@ pub fn run_grid_serial<M, S>(
     mut on_run: impl FnMut(&CompareRun),
 ) -> Result<Vec<CompareRun>, CompareError>
 where
-    M: StructuralModel,
+    M: StructuralModel + Sync,
     S: EigenSolver,
 {
     let registry = crate::update::registry::registry();

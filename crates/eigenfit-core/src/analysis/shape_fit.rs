@@ -10,7 +10,7 @@
 use crate::eigen::EigenSolver;
 use crate::model::{ParameterSet, StructuralModel};
 use crate::problem::{Linearisation, Objective, Pairing, Problem, ResidualError};
-use crate::sensitivity::eigenvector_derivatives_nelson_modes;
+use crate::sensitivity::{eigenvector_derivatives_nelson_modes, Sensitivities};
 use nalgebra::{DMatrix, DVector};
 
 /// Default standard deviation of a unit-length measured shape's entries.
@@ -117,30 +117,25 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
     }
 }
 
-impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
-    fn parameters(&self) -> &ParameterSet {
-        self.problem.parameters()
-    }
-
-    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
-        // The modes the frequency rows were paired on: one eigen-solve per linearisation.
-        let (mut lin, sens) = self.problem.linearise_with_modes(p)?;
-        let (modes, derivatives) = (&sens.modes, &sens.derivatives);
+impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
+    /// The residual of every row at the frequency linearisation `lin` (solved with `sens`), and
+    /// (u, ‖s‖) of each paired mode's model shape at the sensors: all of a linearisation but its
+    /// shape derivatives.
+    #[allow(clippy::type_complexity)]
+    fn residual_rows(
+        &self,
+        lin: &Linearisation,
+        sens: &Sensitivities,
+    ) -> Result<(DVector<f64>, Vec<(DVector<f64>, f64)>), ResidualError> {
+        let modes = &sens.modes;
         let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
             return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
         };
-        let system = &sens.system;
-        let np = p.len();
         let m = lin.residual.len();
         let ns = sensor_dofs.len();
-        let rows = m + m * ns;
-        let mut residual = DVector::zeros(rows);
-        let mut jacobian = DMatrix::zeros(rows, np);
-        let w = self.frequency_weight / self.scale;
-        residual.rows_mut(0, m).copy_from(&(&lin.residual * w));
-        jacobian.rows_mut(0, m).copy_from(&(&lin.jacobian * w));
+        let mut residual = DVector::zeros(m + m * ns);
+        residual.rows_mut(0, m).copy_from(&(&lin.residual * (self.frequency_weight / self.scale)));
         let ws = 1.0 / (self.shape_std * self.scale);
-        // (u, ‖s‖) of each paired mode, the residual rows filled on the way.
         let mut units = Vec::with_capacity(lin.paired_modes.len());
         for (j, (meas, &k)) in self.problem.measured.modes().iter().zip(&lin.paired_modes).enumerate() {
             let d = meas
@@ -170,6 +165,30 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
             residual.rows_mut(m + j * ns, ns).copy_from(&((ud - &u) * ws));
             units.push((u, sn));
         }
+        Ok((residual, units))
+    }
+}
+
+impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
+    fn parameters(&self) -> &ParameterSet {
+        self.problem.parameters()
+    }
+
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        // The modes the frequency rows were paired on: one eigen-solve per linearisation.
+        let (mut lin, sens) = self.problem.linearise_with_modes(p)?;
+        let (residual, units) = self.residual_rows(&lin, &sens)?;
+        let (modes, derivatives) = (&sens.modes, &sens.derivatives);
+        let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
+            return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
+        };
+        let system = &sens.system;
+        let np = p.len();
+        let m = lin.residual.len();
+        let ns = sensor_dofs.len();
+        let mut jacobian = DMatrix::zeros(residual.len(), np);
+        jacobian.rows_mut(0, m).copy_from(&(&lin.jacobian * (self.frequency_weight / self.scale)));
+        let ws = 1.0 / (self.shape_std * self.scale);
         // Every paired mode and parameter in one call: at large sizes their systems share the
         // eigen-solve's factor (no factorisation per mode).
         let ks = &lin.paired_modes[..units.len()];
@@ -188,5 +207,13 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
         lin.has_std = self.has_std();
         lin.rows_weighted = true;
         Ok(lin)
+    }
+
+    /// ½‖r‖² without the shapes' derivatives (Nelson's systems are most of a large model's
+    /// linearisation): the same eigen-solve, pairing and rows as [`linearise`](Self::linearise).
+    fn cost(&self, p: &[f64]) -> Option<f64> {
+        let (lin, sens) = self.problem.linearise_with_modes(p).ok()?;
+        let (residual, _) = self.residual_rows(&lin, &sens).ok()?;
+        Some(0.5 * residual.norm_squared())
     }
 }

@@ -139,12 +139,13 @@ fn scatter_with<P: Objective>(
     }
     let old = *scale(problem);
     *scale(problem) = old * scatter;
-    let result = problem
-        .linearise(&at.parameters)
-        .ok()
-        // The rescaled rows are in noise units, as weights from std would put them.
-        .and_then(|lin| weighted(problem, &lin))
-        .map(|u| (u, scatter));
+    // `scale` divides every row, so the estimate's linearisation at the new scale is `at`'s
+    // divided by σ̂: no evaluation (one is a linearisation of seconds on a large model). The
+    // rescaled rows are in noise units, as weights from std would put them.
+    let mut lin = at.clone();
+    lin.residual /= scatter;
+    lin.jacobian /= scatter;
+    let result = weighted(problem, &lin).map(|u| (u, scatter));
     *scale(problem) = old;
     result
 }

@@ -55,6 +55,7 @@ fn stack_eigen(np: usize, parts: &[Linearisation]) -> Option<EigenView> {
         model_eigenvalues: stack_rows(views.iter().map(|v| &v.model_eigenvalues)),
         measured_eigenvalues: stack_rows(views.iter().map(|v| &v.measured_eigenvalues)),
         eigenvalue_jacobian: stack_blocks(np, views.iter().map(|v| &v.eigenvalue_jacobian)),
+        isolation: stack_rows(views.iter().map(|v| &v.isolation)),
     })
 }
 

@@ -99,6 +99,21 @@ pub struct EigenView {
     pub measured_eigenvalues: DVector<f64>,
     /// ∂λ/∂p of the paired modes in physical parameter units (the paper's sensitivity matrix).
     pub eigenvalue_jacobian: DMatrix<f64>,
+    /// Each paired eigenvalue's relative distance to the nearest other computed one, 0 for the
+    /// highest computed (its upper neighbour was not kept): where it is small the eigenvalue is
+    /// (nearly) repeated and its row of ∂λ/∂p is that of one vector of the eigenspace.
+    pub isolation: DVector<f64>,
+}
+
+/// λₖ's relative distance to the nearest other of the ascending `eigenvalues`, 0 for the last
+/// (its upper neighbour is not known).
+fn isolation(eigenvalues: &[f64], k: usize) -> f64 {
+    if k + 1 >= eigenvalues.len() {
+        return 0.0;
+    }
+    let lambda = eigenvalues[k];
+    let below = k.checked_sub(1).map_or(f64::INFINITY, |i| lambda - eigenvalues[i]);
+    below.min(eigenvalues[k + 1] - lambda) / lambda.abs().max(f64::MIN_POSITIVE)
 }
 
 impl Linearisation {
@@ -263,6 +278,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             model_eigenvalues: DVector::zeros(m),
             measured_eigenvalues: DVector::zeros(m),
             eigenvalue_jacobian: DMatrix::zeros(m, np),
+            isolation: DVector::zeros(m),
         };
         let mut lin = Linearisation {
             parameters: p.to_vec(),
@@ -286,6 +302,7 @@ impl<M: StructuralModel, S: EigenSolver> Problem<M, S> {
             lin.measured_hz[row] = fm;
             lin.round_off[row] = 0.5 * sens.eigenvalue_round_off[k];
             eigen.eigenvalue_jacobian.row_mut(row).copy_from(&sens.eigenvalues.row(k));
+            eigen.isolation[row] = isolation(sens.modes.eigenvalues.as_slice(), k);
             let (r, scale, sigma) = self.residual_terms(meas, lambda);
             lin.residual[row] = r / sigma;
             lin.jacobian.row_mut(row).copy_from(&(sens.eigenvalues.row(k) * (scale / sigma)));

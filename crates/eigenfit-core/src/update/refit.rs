@@ -197,6 +197,7 @@ impl Objective for Held<'_> {
                 model_eigenvalues: e.model_eigenvalues.clone(),
                 measured_eigenvalues: e.measured_eigenvalues.clone(),
                 eigenvalue_jacobian: e.eigenvalue_jacobian.select_columns(&self.free),
+                isolation: e.isolation.clone(),
             }),
         };
         let mut seen = self.seen.borrow_mut();
