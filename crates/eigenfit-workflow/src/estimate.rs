@@ -15,8 +15,8 @@ use crate::simulate::check_roundoff_of;
 use crate::source::ModelSource;
 use crate::test_data::{self, updated_model_toml, Fit, ShapeReport, TestData, TestDataOptions};
 use eigenfit_core::analysis::alternatives::{
-    adopt_better_minimum, better_minimum, like_exchanges, listed_alternatives, local_minima_refit,
-    default_screening, mirror_solutions, screened_search, search_starts, Equivalence, Mirrors,
+    adopt_better_minimum, better_minimum, default_screening, like_exchanges, listed_alternatives,
+    local_minima_refit, mirror_solutions, screened_search, search_starts, Equivalence, Mirrors,
 };
 use eigenfit_core::analysis::verdict::{at_limits, check_reachable, check_softest, judge, FitQuality};
 use eigenfit_core::analysis::{Identifiability, Rank, Uncertainty};

@@ -369,7 +369,8 @@ fn best_by_prediction(at: &Linearisation, points: &[Vec<f64>], keep: usize) -> V
     let mut ranked: Vec<(f64, &Vec<f64>)> = points
         .iter()
         .map(|p| {
-            let step = nalgebra::DVector::from_iterator(p.len(), p.iter().zip(&at.parameters).map(|(a, b)| a - b));
+            let step =
+                nalgebra::DVector::from_iterator(p.len(), p.iter().zip(&at.parameters).map(|(a, b)| a - b));
             (0.5 * (&at.residual - &at.jacobian * step).norm_squared(), p)
         })
         .collect();
@@ -488,7 +489,11 @@ fn fitted_minima_within(
         }
     }
     for end in ends {
-        match out.minima.iter_mut().find(|m| scaled_distance(problem, &m.parameters, &end.parameters) <= SAME_MINIMUM) {
+        match out
+            .minima
+            .iter_mut()
+            .find(|m| scaled_distance(problem, &m.parameters, &end.parameters) <= SAME_MINIMUM)
+        {
             Some(m) if end.cost() < m.cost() => *m = end,
             Some(_) => {}
             None => out.minima.push(end),
@@ -719,7 +724,9 @@ pub fn mirror_solutions(
     let candidates: Vec<&Vec<usize>> = permutations
         .iter()
         // (Nearly) equal values: the exchange is the same point.
-        .filter(|perm| scaled_distance(problem, &permuted(&at.parameters, perm), &at.parameters) > MIRROR_DISTANCE)
+        .filter(|perm| {
+            scaled_distance(problem, &permuted(&at.parameters, perm), &at.parameters) > MIRROR_DISTANCE
+        })
         .collect();
     let broken = broken_symmetries(problem, at, &candidates, &budgeted);
     for (perm, broken) in candidates.into_iter().zip(broken) {
@@ -972,7 +979,7 @@ mod tests {
         let far = vec![1e4, 4e4];
         let ranked = best_by_prediction(&at, &[far.clone(), near.clone()], 1);
         assert_eq!(ranked, vec![near]);
-        assert_eq!(best_by_prediction(&at, &[far.clone()], 3), vec![far]);
+        assert_eq!(best_by_prediction(&at, std::slice::from_ref(&far), 3), vec![far]);
     }
 
     /// ground –k₁– m –k₂– m –k₃– ground with equal masses: symmetric under k₁ ↔ k₃ only.
