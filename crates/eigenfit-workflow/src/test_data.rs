@@ -296,6 +296,16 @@ impl Objective for Fit<'_> {
             Fit::Shapes(s) => Objective::cost(s, p),
         }
     }
+    fn linearise_accepted(
+        &self,
+        p: &[f64],
+        accept: &dyn Fn(f64) -> bool,
+    ) -> Result<Option<Linearisation>, ResidualError> {
+        match self {
+            Fit::Frequencies(q) => q.linearise_accepted(p, accept),
+            Fit::Shapes(s) => s.linearise_accepted(p, accept),
+        }
+    }
 }
 
 /// The measured modes (numbers from 1, `mode_numbers` in the data's order) that the residual

@@ -429,6 +429,23 @@ impl Objective for Reach<'_> {
         self.saw(cost);
         Some(cost)
     }
+
+    fn linearise_accepted(
+        &self,
+        p: &[f64],
+        accept: &dyn Fn(f64) -> bool,
+    ) -> Result<Option<Linearisation>, crate::problem::ResidualError> {
+        if !self.admit() {
+            return Err(crate::problem::ResidualError::BudgetExhausted { limit: self.seen.get() });
+        }
+        let seen = std::cell::Cell::new(f64::INFINITY);
+        let lin = self.inner.linearise_accepted(p, &|cost| {
+            seen.set(cost);
+            accept(cost)
+        })?;
+        self.saw(seen.get());
+        Ok(lin)
+    }
 }
 
 /// The Halton design of `starts` points over `problem`'s search ranges.

@@ -167,23 +167,22 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         }
         Ok((residual, units))
     }
-}
 
-impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
-    fn parameters(&self) -> &ParameterSet {
-        self.problem.parameters()
-    }
-
-    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
-        // The modes the frequency rows were paired on: one eigen-solve per linearisation.
-        let (mut lin, sens) = self.problem.linearise_with_modes(p)?;
-        let (residual, units) = self.residual_rows(&lin, &sens)?;
+    /// The linearisation of every row: `lin` (the frequency rows' own, solved with `sens`) with
+    /// `residual` and the Jacobian of the frequency rows and, by Nelson's method, of the shapes
+    /// (`units` from [`residual_rows`](Self::residual_rows)).
+    fn with_jacobian(
+        &self,
+        mut lin: Linearisation,
+        sens: &Sensitivities,
+        residual: DVector<f64>,
+        units: &[(DVector<f64>, f64)],
+    ) -> Result<Linearisation, ResidualError> {
         let (modes, derivatives) = (&sens.modes, &sens.derivatives);
         let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
             return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
         };
-        let system = &sens.system;
-        let np = p.len();
+        let np = lin.parameters.len();
         let m = lin.residual.len();
         let ns = sensor_dofs.len();
         let mut jacobian = DMatrix::zeros(residual.len(), np);
@@ -192,7 +191,7 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
         // Every paired mode and parameter in one call: at large sizes their systems share the
         // eigen-solve's factor (no factorisation per mode).
         let ks = &lin.paired_modes[..units.len()];
-        let dphis = eigenvector_derivatives_nelson_modes(system, modes, ks, derivatives)?;
+        let dphis = eigenvector_derivatives_nelson_modes(&sens.system, modes, ks, derivatives)?;
         for (j, ((u, sn), dphi_k)) in units.iter().zip(&dphis).enumerate() {
             for (i, dphi) in dphi_k.iter().enumerate() {
                 let ds = DVector::from_iterator(ns, sensor_dofs.iter().map(|&dof| dphi[dof]));
@@ -207,6 +206,33 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
         lin.has_std = self.has_std();
         lin.rows_weighted = true;
         Ok(lin)
+    }
+}
+
+impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
+    fn parameters(&self) -> &ParameterSet {
+        self.problem.parameters()
+    }
+
+    fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
+        // The modes the frequency rows were paired on: one eigen-solve per linearisation.
+        let (lin, sens) = self.problem.linearise_with_modes(p)?;
+        let (residual, units) = self.residual_rows(&lin, &sens)?;
+        self.with_jacobian(lin, &sens, residual, &units)
+    }
+
+    /// A rejected trial skips Nelson's systems, most of a large model's linearisation.
+    fn linearise_accepted(
+        &self,
+        p: &[f64],
+        accept: &dyn Fn(f64) -> bool,
+    ) -> Result<Option<Linearisation>, ResidualError> {
+        let (lin, sens) = self.problem.linearise_with_modes(p)?;
+        let (residual, units) = self.residual_rows(&lin, &sens)?;
+        if !accept(0.5 * residual.norm_squared()) {
+            return Ok(None);
+        }
+        self.with_jacobian(lin, &sens, residual, &units).map(Some)
     }
 
     /// ½‖r‖² without the shapes' derivatives (Nelson's systems are most of a large model's

@@ -20,6 +20,17 @@ pub trait Objective {
     fn cost(&self, p: &[f64]) -> Option<f64> {
         self.linearise(p).ok().map(|l| l.cost())
     }
+    /// A trial point: [`linearise`](Self::linearise) at `p` when `accept` takes the cost there,
+    /// `Ok(None)` when it does not — one evaluation either way, but an implementation may skip
+    /// the Jacobian of a rejected trial (a shape fit's Nelson systems). Wrappers forward it.
+    fn linearise_accepted(
+        &self,
+        p: &[f64],
+        accept: &dyn Fn(f64) -> bool,
+    ) -> Result<Option<Linearisation>, ResidualError> {
+        let lin = self.linearise(p)?;
+        Ok(accept(lin.cost()).then_some(lin))
+    }
 }
 
 impl<M: StructuralModel, S: EigenSolver> Objective for Problem<M, S> {

@@ -101,6 +101,16 @@ impl Objective for Budgeted<'_> {
         }
         self.inner.cost(p)
     }
+    fn linearise_accepted(
+        &self,
+        p: &[f64],
+        accept: &dyn Fn(f64) -> bool,
+    ) -> Result<Option<Linearisation>, ResidualError> {
+        if !self.budget.charge() {
+            return Err(ResidualError::BudgetExhausted { limit: self.budget.limit });
+        }
+        self.inner.linearise_accepted(p, accept)
+    }
 }
 
 #[cfg(test)]

@@ -42,4 +42,12 @@ impl Objective for Counted<'_> {
         self.charge();
         self.inner.cost(p)
     }
+    fn linearise_accepted(
+        &self,
+        p: &[f64],
+        accept: &dyn Fn(f64) -> bool,
+    ) -> Result<Option<Linearisation>, ResidualError> {
+        self.charge();
+        self.inner.linearise_accepted(p, accept)
+    }
 }

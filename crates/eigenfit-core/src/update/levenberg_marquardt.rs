@@ -485,21 +485,20 @@ impl LevenbergMarquardt {
                 };
             }
             let predicted = delta.dot(&g) - 0.5 * delta.dot(&(&a * &delta));
-            let trial = match problem.linearise(&p_new) {
-                Ok(t) if t.residual.iter().all(|v| v.is_finite()) => t,
+            // The gain ratio decides from the cost alone: a rejected trial's Jacobian is never
+            // used, and a shape fit skips it (`linearise_accepted`).
+            let accept = |cost: f64| cost.is_finite() && predicted > 0.0 && (cost0 - cost) / predicted > 1e-4;
+            let trial = match problem.linearise_accepted(&p_new, &accept) {
+                Ok(Some(t)) if t.residual.iter().all(|v| v.is_finite()) => t,
                 _ => {
                     self.reject();
                     continue;
                 }
             };
-            let actual = cost0 - trial.cost();
-            if predicted > 0.0 && actual / predicted > 1e-4 {
-                let rho = actual / predicted;
-                self.mu *= f64::max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0).powi(3));
-                self.nu = 2.0;
-                return Ok(Some(Step { next: trial, status: StepStatus::Continue }));
-            }
-            self.reject();
+            let rho = (cost0 - trial.cost()) / predicted;
+            self.mu *= f64::max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0).powi(3));
+            self.nu = 2.0;
+            return Ok(Some(Step { next: trial, status: StepStatus::Continue }));
         }
         Err(UpdateError::Stalled(format!("no acceptable step in {} trials", self.settings.max_trials)))
     }

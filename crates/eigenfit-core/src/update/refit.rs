@@ -181,6 +181,25 @@ impl Objective for Held<'_> {
 
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
         let full = self.inner.linearise(&self.widen(p))?;
+        Ok(self.reduced(p, full))
+    }
+
+    fn cost(&self, p: &[f64]) -> Option<f64> {
+        self.inner.cost(&self.widen(p))
+    }
+
+    fn linearise_accepted(
+        &self,
+        p: &[f64],
+        accept: &dyn Fn(f64) -> bool,
+    ) -> Result<Option<Linearisation>, ResidualError> {
+        Ok(self.inner.linearise_accepted(&self.widen(p), accept)?.map(|full| self.reduced(p, full)))
+    }
+}
+
+impl Held<'_> {
+    /// The linearisation at the free parameters `p` of `full`, `inner`'s at the widened point.
+    fn reduced(&self, p: &[f64], full: Linearisation) -> Linearisation {
         // The full one is kept for the expansion back: the reduced one copies its rows and only
         // the free parameters' columns (no copy of the full Jacobians).
         let reduced = Linearisation {
@@ -205,11 +224,7 @@ impl Objective for Held<'_> {
             seen.remove(0);
         }
         seen.push(full);
-        Ok(reduced)
-    }
-
-    fn cost(&self, p: &[f64]) -> Option<f64> {
-        self.inner.cost(&self.widen(p))
+        reduced
     }
 }
 
