@@ -834,6 +834,9 @@ fn broken_symmetries(
         .collect();
     let Some(view) = budgeted.linearise(&centre).ok().and_then(|l| l.eigen) else { return broken };
     let jac = &view.eigenvalue_jacobian;
+    if jac.ncols() != n || view.isolation.len() != jac.nrows() {
+        return broken;
+    }
     for (perm, broken) in permutations.iter().zip(&mut broken) {
         *broken = (0..jac.nrows()).filter(|&k| view.isolation[k] >= ISOLATED_EIGENVALUE).any(|k| {
             let row = jac.row(k);
