@@ -652,8 +652,15 @@ pub fn run(
         progress.end();
     }
     // Never a fit whose model frequencies are lost to round-off (an extreme stiffness).
+    // A shape fit's MAC report solves the modes at the estimate anyway: the check reads them.
     let system = model.assemble(&estimate.parameters).map_err(|e| input(e.to_string()))?;
-    if let Ok(modes) = solver.lowest(&system, mode_numbers.iter().copied().max().unwrap_or(1)) {
+    let (mac, mac_modes) = fit.mac_with_modes(&estimate.parameters, options.shape.mac_threshold).unzip();
+    let highest = mode_numbers.iter().copied().max().unwrap_or(1);
+    let modes = match mac_modes.filter(|m| m.count() >= highest) {
+        Some(modes) => Ok(modes),
+        None => solver.lowest(&system, highest),
+    };
+    if let Ok(modes) = modes {
         notes.extend(check_roundoff_of(&system, &modes, Some(&mode_numbers))?);
     }
     // Whether the data determine the parameters: the numerical rank of the weighted Jacobian of
@@ -682,7 +689,6 @@ pub fn run(
         (None, None)
     };
     phases.push(("intervals", budget.used()));
-    let mac = fit.mac(&estimate.parameters, options.shape.mac_threshold);
     // Mirrors first, then the other minima not already listed, each judged against the estimate.
     let alternatives = listed_alternatives(&fit, &estimate.last, mirrors.symmetric, &minima);
     let alternatives_sigma = Equivalence::at(&estimate.last, np).sigma_source();

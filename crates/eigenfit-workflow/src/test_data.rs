@@ -8,7 +8,7 @@ use crate::error::{failure, input, WorkflowError};
 use crate::model::Updatable;
 use crate::named::Named;
 use eigenfit_core::analysis::{ShapeFit, Uncertainty};
-use eigenfit_core::eigen::EigenSolver;
+use eigenfit_core::eigen::{EigenSolver, Modes};
 use eigenfit_core::measurement::mac::MacReport;
 use eigenfit_core::measurement::sensors::{self, NodeLayout, SensorSet};
 use eigenfit_core::measurement::{measured_csv, uff, Measurement};
@@ -264,8 +264,14 @@ impl<'a> Fit<'a> {
 
     /// The MAC report at the estimate (shapes only).
     pub fn mac(&self, p: &[f64], threshold: f64) -> Option<MacReport> {
+        self.mac_with_modes(p, threshold).map(|(report, _)| report)
+    }
+
+    /// [`mac`](Self::mac) and the model modes it was computed from (the lowest 2m + 2), for
+    /// the other checks at the estimate without a second eigen-solve.
+    pub fn mac_with_modes(&self, p: &[f64], threshold: f64) -> Option<(MacReport, Modes)> {
         let Fit::Shapes(s) = self else { return None };
-        let (model, paired) = s.model_at_sensors(p).ok()?;
+        let (model, paired, modes) = s.model_at_sensors(p).ok()?;
         let measured: Vec<(usize, &[f64])> = s
             .problem
             .measured
@@ -273,7 +279,7 @@ impl<'a> Fit<'a> {
             .iter()
             .filter_map(|m| m.shape.as_deref().map(|v| (m.mode, v)))
             .collect();
-        Some(MacReport::new(&measured, &model, &paired, threshold))
+        Some((MacReport::new(&measured, &model, &paired, threshold), modes))
     }
 }
 

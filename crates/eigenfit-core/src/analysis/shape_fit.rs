@@ -58,9 +58,14 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         self.measured_shape_std && self.problem.measured.has_std()
     }
 
-    /// The model shapes at the sensors, one per computed mode, and the paired model modes,
+    /// The model shapes at the sensors, one per computed mode, the paired model modes, and the
+    /// computed modes themselves (for other checks at the same point without a second solve),
     /// at `p`.
-    pub fn model_at_sensors(&self, p: &[f64]) -> Result<(Vec<Vec<f64>>, Vec<usize>), ResidualError> {
+    #[allow(clippy::type_complexity)]
+    pub fn model_at_sensors(
+        &self,
+        p: &[f64],
+    ) -> Result<(Vec<Vec<f64>>, Vec<usize>, crate::eigen::Modes), ResidualError> {
         let (lin, sens) = self.problem.linearise_with_modes(p)?;
         let modes = &sens.modes;
         let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
@@ -68,7 +73,7 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         };
         let shapes =
             (0..modes.count()).map(|k| sensor_dofs.iter().map(|&d| modes.shapes[(d, k)]).collect()).collect();
-        Ok((shapes, lin.paired_modes))
+        Ok((shapes, lin.paired_modes, sens.modes))
     }
 
     /// 95 % intervals at the estimate `at` (a linearisation of this fit). With standard
