@@ -618,7 +618,11 @@ pub fn run(
         // takes seconds, is screened by misfit; starts given on the command line are each
         // fitted. Skipped with no start.
         let (extra, refit) = (&mirrors.asymmetric, &*refit);
-        let fit_evaluations = phases.iter().find(|(name, _)| *name == "fit").map_or(0, |(_, used)| *used);
+        // The fit's own evaluations (the phases hold running totals: a sampler's come before).
+        let fit_evaluations = phases
+            .iter()
+            .position(|(name, _)| *name == "fit")
+            .map_or(0, |i| phases[i].1 - i.checked_sub(1).map_or(0, |j| phases[j].1));
         let screening = default_screening(np, model.dofs(), fit_evaluations);
         match screening.filter(|_| request.alternative_starts.is_none()) {
             _ if starts == 0 => {}
