@@ -675,8 +675,7 @@ pub fn like_exchanges(problem: &dyn Objective) -> Vec<Vec<usize>> {
     let mut out = Vec::new();
     for i in 0..params.len() {
         for j in i + 1..params.len() {
-            let (a, b) = (&params[i], &params[j]);
-            if a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper {
+            if alike(&params[i], &params[j]) {
                 let mut swap: Vec<usize> = (0..params.len()).collect();
                 swap.swap(i, j);
                 out.push(swap);
@@ -684,6 +683,11 @@ pub fn like_exchanges(problem: &dyn Objective) -> Vec<Vec<usize>> {
         }
     }
     out
+}
+
+/// Two parameters an exchange may swap: the same unit, scale and limits.
+fn alike(a: &crate::model::Parameter, b: &crate::model::Parameter) -> bool {
+    a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper
 }
 
 /// What the exchanges of [`mirror_solutions`] gave.
@@ -817,11 +821,7 @@ fn broken_symmetries(
         }
     }
     let roots: Vec<usize> = (0..n).map(|i| root(&mut class, i)).collect();
-    let alike = |i: usize, j: usize| {
-        let (a, b) = (&params[i], &params[j]);
-        a.unit == b.unit && a.scale == b.scale && a.lower == b.lower && a.upper == b.upper
-    };
-    if (0..n).any(|i| !alike(i, roots[i])) {
+    if (0..n).any(|i| !alike(&params[i], &params[roots[i]])) {
         return broken;
     }
     let centre: Vec<f64> = (0..n)
