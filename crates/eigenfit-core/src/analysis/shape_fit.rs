@@ -58,6 +58,14 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         self.measured_shape_std && self.problem.measured.has_std()
     }
 
+    /// The model DOF of each sensor (the MAC pairing's), which shape residuals need.
+    fn sensor_dofs(&self) -> Result<&[usize], ResidualError> {
+        match &self.problem.pairing {
+            Pairing::Mac { sensor_dofs } => Ok(sensor_dofs),
+            _ => Err(ResidualError::Mac("shape residuals need MAC pairing".into())),
+        }
+    }
+
     /// The model shapes at the sensors, one per computed mode, the paired model modes, and the
     /// computed modes themselves (for other checks at the same point without a second solve),
     /// at `p`.
@@ -66,11 +74,9 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         &self,
         p: &[f64],
     ) -> Result<(Vec<Vec<f64>>, Vec<usize>, crate::eigen::Modes), ResidualError> {
+        let sensor_dofs = self.sensor_dofs()?;
         let (lin, sens) = self.problem.linearise_with_modes(p)?;
         let modes = &sens.modes;
-        let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
-            return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
-        };
         let shapes =
             (0..modes.count()).map(|k| sensor_dofs.iter().map(|&d| modes.shapes[(d, k)]).collect()).collect();
         Ok((shapes, lin.paired_modes, sens.modes))
@@ -132,10 +138,7 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         lin: &Linearisation,
         sens: &Sensitivities,
     ) -> Result<(DVector<f64>, Vec<(DVector<f64>, f64)>), ResidualError> {
-        let modes = &sens.modes;
-        let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
-            return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
-        };
+        let (modes, sensor_dofs) = (&sens.modes, self.sensor_dofs()?);
         let m = lin.residual.len();
         let ns = sensor_dofs.len();
         let mut residual = DVector::zeros(m + m * ns);
@@ -173,6 +176,19 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         Ok((residual, units))
     }
 
+    /// At `p`: the frequency rows' linearisation, the modes and derivatives it was solved with
+    /// (the modes the frequency rows were paired on: one eigen-solve), every row's residual and
+    /// each paired mode's unit shape at the sensors ([`residual_rows`](Self::residual_rows)).
+    #[allow(clippy::type_complexity)]
+    fn rows_at(
+        &self,
+        p: &[f64],
+    ) -> Result<(Linearisation, Sensitivities, DVector<f64>, Vec<(DVector<f64>, f64)>), ResidualError> {
+        let (lin, sens) = self.problem.linearise_with_modes(p)?;
+        let (residual, units) = self.residual_rows(&lin, &sens)?;
+        Ok((lin, sens, residual, units))
+    }
+
     /// The linearisation of every row: `lin` (the frequency rows' own, solved with `sens`) with
     /// `residual` and the Jacobian of the frequency rows and, by Nelson's method, of the shapes
     /// (`units` from [`residual_rows`](Self::residual_rows)).
@@ -183,10 +199,7 @@ impl<M: StructuralModel, S: EigenSolver> ShapeFit<M, S> {
         residual: DVector<f64>,
         units: &[(DVector<f64>, f64)],
     ) -> Result<Linearisation, ResidualError> {
-        let (modes, derivatives) = (&sens.modes, &sens.derivatives);
-        let Pairing::Mac { sensor_dofs } = &self.problem.pairing else {
-            return Err(ResidualError::Mac("shape residuals need MAC pairing".into()));
-        };
+        let (modes, derivatives, sensor_dofs) = (&sens.modes, &sens.derivatives, self.sensor_dofs()?);
         let np = lin.parameters.len();
         let m = lin.residual.len();
         let ns = sensor_dofs.len();
@@ -220,9 +233,7 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
     }
 
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
-        // The modes the frequency rows were paired on: one eigen-solve per linearisation.
-        let (lin, sens) = self.problem.linearise_with_modes(p)?;
-        let (residual, units) = self.residual_rows(&lin, &sens)?;
+        let (lin, sens, residual, units) = self.rows_at(p)?;
         self.with_jacobian(lin, &sens, residual, &units)
     }
 
@@ -232,8 +243,7 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
         p: &[f64],
         accept: &dyn Fn(f64) -> bool,
     ) -> Result<Option<Linearisation>, ResidualError> {
-        let (lin, sens) = self.problem.linearise_with_modes(p)?;
-        let (residual, units) = self.residual_rows(&lin, &sens)?;
+        let (lin, sens, residual, units) = self.rows_at(p)?;
         if !accept(0.5 * residual.norm_squared()) {
             return Ok(None);
         }
@@ -243,8 +253,7 @@ impl<M: StructuralModel, S: EigenSolver> Objective for ShapeFit<M, S> {
     /// ½‖r‖² without the shapes' derivatives (Nelson's systems are most of a large model's
     /// linearisation): the same eigen-solve, pairing and rows as [`linearise`](Self::linearise).
     fn cost(&self, p: &[f64]) -> Option<f64> {
-        let (lin, sens) = self.problem.linearise_with_modes(p).ok()?;
-        let (residual, _) = self.residual_rows(&lin, &sens).ok()?;
+        let (_, _, residual, _) = self.rows_at(p).ok()?;
         Some(0.5 * residual.norm_squared())
     }
 }
