@@ -693,6 +693,20 @@ pub fn run(
         (None, None)
     };
     phases.push(("intervals", budget.used()));
+    if let Some(u) = &unc {
+        let widened = u.widened_by_round_off(model.parameters());
+        if !widened.is_empty() {
+            let named: Vec<&str> = widened.iter().map(|&i| names[i].as_str()).collect();
+            notes.push(format!(
+                "the model's frequencies are defined by its matrices only to {:.1e} (round-off on a fine mesh): \
+                 that alone moves {} by up to {:.1e} (in ln for a log-scaled parameter), and their intervals are widened by as much — \
+                 no data can place them closer with this model in double precision",
+                estimate.last.max_round_off(),
+                named.join(", "),
+                widened.iter().map(|&i| u.round_off_reach[i]).fold(0.0, f64::max),
+            ));
+        }
+    }
     // Mirrors first, then the other minima not already listed, each judged against the estimate.
     let alternatives = listed_alternatives(&fit, &estimate.last, mirrors.symmetric, &minima);
     let alternatives_sigma = Equivalence::at(&estimate.last, np).sigma_source();

@@ -378,8 +378,9 @@ pub struct SearchReport {
     pub abandoned: usize,
     /// Δχ² above the estimate within which a local fit had to come (`null` when σ is unknown).
     pub reach_delta_chi2: Option<f64>,
-    /// Most evaluations the search could spend (`null`: no cap but the task's budget): on a
-    /// model whose evaluation takes seconds, as many as the fit took.
+    /// Evaluations after which the search starts no further batch of local fits (`null`: no cap
+    /// but the task's budget): on a model whose evaluation takes seconds, as many as the fit
+    /// took. The first batch runs whatever the ranking cost, and a batch once started ends.
     pub most_evaluations: Option<usize>,
     /// Starts kept by the ranking but not fitted because `most_evaluations` were spent.
     pub not_fitted: usize,
@@ -407,11 +408,13 @@ impl SearchReport {
         let mut notes = Vec::new();
         if let Some(most) = self.most_evaluations {
             notes.push(format!(
-                "one evaluation of this model takes seconds, so the search for other solutions spent at most as many \
-                 evaluations as the fit ({most}): it ranked {} starts and fitted {} of them locally{}; --alternative-starts N \
-                 fits N starts in full",
+                "one evaluation of this model takes seconds, so the search for other solutions was proportioned to \
+                 the fit: it ranked {} starts and fitted {} of them locally, the first {} whatever they cost and further \
+                 ones only while it had spent fewer evaluations than the fit ({most}){}; --alternative-starts N fits N \
+                 starts in full",
                 self.ranked,
                 self.fitted,
+                eigenfit_core::analysis::alternatives::FITS_AT_ONCE,
                 if self.not_fitted > 0 { format!(" ({} more left unfitted)", self.not_fitted) } else { String::new() },
             ));
         }

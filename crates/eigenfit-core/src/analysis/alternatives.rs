@@ -296,7 +296,7 @@ pub const DEAR_MODEL_DOFS: usize = 20_000;
 /// exchanged points ([`screened_fits`]). On a dear model the search costs at most what the fit
 /// cost: `free + 1` design points ranked, the exchanged points ranked by the linearised misfit
 /// (no evaluation), and local fits from the best, [`FITS_AT_ONCE`] at a time, until the search
-/// has spent `fit_evaluations`.
+/// has spent `fit_evaluations` (the first batch whatever the ranking cost).
 pub fn default_screening(free: usize, dofs: usize, fit_evaluations: usize) -> Option<Screening> {
     if dofs >= DEAR_MODEL_DOFS {
         return Some(Screening {
@@ -473,7 +473,7 @@ fn fitted_minima(
 /// The local fits are independent: they run on rayon's threads, and their minima are merged in
 /// the starts' order, so the result does not depend on the threads. With `most_evaluations`
 /// they run [`FITS_AT_ONCE`] at a time and no further batch starts once the search (ranking
-/// included: `budget.used()` since `since`) has spent that many.
+/// included: `budget.used()` since `since`) has spent that many; the first batch always runs.
 fn fitted_minima_within(
     problem: &(dyn Objective + Sync),
     points: Vec<Vec<f64>>,
@@ -488,8 +488,9 @@ fn fitted_minima_within(
     let batch = if cap.is_some() { FITS_AT_ONCE } else { points.len().max(1) };
     let mut out = Fitted::default();
     let mut ends: Vec<Linearisation> = Vec::new();
-    for chunk in points.chunks(batch) {
-        let spent = cap.is_some_and(|(since, most)| budget.used() - since >= most);
+    for (i, chunk) in points.chunks(batch).enumerate() {
+        // The first batch always runs: a search that only ranked would test nothing.
+        let spent = i > 0 && cap.is_some_and(|(since, most)| budget.used() - since >= most);
         if budget.exhausted() || spent {
             out.not_fitted += chunk.len();
             continue;

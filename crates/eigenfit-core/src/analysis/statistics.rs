@@ -65,6 +65,26 @@ pub struct Uncertainty {
     /// than a factor of 10 each way for log parameters (σ = 1/singular value above the profile
     /// trigger): combinations of parameters the data barely tell apart, null directions included.
     pub poorly_determined: Vec<Vec<f64>>,
+    /// How far each parameter can move, in scaled units (ln for log parameters), by the round-off
+    /// of the model's frequencies alone; its interval is widened by that much at each end.
+    pub round_off_reach: Vec<f64>,
+}
+
+impl Uncertainty {
+    /// The parameters whose interval is mostly round-off: the reach is at least a tenth of the
+    /// interval's scaled width (each end is widened by it), as indices.
+    pub fn widened_by_round_off(&self, params: &crate::model::ParameterSet) -> Vec<usize> {
+        params
+            .iter()
+            .enumerate()
+            .filter(|&(i, p)| {
+                let reach = self.round_off_reach.get(i).copied().unwrap_or(0.0);
+                let [lo, hi] = self.intervals[i];
+                reach > 0.0 && 10.0 * reach >= (p.to_scaled(hi) - p.to_scaled(lo)).abs()
+            })
+            .map(|(i, _)| i)
+            .collect()
+    }
 }
 
 /// Evaluations one call of [`uncertainty`] may spend on profile refits.
@@ -428,13 +448,19 @@ fn weighted_uncertainty(
             Err(OutOfBudget) => Err(OutOfBudget),
         })
     };
+    let reach = round_off_reach(&scaled_cov, &js, at);
     let mut intervals = Vec::with_capacity(np);
     let mut identifiability = Vec::with_capacity(np);
     for (i, par) in params.iter().enumerate() {
         let sigma = scaled_cov[(i, i)].sqrt();
+        let widen = |s: f64, dir: f64| par.from_scaled(s + dir * reach[i]);
+        // A profiled bound, within the limits (unchanged, bit for bit, without round-off).
+        let widen_bound = |b: f64, dir: f64| match reach[i] > 0.0 {
+            true => widen(par.to_scaled(b), dir).clamp(par.lower, par.upper),
+            false => b,
+        };
         if !profiled[i] {
-            intervals
-                .push([par.from_scaled(s_hat[i] - Z_95 * sigma), par.from_scaled(s_hat[i] + Z_95 * sigma)]);
+            intervals.push([widen(s_hat[i] - Z_95 * sigma, -1.0), widen(s_hat[i] + Z_95 * sigma, 1.0)]);
             identifiability.push(Identifiability::Determined);
             continue;
         }
@@ -446,7 +472,10 @@ fn weighted_uncertainty(
             // Out of budget: say nothing the refits did not establish.
             _ => (None, None),
         };
-        intervals.push([lower.unwrap_or(par.lower), upper.unwrap_or(par.upper)]);
+        intervals.push([
+            lower.map_or(par.lower, |b| widen_bound(b, -1.0)),
+            upper.map_or(par.upper, |b| widen_bound(b, 1.0)),
+        ]);
         identifiability.push(match (lower, upper) {
             (Some(_), Some(_)) => Identifiability::Determined,
             (Some(lower), None) => Identifiability::LowerBoundOnly { lower },
@@ -463,7 +492,33 @@ fn weighted_uncertainty(
         budget_exhausted,
         poorly_determined: rank.weaker_than(1.0 / PROFILE_TRIGGER).to_vec(),
         rank,
+        round_off_reach: reach,
     })
+}
+
+/// How far, in scaled units, each parameter of the estimate `at` can move by the round-off of
+/// its rows alone ([`Linearisation::residual_round_off_rows`], δr): Σₖ |(C Jsᵀ)ᵢₖ| δrₖ with C
+/// the scaled covariance — the worst case of the rows' roundings, which are not noise the
+/// scatter would show (a 10⁵-DOF plate's frequencies jump by ~1e-8 between neighbouring points,
+/// far above its 1e-13 misfit's σ̂). The intervals are widened by it; negligible (ε-level) on a
+/// coarse model, 0 where the round-off is not known.
+fn round_off_reach(scaled_cov: &DMatrix<f64>, js: &DMatrix<f64>, at: &Linearisation) -> Vec<f64> {
+    let np = scaled_cov.nrows();
+    let rows = at.residual_round_off_rows();
+    if rows.iter().all(|&d| d == 0.0) || rows.len() != js.nrows() {
+        return vec![0.0; np];
+    }
+    let gain = scaled_cov * js.transpose();
+    (0..np)
+        .map(|i| {
+            let w: f64 = rows.iter().enumerate().map(|(k, d)| gain[(i, k)].abs() * d).sum();
+            if w.is_finite() {
+                w
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 /// Runs `job` on every side on rayon's threads, telling `report` how many are done as each

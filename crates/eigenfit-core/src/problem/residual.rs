@@ -151,6 +151,41 @@ impl Linearisation {
         self.round_off.iter().fold(0.0, |m, &v| f64::max(m, v))
     }
 
+    /// Each row's round-off in the residual's own weighted units: for the rows of the eigenvalue
+    /// view, the row's [`round_off`](Self::round_off) carried through its weight (a frequency row
+    /// is ∂r/∂λ times ∂λ/∂p, so |∂r/∂λ| is the ratio of the two rows' norms); 0 for every other
+    /// row (shape components), and for a row not parallel to its ∂λ/∂p or without a finite
+    /// round-off. The residual the matrices' rounding alone can make.
+    pub fn residual_round_off_rows(&self) -> DVector<f64> {
+        let mut rows = DVector::zeros(self.residual.len());
+        let Some(view) = &self.eigen else { return rows };
+        let m = view.model_eigenvalues.len();
+        if self.round_off.len() != m
+            || self.jacobian.nrows() < m
+            || rows.len() < m
+            || view.eigenvalue_jacobian.ncols() != self.jacobian.ncols()
+        {
+            return rows;
+        }
+        for k in 0..m {
+            let (row, de) = (self.jacobian.row(k), view.eigenvalue_jacobian.row(k));
+            let (rn, en) = (row.norm(), de.norm());
+            let parallel = row.dot(&de).abs() >= (1.0 - 1e-6) * rn * en;
+            let rho = 2.0 * self.round_off[k];
+            if rn > 0.0 && en > 0.0 && parallel && rho.is_finite() {
+                rows[k] = rn / en * view.model_eigenvalues[k].abs() * rho;
+            }
+        }
+        rows
+    }
+
+    /// ‖δr‖ of [`residual_round_off_rows`](Self::residual_round_off_rows): no step that
+    /// promises less than ½‖δr‖² is worth taking. 0 when not known (no eigenvalue view, a
+    /// run-up's rows).
+    pub fn residual_round_off(&self) -> f64 {
+        self.residual_round_off_rows().norm()
+    }
+
     /// Largest |f_model − f_measured| / f_measured.
     pub fn max_rel_diff(&self) -> f64 {
         self.frequencies_hz

@@ -441,7 +441,16 @@ impl LevenbergMarquardt {
         }
         let a = js_free.transpose() * &js_free;
         let g = js_free.transpose() * &current.residual;
-        if self.cost_tolerance > 0.0 && gauss_newton_decrease(&a, &g, &free) <= self.cost_tolerance {
+        // With more data than free parameters, a Gauss–Newton step that promises less than the
+        // model's own round-off can make (½‖δr‖², the frequencies as the matrices define them)
+        // only chases rounding: on a fine mesh the misfit's last digits jump between
+        // neighbouring points, trials are rejected and damping, not the data, ends the run many
+        // evaluations later. As many data as parameters have an exact solution, which the
+        // iteration reaches quadratically whatever the rounding (`exact_fit_level`).
+        let overdetermined = current.residual.len() > free.iter().filter(|&&f| f).count();
+        let floor = if overdetermined { 0.5 * current.residual_round_off().powi(2) } else { 0.0 };
+        let tolerance = self.cost_tolerance.max(floor);
+        if tolerance > 0.0 && gauss_newton_decrease(&a, &g, &free) <= tolerance {
             return Ok(None);
         }
         // Marquardt scaling, floored so a (nearly) insensitive parameter still gets damped.
