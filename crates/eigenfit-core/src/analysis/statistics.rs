@@ -468,14 +468,11 @@ fn weighted_uncertainty(
         let lower = side_of(i, -1.0).unwrap_or(Ok(None));
         let upper = side_of(i, 1.0).unwrap_or(Ok(None));
         let (lower, upper) = match (lower, upper) {
-            (Ok(l), Ok(u)) => (l, u),
+            (Ok(l), Ok(u)) => (l.map(|b| widen_bound(b, -1.0)), u.map(|b| widen_bound(b, 1.0))),
             // Out of budget: say nothing the refits did not establish.
             _ => (None, None),
         };
-        intervals.push([
-            lower.map_or(par.lower, |b| widen_bound(b, -1.0)),
-            upper.map_or(par.upper, |b| widen_bound(b, 1.0)),
-        ]);
+        intervals.push([lower.unwrap_or(par.lower), upper.unwrap_or(par.upper)]);
         identifiability.push(match (lower, upper) {
             (Some(_), Some(_)) => Identifiability::Determined,
             (Some(lower), None) => Identifiability::LowerBoundOnly { lower },

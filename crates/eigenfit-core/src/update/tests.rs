@@ -430,7 +430,8 @@ impl Objective for Jittered<'_> {
     fn linearise(&self, p: &[f64]) -> Result<Linearisation, ResidualError> {
         let mut lin = self.inner.linearise(p)?;
         // Deterministic pseudo-random rows in [−η, η], hashed from p's bits (FNV, then a mixer).
-        let mut h = p.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, v| (h ^ v.to_bits()).wrapping_mul(0x100_0000_01b3));
+        let mut h =
+            p.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, v| (h ^ v.to_bits()).wrapping_mul(0x100_0000_01b3));
         for r in lin.residual.iter_mut() {
             h ^= h >> 33;
             h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
