@@ -353,7 +353,14 @@ pub fn screened_search(
     // In cost units (½Σr²): Δχ² = 2Δcost/σ².
     let reach = test.sigma2.map(|s2| (test.best_cost + 0.5 * REACH_THRESHOLDS * test.threshold * s2, s2));
     let cap = screening.most_evaluations.map(|most| (since, most));
-    let found = fitted_minima_within(problem, points, budget, refit, reach.map(|r| r.0), cap);
+    let found = fitted_minima_within(
+        problem,
+        points,
+        budget,
+        refit,
+        reach.map(|r| (r.0, at.parameters.as_slice())),
+        cap,
+    );
     Search {
         minima: found.minima,
         fitted: found.fitted,
@@ -379,18 +386,27 @@ fn best_by_prediction(at: &Linearisation, points: &[Vec<f64>], keep: usize) -> V
 }
 
 /// `inner` for one local fit of the search, abandoned (its own budget refused) once it has had
-/// [`REACH_EVALUATIONS`] evaluations and the lowest cost seen is still above `within`.
+/// [`REACH_EVALUATIONS`] evaluations and the lowest cost seen is still above `within`; ended as
+/// soon as it is linearised within [`SAME_MINIMUM`] of the estimate `home` below `within` —
+/// arrived in the estimate's own minimum, which is all the search asks of it (on a fine mesh the
+/// rest would be iterations in the round-off around a point already known).
 struct Reach<'a> {
     inner: &'a dyn Objective,
     local: &'a Budget,
     within: f64,
+    home: &'a [f64],
     seen: std::cell::Cell<usize>,
     best: std::cell::Cell<f64>,
     abandoned: std::cell::Cell<bool>,
+    arrived: std::cell::RefCell<Option<Linearisation>>,
 }
 
 impl Reach<'_> {
     fn admit(&self) -> bool {
+        if self.arrived.borrow().is_some() {
+            self.local.refuse();
+            return false;
+        }
         if self.seen.get() >= REACH_EVALUATIONS && self.best.get() > self.within {
             self.abandoned.set(true);
             self.local.refuse();
@@ -403,6 +419,15 @@ impl Reach<'_> {
     fn saw(&self, cost: f64) {
         if cost < self.best.get() {
             self.best.set(cost);
+        }
+    }
+
+    /// Notes `lin` as the arrival when it lies in the estimate's own minimum.
+    fn home_reached(&self, lin: &Linearisation) {
+        if lin.cost() <= self.within
+            && scaled_distance(self.inner, &lin.parameters, self.home) <= SAME_MINIMUM
+        {
+            *self.arrived.borrow_mut() = Some(lin.clone());
         }
     }
 }
@@ -418,6 +443,7 @@ impl Objective for Reach<'_> {
         }
         let lin = self.inner.linearise(p)?;
         self.saw(lin.cost());
+        self.home_reached(&lin);
         Ok(lin)
     }
 
@@ -444,6 +470,9 @@ impl Objective for Reach<'_> {
             accept(cost)
         })?;
         self.saw(seen.get());
+        if let Some(lin) = &lin {
+            self.home_reached(lin);
+        }
         Ok(lin)
     }
 }
@@ -466,9 +495,10 @@ fn fitted_minima(
     fitted_minima_within(problem, points, budget, refit, None, None).minima
 }
 
-/// [`fitted_minima`], each local fit abandoned when it has not come below the cost `reach`
-/// within [`REACH_EVALUATIONS`] evaluations (no rule for `None`); also the starts fitted and
-/// the fits abandoned.
+/// [`fitted_minima`], each local fit abandoned when it has not come below the cost `reach.0`
+/// within [`REACH_EVALUATIONS`] evaluations, and ended when it arrives in the minimum at
+/// `reach.1` (the estimate; [`Reach`]) (no rule for `None`); also the starts fitted and the fits
+/// abandoned.
 ///
 /// The local fits are independent: they run on rayon's threads, and their minima are merged in
 /// the starts' order, so the result does not depend on the threads. With `most_evaluations`
@@ -479,7 +509,7 @@ fn fitted_minima_within(
     points: Vec<Vec<f64>>,
     budget: &Budget,
     refit: &dyn Refit,
-    reach: Option<f64>,
+    reach: Option<(f64, &[f64])>,
     cap: Option<(usize, usize)>,
 ) -> Fitted {
     use rayon::prelude::*;
@@ -548,14 +578,14 @@ fn local_fit(
     start: &[f64],
     budget: &Budget,
     refit: &dyn Refit,
-    reach: Option<f64>,
+    reach: Option<(f64, &[f64])>,
 ) -> LocalFit {
     if budget.exhausted() {
         return LocalFit::Failed;
     }
     let est = match reach {
         None => refit.refit(problem, start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, budget),
-        Some(within) => {
+        Some((within, home)) => {
             // The search's budget is charged through `charged`; the fit's own budget is
             // refused when the fit is abandoned, which ends it as a spent budget would.
             let (charged, local) = (budget.wrap(problem), Budget::unlimited());
@@ -563,11 +593,16 @@ fn local_fit(
                 inner: &charged,
                 local: &local,
                 within,
+                home,
                 seen: 0.into(),
                 best: f64::INFINITY.into(),
                 abandoned: false.into(),
+                arrived: None.into(),
             };
             let est = refit.refit(&reach, start, &RefitRequest::default(), LOCAL_FIT_ITERATIONS, &local);
+            if let Some(home) = reach.arrived.take() {
+                return LocalFit::Converged(Box::new(home));
+            }
             if reach.abandoned.get() {
                 return LocalFit::Abandoned;
             }
@@ -1116,6 +1151,40 @@ mod tests {
     }
 
     #[test]
+    fn a_local_fit_that_arrives_in_the_estimates_minimum_ends_there() {
+        let chain = Chain::new(&[1.0, 2.0]);
+        let truth = [4e4, 1e4];
+        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let at = fit(&problem, &truth);
+        let start = vec![at.parameters[0] * 1.5, at.parameters[1] * 0.7];
+        let (full, arriving) = (Budget::new(1_000), Budget::new(1_000));
+        let plain = fitted_minima_within(&problem, vec![start.clone()], &full, &Damped, None, None);
+        let home = fitted_minima_within(
+            &problem,
+            vec![start],
+            &arriving,
+            &Damped,
+            Some((f64::MAX, &at.parameters)),
+            None,
+        );
+        // The same minimum, the estimate's, reached either way; ended on arrival, sooner.
+        assert_eq!((home.fitted, home.abandoned, home.minima.len(), plain.minima.len()), (1, 0, 1, 1));
+        for m in [&home.minima[0], &plain.minima[0]] {
+            assert!(
+                scaled_distance(&problem, &m.parameters, &at.parameters) <= SAME_MINIMUM,
+                "{:?}",
+                m.parameters
+            );
+        }
+        assert!(
+            arriving.used() < full.used(),
+            "{} evaluations on arrival, {} in full",
+            arriving.used(),
+            full.used()
+        );
+    }
+
+    #[test]
     fn a_local_fit_that_does_not_come_within_reach_is_abandoned_after_its_evaluations() {
         let chain = Chain::new(&[1.0, 2.0]);
         let truth = [4e4, 1e4];
@@ -1126,8 +1195,14 @@ mod tests {
         let mut abandoned_seen = 0;
         for start in design(&problem, 12) {
             let budget = Budget::new(1_000);
-            let Fitted { minima, fitted, abandoned, .. } =
-                fitted_minima_within(&problem, vec![start.clone()], &budget, &Damped, Some(-1.0), None);
+            let Fitted { minima, fitted, abandoned, .. } = fitted_minima_within(
+                &problem,
+                vec![start.clone()],
+                &budget,
+                &Damped,
+                Some((-1.0, &at.parameters)),
+                None,
+            );
             assert_eq!(fitted, 1);
             if abandoned == 1 {
                 abandoned_seen += 1;
