@@ -49,7 +49,7 @@ fn same(x: f64, y: f64, scale: f64) -> bool {
     (x - y).abs() <= SAME * x.abs().max(y.abs()).max(scale)
 }
 
-/// The non-identity permutations π (π[i] = the parameter that parameter i is exchanged with)
+/// The non-identity permutations π (π\[i\] = the parameter that parameter i is exchanged with)
 /// that keep every invariant of the parameters' matrices, among parameters that `like(i, j)`
 /// allows to exchange (same unit, scale and limits). `terms[i]` = (∂K/∂pᵢ, ∂M/∂pᵢ).
 pub(crate) fn invariant_permutations(

@@ -186,7 +186,7 @@ fn lowest_modes(objective: &RunupObjective, fewest: usize) -> Option<usize> {
 
 /// Fits the factors of `objective` (on the run-up's `factors`) from `initial` with core's
 /// damped least squares, in stages when the selection holds more than the direct stiffnesses
-/// ([`Plan::new`]: direct stiffnesses, then damping, then everything; the first stages on the
+/// (`Plan::new`: direct stiffnesses, then damping, then everything; the first stages on the
 /// modes below the run-up's widest frequency gap, each but the last two capped at
 /// [`WARM_UP_ITERATIONS`]). When the fit does not pass the verdict's χ² test (without std: is
 /// not exact), up to `restarts` restarts from the best screened starts (factors ⅓…3 on the

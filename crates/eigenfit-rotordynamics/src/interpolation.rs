@@ -236,7 +236,7 @@ pub struct Table {
 
 #[derive(Debug, Clone, PartialEq)]
 enum SplineCurve {
-    /// a + b t + c t² with t = Ω − speeds[0] (the line or parabola through 2 or 3 points).
+    /// a + b t + c t² with t = Ω − speeds\[0\] (the line or parabola through 2 or 3 points).
     Polynomial([f64; 3]),
     /// A cubic B-spline: knots (clamped, end knots repeated 4 times) and coefficients.
     Spline { knots: Vec<f64>, coefficients: Vec<f64> },

@@ -102,7 +102,7 @@ fn toml_written(x: f64) -> String {
 }
 
 /// Where an element table of a TOML ROSS file holds its first NaN or infinity:
-/// "`<element>`: `<key>`[<index>]… = <value as written>".
+/// "`<element>`: `<key>[<index>]`… = `<value as written>`".
 fn non_finite_toml(root: &toml::Table) -> Option<String> {
     fn within(v: &toml::Value, at: String) -> Option<String> {
         match v {

@@ -40,7 +40,7 @@ const RANKING_MARGIN: f64 = 1e3;
 /// ones (Im λ > 0) of lowest damped frequency Im λ (fewer when fewer oscillate), converged to
 /// an Arnoldi residual below 1e-12 relative; the other wanted ones, which only rank them, have
 /// converged below 1e-8 or lie far enough above them in damped frequency for their error
-/// estimate ([`RANKING_MARGIN`]). The Krylov
+/// estimate (`RANKING_MARGIN`). The Krylov
 /// space starts from a fixed generic vector: results do not depend on a random seed (nor on
 /// other speeds: starting from the modes of the previous speed of a sweep was tried and saved
 /// no step on ROSS's compressor). `None` when the band LU fails (K singular: a free

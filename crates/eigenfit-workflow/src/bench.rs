@@ -608,7 +608,7 @@ impl BenchProblem {
     }
 
     /// Why `method` does not apply to this problem, if it does not: a strategy that solves with
-    /// the model's eigenvalues ([`UpdateStrategy::needs_eigenvalues`], built-in or registered)
+    /// the model's eigenvalues ([`UpdateStrategy::needs_eigenvalues`](eigenfit_core::update::UpdateStrategy::needs_eigenvalues), built-in or registered)
     /// on a run-up, whose rows are whirl frequencies at many speeds.
     fn refuses(&self, method: &Method) -> Option<String> {
         match (&self.data, method) {

@@ -415,7 +415,7 @@ impl SearchReport {
                 self.ranked,
                 self.fitted,
                 eigenfit_core::analysis::alternatives::FITS_AT_ONCE,
-                if self.not_fitted > 0 { format!(" ({} more left unfitted)", self.not_fitted) } else { String::new() },
+                if self.not_fitted > 0 { format!("; {} more were left unfitted", self.not_fitted) } else { String::new() },
             ));
         }
         if self.abandoned > 0 {

@@ -1414,7 +1414,7 @@ fn refit<E: EffectSearch>(
     }
 }
 
-/// The step unit of every parameter of a refit ([`LevenbergMarquardt::with_step_units`]): 1 for
+/// The step unit of every parameter of a refit ([`LevenbergMarquardt::with_step_units`](crate::update::LevenbergMarquardt::with_step_units)): 1 for
 /// the `base_len` base parameters (in their own scale: a stiffness's log), and for each effect
 /// value on a linear scale the size of its plausible range (the largest |value| it admits), so
 /// the damped step's cap (ln 100 ≈ 4.6 units per step) means the same for every candidate,
