@@ -698,9 +698,9 @@ pub fn run(
         if !widened.is_empty() {
             let named: Vec<&str> = widened.iter().map(|&i| names[i].as_str()).collect();
             notes.push(format!(
-                "the model's frequencies are defined by its matrices only to {:.1e} (round-off on a fine mesh): \
-                 that alone moves {} by up to {:.1e} (in ln for a log-scaled parameter), and their intervals are widened by as much — \
-                 no data can place them closer with this model in double precision",
+                "round-off on a fine mesh: the model's frequencies jump between neighbouring points (bound {:.1e} \
+                 relative, scaled to the jitter measured at the estimate); that alone moves {} by up to {:.1e} (in ln \
+                 for a log-scaled parameter), and their intervals are widened by as much",
                 estimate.last.max_round_off(),
                 named.join(", "),
                 widened.iter().map(|&i| u.round_off_reach[i]).fold(0.0, f64::max),

@@ -40,7 +40,7 @@ pub struct LevenbergMarquardt {
     restarts: usize,
     stuck_for: usize,
     recent_cost: f64,
-    /// The residual's round-off jitter, measured in this run ([`jitter`]).
+    /// The residual's round-off jitter, measured in this run ([`residual_jitter`]).
     jitter: Option<f64>,
 }
 
@@ -465,7 +465,11 @@ impl LevenbergMarquardt {
             if promised <= bound {
                 let jitter = match self.jitter {
                     Some(j) => j,
-                    None => *self.jitter.insert(jitter(problem, current, &js_full, &s0, &free, bound)),
+                    // Where the measurement fails (a spent budget) the bound stands.
+                    None => *self.jitter.insert(
+                        residual_jitter(problem, current, &js_full, &s0, &free)
+                            .unwrap_or((2.0 * bound).sqrt()),
+                    ),
                 };
                 if promised <= 0.5 * jitter * jitter {
                     return Ok(None);
@@ -553,24 +557,23 @@ fn gauss_newton_decrease(a: &DMatrix<f64>, g: &DVector<f64>, free: &[bool]) -> f
     lhs.cholesky().map_or(f64::INFINITY, |c| 0.5 * g.dot(&c.solve(g)))
 }
 
-/// Scaled distance of the point [`jitter`] evaluates from the current one, along each free
+/// Scaled distance of the point [`residual_jitter`] evaluates from the current one, along each free
 /// parameter: far above round-off in the parameters, far below where the residual's curvature
 /// shows (½δ²·r″ ~ 1e-18·r″).
 const JITTER_STEP: f64 = 1e-9;
 
 /// The residual's round-off jitter at `current` (scaled Jacobian `js` at scaled point `s0`):
-/// ‖r(p′) − r(p) − J·δ‖/√2 at a point p′ a [`JITTER_STEP`] away along every `free` parameter
+/// ‖r(p′) − r(p) + J·δ‖/√2 at a point p′ a [`JITTER_STEP`] away along every `free` parameter
 /// (alternating signs, turned back at a bound) — what is left of the change once the model's own
-/// is taken out is the difference of two roundings. One evaluation; where it fails (budget), the
-/// bound `bound` (½‖δr‖²) stands.
-fn jitter(
+/// is taken out is the difference of two roundings. One evaluation; `None` where it fails (a
+/// spent budget).
+pub(crate) fn residual_jitter(
     problem: &dyn Objective,
     current: &Linearisation,
     js: &DMatrix<f64>,
     s0: &[f64],
     free: &[bool],
-    bound: f64,
-) -> f64 {
+) -> Option<f64> {
     let params = problem.parameters();
     let (lo, hi) = scaled_bounds(params);
     let delta = DVector::from_iterator(
@@ -590,10 +593,11 @@ fn jitter(
     let p: Vec<f64> = params.iter().enumerate().map(|(i, q)| q.from_scaled(s0[i] + delta[i])).collect();
     match problem.linearise(&p) {
         Ok(there) if there.residual.len() == current.residual.len() => {
-            let left = &there.residual - &current.residual - js * &delta;
-            left.norm() / std::f64::consts::SQRT_2
+            // J is ∂(model)/∂p (J·Δp ≈ r): the residual moves by −J·δ.
+            let left = &there.residual - &current.residual + js * &delta;
+            Some(left.norm() / std::f64::consts::SQRT_2)
         }
-        _ => (2.0 * bound).sqrt(),
+        _ => None,
     }
 }
 
