@@ -906,11 +906,11 @@ mod tests {
         let budget = Budget::new(1_000);
         let u = uncertainty_observed(&stated, &at_stated, &budget, &mut []).unwrap();
         assert_eq!(budget.used(), 1, "one evaluation measures the jitter");
-        for i in 0..2 {
+        for (i, &by_bound) in bound.iter().enumerate() {
             let [lo, hi] = plain.intervals[i];
             let width = (hi.ln() - lo.ln()).abs();
             // Taken at its word the bound would widen each end by a large part of the width ...
-            assert!(bound[i] > 0.1 * width, "bound {:e}, width {width:e}", bound[i]);
+            assert!(by_bound > 0.1 * width, "bound {by_bound:e}, width {width:e}");
             // ... measured, it widens nothing the width would show.
             assert!(u.round_off_reach[i] < 1e-9 * width, "{:?}", u.round_off_reach);
             assert!(
