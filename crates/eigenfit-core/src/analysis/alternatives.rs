@@ -948,6 +948,17 @@ mod tests {
         .unwrap()
     }
 
+    /// The springs of [`two_springs`].
+    const TWO_SPRINGS: [f64; 2] = [4e4, 1e4];
+
+    /// ground –k₁– m₁ –k₂– m₂ (1 and 2 kg) at [`TWO_SPRINGS`], its two frequencies measured with
+    /// a std of 0.1 %: the problem the search's tests share.
+    fn two_springs() -> Problem<Chain, DenseSolver> {
+        let chain = Chain::new(&[1.0, 2.0]);
+        let data = measured(&chain, &TWO_SPRINGS, Some(1e-3));
+        Problem::new(chain, DenseSolver, data)
+    }
+
     fn fit(problem: &dyn Objective, start: &[f64]) -> Linearisation {
         let mut lm = LevenbergMarquardt::default().with_max_restarts(0);
         Driver::default().run(problem, &mut lm, start).unwrap().last
@@ -1000,9 +1011,7 @@ mod tests {
     /// no batch once the cap is spent — the same result every run, whatever the threads.
     #[test]
     fn a_capped_search_starts_no_local_fit_once_its_evaluations_are_spent() {
-        let chain = Chain::new(&[1.0, 2.0]);
-        let truth = [4e4, 1e4];
-        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let (problem, truth) = (two_springs(), TWO_SPRINGS);
         let at = fit(&problem, &truth);
         let extra = vec![vec![1e4, 4e4], vec![2e4, 2e4], vec![3e4, 1.5e4]];
         let screening = Screening { starts: 6, keep: 6, most_evaluations: Some(12), predict_extra: true };
@@ -1027,9 +1036,7 @@ mod tests {
 
     #[test]
     fn extra_starts_are_ranked_by_the_misfit_the_linearisation_predicts() {
-        let chain = Chain::new(&[1.0, 2.0]);
-        let truth = [4e4, 1e4];
-        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let (problem, truth) = (two_springs(), TWO_SPRINGS);
         let at = fit(&problem, &truth);
         let near = vec![4.1e4, 1.01e4];
         let far = vec![1e4, 4e4];
@@ -1096,9 +1103,7 @@ mod tests {
     /// came from — a convergence plot ends at the reported estimate.
     #[test]
     fn an_adopted_deeper_minimum_ends_the_history_of_the_estimate() {
-        let chain = Chain::new(&[1.0, 2.0]);
-        let truth = [4e4, 1e4];
-        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let (problem, truth) = (two_springs(), TWO_SPRINGS);
         let mut lm = LevenbergMarquardt::default().with_max_restarts(0);
         let mut estimate = Driver { max_iterations: 1 }.run(&problem, &mut lm, &[2e4, 2e4]).unwrap();
         let fit_end = estimate.last.parameters.clone();
@@ -1123,9 +1128,7 @@ mod tests {
 
     #[test]
     fn equally_good_is_the_chi2_test_at_the_significance_level() {
-        let chain = Chain::new(&[1.0, 2.0]);
-        let truth = [4e4, 1e4];
-        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let (problem, truth) = (two_springs(), TWO_SPRINGS);
         let at = problem.linearise(&truth).unwrap();
         let test = Equivalence::at(&at, 2);
         // χ²₀.₉₅(2) = 5.99.
@@ -1152,9 +1155,7 @@ mod tests {
 
     #[test]
     fn a_local_fit_that_arrives_in_the_estimates_minimum_ends_there() {
-        let chain = Chain::new(&[1.0, 2.0]);
-        let truth = [4e4, 1e4];
-        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let (problem, truth) = (two_springs(), TWO_SPRINGS);
         let at = fit(&problem, &truth);
         let start = vec![at.parameters[0] * 1.5, at.parameters[1] * 0.7];
         let (full, arriving) = (Budget::new(1_000), Budget::new(1_000));
@@ -1186,9 +1187,7 @@ mod tests {
 
     #[test]
     fn a_local_fit_that_does_not_come_within_reach_is_abandoned_after_its_evaluations() {
-        let chain = Chain::new(&[1.0, 2.0]);
-        let truth = [4e4, 1e4];
-        let problem = Problem::new(&chain, DenseSolver, measured(&chain, &truth, Some(1e-3)));
+        let (problem, truth) = (two_springs(), TWO_SPRINGS);
         let at = fit(&problem, &truth);
         // A negative cost no fit can reach: every fit still running after its probe is
         // abandoned, having cost exactly the probe; one that ends sooner ends by itself.

@@ -895,14 +895,8 @@ mod tests {
         assert!(plain.round_off_reach.iter().all(|&w| w < 1e-12), "{:?}", plain.round_off_reach);
         let stated = Stated { inner: &problem, stated: 1e-5 };
         let at_stated = crate::problem::Objective::linearise(&stated, &at.parameters).unwrap();
-        let bound = super::round_off_reach(
-            &(at_stated.scaled_jacobian(problem.parameters()).transpose()
-                * at_stated.scaled_jacobian(problem.parameters()))
-            .try_inverse()
-            .unwrap(),
-            &at_stated.scaled_jacobian(problem.parameters()),
-            &at_stated,
-        );
+        let js = at_stated.scaled_jacobian(problem.parameters());
+        let bound = super::round_off_reach(&(js.transpose() * &js).try_inverse().unwrap(), &js, &at_stated);
         let budget = Budget::new(1_000);
         let u = uncertainty_observed(&stated, &at_stated, &budget, &mut []).unwrap();
         assert_eq!(budget.used(), 1, "one evaluation measures the jitter");

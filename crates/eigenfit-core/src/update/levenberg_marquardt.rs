@@ -436,7 +436,6 @@ impl LevenbergMarquardt {
                     && !(s0[i] >= hi[i] && g_full[i] > 0.0)
             })
             .collect();
-        let js_full = js.clone();
         let mut js_free = js;
         for i in (0..np).filter(|&i| !free[i]) {
             js_free.column_mut(i).fill(0.0);
@@ -467,7 +466,7 @@ impl LevenbergMarquardt {
                     Some(j) => j,
                     // Where the measurement fails (a spent budget) the bound stands.
                     None => *self.jitter.insert(
-                        residual_jitter(problem, current, &js_full, &s0, &free)
+                        residual_jitter(problem, current, &js_free, &s0, &free)
                             .unwrap_or((2.0 * bound).sqrt()),
                     ),
                 };
@@ -562,7 +561,8 @@ fn gauss_newton_decrease(a: &DMatrix<f64>, g: &DVector<f64>, free: &[bool]) -> f
 /// shows (½δ²·r″ ~ 1e-18·r″).
 const JITTER_STEP: f64 = 1e-9;
 
-/// The residual's round-off jitter at `current` (scaled Jacobian `js` at scaled point `s0`):
+/// The residual's round-off jitter at `current` (scaled Jacobian `js` at scaled point `s0`; only
+/// the `free` columns are read, the step being zero along the others):
 /// ‖r(p′) − r(p) + J·δ‖/√2 at a point p′ a [`JITTER_STEP`] away along every `free` parameter
 /// (alternating signs, turned back at a bound) — what is left of the change once the model's own
 /// is taken out is the difference of two roundings. One evaluation; `None` where it fails (a
